@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "surftex/command.h"
+
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "geometry/errors.h"
+#include "geometry/output_file.h"
+
+namespace surftex::cli {
+
+std::vector<Subcommand>& registry() {
+  static std::vector<Subcommand> r;
+  return r;
+}
+
+void add_common_options(CLI::App& app, CommonOptions& opt) {
+  app.add_option("--seed", opt.seed,
+                 "Seed for every random choice; the same input and seed give the same output "
+                 "(any non-negative integer, default 1)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", opt.threads,
+                 "Worker threads (0 = all cores, default 0; 1..1024)")
+      ->check(CLI::Range(0, 1024));
+  app.add_option("--report", opt.report_path,
+                 "Write a JSON report (timings, counts, quality figures) to this file");
+  app.add_flag("--force", opt.force, "Replace output files that already exist (default: refuse)");
+  app.add_flag("-q,--quiet", opt.quiet, "No progress display, even on a terminal");
+}
+
+std::shared_ptr<void> apply_thread_limit(int threads) {
+  std::size_t n = threads > 0 ? static_cast<std::size_t>(threads)
+                              : std::max(1u, std::thread::hardware_concurrency());
+  return std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism, n);
+}
+
+ProgressCallback terminal_progress(bool quiet) {
+  if (quiet || !::isatty(STDERR_FILENO)) return {};
+  auto last = std::make_shared<std::pair<std::string, int>>("", -1);
+  auto mu = std::make_shared<std::mutex>();
+  return [last, mu](std::string_view stage, double fraction) {
+    std::lock_guard<std::mutex> lock(*mu);
+    int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
+    if (last->first == stage && last->second == pct) return;
+    last->first = std::string(stage);
+    last->second = pct;
+    std::fprintf(stderr, "\r\033[K%.*s %3d%%", static_cast<int>(stage.size()), stage.data(), pct);
+    if (pct >= 100) std::fputc('\n', stderr);
+    std::fflush(stderr);
+  };
+}
+
+void write_report(const CommonOptions& opt, const std::string& command, nlohmann::json report) {
+  if (opt.report_path.empty()) return;
+  report["command"] = command;
+  report["seed"] = opt.seed;
+  report["threads"] = opt.threads;
+  write_file_atomic(opt.report_path, report.dump(2) + "\n", true);
+}
+
+void require_input_file(const std::string& input, const std::string& what) {
+  std::error_code ec;
+  if (input.empty()) throw InvalidInputError(what + " path is empty");
+  if (!std::filesystem::exists(input, ec)) throw IOError(what + " '" + input + "' does not exist");
+  if (!std::filesystem::is_regular_file(input, ec))
+    throw IOError(what + " '" + input + "' is not a regular file");
+}
+
+void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force) {
+  for (const auto& in : inputs)
+    if (!in.empty() && same_file(output, in))
+      throw InvalidInputError("output '" + output + "' is the input file '" + in +
+                              "'; refusing to overwrite an input");
+  std::error_code ec;
+  if (!force && std::filesystem::exists(output, ec) && !std::filesystem::is_directory(output, ec))
+    throw IOError("output '" + output + "' already exists (pass --force to replace it)");
+}
+
+}  // namespace surftex::cli

@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// The subcommand registry of the `surftex` command. Each apps/surftex/cmd_*.cpp
+// defines one subcommand and registers it with a static SubcommandRegistrar;
+// main.cpp needs no edit when a subcommand is added. Apps are thin: parse,
+// validate, call the library, report (STYLE.md 7).
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geometry/progress.h"
+
+namespace surftex::cli {
+
+/// Options every subcommand takes (issue 2, item 7).
+struct CommonOptions {
+  std::uint64_t seed = 1;
+  int threads = 0;          // 0 = all cores
+  std::string report_path;  // JSON report, empty = none
+  bool force = false;       // replace existing outputs
+  bool quiet = false;       // no progress even on a terminal
+};
+
+/// Adds --seed, --threads, --report, --force, --quiet to `app`.
+void add_common_options(CLI::App& app, CommonOptions& opt);
+
+/// Applies --threads to TBB/OpenMP-style pools for the rest of the run; the
+/// returned object keeps the limit alive.
+std::shared_ptr<void> apply_thread_limit(int threads);
+
+/// A progress callback that draws on stderr when it is a terminal and
+/// !quiet, and does nothing in pipes.
+ProgressCallback terminal_progress(bool quiet);
+
+/// Writes `report` (adds "command", "seed", "threads") atomically to
+/// opt.report_path if set.
+void write_report(const CommonOptions& opt, const std::string& command, nlohmann::json report);
+
+/// Throws InvalidInputError if `input` does not exist or is not a regular file.
+void require_input_file(const std::string& input, const std::string& what);
+
+/// Throws if `output` names the same file as any of `inputs` (never overwrite
+/// what the user gave), or exists while !force.
+void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force);
+
+struct Subcommand {
+  std::string name;
+  std::string description;
+  /// Declares the options on `app`; returns the function to run after parsing.
+  std::function<std::function<int()>(CLI::App& app)> setup;
+};
+
+std::vector<Subcommand>& registry();
+
+struct SubcommandRegistrar {
+  explicit SubcommandRegistrar(Subcommand s) { registry().push_back(std::move(s)); }
+};
+
+}  // namespace surftex::cli

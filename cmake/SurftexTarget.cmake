@@ -1,0 +1,28 @@
+# Per-target build hygiene: warnings and sanitizers only on our own targets,
+# never directory-wide (third-party headers are SYSTEM includes).
+function(surftex_target_options target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(SURFTEX_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# A module library built from every .cpp in its folder: one algorithm per
+# header/source pair, so adding an algorithm needs no CMake edit.
+function(surftex_add_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  file(GLOB _srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  if(_srcs)
+    add_library(surftex_${name} STATIC ${_srcs})
+    target_include_directories(surftex_${name} PUBLIC "${PROJECT_SOURCE_DIR}/src")
+    target_link_libraries(surftex_${name} PUBLIC ${ARG_DEPS})
+    surftex_target_options(surftex_${name})
+    add_library(surftex::${name} ALIAS surftex_${name})
+  else()  # a module with no sources yet
+    add_library(surftex_${name} INTERFACE)
+    target_include_directories(surftex_${name} INTERFACE "${PROJECT_SOURCE_DIR}/src")
+    target_link_libraries(surftex_${name} INTERFACE ${ARG_DEPS})
+    add_library(surftex::${name} ALIAS surftex_${name})
+  endif()
+endfunction()

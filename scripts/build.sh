@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Configures and builds surftex into build/ (or $SURFTEX_BUILD_DIR).
+# Usage: scripts/build.sh [extra cmake -D options]
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${SURFTEX_BUILD_DIR:-$root/build}"
+export CCACHE_BASEDIR="$root" CCACHE_COMPRESS=1
+gen=()
+if command -v ninja >/dev/null 2>&1; then gen=(-G Ninja); fi
+if [[ ! -f "$build/CMakeCache.txt" ]]; then
+  cmake -S "$root" -B "$build" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+else
+  cmake -S "$root" -B "$build" "$@" >/dev/null
+fi
+jobs="${SURFTEX_JOBS:-$(nproc)}"
+cmake --build "$build" -j "$jobs"

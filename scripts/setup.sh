@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs every system dependency surftex needs from Debian 12 packages.
+# Idempotent: packages already present are not reinstalled; apt is only
+# consulted when something is missing.
+set -euo pipefail
+
+PKGS=(
+  cmake g++ make ninja-build ccache pkg-config
+  libcgal-dev libcgal-demo libgmp-dev libmpfr-dev
+  libeigen3-dev libtet1.5-dev
+  libopenimageio-dev openimageio-tools
+  libboost-graph-dev libboost-dev
+  libgtest-dev libgmock-dev
+  libnanoflann-dev libtbb-dev libcli11-dev nlohmann-json3-dev libtinygltf-dev libstb-dev
+)
+# Optional peers used only by benchmarks (bench/): G'MIC.
+if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
+
+missing=()
+for p in "${PKGS[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if (( ${#missing[@]} == 0 )); then
+  echo "setup: all ${#PKGS[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup: done"

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The README's test command: installs system packages (scripts/setup.sh),
+# builds from scratch if needed, runs every test suite with ctest. With
+# --sanitize (or CI=true) it runs the whole suite a second time built with
+# AddressSanitizer + UndefinedBehaviorSanitizer.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+sanitize=0
+for a in "$@"; do
+  case "$a" in
+    --sanitize) sanitize=1 ;;
+    -h|--help) echo "usage: scripts/test.sh [--sanitize]"; exit 0 ;;
+    *) echo "error: unknown option '$a'" >&2; exit 2 ;;
+  esac
+done
+if [[ "${CI:-}" == "true" ]]; then sanitize=1; fi
+
+bash "$root/scripts/setup.sh"
+SURFTEX_BUILD_DIR="$root/build" bash "$root/scripts/build.sh"
+(cd "$root/build" && ctest --output-on-failure -j "$(nproc)")
+
+if [[ $sanitize == 1 ]]; then
+  echo "== sanitizer suite (ASan + UBSan) =="
+  SURFTEX_BUILD_DIR="$root/build-asan" bash "$root/scripts/build.sh" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSURFTEX_SANITIZE=ON -DSURFTEX_BUILD_BENCH=OFF
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  (cd "$root/build-asan" && SURFTEX_SANITIZED=1 ctest --output-on-failure -j "$(nproc)")
+fi
