@@ -579,18 +579,33 @@ Camera fit_camera(const BBox3f& box, float azimuth_deg, float elevation_deg, Cam
   V3 d{std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el)};   // centre -> eye
   V3 up{-std::sin(az) * std::sin(el), std::cos(el), -std::cos(az) * std::sin(el)};  // d/d(elevation)
   const double margin = 1.05;
+  const V3 right = cross(mul(d, -1.0), up);  // forward x up
+  // The eight box corners in the camera frame around the box centre (z towards the eye).
+  double max_x = 0, max_y = 0, max_z = -r;
+  V3 corner_xyz[8];
+  for (int i = 0; i < 8; ++i) {
+    V3 p{(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]};
+    V3 q = sub(p, c);
+    corner_xyz[i] = {dot(q, right), dot(q, up), dot(q, d)};
+    max_x = std::max(max_x, std::abs(corner_xyz[i][0]));
+    max_y = std::max(max_y, std::abs(corner_xyz[i][1]));
+    max_z = std::max(max_z, corner_xyz[i][2]);
+  }
   Camera cam;
   cam.projection = projection;
   double dist;
   if (projection == Camera::Projection::Perspective) {
-    double half_v = cam.fov_y_deg * kPi / 360.0;
-    double half_h = std::atan(std::tan(half_v) * aspect);
-    dist = margin * r / std::sin(std::min(half_v, half_h));
-    cam.near_plane = static_cast<float>(std::max(0.5 * (dist - r), 1e-4 * r));
+    // Nearest eye distance that keeps every corner inside the frustum, with the margin.
+    const double tan_v = std::tan(cam.fov_y_deg * kPi / 360.0), tan_h = tan_v * aspect;
+    dist = 0;
+    for (const V3& q : corner_xyz)
+      dist = std::max({dist, q[2] + margin * std::abs(q[0]) / tan_h, q[2] + margin * std::abs(q[1]) / tan_v});
+    dist = std::max(dist, max_z + 1e-3 * r);
+    cam.near_plane = static_cast<float>(std::max(0.5 * (dist - max_z), 1e-4 * r));
   } else {
-    cam.ortho_half_height = static_cast<float>(margin * r / std::min(1.0, static_cast<double>(aspect)));
-    dist = 3.0 * r;
-    cam.near_plane = static_cast<float>(r);
+    cam.ortho_half_height = static_cast<float>(margin * std::max({max_y, max_x / aspect, 1e-6 * r}));
+    dist = max_z + r;
+    cam.near_plane = static_cast<float>(0.5 * r);
   }
   V3 eye = add(c, mul(d, dist));
   cam.eye = {static_cast<float>(eye[0]), static_cast<float>(eye[1]), static_cast<float>(eye[2])};

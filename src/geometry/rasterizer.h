@@ -73,8 +73,11 @@ struct Camera {
 
 /// A camera on the sphere around `box`: azimuth rotates about the world +Y
 /// axis (0 = looking from +Z towards -Z, 90 = from +X), elevation lifts the eye
-/// towards +Y (-90..90 degrees). The bounding sphere of the box fills the
-/// image's shorter side with a small margin. `aspect` = width / height.
+/// towards +Y (-90..90 degrees). The camera looks at the box centre from the
+/// nearest distance (perspective, 35 degree vertical field of view) or with the
+/// smallest view height (orthographic) that keeps all eight box corners inside
+/// the image with a 5% margin; the near plane lies in front of the box.
+/// `aspect` = width / height.
 /// Throws InvalidInputError on non-finite angles or aspect <= 0.
 Camera fit_camera(const BBox3f& box, float azimuth_deg, float elevation_deg,
                   Camera::Projection projection = Camera::Projection::Perspective,
