@@ -299,7 +299,9 @@ class GraphcutSynthesizer {
       pw_ = std::min(ex.width, lim_w);
       ph_ = std::min(ex.height, lim_h);
     } else {
-      int ps = o.patch_size > 0 ? o.patch_size : std::min({64, ex.width, ex.height});
+      const int min_side = std::min(ex.width, ex.height);
+      const int auto_ps = std::min(min_side, std::clamp(min_side / 3, 64, 128));
+      int ps = o.patch_size > 0 ? o.patch_size : auto_ps;
       pw_ = std::min({ps, ex.width, lim_w});
       ph_ = std::min({ps, ex.height, lim_h});
     }

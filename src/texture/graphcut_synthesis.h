@@ -58,8 +58,10 @@ enum class PlacementMode {
 
 struct GraphcutOptions {
   PlacementMode placement = PlacementMode::SubPatch;
-  /// Side of a (square) patch in pixels, 0 = automatic: min(64, exemplar width,
-  /// exemplar height); always clipped to the exemplar and output sizes. Ignored
+  /// Side of a (square) patch in pixels, 0 = automatic: s/3 clamped to
+  /// [64, 128], at most s, where s = min(exemplar width, exemplar height)
+  /// (fewer, larger patches on large exemplars); always clipped to the
+  /// exemplar and output sizes. Ignored
   /// by EntirePatch (the patch is the exemplar). Range 0 or >= 4.
   int patch_size = 0;
   /// Overlap between neighbouring patches of the fill pass in pixels, 0 =
