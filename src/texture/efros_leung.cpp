@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <queue>
 #include <random>
@@ -21,6 +22,129 @@ namespace surftex {
 namespace {
 
 using Scored = std::pair<float, int>;  // (error, candidate position); compared lexicographically
+constexpr int kLanes = 8;
+constexpr std::size_t kPad = 4 * kLanes;
+
+// Pass-1 kernel: unweighted SSD of `len` consecutive candidate positions
+// starting at buffer index `row`, over `nk` known neighbours (buffer offsets
+// delta[k], values tv[k * C + c]). Candidates are processed 8 at a time in one
+// vector register (GCC vector extension), so the accumulator never leaves the
+// register; every lane performs the same operations in the same order, so
+// the result does not depend on the instruction set picked at run time.
+// Early abandon: every 4 neighbours, if all 8 partial sums exceed `limit`
+// (the current n-th best) the group stops; its outputs are then partial
+// sums, already > limit, which the caller discards as it would the full ones.
+typedef float V8 __attribute__((vector_size(kLanes * sizeof(float))));
+typedef int I8 __attribute__((vector_size(kLanes * sizeof(int))));
+
+template <int C>
+__attribute__((always_inline)) inline void span_ssd_impl(const float* planes, std::size_t plane_size,
+                                                         const int* delta, const float* tv, int nk,
+                                                         int len, std::size_t row, float limit,
+                                                         float* out) {
+  for (int i = 0; i < len; i += kLanes) {
+    V8 acc = {};
+    V8 lim;
+    for (int l = 0; l < kLanes; ++l) lim[l] = limit;
+    for (int k = 0; k < nk; ++k) {
+      const float* base = planes + row + i + delta[k];
+      for (int c = 0; c < C; ++c) {
+        V8 v;
+        std::memcpy(&v, base + c * plane_size, sizeof(V8));
+        const V8 d = v - tv[k * C + c];
+        acc += d * d;
+      }
+      if ((k & 3) == 3) {
+        const I8 over = acc > lim;
+        int all = -1;
+        for (int l = 0; l < kLanes; ++l) all &= over[l];
+        if (all) break;
+      }
+    }
+    std::memcpy(out + i, &acc, sizeof(V8));  // out has room for a full group
+  }
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define SURFTEX_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define SURFTEX_SIMD_CLONES
+#endif
+
+SURFTEX_SIMD_CLONES void span_ssd_c1(const float* p, std::size_t ps, const int* d, const float* t,
+                                     int nk, int len, std::size_t row, float lim, float* out) {
+  span_ssd_impl<1>(p, ps, d, t, nk, len, row, lim, out);
+}
+SURFTEX_SIMD_CLONES void span_ssd_c3(const float* p, std::size_t ps, const int* d, const float* t,
+                                     int nk, int len, std::size_t row, float lim, float* out) {
+  span_ssd_impl<3>(p, ps, d, t, nk, len, row, lim, out);
+}
+SURFTEX_SIMD_CLONES void span_ssd_c4(const float* p, std::size_t ps, const int* d, const float* t,
+                                     int nk, int len, std::size_t row, float lim, float* out) {
+  span_ssd_impl<4>(p, ps, d, t, nk, len, row, lim, out);
+}
+// Pass-2 kernel: Gaussian-weighted SSD of one candidate `id`. The window is
+// stored per active row as nv groups of 8 offsets starting at buffer offset
+// roff[r]; weights are 0 at unknown offsets (and past the window), so they
+// contribute exactly 0. Lanes are summed in a fixed order at the end.
+template <int C>
+__attribute__((always_inline)) inline float weighted_ssd_impl(const float* planes,
+                                                              std::size_t plane_size, int Cr,
+                                                              const int* roff, const float* w,
+                                                              const float* t, int nrows, int nv,
+                                                              int id) {
+  const int ch = C > 0 ? C : Cr;
+  V8 acc = {};
+  for (int r = 0; r < nrows; ++r)
+    for (int g = 0; g < nv; ++g) {
+      const std::size_t o = static_cast<std::size_t>(r) * nv + g;
+      V8 wv;
+      std::memcpy(&wv, w + o * kLanes, sizeof(V8));
+      V8 sq = {};
+      for (int c = 0; c < ch; ++c) {
+        V8 v, tv;
+        std::memcpy(&v, planes + c * plane_size + id + roff[r] + g * kLanes, sizeof(V8));
+        std::memcpy(&tv, t + ((static_cast<std::size_t>(r) * ch + c) * nv + g) * kLanes, sizeof(V8));
+        const V8 d = v - tv;
+        sq += d * d;
+      }
+      acc += wv * sq;
+    }
+  float e = 0.f;
+  for (int l = 0; l < kLanes; ++l) e += acc[l];
+  return e;
+}
+SURFTEX_SIMD_CLONES float weighted_ssd_c1(const float* p, std::size_t ps, const int* ro,
+                                          const float* w, const float* t, int nr, int nv, int id) {
+  return weighted_ssd_impl<1>(p, ps, 1, ro, w, t, nr, nv, id);
+}
+SURFTEX_SIMD_CLONES float weighted_ssd_c3(const float* p, std::size_t ps, const int* ro,
+                                          const float* w, const float* t, int nr, int nv, int id) {
+  return weighted_ssd_impl<3>(p, ps, 3, ro, w, t, nr, nv, id);
+}
+SURFTEX_SIMD_CLONES float weighted_ssd_c4(const float* p, std::size_t ps, const int* ro,
+                                          const float* w, const float* t, int nr, int nv, int id) {
+  return weighted_ssd_impl<4>(p, ps, 4, ro, w, t, nr, nv, id);
+}
+float weighted_ssd_any(const float* p, std::size_t ps, int C, const int* ro, const float* w,
+                       const float* t, int nr, int nv, int id) {
+  return weighted_ssd_impl<0>(p, ps, C, ro, w, t, nr, nv, id);
+}
+
+// Any channel count: accumulate channel by channel (C = 2 or > 4).
+void span_ssd_any(const float* p, std::size_t ps, int C, const int* d, const float* t, int nk,
+                  int len, std::size_t row, float* out) {
+  std::fill(out, out + len, 0.f);
+  for (int k = 0; k < nk; ++k)
+    for (int c = 0; c < C; ++c) {
+      const float* src = p + c * ps + row + d[k];
+      const float tv = t[k * C + c];
+      for (int i = 0; i < len; ++i) {
+        const float x = src[i] - tv;
+        out[i] += x * x;
+      }
+    }
+}
 
 int lo_of(int n) { return -(n / 2); }
 int hi_of(int n) { return n - 1 - n / 2; }
@@ -50,7 +174,7 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
   s.ph = img.height;
   s.channels = img.channels;
   const std::size_t n = static_cast<std::size_t>(s.pw) * s.ph;
-  s.planes.resize(n * s.channels);
+  s.planes.resize(n * s.channels + kPad, 0.f);  // padding: vector loads may overrun a row
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < s.channels; ++c) s.planes[c * n + i] = img.data[i * s.channels + c];
   const int lo = lo_of(window), hi = hi_of(window);
@@ -88,7 +212,7 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
     for (int x = sp.x0; x < sp.x1; ++x) s.ids.push_back(sp.y * s.pw + x);
   }
   // Blocks of spans for pass 1 (the partition does not affect the result).
-  const int want = std::max(1, 4 * tbb::this_task_arena::max_concurrency());
+  const int want = std::max(1, tbb::this_task_arena::max_concurrency());
   const int per = std::max<int>(1, (static_cast<int>(s.ids.size()) + want - 1) / want);
   int b0 = 0, acc = 0;
   for (int i = 0; i < static_cast<int>(s.spans.size()); ++i) {
@@ -109,18 +233,6 @@ struct KnownOffset {
   float weight;
   bool in_first;
 };
-
-// Bounded best-n list under the strict order (error, id).
-void keep_best(std::vector<Scored>& heap, std::size_t n, Scored v) {
-  if (heap.size() < n) {
-    heap.push_back(v);
-    std::push_heap(heap.begin(), heap.end());
-  } else if (v < heap.front()) {
-    std::pop_heap(heap.begin(), heap.end());
-    heap.back() = v;
-    std::push_heap(heap.begin(), heap.end());
-  }
-}
 
 class Synthesizer {
  public:
@@ -158,6 +270,11 @@ class Synthesizer {
   std::vector<float> value_;             // known values, [k * C + c]
   std::vector<float> weight_;            // Gaussian weight per known neighbour
   std::vector<int> first_idx_;           // known neighbours inside the first-pass window
+  std::vector<int> p2_roff_;
+  std::vector<float> p2_w_, p2_t_;
+  int p2_row_dy_ = 0;
+  std::vector<int> p1_delta_;
+  std::vector<float> p1_value_;
   std::vector<std::vector<Scored>> block_heaps_;
   std::vector<std::vector<float>> block_acc_;
   std::vector<int> pre_;
@@ -288,6 +405,10 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   const int px = p % W, py = p / W;
   const int lo = lo_of(window_), hi = hi_of(window_);
   const int flo = lo_of(first_), fhi = hi_of(first_);
+  const int nv = (window_ + kLanes - 1) / kLanes, rowlen = nv * kLanes;
+  p2_roff_.clear();
+  p2_w_.clear();
+  p2_t_.clear();
   int g = 0;
   for (int dy = lo; dy <= hi; ++dy)
     for (int dx = lo; dx <= hi; ++dx, ++g) {
@@ -301,6 +422,16 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
       weight_.push_back(gauss_[g]);
       const float* v = out_.pixel(x, y);
       value_.insert(value_.end(), v, v + C);
+      // Row-grouped copy for the pass-2 kernel.
+      if (p2_roff_.empty() || p2_row_dy_ != dy) {
+        p2_row_dy_ = dy;
+        p2_roff_.push_back(dy * s.pw + lo);
+        p2_w_.resize(p2_w_.size() + rowlen, 0.f);
+        p2_t_.resize(p2_t_.size() + static_cast<std::size_t>(rowlen) * C, 0.f);
+      }
+      const std::size_t r = p2_roff_.size() - 1;
+      p2_w_[r * rowlen + (dx - lo)] = gauss_[g];
+      for (int c = 0; c < C; ++c) p2_t_[(r * C + c) * rowlen + (dx - lo)] = v[c];
     }
 }
 
@@ -316,30 +447,45 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
     block_heaps_.resize(nb);
     block_acc_.resize(nb);
   }
+  // Offsets and values of the neighbours pass 1 compares, contiguous.
+  p1_delta_.clear();
+  p1_value_.clear();
+  for (int k : use) {
+    p1_delta_.push_back(delta_[k]);
+    p1_value_.insert(p1_value_.end(), value_.begin() + static_cast<std::ptrdiff_t>(k) * C,
+                     value_.begin() + static_cast<std::ptrdiff_t>(k + 1) * C);
+  }
+  const int nk = static_cast<int>(p1_delta_.size());
+  const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
+  // Each block keeps a buffer of candidates that may still be among the n
+  // best: those with error <= limit, the n-th smallest error seen so far
+  // (re-established by nth_element whenever the buffer reaches 8n). Exact:
+  // anything above the limit has n better candidates in the same block.
   auto run_block = [&](int b) {
-    std::vector<Scored>& heap = block_heaps_[b];
+    std::vector<Scored>& buf = block_heaps_[b];
     std::vector<float>& acc = block_acc_[b];
-    heap.clear();
-    acc.resize(s.max_span);
+    buf.clear();
+    acc.resize(s.max_span + kLanes);
+    float* a = acc.data();
+    float limit = std::numeric_limits<float>::infinity();
+    const std::size_t cap = std::max<std::size_t>(8 * n, 64);
     for (int si = s.blocks[b].first; si < s.blocks[b].second; ++si) {
       const auto& sp = s.spans[si];
       const int len = sp.x1 - sp.x0;
-      float* a = acc.data();
-      std::fill(a, a + len, 0.f);
       const std::size_t row = static_cast<std::size_t>(sp.y) * s.pw + sp.x0;
-      for (int k : use)
-        for (int c = 0; c < C; ++c) {
-          const float* src = s.plane(c) + row + delta_[k];
-          const float t = value_[static_cast<std::size_t>(k) * C + c];
-          for (int i = 0; i < len; ++i) {  // contiguous: vectorises
-            const float d = src[i] - t;
-            a[i] += d * d;
-          }
-        }
+      switch (C) {
+        case 1: span_ssd_c1(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
+        case 3: span_ssd_c3(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
+        case 4: span_ssd_c4(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
+        default: span_ssd_any(s.planes.data(), ps, C, p1_delta_.data(), p1_value_.data(), nk, len, row, a);
+      }
       const int id0 = sp.y * s.pw + sp.x0;
-      for (int i = 0; i < len; ++i) {
-        if (heap.size() >= n && !(Scored{a[i], id0 + i} < heap.front())) continue;
-        keep_best(heap, n, {a[i], id0 + i});
+      for (int i = 0; i < len; ++i)
+        if (a[i] <= limit) buf.push_back({a[i], id0 + i});
+      if (buf.size() >= cap) {
+        std::nth_element(buf.begin(), buf.begin() + (n - 1), buf.end());
+        buf.resize(n);
+        limit = buf[n - 1].first;  // the n-th smallest error
       }
     }
   };
@@ -370,16 +516,18 @@ void Synthesizer::score_full(const SearchImage& s, const std::vector<int>& ids,
   const float inv = wsum > 0 ? static_cast<float>(1.0 / wsum) : 1.f;
   out.resize(ids.size());
   const int nk = static_cast<int>(delta_.size());
+  const int nv = (window_ + kLanes - 1) / kLanes;
+  const int nr = static_cast<int>(p2_roff_.size());
+  const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
+  const float* P = s.planes.data();
   auto score = [&](std::size_t i) {
     const int id = ids[i];
-    float e = 0.f;
-    for (int k = 0; k < nk; ++k) {
-      float sq = 0.f;
-      for (int c = 0; c < C; ++c) {
-        const float d = s.plane(c)[id + delta_[k]] - value_[static_cast<std::size_t>(k) * C + c];
-        sq += d * d;
-      }
-      e += weight_[k] * sq;
+    float e;
+    switch (C) {
+      case 1: e = weighted_ssd_c1(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
+      case 3: e = weighted_ssd_c3(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
+      case 4: e = weighted_ssd_c4(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
+      default: e = weighted_ssd_any(P, ps, C, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id);
     }
     out[i] = {e * inv, id};
   };
@@ -415,9 +563,9 @@ void Synthesizer::seed_patch(int p) {
       const int x = px + dx, y = py + dy;
       if (x < 0 || y < 0 || x >= W || y >= H) continue;
       const int q = y * W + x;
-      if (state_[q] != PixelState::Fill || known_[q]) continue;
-      // Neighbouring Fill pixels may search another exemplar/rotation; the
-      // seed nonetheless comes from one patch so that it is coherent.
+      // Only Fill pixels that search the same exemplar and orientation, so
+      // a seed never puts texture k where the index map asks for another.
+      if (state_[q] != PixelState::Fill || known_[q] || key_[q] != key_[p]) continue;
       for (int c = 0; c < C; ++c) out_.at(x, y, c) = s.plane(c)[id + dy * s.pw + dx];
       mark_filled(q);
       ++seeded_;
