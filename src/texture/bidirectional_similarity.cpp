@@ -139,6 +139,12 @@ double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
           break;
         }
         k = std::min(base.count, k * 2);
+        if (k > base.count / 8) {  // the subspace does not separate: scan all
+          for (std::size_t j = 0; j < base.count; ++j)
+            b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
+          best[i] = b;
+          break;
+        }
       }
     });
   }
