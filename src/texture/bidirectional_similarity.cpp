@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "texture/bidirectional_similarity.h"
+
+#include <Eigen/Dense>
+#include <nanoflann.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "geometry/errors.h"
+
+namespace surftex {
+namespace {
+
+struct Patches {
+  int dim = 0;
+  std::size_t count = 0;
+  std::vector<float> v;  // count x dim
+  const float* row(std::size_t i) const { return v.data() + i * dim; }
+};
+
+Patches extract(const Image& img, int k, bool wrap, int stride) {
+  Patches p;
+  p.dim = k * k * img.channels;
+  const int nx = wrap ? img.width : img.width - k + 1;
+  const int ny = wrap ? img.height : img.height - k + 1;
+  for (int y = 0; y < ny; y += stride)
+    for (int x = 0; x < nx; x += stride) {
+      for (int j = 0; j < k; ++j)
+        for (int i = 0; i < k; ++i) {
+          const int sx = (x + i) % img.width, sy = (y + j) % img.height;
+          const float* px = img.pixel(sx, sy);
+          p.v.insert(p.v.end(), px, px + img.channels);
+        }
+      ++p.count;
+    }
+  return p;
+}
+
+double ssd(const float* a, const float* b, int dim) {
+  double s = 0;
+  for (int i = 0; i < dim; ++i) {
+    const double d = static_cast<double>(a[i]) - b[i];
+    s += d * d;
+  }
+  return s;
+}
+
+struct Cloud {
+  const std::vector<double>* pts;
+  int dim;
+  std::size_t n;
+  std::size_t kdtree_get_point_count() const { return n; }
+  double kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i * dim + d]; }
+  template <class B>
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud,
+                                                 -1, std::uint32_t>;
+
+// PCA basis (dim x d, orthonormal columns) and mean from a sample of patches.
+struct Pca {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd basis;
+};
+
+Pca fit_pca(const Patches& a, const Patches& b, int d) {
+  const int dim = a.dim;
+  Pca pca;
+  pca.mean = Eigen::VectorXd::Zero(dim);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(dim, dim);
+  std::size_t used = 0;
+  auto add = [&](const Patches& p) {
+    const std::size_t step = std::max<std::size_t>(1, p.count / 8000);
+    for (std::size_t i = 0; i < p.count; i += step) {
+      Eigen::Map<const Eigen::VectorXf> r(p.row(i), dim);
+      Eigen::VectorXd x = r.cast<double>();
+      pca.mean += x;
+      cov.selfadjointView<Eigen::Lower>().rankUpdate(x);
+      ++used;
+    }
+  };
+  add(a);
+  add(b);
+  pca.mean /= static_cast<double>(used);
+  cov = cov.selfadjointView<Eigen::Lower>();
+  cov /= static_cast<double>(used);
+  cov -= pca.mean * pca.mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(cov);
+  if (es.info() != Eigen::Success)
+    throw SolverError("bidirectional_similarity: PCA eigen decomposition failed");
+  pca.basis = es.eigenvectors().rightCols(d);  // eigenvalues ascend: keep the largest
+  return pca;
+}
+
+std::vector<double> project(const Patches& p, const Pca& pca) {
+  const int d = static_cast<int>(pca.basis.cols());
+  std::vector<double> out(p.count * d);
+  tbb::parallel_for(std::size_t(0), p.count, [&](std::size_t i) {
+    Eigen::Map<const Eigen::VectorXf> r(p.row(i), p.dim);
+    Eigen::VectorXd c = pca.basis.transpose() * (r.cast<double>() - pca.mean);
+    std::copy(c.data(), c.data() + d, out.begin() + i * d);
+  });
+  return out;
+}
+
+// Mean over `queries` of the distance to the nearest patch of `base`.
+double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
+                    const std::vector<double>& qproj, const std::vector<double>& bproj) {
+  std::vector<double> best(queries.count);
+  if (!pca) {
+    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
+      double b = std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < base.count; ++j) b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
+      best[i] = b;
+    });
+  } else {
+    const int d = static_cast<int>(pca->basis.cols());
+    Cloud cloud{&bproj, d, base.count};
+    Tree tree(d, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
+      std::size_t k = std::min<std::size_t>(16, base.count);
+      std::vector<std::uint32_t> idx;
+      std::vector<double> lb;
+      while (true) {
+        idx.resize(k);
+        lb.resize(k);
+        const std::size_t got = tree.knnSearch(qproj.data() + i * d, k, idx.data(), lb.data());
+        double b = std::numeric_limits<double>::infinity();
+        for (std::size_t j = 0; j < got; ++j) b = std::min(b, ssd(queries.row(i), base.row(idx[j]), base.dim));
+        // Unvisited patches are at least lb[got-1] away (projection lower bound).
+        if (got >= base.count || lb[got - 1] >= b * (1.0 - 1e-9)) {
+          best[i] = b;
+          break;
+        }
+        k = std::min(base.count, k * 2);
+        if (k > base.count / 8) {  // the subspace does not separate: scan all
+          for (std::size_t j = 0; j < base.count; ++j)
+            b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
+          best[i] = b;
+          break;
+        }
+      }
+    });
+  }
+  double sum = 0;
+  for (double v : best) sum += v;
+  return sum / static_cast<double>(queries.count) / base.dim;
+}
+
+}  // namespace
+
+BidirectionalResult bidirectional_similarity(const Image& output, const Image& exemplar,
+                                             const BidirectionalOptions& opt) {
+  auto bad = [](const std::string& m) { throw InvalidInputError("bidirectional_similarity: " + m); };
+  if (output.empty()) bad("output image is empty");
+  if (exemplar.empty()) bad("exemplar image is empty");
+  if (output.channels != exemplar.channels)
+    bad("output has " + std::to_string(output.channels) + " channels, exemplar " +
+        std::to_string(exemplar.channels));
+  if (opt.patch < 1 || opt.patch > 31) bad("patch " + std::to_string(opt.patch) + " outside 1..31");
+  if (opt.stride < 1) bad("stride " + std::to_string(opt.stride) + " < 1");
+  if (opt.pca_dims < 1) bad("pca_dims " + std::to_string(opt.pca_dims) + " < 1");
+  if (output.width < opt.patch || output.height < opt.patch)
+    bad("patch " + std::to_string(opt.patch) + " larger than the output (" +
+        std::to_string(output.width) + "x" + std::to_string(output.height) + ")");
+  if (!opt.periodic_exemplar && (exemplar.width < opt.patch || exemplar.height < opt.patch))
+    bad("patch " + std::to_string(opt.patch) + " larger than the exemplar (" +
+        std::to_string(exemplar.width) + "x" + std::to_string(exemplar.height) + ")");
+  const Patches out = extract(output, opt.patch, false, opt.stride);
+  const Patches ex = extract(exemplar, opt.patch, opt.periodic_exemplar, 1);
+  BidirectionalResult r;
+  r.output_patches = out.count;
+  r.exemplar_patches = ex.count;
+  if (opt.brute_force) {
+    std::vector<double> none;
+    r.coherence = mean_nearest(out, ex, nullptr, none, none);
+    r.completeness = mean_nearest(ex, out, nullptr, none, none);
+  } else {
+    const Pca pca = fit_pca(ex, out, std::min(opt.pca_dims, ex.dim));
+    const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
+    r.coherence = mean_nearest(out, ex, &pca, pout, pex);
+    r.completeness = mean_nearest(ex, out, &pca, pex, pout);
+  }
+  r.total = r.coherence + r.completeness;
+  return r;
+}
+
+}  // namespace surftex

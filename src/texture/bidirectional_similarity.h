@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Bidirectional similarity between a synthesised image and its exemplar
+// (Simakov, Caspi, Shechtman & Irani 2008, "Summarizing visual data using
+// bidirectional similarity", equation 1), used as a quality figure:
+//  - coherence   = mean over every k x k patch Q of the output of
+//                  min over exemplar patches P of D(P, Q)
+//                  (no output patch is foreign to the exemplar; 0 when the
+//                  output is a patchwork of verbatim exemplar copies);
+//  - completeness = mean over every exemplar patch P of min over output
+//                  patches Q of D(P, Q) (the output shows all of the exemplar);
+//  - total = coherence + completeness.
+// D is the SSD over the patch divided by k*k*channels (mean squared
+// difference per value, in squared image units), so figures compare across
+// image and patch sizes.
+//
+// Nearest neighbours are exact (up to float rounding): patches are projected
+// on the leading principal components (Eigen), a nanoflann kd-tree returns the
+// nearest candidates in that subspace, and they are re-ranked with the full
+// distance; since the subspace distance is a lower bound of the full one, the
+// candidate list is doubled until its farthest lower bound is no smaller than
+// the best full distance found, which proves the nearest one was seen.
+//
+// Throws InvalidInputError on empty images, different channel counts,
+// patch outside 1..31 or larger than an image, or stride < 1.
+
+#include <cstddef>
+
+#include "geometry/image.h"
+
+namespace surftex {
+
+struct BidirectionalOptions {
+  /// Patch side k, 1..31. Default 7.
+  int patch = 7;
+  /// Exemplar patches wrap around its edges (periodic exemplar): every
+  /// exemplar pixel starts a patch. Default off (patches fully inside).
+  bool periodic_exemplar = false;
+  /// Step between output patch positions (1 = every patch), >= 1. Larger
+  /// steps subsample big outputs.
+  int stride = 1;
+  /// Dimensions kept by the PCA projection for the kd-tree (1..k*k*channels,
+  /// clamped), default 16. Affects speed only, not the result.
+  int pca_dims = 16;
+  /// Brute-force search instead of the kd-tree (reference; slow).
+  bool brute_force = false;
+};
+
+struct BidirectionalResult {
+  double coherence = 0.0;
+  double completeness = 0.0;
+  double total = 0.0;
+  std::size_t output_patches = 0;
+  std::size_t exemplar_patches = 0;
+};
+
+BidirectionalResult bidirectional_similarity(const Image& output, const Image& exemplar,
+                                             const BidirectionalOptions& opt = {});
+
+}  // namespace surftex

@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Small image utilities shared by the synthesis code: luminance, crop,
+// bilinear resize and rotation (with or without toroidal wrap).
+//
+// Inputs and outputs are surftex::Image (float, interleaved channels, (0,0)
+// top-left). Every function throws InvalidInputError (naming the argument)
+// on an empty image or an out-of-range parameter.
+
+#include "geometry/image.h"
+
+namespace surftex {
+
+/// Rec. 709 luminance of an RGB(A) image (alpha ignored); a 1- or 2-channel
+/// image returns its first channel. Output: 1 channel, same size.
+Image luminance(const Image& img);
+
+/// The w x h block starting at (x, y); coordinates wrap toroidally when
+/// `wrap`, else the block must lie inside `img`.
+Image crop(const Image& img, int x, int y, int w, int h, bool wrap = false);
+
+/// Bilinear resize to w x h (pixel centres aligned: sample (i+0.5)*W/w-0.5,
+/// clamped to the border). Suitable for moderate scale changes; for strong
+/// minification build a pyramid first.
+Image resize_bilinear(const Image& img, int w, int h);
+
+/// Bilinear sample at continuous pixel coordinates (x, y) (pixel centres at
+/// integers). With `wrap`, coordinates wrap around; without, they are clamped.
+/// Writes img.channels values to `out`.
+void sample_bilinear(const Image& img, double x, double y, bool wrap, float* out);
+
+/// Rotates `img` by `radians` counter-clockwise as displayed (y down on
+/// screen, so the exemplar +x axis maps to (cos a, -sin a) in pixel
+/// coordinates) about its centre, bilinear. The output has size out_w x
+/// out_h, centred on the same point. Pixels whose source lies outside the
+/// image are 0 unless `wrap` (the image is treated as periodic).
+/// `valid` (if non-null) receives a 1-channel mask: 1 where the bilinear
+/// footprint lies fully inside the source (always 1 with `wrap`), else 0.
+Image rotate_image(const Image& img, double radians, int out_w, int out_h, bool wrap,
+                   Image* valid = nullptr);
+
+}  // namespace surftex

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Pre-rotated exemplars for oriented synthesis (Gorla et al. 2003, section
+// 3.3.2): the exemplar is rotated into K quantised orientations once, and the
+// neighbourhood search for a pixel runs in the rotation closest to the
+// direction the field asks for there.
+//
+// Angle convention (used by the whole synthesis code): an angle a (radians)
+// rotates the texture counter-clockwise as displayed, i.e. the exemplar's +x
+// axis is drawn along (cos a, -sin a) in pixel coordinates (x right, y down).
+// Orientation k of K is the angle 2*pi*k/K; directions are not folded to
+// [0, pi) because a direction field may distinguish a from a + pi.
+//
+// Cropping (the paper leaves it open):
+// - non-periodic exemplar: each rotation is stored in the bounding box of the
+//   rotated exemplar (same size parity as the source so that the centres
+//   coincide), with a validity mask that is 1 where the bilinear footprint is
+//   fully inside the source. Synthesis only uses neighbourhoods that are
+//   entirely valid, so the usable region shrinks with the window near the
+//   rotated corners.
+// - periodic exemplar (tiles seamlessly): samples wrap toroidally, so every
+//   pixel is valid; the rotation is stored as a (W + 2m) x (H + 2m) block
+//   around the centre, with m the margin asked for (synthesis passes half
+//   its window), so that all W x H positions of one period can be
+//   neighbourhood centres.
+// Rotation 0 is an exact copy of the exemplar (no resampling).
+
+#include <vector>
+
+#include "geometry/image.h"
+
+namespace surftex {
+
+struct RotatedExemplarOptions {
+  /// Number of orientations K over [0, 2 pi); 1..128, default 64 (Gorla used
+  /// 64 to 128 and saw no gain beyond).
+  int rotations = 64;
+  /// The exemplar tiles seamlessly (wrap when sampling).
+  bool periodic = false;
+  /// Extra border around one period for periodic exemplars (pixels, >= 0).
+  int margin = 0;
+  /// Build only these orientation indices (empty = all K). Others stay empty.
+  std::vector<int> only;
+};
+
+struct RotatedExemplar {
+  double angle = 0.0;  ///< radians, 2 pi k / K
+  Image image;         ///< same channels as the exemplar
+  Image valid;         ///< 1 channel, 1 = usable sample, 0 = outside the source
+};
+
+struct RotatedExemplarSet {
+  int rotations = 0;
+  bool periodic = false;
+  std::vector<RotatedExemplar> items;  ///< size K; unbuilt ones have empty images
+  /// Index of the orientation closest to `radians` (any real value).
+  int index_for_angle(double radians) const;
+};
+
+/// Index of the orientation closest to `radians` among K = `rotations`.
+int rotation_index(double radians, int rotations);
+
+/// One rotation of `exemplar` by `radians` (convention above).
+RotatedExemplar rotate_exemplar(const Image& exemplar, double radians, bool periodic,
+                                int margin = 0);
+
+/// All K rotations (or those in opt.only). Throws InvalidInputError on an
+/// empty exemplar, rotations outside 1..128, margin < 0 or an index outside 0..K-1.
+RotatedExemplarSet rotated_exemplars(const Image& exemplar, const RotatedExemplarOptions& opt = {});
+
+}  // namespace surftex
