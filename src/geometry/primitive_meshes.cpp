@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/primitive_meshes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -9,6 +10,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/properties.h"
 
 namespace surftex {
 
@@ -132,6 +134,32 @@ void make_torus(Mesh& mesh, double R, double r, int nu, int nv) {
       t.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
     }
   build(mesh, p, t);
+}
+
+void assign_torus_uvs(Mesh& mesh, double R, double repeats_u, double repeats_v) {
+  require(repeats_u > 0 && repeats_v > 0, "torus UV repeats must be positive");
+  auto uv = get_or_add(mesh, kCornerUV);
+  for (FaceIndex f : mesh.faces()) {
+    std::array<double, 3> us{}, vs{};
+    std::array<HalfedgeIndex, 3> hs{};
+    int k = 0;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      if (k == 3) throw InvalidInputError("assign_torus_uvs needs a triangle mesh");
+      const Point3& p = mesh.point(mesh.target(h));
+      double rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
+      double a = std::atan2(p.y(), p.x()), b = std::atan2(p.z(), rho - R);
+      us[k] = (a < 0 ? a + 2 * kPi : a) / (2 * kPi);
+      vs[k] = (b < 0 ? b + 2 * kPi : b) / (2 * kPi);
+      hs[k++] = h;
+    }
+    // Unwrap across the seam: lift small values when the face spans it.
+    for (auto* c : {&us, &vs}) {
+      double hi = std::max({(*c)[0], (*c)[1], (*c)[2]});
+      for (double& x : *c)
+        if (hi - x > 0.5) x += 1.0;
+    }
+    for (int i = 0; i < k; ++i) uv[hs[i]] = {us[i] * repeats_u, vs[i] * repeats_v};
+  }
 }
 
 void make_cylinder(Mesh& mesh, double radius, double height, int nu, int nv) {

@@ -28,6 +28,14 @@ void make_icosphere(Mesh& mesh, int subdivisions, double radius = 1.0);
 /// in triangles: nu*nv vertices, 2*nu*nv faces, closed, genus 1.
 void make_torus(Mesh& mesh, double R, double r, int nu, int nv);
 
+/// Per-corner texture coordinates (kCornerUV) for a torus around the z axis
+/// with major radius R (as made by make_torus): u = angle around z / 2 pi,
+/// v = angle around the tube / 2 pi, each times its repeat count; corners of a
+/// face across the angular seam get u or v beyond the seam (no wrap-around
+/// triangle), so a periodic texture maps seamlessly. Throws InvalidInputError
+/// if repeats are not positive.
+void assign_torus_uvs(Mesh& mesh, double R, double repeats_u, double repeats_v);
+
 /// Open cylinder around the z axis, radius r, z in [0,height], nu around, nv
 /// along: nu*(nv+1) vertices, 2 nu nv faces, two border loops.
 void make_cylinder(Mesh& mesh, double radius, double height, int nu, int nv);

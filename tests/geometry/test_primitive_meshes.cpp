@@ -71,3 +71,20 @@ TEST(PrimitiveMeshes, InvalidParametersThrow) {
   EXPECT_THROW(make_torus(m, 1.0, 2.0, 8, 8), InvalidInputError);
   EXPECT_THROW(make_icosphere(m, 12), InvalidInputError);
 }
+
+TEST(PrimitiveMeshes, TorusUVsAreContinuousAcrossTheSeam) {
+  Mesh m;
+  make_torus(m, 2.0, 0.5, 16, 8);
+  assign_torus_uvs(m, 2.0, 2.0, 1.0);
+  auto uv = m.property_map<HalfedgeIndex, std::array<double, 2>>("h:uv").first;
+  double max_du = 0, max_dv = 0;
+  for (FaceIndex f : m.faces()) {
+    HalfedgeIndex h = m.halfedge(f);
+    auto a = uv[h], b = uv[m.next(h)], c = uv[m.prev(h)];
+    max_du = std::max({max_du, std::abs(a[0] - b[0]), std::abs(b[0] - c[0]), std::abs(a[0] - c[0])});
+    max_dv = std::max({max_dv, std::abs(a[1] - b[1]), std::abs(b[1] - c[1]), std::abs(a[1] - c[1])});
+  }
+  // One grid step is 2/16 in u (two repeats) and 1/8 in v: no face spans the seam.
+  EXPECT_LE(max_du, 2.0 / 16 + 1e-9);
+  EXPECT_LE(max_dv, 1.0 / 8 + 1e-9);
+}

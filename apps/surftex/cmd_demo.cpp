@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// `surftex demo [-o DIR]`: a tour of surftex on built-in inputs that the
+// project generates itself (procedural textures and meshes built in code), so
+// it runs on a fresh machine with no data. Each step writes its outputs into
+// DIR and a line into DIR/report.json.
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "geometry/errors.h"
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/output_file.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
+#include "geometry/rasterizer.h"
+#include "geometry/render_mesh.h"
+#include "geometry/timer.h"
+#include "geometry/write_mesh.h"
+#include "surftex/command.h"
+#include "surftex/demo_steps.h"
+#include "texture/bidirectional_similarity.h"
+#include "texture/efros_leung.h"
+#include "texture/graphcut_synthesis.h"
+#include "texture/histogram_distance.h"
+#include "texture/procedural_texture.h"
+#include "texture/tileable_tile.h"
+#include "texture/wrap_seam_ratio.h"
+
+namespace fs = std::filesystem;
+
+namespace surftex::cli {
+
+std::vector<DemoStep>& demo_steps() {
+  static std::vector<DemoStep> steps;
+  return steps;
+}
+
+namespace {
+
+constexpr const char* kMarker = ".surftex-demo";
+
+// The demo owns DIR: it may replace its own earlier outputs there (marked by
+// kMarker), but never writes into a non-empty folder it did not create.
+void prepare_demo_dir(const std::string& dir, bool force) {
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec)) throw IOError("demo output '" + dir + "' exists and is not a folder");
+    bool empty = fs::is_empty(dir, ec);
+    if (!empty && !fs::exists(fs::path(dir) / kMarker, ec) && !force)
+      throw IOError("demo folder '" + dir +
+                    "' is not empty and was not made by `surftex demo` (pass --force or choose another -o)");
+  }
+  ensure_directory(dir);
+  write_file_atomic((fs::path(dir) / kMarker).string(), "made by surftex demo\n", true);
+}
+
+void save_render(const Mesh& mesh, const std::string& path, const RenderMeshOptions& rmo,
+                 RenderOptions ro, float az, float el) {
+  RenderMesh rm = make_render_mesh(mesh, rmo);
+  ro.width = ro.height = 768;
+  Camera cam = fit_camera(bounding_box(rm), az, el);
+  write_image(path, render(rm, cam, ro).color);
+}
+
+// Step 1: image synthesis from a generated exemplar by the three 2D engines.
+nlohmann::json step_synthesis(DemoContext& ctx) {
+  nlohmann::json j;
+  Image cells = make_cells(64, 4, ctx.seed);
+  write_image(ctx.path("exemplar_cells.png"), cells);
+  Image stripes = make_stripes(64, 8, 0);
+  write_image(ctx.path("exemplar_stripes.png"), stripes);
+  ctx.exemplar = cells;
+
+  Timer t;
+  ElOptions el;
+  el.window = 11;
+  el.seed = ctx.seed;
+  el.progress = ctx.progress;
+  Image el_out = efros_leung_synthesize(cells, 128, 128, el);
+  write_image(ctx.path("synth_el2pass.png"), el_out);
+  j["el2pass"] = {{"seconds", t.seconds()},
+                  {"size", "128x128"},
+                  {"bidirectional_similarity", bidirectional_similarity(el_out, cells, {.patch = 7, .periodic_exemplar = true, .stride = 2}).total},
+                  {"histogram_chi2", histogram_chi_square(el_out, cells)}};
+
+  // Oriented synthesis (Gorla 3.3.2): stripes turned by a radial angle field.
+  t.reset();
+  ElInput in;
+  in.exemplars = {stripes};
+  in.target = Image(128, 128, 3);
+  in.angle_fn = [](int x, int y) { return std::atan2(64.0 - y, x - 64.0); };
+  ElOptions eo = el;
+  eo.rotations = 32;
+  Image oriented = efros_leung_synthesize(in, eo).image;
+  write_image(ctx.path("synth_oriented_radial.png"), oriented);
+  j["oriented"] = {{"seconds", t.seconds()}, {"rotations", eo.rotations}};
+
+  t.reset();
+  GraphcutOptions gc;
+  gc.seed = ctx.seed;
+  gc.progress = ctx.progress;
+  Image gc_out = graphcut_synthesize(cells, 256, 256, gc);
+  write_image(ctx.path("synth_graphcut.png"), gc_out);
+  j["graphcut"] = {{"seconds", t.seconds()},
+                   {"size", "256x256"},
+                   {"bidirectional_similarity", bidirectional_similarity(gc_out, cells, {.patch = 7, .periodic_exemplar = true, .stride = 4}).total}};
+
+  t.reset();
+  TileOptions to;
+  to.seed = ctx.seed;
+  to.progress = ctx.progress;
+  ctx.tile = make_tileable(make_noise(96, 4, ctx.seed), 128, to);
+  write_image(ctx.path("tile_noise.png"), ctx.tile);
+  j["tile"] = {{"seconds", t.seconds()}, {"wrap_seam_ratio", wrap_seam_ratio(ctx.tile)}};
+  return j;
+}
+
+// Step 2: a torus textured with the periodic tile, exported and rendered.
+nlohmann::json step_textured_torus(DemoContext& ctx) {
+  Mesh torus;
+  make_torus(torus, 2.0, 0.7, 96, 48);
+  assign_torus_uvs(torus, 2.0, 4.0, 2.0);
+  WriteMeshOptions wo;
+  wo.texture = &ctx.tile;
+  write_mesh(ctx.path("torus_tiled.obj"), torus, wo);
+  write_mesh(ctx.path("torus_tiled.glb"), torus, wo);
+  RenderMeshOptions rmo;
+  rmo.corner_uvs = true;
+  RenderOptions ro;
+  ro.color_source = RenderOptions::ColorSource::Texture;
+  ro.texture = &ctx.tile;
+  save_render(torus, ctx.path("torus_tiled.png"), rmo, ro, 20.f, 35.f);
+  return {{"faces", torus.number_of_faces()}, {"files", {"torus_tiled.obj", "torus_tiled.glb", "torus_tiled.png"}}};
+}
+
+std::function<int()> setup(CLI::App& app) {
+  auto dir = std::make_shared<std::string>("out/demo");
+  auto common = std::make_shared<CommonOptions>();
+  app.add_option("-o,--output", *dir,
+                 "Folder for the demo's meshes, renders and report.json (default out/demo; created if "
+                 "absent; the demo replaces its own earlier outputs there, and refuses a non-empty folder "
+                 "it did not make unless --force)");
+  add_common_options(app, *common);
+  return [dir, common]() -> int {
+    auto threads = apply_thread_limit(common->threads);
+    prepare_demo_dir(*dir, common->force);
+    DemoContext ctx;
+    ctx.dir = *dir;
+    ctx.seed = common->seed;
+    ctx.progress = terminal_progress(common->quiet);
+    std::vector<DemoStep> steps{{10, "synthesis", "2D synthesis: two-pass Efros-Leung, oriented, graph-cut, tile",
+                                 step_synthesis},
+                                {20, "textured_torus", "a torus textured with the tile (OBJ, GLB, render)",
+                                 step_textured_torus}};
+    for (auto& s : demo_steps()) steps.push_back(s);
+    std::stable_sort(steps.begin(), steps.end(), [](auto& a, auto& b) { return a.order < b.order; });
+    nlohmann::json report;
+    Timer total;
+    for (auto& s : steps) {
+      std::fprintf(stderr, "demo: %s\n", s.description.c_str());
+      Timer t;
+      nlohmann::json r = s.run(ctx);
+      r["seconds_total"] = t.seconds();
+      report["steps"][s.name] = r;
+    }
+    report["seconds"] = total.seconds();
+    report["output_dir"] = *dir;
+    CommonOptions ro = *common;
+    if (ro.report_path.empty()) ro.report_path = (fs::path(*dir) / "report.json").string();
+    write_report(ro, "demo", report);
+    std::printf("demo: done in %.1f s; results in %s (report.json lists them)\n", total.seconds(), dir->c_str());
+    return 0;
+  };
+}
+
+SubcommandRegistrar reg{{"demo", "Tour of every method on built-in inputs the project generates (writes into out/demo)",
+                         setup}};
+
+}  // namespace
+}  // namespace surftex::cli
