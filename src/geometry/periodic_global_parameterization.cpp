@@ -19,7 +19,7 @@ namespace surftex {
 namespace {
 
 using Cplx = std::complex<double>;
-using SpMat = Eigen::SparseMatrix<double>;
+using SpMat = Eigen::SparseMatrix<Cplx>;
 using Ldlt = Eigen::SimplicialLDLT<SpMat>;
 
 struct FaceGrad {
@@ -150,10 +150,12 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   var = std::move(new_var);
   n_var = count;
 
-  auto build = [&](int c, const std::vector<Cplx>& z, SpMat& A, Eigen::VectorXd& rhs) {
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(static_cast<std::size_t>(n_var) * 16);
-    rhs = Eigen::VectorXd::Zero(2 * n_var);
+  // Complex Hermitian form of F_PGP: for the residual z_j - r z_i (r = exp(2 pi
+  // i alpha_ij)), A(i,i) += w, A(j,j) += w, A(j,i) = -w r, A(i,j) = -w conj(r).
+  auto build = [&](int c, const std::vector<Cplx>& z, SpMat& A, Eigen::VectorXcd& rhs) {
+    std::vector<Eigen::Triplet<Cplx>> trip;
+    trip.reserve(static_cast<std::size_t>(n_var) * 8);
+    rhs = Eigen::VectorXcd::Zero(n_var);
     for (EdgeIndex e : mesh.edges()) {
       const HalfedgeIndex h = mesh.halfedge(e, 0);
       const std::size_t i = mesh.source(h).idx(), j = mesh.target(h).idx();
@@ -162,37 +164,19 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       double w = 0;
       if (!mesh.is_border(h)) w += face_area(mesh, mesh.face(h));
       if (!mesh.is_border(mesh.opposite(h))) w += face_area(mesh, mesh.face(mesh.opposite(h)));
-      const double ang = 2 * M_PI * alpha[h.idx()][c];
-      const double cs = std::cos(ang), sn = std::sin(ang);
-      // residual z_j - R z_i with R = rotation by +ang.
-      if (vi >= 0) {
-        trip.emplace_back(2 * vi, 2 * vi, w);
-        trip.emplace_back(2 * vi + 1, 2 * vi + 1, w);
-      }
-      if (vj >= 0) {
-        trip.emplace_back(2 * vj, 2 * vj, w);
-        trip.emplace_back(2 * vj + 1, 2 * vj + 1, w);
-      }
+      const Cplx r = std::polar(1.0, 2 * M_PI * alpha[h.idx()][c]);
+      if (vi >= 0) trip.emplace_back(vi, vi, Cplx(w, 0));
+      if (vj >= 0) trip.emplace_back(vj, vj, Cplx(w, 0));
       if (vi >= 0 && vj >= 0) {
-        trip.emplace_back(2 * vj, 2 * vi, -w * cs);
-        trip.emplace_back(2 * vj, 2 * vi + 1, w * sn);
-        trip.emplace_back(2 * vj + 1, 2 * vi, -w * sn);
-        trip.emplace_back(2 * vj + 1, 2 * vi + 1, -w * cs);
-        trip.emplace_back(2 * vi, 2 * vj, -w * cs);
-        trip.emplace_back(2 * vi, 2 * vj + 1, -w * sn);
-        trip.emplace_back(2 * vi + 1, 2 * vj, w * sn);
-        trip.emplace_back(2 * vi + 1, 2 * vj + 1, -w * cs);
-      } else if (vj >= 0) {  // i locked: rhs_j += w R z_i
-        const Cplx zi = z[i];
-        rhs[2 * vj] += w * (cs * zi.real() - sn * zi.imag());
-        rhs[2 * vj + 1] += w * (sn * zi.real() + cs * zi.imag());
-      } else {  // j locked: rhs_i += w R^T z_j
-        const Cplx zj = z[j];
-        rhs[2 * vi] += w * (cs * zj.real() + sn * zj.imag());
-        rhs[2 * vi + 1] += w * (-sn * zj.real() + cs * zj.imag());
+        trip.emplace_back(vj, vi, -w * r);
+        trip.emplace_back(vi, vj, -w * std::conj(r));
+      } else if (vj >= 0) {
+        rhs[vj] += w * r * z[i];
+      } else {
+        rhs[vi] += w * std::conj(r) * z[j];
       }
     }
-    A.resize(2 * n_var, 2 * n_var);
+    A.resize(n_var, n_var);
     A.setFromTriplets(trip.begin(), trip.end());
   };
 
@@ -201,7 +185,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   auto run = [&](int c) {
     if (n_var == 0) return;
     SpMat A;
-    Eigen::VectorXd rhs;
+    Eigen::VectorXcd rhs;
     build(c, *zc[c], A, rhs);
     if (!same_pattern) solver[c].analyzePattern(A);
     solver[c].factorize(A);
@@ -209,7 +193,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       failure[c] = "factorisation failed";
       return;
     }
-    const Eigen::VectorXd x = solver[c].solve(rhs);
+    const Eigen::VectorXcd x = solver[c].solve(rhs);
     if (solver[c].info() != Eigen::Success) {
       failure[c] = "solve failed";
       return;
@@ -217,7 +201,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     std::vector<Cplx>& z = *zc[c];
     for (std::size_t v = 0; v < var.size(); ++v) {
       if (var[v] < 0) continue;
-      const Cplx val(x[2 * var[v]], x[2 * var[v] + 1]);
+      const Cplx val = x[var[v]];
       const double a = std::abs(val);
       z[v] = (a > 1e-300 && std::isfinite(a)) ? val / a : Cplx(1, 0);
     }

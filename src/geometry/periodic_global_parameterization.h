@@ -16,7 +16,7 @@
 // unavoidable near singularities, and matching per edge keeps the local
 // gradients consistent everywhere else). Equation (3) z_j = exp(2 pi i alpha_ij) z_i
 // is solved in the least squares sense, F_PGP = sum (A_T + A_T') |z_j - R z_i|^2,
-// as a sparse SPD system in 2x2 real blocks (Eigen SimplicialLDLT, symbolic
+// as a sparse Hermitian positive definite complex system (Eigen SimplicialLDLT, symbolic
 // analysis reused while the free set is unchanged). The paper writes R with
 // the opposite rotation sign and a 2 pi missing in the rounding of (4); we use
 // the self-consistent signs.
