@@ -18,6 +18,7 @@
 #include "geometry/effect_area.h"
 #include "geometry/mesh.h"
 #include "geometry/periodic_global_parameterization.h"
+#include "geometry/pgp_singularities.h"
 #include "geometry/principal_curvatures.h"
 #include "geometry/read_mesh.h"
 #include "geometry/scalar_field_interpolation.h"
@@ -90,6 +91,9 @@ int main(int argc, char** argv) {
                              material_field_options());
     PeriodicGlobalParameterization pgp(mesh);
     emit(name, nf, "pgp_initialize", best_of_3([&] { pgp.initialize(); }));
+    PgpSingularities sing;
+    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
+    emit(name, nf, "detect_singularities", t_sing, {{"singular_fraction", sing.singular_fraction}});
 
     // Local update: effect area of 25% of the faces around a vertex.
     EffectAreaOptions eo;

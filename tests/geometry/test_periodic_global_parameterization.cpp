@@ -181,3 +181,72 @@ TEST(PeriodicGlobalParameterization, RejectsBadInput) {
 
 }  // namespace
 }  // namespace surftex
+
+#include "geometry/pgp_singularities.h"
+
+namespace surftex {
+namespace {
+
+TEST(PgpSingularities, RegularGridHasNoneAndCornersAreTheCharts) {
+  Mesh m;
+  make_grid(m, 10, 10);
+  interpolate_direction_field(m, {{0, {1, 0.2, 0}}}, {});
+  interpolate_scalar_field(m, {{0, 0.15}}, scale_field_options());
+  periodic_global_parameterization(m);
+  const PgpSingularities s = detect_pgp_singularities(m);
+  EXPECT_EQ(s.singular_faces, 0u);
+  const auto p = singular_lookup_positions(s, 5, {0.2, 0.3, 0.5});
+  const auto q = plain_lookup_position(s, 5, {0.2, 0.3, 0.5});
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 3; ++d) EXPECT_DOUBLE_EQ(p[k][d], q[d]);
+}
+
+struct Rgb {
+  double r, g, b;
+  Rgb operator+(const Rgb& o) const { return {r + o.r, g + o.g, b + o.b}; }
+  Rgb operator*(double w) const { return {r * w, g * w, b * w}; }
+};
+
+TEST(PgpSingularities, BlendingHidesTheSeamsOfASphere) {
+  Mesh m;
+  make_icosphere(m, 4);
+  interpolate_direction_field(m, constraints_from_constant_vector(m, {0, 0, 1}), {});
+  interpolate_scalar_field(m, {{0, 0.1}}, scale_field_options());
+  periodic_global_parameterization(m);
+  const PgpSingularities s = detect_pgp_singularities(m);
+  EXPECT_GT(s.singular_fraction, 0.0);
+  EXPECT_LT(s.singular_fraction, 0.5);
+  // A smooth periodic colour: discontinuity across mismatched edges, measured
+  // at the edge midpoint seen from both faces.
+  auto tile = [](const StmPoint& p) {
+    return Rgb{0.5 + 0.5 * std::sin(2 * M_PI * p[0]), 0.5 + 0.5 * std::cos(2 * M_PI * p[1]), 0.0};
+  };
+  auto bary_mid = [&](FaceIndex f, VertexIndex a, VertexIndex b) {
+    std::array<double, 3> w{0, 0, 0};
+    HalfedgeIndex h = m.halfedge(f);
+    for (int c = 0; c < 3; ++c, h = m.next(h))
+      if (m.target(h) == a || m.target(h) == b) w[c] = 0.5;
+    return w;
+  };
+  double plain = 0, fixed = 0;
+  std::size_t edges = 0;
+  for (EdgeIndex e : m.edges()) {
+    if (!s.mismatched_edge[e.idx()]) continue;
+    const HalfedgeIndex h = m.halfedge(e, 0);
+    const VertexIndex a = m.source(h), b = m.target(h);
+    const FaceIndex f = m.face(h), g = m.face(m.opposite(h));
+    const auto wf = bary_mid(f, a, b), wg = bary_mid(g, a, b);
+    const Rgb p1 = tile(plain_lookup_position(s, f.idx(), wf));
+    const Rgb p2 = tile(plain_lookup_position(s, g.idx(), wg));
+    const Rgb f1 = blended_lookup(s, f.idx(), wf, tile), f2 = blended_lookup(s, g.idx(), wg, tile);
+    plain += std::abs(p1.r - p2.r) + std::abs(p1.g - p2.g);
+    fixed += std::abs(f1.r - f2.r) + std::abs(f1.g - f2.g);
+    ++edges;
+  }
+  ASSERT_GT(edges, 0u);
+  EXPECT_GT(plain / edges, 0.05);
+  EXPECT_LT(fixed / edges, 1e-9);
+}
+
+}  // namespace
+}  // namespace surftex
