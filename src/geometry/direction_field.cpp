@@ -1,0 +1,294 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "geometry/direction_field.h"
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <string>
+
+#include "geometry/effect_area.h"
+#include "geometry/errors.h"
+#include "geometry/mesh_util.h"
+#include "geometry/properties.h"
+
+namespace surftex {
+namespace {
+
+void check_symmetry(int n, const char* who) {
+  if (n != 1 && n != 2 && n != 4)
+    throw InvalidInputError(std::string(who) + ": symmetry must be 1, 2 or 4, got " +
+                            std::to_string(n));
+}
+
+/// Closest representative of `theta` (mod 2 pi / N) to `target`.
+double closest_representative(double theta, double target, int n) {
+  const double step = 2 * M_PI / n;
+  const double k = std::round((target - theta) / step);
+  return theta + k * step;
+}
+
+}  // namespace
+
+DirectionFieldResult interpolate_direction_field(Mesh& mesh,
+                                                 const std::vector<DirectionConstraint>& constraints,
+                                                 const DirectionFieldOptions& opt) {
+  check_symmetry(opt.symmetry, "interpolate_direction_field");
+  require_triangle_mesh(mesh, "interpolate_direction_field");
+  const int N = opt.symmetry;
+  const std::size_t nf = mesh.num_faces();
+  if (opt.area && opt.area->face_free.size() != nf)
+    throw InvalidInputError("interpolate_direction_field: effect area has " +
+                            std::to_string(opt.area->face_free.size()) + " faces, mesh has " +
+                            std::to_string(nf));
+  auto dir = mesh.add_property_map<FaceIndex, Vector3>(opt.direction_map, Vector3(0, 0, 0)).first;
+
+  std::vector<FaceFrame> frames(nf);
+  for (FaceIndex f : mesh.faces()) frames[f.idx()] = face_frame(mesh, f);
+  auto is_free = [&](FaceIndex f) { return !opt.area || opt.area->face_free[f.idx()]; };
+
+  // State per face: 0 = free unknown, 1 = locked (constraint or outside area).
+  std::vector<char> locked(nf, 0);
+  std::vector<double> theta(nf, 0.0);  // locked angle in the face frame
+  DirectionFieldResult res;
+  for (const DirectionConstraint& c : constraints) {
+    if (c.face >= nf || mesh.is_removed(FaceIndex(c.face)))
+      throw InvalidInputError("interpolate_direction_field: constraint face " +
+                              std::to_string(c.face) + " out of range (" + std::to_string(nf) +
+                              " faces)");
+    const FaceIndex f(c.face);
+    if (!is_free(f)) continue;  // outside the effect area: keeps its value
+    const Vector3 d(c.direction[0], c.direction[1], c.direction[2]);
+    const FaceFrame& fr = frames[c.face];
+    const Vector3 t = d - (d * fr.n) * fr.n;
+    if (!(norm(t) > 1e-9 * std::max(norm(d), 1e-300)) || !std::isfinite(norm(d)))
+      throw InvalidInputError("interpolate_direction_field: constraint direction on face " +
+                              std::to_string(c.face) + " is zero or normal to the face");
+    if (!locked[c.face]) ++res.constrained_faces;
+    locked[c.face] = 1;
+    theta[c.face] = fr.angle_of(t);
+  }
+  for (FaceIndex f : mesh.faces()) {
+    if (is_free(f)) continue;
+    locked[f.idx()] = 1;
+    const Vector3 d = dir[f];
+    theta[f.idx()] = norm(d) > 0 ? frames[f.idx()].angle_of(d) : 0.0;
+  }
+
+  // Free faces reachable from a locked face through free faces get solved;
+  // the others (components without any constraint) get e1.
+  std::vector<int> var(nf, -1);
+  std::vector<char> reach(nf, 0);
+  std::deque<FaceIndex> queue;
+  for (FaceIndex f : mesh.faces())
+    if (locked[f.idx()]) {
+      reach[f.idx()] = 1;
+      queue.push_back(f);
+    }
+  std::vector<FaceIndex> order;  // BFS order of the free faces from the locked ones
+  while (!queue.empty()) {
+    const FaceIndex f = queue.front();
+    queue.pop_front();
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      const HalfedgeIndex o = mesh.opposite(h);
+      if (mesh.is_border(o)) continue;
+      const FaceIndex g = mesh.face(o);
+      if (reach[g.idx()]) continue;
+      reach[g.idx()] = 1;
+      order.push_back(g);
+      queue.push_back(g);
+    }
+  }
+  int n_var = 0;
+  for (FaceIndex g : order) var[g.idx()] = n_var++;
+  for (FaceIndex f : mesh.faces())
+    if (!locked[f.idx()] && !reach[f.idx()]) ++res.unconstrained_faces;
+  if (std::none_of(locked.begin(), locked.end(), [](char c) { return c != 0; }) &&
+      mesh.number_of_faces() > 0)
+    throw InvalidInputError("interpolate_direction_field: no orientation constraint given");
+
+  // Angle of the halfedge vector of h in the frame of face x.
+  auto edge_angle = [&](HalfedgeIndex h, std::size_t x) {
+    const Vector3 e = mesh.point(mesh.target(h)) - mesh.point(mesh.source(h));
+    return frames[x].angle_of(e);
+  };
+
+  std::vector<double> solved(nf, 0.0);
+  if (n_var > 0) {
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(static_cast<std::size_t>(n_var) * 16);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * n_var);
+    for (EdgeIndex e : mesh.edges()) {
+      if (mesh.is_border(e)) continue;
+      const HalfedgeIndex h = mesh.halfedge(e, 0);
+      const HalfedgeIndex o = mesh.opposite(h);
+      const std::size_t f = mesh.face(h).idx(), g = mesh.face(o).idx();
+      const int vf = var[f], vg = var[g];
+      if (vf < 0 && vg < 0) continue;
+      const double area = face_area(mesh, FaceIndex(f)) + face_area(mesh, FaceIndex(g));
+      const double len2 = (mesh.point(mesh.target(h)) - mesh.point(mesh.source(h))).squared_length();
+      const double w = area > 0 ? std::min(3 * len2 / area, 1e3) : 1e3;
+      const double ang = N * (edge_angle(h, g) - edge_angle(h, f));
+      const double c = std::cos(ang), s = std::sin(ang);
+      // residual u_g - R u_f, R = [[c,-s],[s,c]].
+      auto add_diag = [&](int v) {
+        trip.emplace_back(2 * v, 2 * v, w);
+        trip.emplace_back(2 * v + 1, 2 * v + 1, w);
+      };
+      if (vf >= 0) add_diag(vf);
+      if (vg >= 0) add_diag(vg);
+      if (vf >= 0 && vg >= 0) {
+        // block (g,f) = -w R, block (f,g) = -w R^T
+        trip.emplace_back(2 * vg, 2 * vf, -w * c);
+        trip.emplace_back(2 * vg, 2 * vf + 1, w * s);
+        trip.emplace_back(2 * vg + 1, 2 * vf, -w * s);
+        trip.emplace_back(2 * vg + 1, 2 * vf + 1, -w * c);
+        trip.emplace_back(2 * vf, 2 * vg, -w * c);
+        trip.emplace_back(2 * vf, 2 * vg + 1, -w * s);
+        trip.emplace_back(2 * vf + 1, 2 * vg, w * s);
+        trip.emplace_back(2 * vf + 1, 2 * vg + 1, -w * c);
+      } else if (vg >= 0) {  // f locked: rhs_g += w R u_f
+        const double ur = std::cos(N * theta[f]), ui = std::sin(N * theta[f]);
+        rhs[2 * vg] += w * (c * ur - s * ui);
+        rhs[2 * vg + 1] += w * (s * ur + c * ui);
+      } else {  // g locked: rhs_f += w R^T u_g
+        const double ur = std::cos(N * theta[g]), ui = std::sin(N * theta[g]);
+        rhs[2 * vf] += w * (c * ur + s * ui);
+        rhs[2 * vf + 1] += w * (-s * ur + c * ui);
+      }
+    }
+    Eigen::SparseMatrix<double> A(2 * n_var, 2 * n_var);
+    A.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+    if (solver.info() != Eigen::Success)
+      throw SolverError("interpolate_direction_field: factorisation failed (" +
+                        std::to_string(n_var) + " free faces)");
+    const Eigen::VectorXd x = solver.solve(rhs);
+    if (solver.info() != Eigen::Success)
+      throw SolverError("interpolate_direction_field: solve failed");
+    for (FaceIndex g : order) {
+      const int v = var[g.idx()];
+      const double a = std::atan2(x[2 * v + 1], x[2 * v]);  // atan2(0,0) = 0: never NaN
+      solved[g.idx()] = (std::isfinite(a) ? a : 0.0) / N;
+    }
+  }
+
+  // Combing: every face in the area may take any of its N representatives
+  // (constraints fix orientations modulo 2 pi / N only). Walk the area breadth
+  // first from the faces outside it (fixed), or from the lowest constrained
+  // face, and give each face the representative closest to its parent's
+  // direction transported across the shared edge.
+  std::vector<double> final_theta(nf, 0.0);
+  for (FaceIndex g : order) final_theta[g.idx()] = solved[g.idx()];
+  for (FaceIndex f : mesh.faces())
+    if (locked[f.idx()]) final_theta[f.idx()] = theta[f.idx()];
+  {
+    std::vector<char> done(nf, 0);
+    std::deque<FaceIndex> q;
+    for (FaceIndex f : mesh.faces())
+      if (!is_free(f)) {
+        done[f.idx()] = 1;
+        q.push_back(f);
+      }
+    // Start components at a constrained face (it keeps its given representative).
+    std::vector<FaceIndex> starts;
+    for (FaceIndex f : mesh.faces())
+      if (locked[f.idx()]) starts.push_back(f);
+    for (FaceIndex f : mesh.faces())
+      if (!locked[f.idx()]) starts.push_back(f);
+    for (FaceIndex f0 : starts) {
+      if (done[f0.idx()] || !(locked[f0.idx()] || reach[f0.idx()])) continue;
+      if (q.empty()) {  // a component not touching the outside: start here
+        done[f0.idx()] = 1;
+        q.push_back(f0);
+      }
+      while (!q.empty()) {
+        const FaceIndex f = q.front();
+        q.pop_front();
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+          const HalfedgeIndex o = mesh.opposite(h);
+          if (mesh.is_border(o)) continue;
+          const FaceIndex g = mesh.face(o);
+          if (done[g.idx()] || !(locked[g.idx()] || reach[g.idx()])) continue;
+          done[g.idx()] = 1;
+          const double transported =
+              final_theta[f.idx()] - edge_angle(h, f.idx()) + edge_angle(h, g.idx());
+          final_theta[g.idx()] = closest_representative(final_theta[g.idx()], transported, N);
+          q.push_back(g);
+        }
+      }
+    }
+  }
+  for (FaceIndex f : mesh.faces()) {
+    if (!is_free(f)) continue;  // bit for bit unchanged outside the area
+    if (!locked[f.idx()] && !reach[f.idx()]) {
+      dir[f] = frames[f.idx()].e1;
+      continue;
+    }
+    dir[f] = frames[f.idx()].direction(final_theta[f.idx()]);
+  }
+  res.solved_faces = static_cast<std::size_t>(n_var);
+  return res;
+}
+
+std::vector<DirectionConstraint> constraints_from_principal_directions(const Mesh& mesh,
+                                                                       double fraction) {
+  if (!(fraction > 0 && fraction <= 1))
+    throw InvalidInputError("constraints_from_principal_directions: fraction must be in (0,1], got " +
+                            std::to_string(fraction));
+  auto kmax = find(mesh, kVertexKmax);
+  auto kmin = find(mesh, kVertexKmin);
+  auto dmax = find(mesh, kVertexDmax);
+  if (!kmax.second || !kmin.second || !dmax.second)
+    throw InvalidInputError(
+        "constraints_from_principal_directions: curvature maps v:kmax/v:kmin/v:dmax absent; run "
+        "compute_principal_curvatures first");
+  std::vector<std::pair<double, std::uint32_t>> aniso;
+  for (FaceIndex f : mesh.faces()) {
+    double a = 0;
+    for (VertexIndex v : face_vertices(mesh, f)) a += kmax.first[v] - kmin.first[v];
+    aniso.push_back({-a / 3, static_cast<std::uint32_t>(f.idx())});
+  }
+  const std::size_t keep =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(fraction * aniso.size())));
+  std::stable_sort(aniso.begin(), aniso.end());
+  std::vector<DirectionConstraint> out;
+  for (std::size_t i = 0; i < std::min(keep, aniso.size()); ++i) {
+    const FaceIndex f(aniso[i].second);
+    const Vector3 n = robust_face_normal(mesh, f);
+    const auto vs = face_vertices(mesh, f);
+    Vector3 ref = dmax.first[vs[0]];
+    Vector3 sum(0, 0, 0);
+    for (VertexIndex v : vs) {
+      Vector3 d = dmax.first[v];
+      if (d * ref < 0) d = -d;  // principal directions are lines
+      sum = sum + d;
+    }
+    const Vector3 t = sum - (sum * n) * n;
+    if (norm(t) < 1e-9) continue;
+    out.push_back({aniso[i].second, {t.x(), t.y(), t.z()}});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const DirectionConstraint& a, const DirectionConstraint& b) { return a.face < b.face; });
+  return out;
+}
+
+std::vector<DirectionConstraint> constraints_from_constant_vector(const Mesh& mesh,
+                                                                  std::array<double, 3> v,
+                                                                  double min_projection) {
+  const Vector3 d(v[0], v[1], v[2]);
+  if (!(norm(d) > 0) || !std::isfinite(norm(d)))
+    throw InvalidInputError("constraints_from_constant_vector: vector must be non-zero and finite");
+  std::vector<DirectionConstraint> out;
+  for (FaceIndex f : mesh.faces()) {
+    const Vector3 n = robust_face_normal(mesh, f);
+    const Vector3 t = d - (d * n) * n;
+    if (norm(t) >= min_projection * norm(d))
+      out.push_back({static_cast<std::uint32_t>(f.idx()), {t.x(), t.y(), t.z()}});
+  }
+  return out;
+}
+
+}  // namespace surftex

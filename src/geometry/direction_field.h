@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Smooth N-symmetry orientation field over faces (Ray et al. 2009, section
+// 2.2): interpolates sparse orientation constraints (user strokes, principal
+// curvature directions, a projected constant vector) into a unit tangent
+// direction d_s per face; d_t is d_s rotated by +90 degrees in the face
+// (d_t = n x d_s) and is not stored.
+//
+// Method (the paper interpolates *orientations*, "letting singularities emerge
+// from the geometry" [HZ00, RLL06, LRL06]; it gives no formulas, so we use the
+// standard representation-vector formulation, a careful equivalent):
+//   - each face f has a frame (e1 along its first edge, e2 = n x e1); a
+//     direction at angle theta is represented by u_f = exp(i N theta), which
+//     is the same for the N directions of an N-symmetric cross (N = 4 for
+//     tiles, 2 for line fields, 1 for vectors);
+//   - across an interior edge shared by f and g, the Levi-Civita connection
+//     maps angles by theta_g = theta_f - a_f + a_g (a_x = the edge's angle in
+//     frame x), so r_fg = exp(i N (a_g - a_f));
+//   - minimise sum_e w_e |u_g - r_fg u_f|^2, w_e = 3 |e|^2 / (A_f + A_g)
+//     (the ratio dual-edge / primal-edge, capped at 1e3 so slivers stay sane),
+//     with constrained faces (and faces outside the effect area) locked: a
+//     sparse symmetric positive definite system in 2x2 real blocks solved once
+//     with Eigen's SimplicialLDLT (info() checked);
+//   - d_s = frame direction of arg(u_f)/N; the N representatives are then
+//     "combed" by a breadth-first walk from the locked faces so that adjacent
+//     faces carry the closest representative (mismatches remain only around
+//     singular vertices).
+// A connected component with no constrained face gets d_s = e1 of each face
+// (and is counted in `unconstrained_faces`).
+//
+// Reads/writes the face map `direction_map` (Vector3, default kFaceDirection
+// "f:dir", created if absent). With an effect area, faces outside it keep their
+// stored direction bit for bit. Throws InvalidInputError (bad symmetry, face
+// index out of range, zero or normal-parallel constraint direction, no
+// constraint and no locked face), SolverError if the factorisation fails.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+struct EffectArea;
+
+/// One orientation constraint: the face and a 3D direction (projected on the
+/// face plane; only its orientation modulo 2 pi / N matters).
+struct DirectionConstraint {
+  std::uint32_t face = 0;
+  std::array<double, 3> direction{1, 0, 0};
+};
+
+struct DirectionFieldOptions {
+  int symmetry = 4;                     ///< N in {1, 2, 4}
+  std::string direction_map = "f:dir";  ///< face map written (kFaceDirection)
+  /// Free faces; nullptr = the whole mesh. Faces outside are locked to the
+  /// current content of direction_map.
+  const EffectArea* area = nullptr;
+};
+
+struct DirectionFieldResult {
+  std::size_t constrained_faces = 0;
+  std::size_t solved_faces = 0;
+  std::size_t unconstrained_faces = 0;
+};
+
+DirectionFieldResult interpolate_direction_field(Mesh& mesh,
+                                                 const std::vector<DirectionConstraint>& constraints,
+                                                 const DirectionFieldOptions& options = {});
+
+/// Constraints from principal directions: the faces whose mean curvature
+/// anisotropy |kmax - kmin| (averaged over the face's vertices) is among the
+/// top `fraction` (0..1] get the face-projected average of their vertices'
+/// kVertexDmax (sign-aligned, valid for N = 2 and 4). Needs the curvature maps
+/// (compute_principal_curvatures); throws InvalidInputError if absent.
+std::vector<DirectionConstraint> constraints_from_principal_directions(const Mesh& mesh,
+                                                                       double fraction = 0.1);
+
+/// A constant 3D vector projected on every face whose plane is not nearly
+/// orthogonal to it (|projection| >= min_projection * |v|); the other faces are
+/// left to the interpolation. Throws InvalidInputError for a zero vector.
+std::vector<DirectionConstraint> constraints_from_constant_vector(const Mesh& mesh,
+                                                                  std::array<double, 3> v,
+                                                                  double min_projection = 0.3);
+
+}  // namespace surftex

@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Simplified Periodic Global Parameterization (Ray et al. 2009, section 2.3,
+// after Ray et al. 2006): per-corner texture coordinates (s,t) whose gradient
+// in each triangle T follows g_s = d_s / S^T and g_t = d_t / S^T (d_t = n x d_s,
+// S^T = mean vertex scale), defined up to integers, so a periodic tile maps
+// seamlessly wherever the field allows it.
+//
+// Per coordinate (s; t is identical) and per vertex i one unit complex number
+// z_i = exp(2 pi i s_i). For each edge (i,j) with faces T, T':
+//   alpha_ij = e_ij . (g^T + g^T') / 2            (in periods; the paper's
+//              2 pi e.g is the same in radians),
+// where g^T' is taken from the representative of T''s N-symmetric cross that
+// best matches T's after transport across the edge (the paper says "there is no
+// swapping of texture coordinates"; with a 4-field some swapping is
+// unavoidable near singularities, and matching per edge keeps the local
+// gradients consistent everywhere else). Equation (3) z_j = exp(2 pi i alpha_ij) z_i
+// is solved in the least squares sense, F_PGP = sum (A_T + A_T') |z_j - R z_i|^2,
+// as a sparse Hermitian positive definite complex system (Eigen SimplicialLDLT, symbolic
+// analysis reused while the free set is unchanged). The paper writes R with
+// the opposite rotation sign and a 2 pi missing in the rounding of (4); we use
+// the self-consistent signs.
+//   - initialisation: one vertex per connected component locked at s = t = 0
+//     (z = 1; `locked_vertex` for the component containing it, the
+//     lowest-index vertex for the others);
+//   - local update: every vertex outside the effect area's free set is locked
+//     to its previous z; only the free vertices are solved.
+// Corner coordinates (equation 4): in face T = (i,j,k) (i = target of
+// halfedge(T)), s_i = Arg(z_i)/2pi, s_j = Arg(z_j)/2pi + p_j with the integer
+// p_j = round(s_i + e_ij.g^T - Arg(z_j)/2pi) (T's own gradient, eq. 1), same for k.
+// The material m of a corner is the vertex material.
+//
+// Reads the face map direction_map (Vector3 d_s), the vertex maps scale_map
+// (S > 0) and material_map (m); writes the halfedge map stm_map (STM, the
+// corner of face(h) at target(h)); absent scale/material maps read as 1 / 0.
+// After an update only corners of faces in the effect area are rewritten.
+// Throws InvalidInputError (missing direction map, non-positive scale, bad
+// options), SolverError (factorisation/solve failure).
+
+#include <array>
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+struct EffectArea;
+
+struct PgpOptions {
+  int symmetry = 4;  ///< symmetry N of the direction field (1, 2 or 4): matching across edges
+  std::uint32_t locked_vertex = 0;  ///< locked at s = t = 0 at initialisation
+  std::string direction_map = "f:dir";
+  std::string scale_map = "v:scale";
+  std::string material_map = "v:material";
+  std::string stm_map = "h:stm";
+};
+
+struct PgpResult {
+  std::size_t free_vertices = 0;
+  double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
+  double seconds = 0;
+  bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
+};
+
+/// Expected increase of (s,t) along each halfedge h (source -> target), in
+/// periods: alpha_h = e_h . (g^T + g^T')/2 of equation (3) (one-sided on the
+/// border). Indexed by halfedge `.idx()`; alpha[opposite] = -alpha.
+std::vector<std::array<double, 2>> pgp_halfedge_alphas(const Mesh& mesh, const PgpOptions& options);
+
+/// Per face and corner c (0..2 = target of halfedge(f), next, next-next), the
+/// texture-space gradient pair (g_s, g_t) as 3D vectors: helper for the
+/// distortion test of section 3. Indexed by face `.idx()`.
+std::vector<std::array<std::array<double, 3>, 2>> pgp_face_gradients(const Mesh& mesh,
+                                                                     const PgpOptions& options);
+
+/// Stateful solver (geometry-central style): keeps the per-vertex complex
+/// coordinates and the symbolic analysis between local updates.
+class PeriodicGlobalParameterization {
+ public:
+  PeriodicGlobalParameterization(Mesh& mesh, PgpOptions options = {});
+  ~PeriodicGlobalParameterization();
+  PeriodicGlobalParameterization(const PeriodicGlobalParameterization&) = delete;
+  PeriodicGlobalParameterization& operator=(const PeriodicGlobalParameterization&) = delete;
+
+  /// Global solve (one locked vertex per component); writes every corner.
+  PgpResult initialize();
+  /// Local solve: vertices outside area.vertex_free keep their previous
+  /// value; corners of faces outside area.face_free are not rewritten.
+  /// Throws InvalidInputError if called before initialize() or the area does
+  /// not match the mesh.
+  PgpResult update(const EffectArea& area);
+
+  /// Per vertex (by `.idx()`) complex coordinates z_s, z_t (unit after solve).
+  const std::vector<std::complex<double>>& z_s() const;
+  const std::vector<std::complex<double>>& z_t() const;
+  /// Restores a previous state (e.g. loaded from disk for `--update`).
+  void set_state(std::vector<std::complex<double>> zs, std::vector<std::complex<double>> zt);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-shot: initialise and write the corners.
+PgpResult periodic_global_parameterization(Mesh& mesh, const PgpOptions& options = {});
+
+}  // namespace surftex

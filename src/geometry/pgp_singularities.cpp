@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "geometry/pgp_singularities.h"
+
+#include <cmath>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/mesh_util.h"
+#include "geometry/properties.h"
+
+namespace surftex {
+
+PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularityOptions& opt) {
+  if (!(opt.distortion_threshold > 0))
+    throw InvalidInputError("detect_pgp_singularities: distortion_threshold must be > 0, got " +
+                            std::to_string(opt.distortion_threshold));
+  if (!(opt.mismatch_tolerance >= 0))
+    throw InvalidInputError("detect_pgp_singularities: mismatch_tolerance must be >= 0");
+  auto found = mesh.property_map<HalfedgeIndex, STM>(opt.pgp.stm_map);
+  if (!found.second)
+    throw InvalidInputError("detect_pgp_singularities: corner map '" + opt.pgp.stm_map + "' absent");
+  const auto& stm = found.first;
+  const auto grads = pgp_face_gradients(mesh, opt.pgp);
+  const auto alpha = pgp_halfedge_alphas(mesh, opt.pgp);
+
+  PgpSingularities out;
+  out.distorted_face.assign(mesh.num_faces(), 0);
+  out.mismatched_edge.assign(mesh.num_edges(), 0);
+  out.singular_vertex.assign(mesh.num_vertices(), 0);
+  out.singular_face.assign(mesh.num_faces(), 0);
+  out.charts.assign(mesh.num_faces(), FaceCharts{});
+  out.corners.assign(mesh.num_faces(), {});
+
+  for (FaceIndex f : mesh.faces()) {
+    const HalfedgeIndex h0 = mesh.halfedge(f);
+    const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
+    for (int c = 0; c < 3; ++c) out.corners[f.idx()][c] = stm[hs[c]];
+    // Gradient of the linear interpolant: sum_c x_c (n x e_c) / (2A), e_c the
+    // edge opposite corner c (counter-clockwise).
+    const Vector3 n = robust_face_normal(mesh, f);
+    const double A2 = 2 * face_area(mesh, f);
+    if (!(A2 > 0)) {
+      out.distorted_face[f.idx()] = 1;
+      continue;
+    }
+    Vector3 gs(0, 0, 0), gt(0, 0, 0);
+    for (int c = 0; c < 3; ++c) {
+      const Vector3 e = mesh.point(mesh.target(hs[(c + 2) % 3])) - mesh.point(mesh.target(hs[(c + 1) % 3]));
+      const Vector3 r = CGAL::cross_product(n, e) / A2;
+      gs = gs + stm[hs[c]][0] * r;
+      gt = gt + stm[hs[c]][1] * r;
+    }
+    const auto& g = grads[f.idx()];
+    const Vector3 es(g[0][0], g[0][1], g[0][2]), et(g[1][0], g[1][1], g[1][2]);
+    const double ds = (gs - es).squared_length(), dt = (gt - et).squared_length();
+    if (ds > opt.distortion_threshold * es.squared_length() ||
+        dt > opt.distortion_threshold * et.squared_length() || !std::isfinite(ds + dt))
+      out.distorted_face[f.idx()] = 1;
+  }
+  for (EdgeIndex e : mesh.edges()) {
+    if (mesh.is_border(e)) continue;
+    const HalfedgeIndex h = mesh.halfedge(e, 0), o = mesh.opposite(h);
+    // Corner of face(h) at target(h) and at source(h) = target(prev(h)).
+    for (int k = 0; k < 2; ++k) {
+      const double d1 = stm[h][k] - stm[mesh.prev(h)][k];
+      const double d2 = stm[mesh.prev(o)][k] - stm[o][k];
+      if (!(std::abs(d1 - d2) <= opt.mismatch_tolerance)) out.mismatched_edge[e.idx()] = 1;
+    }
+  }
+  for (VertexIndex v : mesh.vertices()) {
+    if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+    bool sing = false;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) {
+      if (mesh.is_border(h)) continue;
+      const FaceIndex f = mesh.face(h);
+      if (out.distorted_face[f.idx()]) sing = true;
+      for (HalfedgeIndex k : CGAL::halfedges_around_face(h, mesh))
+        if (out.mismatched_edge[mesh.edge(k).idx()]) sing = true;
+    }
+    out.singular_vertex[v.idx()] = sing;
+  }
+  // Charts.
+  for (FaceIndex f : mesh.faces()) {
+    const HalfedgeIndex h0 = mesh.halfedge(f);
+    const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
+    bool any = false;
+    for (int k = 0; k < 3; ++k) {
+      const VertexIndex vi = mesh.target(hs[k]);
+      if (!out.singular_vertex[vi.idx()]) {
+        for (int l = 0; l < 3; ++l) out.charts[f.idx()][k][l] = stm[hs[l]];
+        continue;
+      }
+      any = true;
+      // The chart's origin: vi's corner in the face of its first non-border halfedge.
+      HalfedgeIndex hv = mesh.halfedge(vi);
+      if (mesh.is_border(hv)) hv = mesh.opposite(mesh.next(hv));  // still targets vi
+      const STM origin = stm[hv];
+      for (int l = 0; l < 3; ++l) {
+        if (l == k) {
+          out.charts[f.idx()][k][l] = origin;
+          continue;
+        }
+        // Halfedge vi -> vl: in face f, from corner k to corner l.
+        const HalfedgeIndex he = (l == (k + 1) % 3) ? hs[l] : hs[k];
+        const double sgn = (l == (k + 1) % 3) ? 1.0 : -1.0;
+        // alpha along vi -> vl.
+        const auto& a = alpha[he.idx()];
+        out.charts[f.idx()][k][l] = {origin[0] + sgn * a[0], origin[1] + sgn * a[1], stm[hs[l]][2]};
+      }
+    }
+    out.singular_face[f.idx()] = any;
+    out.singular_faces += any;
+  }
+  out.singular_fraction =
+      mesh.number_of_faces() ? double(out.singular_faces) / mesh.number_of_faces() : 0.0;
+  return out;
+}
+
+}  // namespace surftex

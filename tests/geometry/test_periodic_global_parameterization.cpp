@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Simplified PGP (Ray et al. 2009 section 2.3) and local updates (2.1).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "geometry/direction_field.h"
+#include "geometry/effect_area.h"
+#include "geometry/mesh_util.h"
+#include "geometry/periodic_global_parameterization.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
+#include "geometry/scalar_field_interpolation.h"
+
+namespace surftex {
+namespace {
+
+double frac_dist(double x) { return std::abs(x - std::round(x)); }
+
+TEST(PeriodicGlobalParameterization, FlatGridConstantFieldIsAffine) {
+  Mesh m;
+  make_grid(m, 24, 24, 2.0, 2.0);
+  const double a = 0.3, S = 0.37;
+  const Vector3 ds(std::cos(a), std::sin(a), 0), dt(-std::sin(a), std::cos(a), 0);
+  interpolate_direction_field(m, {{0, {ds.x(), ds.y(), 0}}}, {});
+  interpolate_scalar_field(m, {{0, S}}, scale_field_options());
+  const PgpResult r = periodic_global_parameterization(m);
+  EXPECT_LT(r.energy_s + r.energy_t, 1e-12);
+  auto stm = find(m, kCornerSTM).first;
+  // (s,t) - (g_s.x, g_t.x) is the same constant modulo integers at every corner.
+  const Point3 o(0, 0, 0);
+  const double s0 = stm[m.halfedge(VertexIndex(0))][0];
+  for (HalfedgeIndex h : m.halfedges()) {
+    if (m.is_border(h)) continue;
+    const Vector3 x = m.point(m.target(h)) - o;
+    EXPECT_LT(frac_dist(stm[h][0] - (x * ds) / S - s0), 1e-6);
+    EXPECT_LT(frac_dist(stm[h][1] - (x * dt) / S), 1e-6);  // t = 0 at the locked vertex 0
+  }
+  // Within a face the corner differences are exactly the prescribed gradient.
+  for (FaceIndex f : m.faces()) {
+    const HalfedgeIndex h0 = m.halfedge(f);
+    for (HalfedgeIndex h : {m.next(h0), m.prev(h0)}) {
+      const Vector3 e = m.point(m.target(h)) - m.point(m.target(h0));
+      EXPECT_NEAR(stm[h][0] - stm[h0][0], e * ds / S, 1e-6);
+      EXPECT_NEAR(stm[h][1] - stm[h0][1], e * dt / S, 1e-6);
+    }
+  }
+}
+
+TEST(PeriodicGlobalParameterization, CylinderIsSeamlessAcrossItsWrap) {
+  Mesh m;
+  const int nu = 64;
+  make_cylinder(m, 1.0, 2.0, nu, 16);
+  // d_s along the horizontal edge of each face (each triangle of a split quad has one).
+  std::vector<DirectionConstraint> c;
+  for (FaceIndex f : m.faces())
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(m.halfedge(f), m)) {
+      const Vector3 e = m.point(m.target(h)) - m.point(m.source(h));
+      if (std::abs(e.z()) < 1e-12) c.push_back({static_cast<std::uint32_t>(f.idx()), {e.x(), e.y(), 0}});
+    }
+  ASSERT_EQ(c.size(), m.number_of_faces());
+  interpolate_direction_field(m, c, {});
+  const double chord = 2 * std::sin(M_PI / nu);
+  const double S = nu * chord / 8;  // 8 periods around
+  interpolate_scalar_field(m, {{0, S}}, scale_field_options());
+  periodic_global_parameterization(m);
+  auto stm = find(m, kCornerSTM).first;
+  // Every vertex: its corners differ by integers only.
+  for (VertexIndex v : m.vertices()) {
+    HalfedgeIndex ref;
+    bool first = true;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
+      if (m.is_border(h)) continue;
+      if (first) ref = h, first = false;
+      EXPECT_LT(frac_dist(stm[h][0] - stm[ref][0]), 1e-6);
+      EXPECT_LT(frac_dist(stm[h][1] - stm[ref][1]), 1e-6);
+    }
+  }
+  // Every interior edge: both faces see the same coordinate difference (no mismatch).
+  for (EdgeIndex e : m.edges()) {
+    if (m.is_border(e)) continue;
+    const HalfedgeIndex h = m.halfedge(e, 0), o = m.opposite(h);
+    // corner of face(h) at target(h) and at source(h) (= target(prev(h))).
+    for (int k = 0; k < 2; ++k) {
+      const double d1 = stm[h][k] - stm[m.prev(h)][k];
+      const double d2 = stm[m.prev(o)][k] - stm[o][k];
+      EXPECT_NEAR(d1, d2, 1e-6);
+    }
+  }
+  // The wrap is a jump of exactly 8 periods around a ring (sum of alphas).
+  const auto alpha = pgp_halfedge_alphas(m, {});
+  double around = 0;
+  for (HalfedgeIndex h : m.halfedges()) {
+    const Point3 a = m.point(m.source(h)), b = m.point(m.target(h));
+    if (std::abs(a.z()) < 1e-12 && std::abs(b.z()) < 1e-12 && !m.is_border(h))
+      around += std::abs(alpha[h.idx()][0]);
+  }
+  EXPECT_NEAR(around, 8.0, 1e-9);
+}
+
+TEST(PeriodicGlobalParameterization, LocalUpdateLeavesTheOutsideBitForBit) {
+  Mesh m;
+  make_torus(m, 3.0, 1.0, 64, 32);
+  interpolate_direction_field(m, {{0, {0, 1, 0}}, {2000, {0, 0, 1}}}, {});
+  interpolate_scalar_field(m, {{0, 0.5}, {500, 0.8}}, scale_field_options());
+  interpolate_scalar_field(m, {{0, 0.0}, {900, 1.0}}, material_field_options());
+  PeriodicGlobalParameterization pgp(m);
+  pgp.initialize();
+  const auto zs0 = pgp.z_s(), zt0 = pgp.z_t();
+  const Mesh before = m;
+
+  // New constraints around vertex 1000.
+  const std::uint32_t c = 1000;
+  EffectAreaOptions eo;
+  eo.radius = 1.5;
+  const EffectArea area = compute_effect_area(m, {c}, eo);
+  ASSERT_GT(area.free_vertices, 50u);
+  ASSERT_LT(area.free_vertices, m.number_of_vertices() / 2);
+  FaceIndex cf = m.face(m.halfedge(VertexIndex(c)));
+  DirectionFieldOptions dopt;
+  dopt.area = &area;
+  interpolate_direction_field(m, {{static_cast<std::uint32_t>(cf.idx()), {1, 1, 1}}}, dopt);
+  ScalarFieldOptions so = scale_field_options();
+  so.area = &area;
+  interpolate_scalar_field(m, {{c, 0.3}}, so);
+  ScalarFieldOptions mo = material_field_options();
+  mo.area = &area;
+  interpolate_scalar_field(m, {{c, 0.9}}, mo);
+  const PgpResult r = pgp.update(area);
+  EXPECT_EQ(r.free_vertices, area.free_vertices);
+
+  auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  auto S0 = find(before, kVertexScale).first, S1 = find(m, kVertexScale).first;
+  auto M0 = find(before, kVertexMaterial).first, M1 = find(m, kVertexMaterial).first;
+  auto D0 = find(before, kFaceDirection).first, D1 = find(m, kFaceDirection).first;
+  auto T0 = find(before, kCornerSTM).first, T1 = find(m, kCornerSTM).first;
+  std::size_t changed = 0;
+  for (VertexIndex v : m.vertices()) {
+    const std::size_t i = v.idx();
+    if (area.vertex_free[i]) {
+      changed += !same(pgp.z_s()[i].real(), zs0[i].real());
+      continue;
+    }
+    EXPECT_TRUE(same(pgp.z_s()[i].real(), zs0[i].real()) && same(pgp.z_s()[i].imag(), zs0[i].imag()));
+    EXPECT_TRUE(same(pgp.z_t()[i].real(), zt0[i].real()) && same(pgp.z_t()[i].imag(), zt0[i].imag()));
+    EXPECT_TRUE(same(S0[v], S1[v]));
+    EXPECT_TRUE(same(M0[v], M1[v]));
+  }
+  EXPECT_GT(changed, area.free_vertices / 2);
+  for (FaceIndex f : m.faces()) {
+    if (area.face_free[f.idx()]) continue;
+    EXPECT_TRUE(same(D0[f].x(), D1[f].x()) && same(D0[f].y(), D1[f].y()) && same(D0[f].z(), D1[f].z()));
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(m.halfedge(f), m))
+      for (int k = 0; k < 3; ++k) EXPECT_TRUE(same(T0[h][k], T1[h][k]));
+  }
+  // A second update over the same area reuses the symbolic analysis.
+  EXPECT_TRUE(pgp.update(area).reused_analysis);
+  // m stays in [0,1], S above epsilon everywhere.
+  for (VertexIndex v : m.vertices()) {
+    EXPECT_GE(M1[v], 0.0);
+    EXPECT_LE(M1[v], 1.0);
+    EXPECT_GT(S1[v], 0.0);
+  }
+}
+
+TEST(PeriodicGlobalParameterization, RejectsBadInput) {
+  Mesh m;
+  make_grid(m, 4, 4);
+  EXPECT_THROW(periodic_global_parameterization(m), InvalidInputError);  // no direction map
+  interpolate_direction_field(m, {{0, {1, 0, 0}}}, {});
+  PgpOptions o;
+  o.locked_vertex = 1000;
+  EXPECT_THROW(periodic_global_parameterization(m, o), InvalidInputError);
+  o.locked_vertex = 0;
+  o.symmetry = 3;
+  EXPECT_THROW(periodic_global_parameterization(m, o), InvalidInputError);
+  PeriodicGlobalParameterization p(m);
+  EXPECT_THROW(p.update(EffectArea::whole(m)), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace surftex
+
+#include "geometry/pgp_singularities.h"
+
+namespace surftex {
+namespace {
+
+TEST(PgpSingularities, RegularGridHasNoneAndCornersAreTheCharts) {
+  Mesh m;
+  make_grid(m, 10, 10);
+  interpolate_direction_field(m, {{0, {1, 0.2, 0}}}, {});
+  interpolate_scalar_field(m, {{0, 0.15}}, scale_field_options());
+  periodic_global_parameterization(m);
+  const PgpSingularities s = detect_pgp_singularities(m);
+  EXPECT_EQ(s.singular_faces, 0u);
+  const auto p = singular_lookup_positions(s, 5, {0.2, 0.3, 0.5});
+  const auto q = plain_lookup_position(s, 5, {0.2, 0.3, 0.5});
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 3; ++d) EXPECT_DOUBLE_EQ(p[k][d], q[d]);
+}
+
+struct Rgb {
+  double r, g, b;
+  Rgb operator+(const Rgb& o) const { return {r + o.r, g + o.g, b + o.b}; }
+  Rgb operator*(double w) const { return {r * w, g * w, b * w}; }
+};
+
+TEST(PgpSingularities, BlendingHidesTheSeamsOfASphere) {
+  Mesh m;
+  make_icosphere(m, 4);
+  interpolate_direction_field(m, constraints_from_constant_vector(m, {0, 0, 1}), {});
+  interpolate_scalar_field(m, {{0, 0.1}}, scale_field_options());
+  periodic_global_parameterization(m);
+  const PgpSingularities s = detect_pgp_singularities(m);
+  EXPECT_GT(s.singular_fraction, 0.0);
+  EXPECT_LT(s.singular_fraction, 0.5);
+  // A smooth periodic colour: discontinuity across mismatched edges, measured
+  // at the edge midpoint seen from both faces.
+  auto tile = [](const StmPoint& p) {
+    return Rgb{0.5 + 0.5 * std::sin(2 * M_PI * p[0]), 0.5 + 0.5 * std::cos(2 * M_PI * p[1]), 0.0};
+  };
+  auto bary_mid = [&](FaceIndex f, VertexIndex a, VertexIndex b) {
+    std::array<double, 3> w{0, 0, 0};
+    HalfedgeIndex h = m.halfedge(f);
+    for (int c = 0; c < 3; ++c, h = m.next(h))
+      if (m.target(h) == a || m.target(h) == b) w[c] = 0.5;
+    return w;
+  };
+  double plain = 0, fixed = 0;
+  std::size_t edges = 0;
+  for (EdgeIndex e : m.edges()) {
+    if (!s.mismatched_edge[e.idx()]) continue;
+    const HalfedgeIndex h = m.halfedge(e, 0);
+    const VertexIndex a = m.source(h), b = m.target(h);
+    const FaceIndex f = m.face(h), g = m.face(m.opposite(h));
+    const auto wf = bary_mid(f, a, b), wg = bary_mid(g, a, b);
+    const Rgb p1 = tile(plain_lookup_position(s, f.idx(), wf));
+    const Rgb p2 = tile(plain_lookup_position(s, g.idx(), wg));
+    const Rgb f1 = blended_lookup(s, f.idx(), wf, tile), f2 = blended_lookup(s, g.idx(), wg, tile);
+    plain += std::abs(p1.r - p2.r) + std::abs(p1.g - p2.g);
+    fixed += std::abs(f1.r - f2.r) + std::abs(f1.g - f2.g);
+    ++edges;
+  }
+  ASSERT_GT(edges, 0u);
+  EXPECT_GT(plain / edges, 0.05);
+  EXPECT_LT(fixed / edges, 1e-9);
+}
+
+}  // namespace
+}  // namespace surftex
