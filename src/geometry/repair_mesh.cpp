@@ -50,10 +50,14 @@ std::size_t count_duplicate_vertices(const Mesh& m) {
 }
 
 std::size_t count_non_manifold_vertices(const Mesh& m) {
-  std::size_t n = 0;
-  for (VertexIndex v : m.vertices())
-    if (!m.is_isolated(v) && PMP::is_non_manifold_vertex(v, m)) ++n;
-  return n;
+  // PMP::non_manifold_vertices is linear (is_non_manifold_vertex per vertex
+  // would be quadratic); it reports one halfedge per umbrella.
+  std::vector<HalfedgeIndex> hs;
+  PMP::non_manifold_vertices(m, std::back_inserter(hs));
+  std::vector<VertexIndex> vs;
+  for (HalfedgeIndex h : hs) vs.push_back(m.target(h));
+  std::sort(vs.begin(), vs.end());
+  return static_cast<std::size_t>(std::unique(vs.begin(), vs.end()) - vs.begin());
 }
 
 std::size_t count_degenerate_faces(const Mesh& m) {
