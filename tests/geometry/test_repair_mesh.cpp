@@ -6,18 +6,12 @@
 
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/boost/graph/helpers.h>
-#include <CGAL/IO/polygon_soup_io.h>
-#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
-#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -355,46 +349,12 @@ struct Outcome {
   RepairReport report;
 };
 
-/// TEMPORARY until surftex's readers are merged: CGAL's soup reader + PMP
-/// soup repair, with a guard against OFF headers that claim more elements
-/// than the file can hold (CGAL's reader resizes to the claimed counts).
-void load_mesh_for_test(const std::string& path, Mesh& m) {
-  std::ifstream in(path);
-  if (!in) throw IOError("cannot open '" + path + "'");
-  if (fs::path(path).extension() == ".off") {
-    std::string line, text;
-    while (std::getline(in, line))
-      if (!line.empty() && line[0] != '#') text += line + " ";
-    std::istringstream words(text);
-    std::string magic;
-    double nv = 0, nf = 0;
-    words >> magic >> nv >> nf;
-    if (!words || nv > double(fs::file_size(path)) || nf > double(fs::file_size(path)))
-      throw IOError("'" + path + "': OFF header counts do not fit the file");
-  }
-  std::vector<Point3> pts;
-  std::vector<std::vector<std::size_t>> polys;
-  bool ok = false;
-  try {
-    ok = CGAL::IO::read_polygon_soup(path, pts, polys);
-  } catch (const std::exception& e) {
-    throw IOError("'" + path + "': " + e.what());
-  }
-  if (!ok || polys.empty()) throw IOError("'" + path + "': unreadable or no faces");
-  for (const auto& poly : polys)
-    for (std::size_t i : poly)
-      if (i >= pts.size()) throw InvalidInputError("'" + path + "': index out of range");
-  PMP::repair_polygon_soup(pts, polys);
-  PMP::orient_polygon_soup(pts, polys);
-  if (polys.empty()) throw TopologyError("'" + path + "': no valid polygon");
-  PMP::polygon_soup_to_polygon_mesh(pts, polys, m);
-}
-
-/// The user's path: load (soup, soup repair, mesh), then repair.
+/// The user's path: surftex::read_polygon_soup + soup_to_mesh, then repair.
 Outcome load_and_repair(const std::string& path, Mesh& m, const RepairOptions& opt) {
   Outcome o;
   try {
-    load_mesh_for_test(path, m);
+    PolygonSoup soup = read_polygon_soup(path);
+    soup_to_mesh(std::move(soup), m);
     o.loaded = true;
   } catch (const Error& e) {
     o.load_error = e.what();
