@@ -53,7 +53,9 @@ int run_repair(const RepairArgs& a) {
   PolygonSoup soup = read_polygon_soup(a.input);
   SoupRepairCounts counts;
   Mesh mesh;
-  soup_to_mesh(std::move(soup), mesh, {}, &counts);
+  SoupToMeshOptions so;
+  so.triangulate = false;  // repair_mesh triangulates, dropping (and counting) what it cannot
+  soup_to_mesh(std::move(soup), mesh, so, &counts);
   const double load_s = t.seconds();
 
   RepairOptions opt;

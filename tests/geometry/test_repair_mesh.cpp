@@ -349,12 +349,16 @@ struct Outcome {
   RepairReport report;
 };
 
-/// The user's path: surftex::read_polygon_soup + soup_to_mesh, then repair.
+/// The user's path (as in `surftex repair`): surftex::read_polygon_soup +
+/// soup_to_mesh without triangulation (repair_mesh triangulates and drops
+/// the polygons that cannot be), then repair.
 Outcome load_and_repair(const std::string& path, Mesh& m, const RepairOptions& opt) {
   Outcome o;
   try {
     PolygonSoup soup = read_polygon_soup(path);
-    soup_to_mesh(std::move(soup), m);
+    SoupToMeshOptions so;
+    so.triangulate = false;
+    soup_to_mesh(std::move(soup), m, so);
     o.loaded = true;
   } catch (const Error& e) {
     o.load_error = e.what();
