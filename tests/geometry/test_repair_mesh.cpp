@@ -395,9 +395,12 @@ TEST(RepairMeshRegression, EveryBrokenFileEndsValidOrRefused) {
   std::vector<std::string> files = broken_files();
   ASSERT_GE(files.size(), 30u);
   std::size_t valid = 0, refused = 0, unreadable = 0;
+  // Under ASan+UBSan the second variant runs on the small files only.
+  const bool sanitized = std::getenv("SURFTEX_SANITIZED") != nullptr;
   for (const auto& path : files) {
     const std::string name = fs::path(path).filename().string();
-    for (int variant = 0; variant < 2; ++variant) {
+    const int variants = sanitized && fs::file_size(path) > 200000 ? 1 : 2;
+    for (int variant = 0; variant < variants; ++variant) {
       RepairOptions opt;
       opt.fill_holes = opt.keep_largest_component = (variant == 1);
       Mesh m;
