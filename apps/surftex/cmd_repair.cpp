@@ -53,7 +53,9 @@ int run_repair(const RepairArgs& a) {
   PolygonSoup soup = read_polygon_soup(a.input);
   SoupRepairCounts counts;
   Mesh mesh;
-  soup_to_mesh(std::move(soup), mesh, {}, &counts);
+  SoupToMeshOptions so;
+  so.triangulate = false;  // repair_mesh triangulates, dropping (and counting) what it cannot
+  soup_to_mesh(std::move(soup), mesh, so, &counts);
   const double load_s = t.seconds();
 
   RepairOptions opt;
@@ -78,17 +80,13 @@ int run_repair(const RepairArgs& a) {
                        {"max_hole_edges", a.max_hole_edges},
                        {"needle_threshold", a.needle},
                        {"cap_threshold", a.cap}};
-  if (!r.valid) {
-    report["written"] = false;
-    write_report(a.common, "repair", report);  // the report says why; no mesh is written
+  if (!r.valid)  // refuse: nothing is written (neither mesh nor report)
     throw TopologyError("cannot repair '" + a.input + "': " + r.refusal);
-  }
   t.reset();
   WriteMeshOptions wo;
   wo.overwrite = a.common.force;
   write_mesh(a.output, mesh, wo);
   report["seconds"]["write"] = t.seconds();
-  report["written"] = true;
   write_report(a.common, "repair", report);
 
   if (!a.common.quiet) {

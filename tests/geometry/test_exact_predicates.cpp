@@ -81,18 +81,23 @@ TEST(ExactPredicates, NearlyCollinearOrientation2D) {
   EXPECT_GT(naive_wrong, 0u) << "the cases no longer trip a naive double kernel";
 }
 
-/// Four points nearly coplanar: a, b, c on the plane x + y + z = 1 (not
-/// exactly representable), d moved along the plane's normal by a few ulps.
+/// Four points nearly coplanar: a, b, c span the plane x = y; d lies a few
+/// ulps off it near (0.5, 0.5, 0.5), far from a, b, c (the 3D form of the
+/// orient2d case above).
 TEST(ExactPredicates, NearlyCoplanarOrientation3D) {
-  const std::array<double, 3> a{0.1, 0.2, 0.7}, b{7.3, -2.1, -4.2}, c{-3.3, 5.9, -1.6};
-  const double u = std::ldexp(1.0, -52);
+  const std::array<double, 3> a{12, 12, 0}, b{24, 24, 0}, c{12, 12, 7};
+  const double u = std::ldexp(1.0, -53);
   std::size_t cases = 0, naive_wrong = 0;
-  for (int i = -12; i <= 12; ++i) {
-    for (int j = -12; j <= 12; ++j) {
-      std::array<double, 3> d{0.3 + i * u, 0.3 + j * u, 0.4};
-      const CGAL::Orientation exact = orient3<Exact>(a, b, c, d);
-      EXPECT_EQ((orient3<Kernel>(a, b, c, d)), exact) << "Epick wrong at " << i << "," << j;
-      if (orient3<Naive>(a, b, c, d) != exact) ++naive_wrong;
+  for (int i = 0; i < 24; ++i) {
+    for (int j = 0; j < 24; ++j) {
+      std::array<double, 3> d{0.5 + i * u, 0.5 + j * u, 0.5};
+      const CGAL::Orientation exact = orient3<Exact>(d, a, b, c);
+      // By hand: det(a-d, b-d, c-d) = 7 * 12 (dy - dx), so the sign is sign(dy - dx).
+      const CGAL::Orientation by_hand =
+          d[1] > d[0] ? CGAL::POSITIVE : (d[1] < d[0] ? CGAL::NEGATIVE : CGAL::ZERO);
+      ASSERT_EQ(exact, by_hand) << i << "," << j;
+      EXPECT_EQ((orient3<Kernel>(d, a, b, c)), exact) << "Epick wrong at " << i << "," << j;
+      if (orient3<Naive>(d, a, b, c) != exact) ++naive_wrong;
       ++cases;
     }
   }

@@ -349,12 +349,16 @@ struct Outcome {
   RepairReport report;
 };
 
-/// The user's path: surftex::read_polygon_soup + soup_to_mesh, then repair.
+/// The user's path (as in `surftex repair`): surftex::read_polygon_soup +
+/// soup_to_mesh without triangulation (repair_mesh triangulates and drops
+/// the polygons that cannot be), then repair.
 Outcome load_and_repair(const std::string& path, Mesh& m, const RepairOptions& opt) {
   Outcome o;
   try {
     PolygonSoup soup = read_polygon_soup(path);
-    soup_to_mesh(std::move(soup), m);
+    SoupToMeshOptions so;
+    so.triangulate = false;
+    soup_to_mesh(std::move(soup), m, so);
     o.loaded = true;
   } catch (const Error& e) {
     o.load_error = e.what();
@@ -391,9 +395,12 @@ TEST(RepairMeshRegression, EveryBrokenFileEndsValidOrRefused) {
   std::vector<std::string> files = broken_files();
   ASSERT_GE(files.size(), 30u);
   std::size_t valid = 0, refused = 0, unreadable = 0;
+  // Under ASan+UBSan the second variant runs on the small files only.
+  const bool sanitized = std::getenv("SURFTEX_SANITIZED") != nullptr;
   for (const auto& path : files) {
     const std::string name = fs::path(path).filename().string();
-    for (int variant = 0; variant < 2; ++variant) {
+    const int variants = sanitized && fs::file_size(path) > 200000 ? 1 : 2;
+    for (int variant = 0; variant < variants; ++variant) {
       RepairOptions opt;
       opt.fill_holes = opt.keep_largest_component = (variant == 1);
       Mesh m;
