@@ -331,7 +331,7 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
   // The steps of PMP::repair_polygon_soup (CGAL 5.5, Polygon_soup_fixer), in
   // its order, called one by one so that each is counted.
   c.duplicate_points_merged = PMP::merge_duplicate_points_in_polygon_soup(pts, polys);
-  PMP::internal::simplify_polygons_in_polygon_soup(pts, polys, Kernel());
+  c.polygons_simplified = PMP::internal::simplify_polygons_in_polygon_soup(pts, polys, Kernel());
   std::size_t before_split = polys.size();
   PMP::internal::split_pinched_polygons_in_polygon_soup(pts, polys, Kernel());
   c.pinched_polygons_split = polys.size() - before_split;

@@ -58,6 +58,7 @@ struct SoupRepairCounts {
   std::size_t duplicate_polygons_removed = 0;
   std::size_t isolated_points_removed = 0;
   std::size_t points_duplicated_to_orient = 0;  ///< non-manifold splits by orient_polygon_soup
+  std::size_t polygons_simplified = 0;  ///< lost consecutive repeated vertices (those left with < 3 are also in degenerate_polygons_removed)
   std::size_t pinched_polygons_split = 0;  ///< extra polygons from splitting pinched ones
   bool oriented = true;  ///< orient_polygon_soup succeeded without splitting
   std::size_t output_vertices = 0, output_faces = 0;  ///< after conversion (and triangulation)
