@@ -3,6 +3,7 @@
 // image it writes, and refusals of bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -54,24 +55,36 @@ TEST(CmdRender, MapsATextureThroughTheMeshUVs) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   Image img = read_image(out);
   Image tex = read_image(test::shared_data("textures/red_checked_384.png"));
-  // Unshaded texture lookups: every surface pixel is a blend of texture colours, so
-  // its red channel stays within the texture's red range.
-  float tmin = 1, tmax = 0;
+  // Unshaded texture lookups: every surface pixel is a blend of texels, so each channel
+  // stays within the texture's range, the pattern shows (channels vary), and the
+  // average colour is the texture's (spot's UV atlas covers the image fairly evenly).
+  double tmin[3] = {1, 1, 1}, tmax[3] = {0, 0, 0}, tmean[3] = {0, 0, 0};
   for (int y = 0; y < tex.height; ++y)
-    for (int x = 0; x < tex.width; ++x) {
-      tmin = std::min(tmin, tex.at(x, y, 0));
-      tmax = std::max(tmax, tex.at(x, y, 0));
-    }
+    for (int x = 0; x < tex.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        tmin[c] = std::min(tmin[c], double(tex.at(x, y, c)));
+        tmax[c] = std::max(tmax[c], double(tex.at(x, y, c)));
+        tmean[c] += tex.at(x, y, c) / (double(tex.width) * tex.height);
+      }
   int surface = 0;
+  double smin[3] = {1, 1, 1}, smax[3] = {0, 0, 0}, smean[3] = {0, 0, 0};
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
       bool bg = img.at(x, y, 0) == 1.f && img.at(x, y, 1) == 1.f && img.at(x, y, 2) == 1.f;
       if (bg) continue;
       ++surface;
-      EXPECT_GE(img.at(x, y, 0), tmin - 1.f / 255);
-      EXPECT_LE(img.at(x, y, 0), tmax + 1.f / 255);
+      for (int c = 0; c < 3; ++c) {
+        double v = img.at(x, y, c);
+        EXPECT_GE(v, tmin[c] - 1.0 / 255);
+        EXPECT_LE(v, tmax[c] + 1.0 / 255);
+        smin[c] = std::min(smin[c], v);
+        smax[c] = std::max(smax[c], v);
+        smean[c] += v;
+      }
     }
-  EXPECT_GT(surface, 300);
+  ASSERT_GT(surface, 300);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(smean[c] / surface, tmean[c], 0.06) << "channel " << c;
+  EXPECT_GT(smax[2] - smin[2], 0.5);
 }
 
 TEST(CmdRender, RefusesBadInputWithAnError) {
