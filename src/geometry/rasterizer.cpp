@@ -399,8 +399,10 @@ class Renderer {
       A[i] = -dy * kOne;  // step per sample in x
       B[i] = dx * kOne;   // step per sample in y
       E[i] = dx * (py - s.y[a]) - dy * (px - s.x[a]);
-      // Fill rule: samples exactly on an edge belong to one side only. Each
-      // direction of an edge is "owned" iff the reverse direction is not.
+      // Top-left fill rule: a sample exactly on an edge belongs to one side
+      // only. In sample space (y down) with positive area, top edges run
+      // dx > 0, dy == 0 and left edges dy < 0; each direction of an edge is
+      // owned iff its reverse is not, so shared edges are drawn exactly once.
       bool owned = dy < 0 || (dy == 0 && dx > 0);
       if (!owned) E[i] -= 1;  // strict inequality on non-owned edges
     }

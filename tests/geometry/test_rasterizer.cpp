@@ -232,6 +232,21 @@ TEST(Rasterizer, SharedEdgesLeaveNoCrackAndNoDoubleHit) {
           else ASSERT_NEAR(r.color.at(x, y, c), col[c], 1e-6f) << x << "," << y;
       }
   }
+  // A fan of 8 triangles around a vertex that lies exactly on a sample centre
+  // (odd image size, odd supersampling), its spokes through sample centres too.
+  RenderMesh fan;
+  fan.positions.push_back({0, 0, 0});
+  for (int k = 0; k < 8; ++k) {
+    const int ring[8][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+    fan.positions.push_back({1.5f * ring[k][0], 1.5f * ring[k][1], 0});
+    fan.triangles.push_back({0, 1 + k, 1 + (k + 1) % 8});
+  }
+  opt.width = opt.height = 65;
+  for (int ss : {1, 3}) {
+    opt.supersample = ss;
+    RenderResult r = render(fan, ortho_camera({0, 0, 1}, {0, 0, 0}, 1.f), opt);
+    EXPECT_EQ(r.fragments, std::size_t(65) * 65 * ss * ss) << "supersample " << ss;
+  }
   // A jittered grid seen in perspective at an angle, larger than the frame:
   // every sample is hit exactly once, through edges and vertices in all directions.
   RenderMesh grid;
