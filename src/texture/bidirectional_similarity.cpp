@@ -111,7 +111,8 @@ std::vector<double> project(const Patches& p, const Pca& pca) {
 
 // Mean over `queries` of the distance to the nearest patch of `base`.
 double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
-                    const std::vector<double>& qproj, const std::vector<double>& bproj) {
+                    const std::vector<double>& qproj, const std::vector<double>& bproj,
+                    std::size_t max_candidates) {
   std::vector<double> best(queries.count);
   if (!pca) {
     tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
@@ -138,8 +139,13 @@ double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
           best[i] = b;
           break;
         }
+        if (max_candidates > 0 && k >= max_candidates) {  // approximate: accept the best seen
+          best[i] = b;
+          break;
+        }
         k = std::min(base.count, k * 2);
-        if (k > base.count / 8) {  // the subspace does not separate: scan all
+        if (max_candidates > 0) k = std::min(k, max_candidates);
+        if (k > base.count / 8 && max_candidates == 0) {  // the subspace does not separate: scan all
           for (std::size_t j = 0; j < base.count; ++j)
             b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
           best[i] = b;
@@ -165,6 +171,7 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
         std::to_string(exemplar.channels));
   if (opt.patch < 1 || opt.patch > 31) bad("patch " + std::to_string(opt.patch) + " outside 1..31");
   if (opt.stride < 1) bad("stride " + std::to_string(opt.stride) + " < 1");
+  if (opt.max_candidates < 0) bad("max_candidates " + std::to_string(opt.max_candidates) + " < 0");
   if (opt.pca_dims < 1) bad("pca_dims " + std::to_string(opt.pca_dims) + " < 1");
   if (output.width < opt.patch || output.height < opt.patch)
     bad("patch " + std::to_string(opt.patch) + " larger than the output (" +
@@ -179,13 +186,13 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
   r.exemplar_patches = ex.count;
   if (opt.brute_force) {
     std::vector<double> none;
-    r.coherence = mean_nearest(out, ex, nullptr, none, none);
-    r.completeness = mean_nearest(ex, out, nullptr, none, none);
+    r.coherence = mean_nearest(out, ex, nullptr, none, none, 0);
+    r.completeness = mean_nearest(ex, out, nullptr, none, none, 0);
   } else {
     const Pca pca = fit_pca(ex, out, std::min(opt.pca_dims, ex.dim));
     const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
-    r.coherence = mean_nearest(out, ex, &pca, pout, pex);
-    r.completeness = mean_nearest(ex, out, &pca, pex, pout);
+    r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates);
+    r.completeness = mean_nearest(ex, out, &pca, pex, pout, opt.max_candidates);
   }
   r.total = r.coherence + r.completeness;
   return r;

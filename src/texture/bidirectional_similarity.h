@@ -42,6 +42,12 @@ struct BidirectionalOptions {
   /// Dimensions kept by the PCA projection for the kd-tree (1..k*k*channels,
   /// clamped), default 16. Affects speed only, not the result.
   int pca_dims = 16;
+  /// 0 (default) = exact search as described above. > 0 = approximate: stop
+  /// growing the re-ranked list at this many candidates and take the best
+  /// seen (an upper bound of the true distance; figures can only be too
+  /// high). Bounds the time on exemplars whose patches PCA separates poorly
+  /// (large, regular ones such as stripes).
+  int max_candidates = 0;
   /// Brute-force search instead of the kd-tree (reference; slow).
   bool brute_force = false;
 };
