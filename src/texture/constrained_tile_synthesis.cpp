@@ -217,7 +217,7 @@ void build_exemplar_level(ExemplarLevel& L, const Image& colour, const Image& ma
 
 // Optimises one indirection map in place at one level (section 1.2 "Optimization").
 void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int passes,
-                  std::uint64_t seed, const ConstrainedSynthesisOptions& opt) {
+                  std::uint64_t seed, const ConstrainedSynthesisOptions& opt, double exclude) {
   const int w = map.width, h = map.height;
   const std::size_t n_out = std::size_t(w) * h;
   const int raw = (2 * kColR + 1) * (2 * kColR + 1) * L.C;
@@ -276,6 +276,12 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
       std::size_t best_c = cur;
       for (int a = 0; a < nc; ++a) {
         const std::size_t c = cand[a];
+        if (exclude > 0) {
+          int dx = std::abs(int(c % L.w) - i), dy = std::abs(int(c / L.w) - j);
+          dx = std::min(dx, L.w - dx);
+          dy = std::min(dy, L.h - dy);
+          if (double(dx) * dx + double(dy) * dy < exclude * exclude) continue;
+        }
         const float* f = &L.cloud.pts[c * L.D];
         double d2 = 0;
         for (int b = 0; b < L.D; ++b) {
@@ -348,7 +354,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
                               "x" + std::to_string(H));
   if (opt.levels < 0 || opt.coarse_passes < 0 || opt.fine_passes < 0 || opt.pca_dims < 1 ||
       !(opt.mask_weight >= 0) || !(opt.reuse_penalty >= 0) || opt.candidates < 1 || opt.candidates > 16 ||
-      !(opt.ann_eps >= 0))
+      !(opt.ann_eps >= 0) || !(opt.exclude_radius >= 0))
     throw InvalidInputError(fn + "option out of range (levels " + std::to_string(opt.levels) +
                             ", passes " + std::to_string(opt.coarse_passes) + "/" +
                             std::to_string(opt.fine_passes) + ", pca_dims " + std::to_string(opt.pca_dims) +
@@ -395,7 +401,8 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
       m = res.maps[k - 1][0];
     }
     if (k > 0 || opt.random_first_layer)
-      optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt);
+      optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt,
+                   opt.exclude_radius * ex[0].w / W);
     report_progress(opt.progress, "tile synthesis", 0.05 + 0.25 * (k + 1) / K);
   }
   // Finer levels: layers are independent.
@@ -408,7 +415,8 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
         continue;
       }
       m = upsample_map(res.maps[k][r - 1], ex[r].w, ex[r].h);
-      optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt);
+      optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt,
+                   opt.exclude_radius * ex[r].w / W);
     }
     int d = ++done;
     report_progress(opt.progress, "tile synthesis", 0.3 + 0.7 * d / K);

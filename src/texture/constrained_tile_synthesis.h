@@ -61,6 +61,11 @@ struct ConstrainedSynthesisOptions {
   /// seeded random coordinates and optimises it too (used to make several
   /// different tiles with the same mask).
   bool random_first_layer = false;
+  /// Candidates whose exemplar position lies closer than this (finest-level
+  /// texels, toroidal) to the output position are refused (>= 0, default 0 =
+  /// none). Used with random_first_layer to force a tile that is a real
+  /// rearrangement of the exemplar rather than the exemplar itself.
+  double exclude_radius = 0;
   std::uint64_t seed = 1;
   ProgressCallback progress;
 };

@@ -130,6 +130,9 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
     tbb::parallel_for(1, M + 1, [&](int m) {
       ConstrainedSynthesisOptions so = opt.synthesis;
       so.random_first_layer = true;
+      // Same mask everywhere would let the synthesis rebuild the key itself;
+      // refusing exemplar pixels near their own position forces a new tile.
+      so.exclude_radius = opt.size / 8.0;
       so.seed = derive_seed(opt.seed, 2000 + m);
       so.progress = nullptr;
       ConstrainedSynthesisResult r = synthesize_constrained_tiles(tiles[0].tile, tiles[0].mask, {tiles[0].mask}, so);
