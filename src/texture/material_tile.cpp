@@ -10,6 +10,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/timer.h"
+#include "texture/tileable_tile.h"
 
 namespace surftex {
 
@@ -46,8 +47,13 @@ KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTil
   KeyTile k;
   k.tile = square_resample(key.texture, opt.size);
   if (!key.mask.empty()) k.mask = binarize_mask(square_resample(binarize_mask(key.mask), opt.size));
-  if (!opt.keys_are_tileable) {
-    // Tileable version: unconstrained toroidal synthesis from the square itself.
+  if (!opt.keys_are_tileable && k.mask.empty()) {
+    // Tileable version: graph-cut textures on the torus (the paper's [KdE*03]).
+    TileOptions to;
+    to.seed = derive_seed(opt.seed, 1000 + index);
+    k.tile = make_tileable(k.tile, opt.size, to);
+  } else if (!opt.keys_are_tileable) {
+    // Tileable version carrying a painted mask: unconstrained toroidal synthesis from the square itself.
     ConstrainedSynthesisOptions so = opt.synthesis;
     so.mask_weight = 0;
     so.random_first_layer = true;

@@ -41,10 +41,12 @@ struct MaterialTileOptions {
   int layers = 8;    ///< M: intervals per key pair (>= 1); a pair gives M+1 layers
   /// Key tiles: the input is first reduced to its largest centred square and
   /// resampled (bilinear) to size x size. If `keys_are_tileable` is false
-  /// (default) the square is then made tileable by unconstrained toroidal
-  /// synthesis from itself (the constrained synthesis with mask weight 0 and a
-  /// random start); its mask is carried along the indirection. If true, the
-  /// square is used as is (it must already tile).
+  /// (default) the square is then made tileable: without a painted mask by
+  /// graph-cut textures on the torus (texture/tileable_tile.h, the paper's
+  /// [KdE*03]); with a painted mask by unconstrained toroidal synthesis from
+  /// itself (the constrained synthesis with mask weight 0 and a random start),
+  /// which carries the mask along its indirection. If true, the square is used
+  /// as is (it must already tile).
   bool keys_are_tileable = false;
   /// One key: same-mask mode (M+1 tiles sharing the key's mask). Ignored for
   /// two or more keys.

@@ -15,30 +15,12 @@
 #include "texture/constrained_tile_synthesis.h"
 #include "texture/material_tile.h"
 #include "texture/procedural_texture.h"
+#include "texture/wrap_seam_ratio.h"
 
 using namespace surftex;
 
 namespace {
 bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
-
-// Wrap-seam ratio: mean absolute jump across the wrap (last -> first column /
-// row) over the mean jump between interior neighbours; ~1 for a tile.
-double wrap_seam_ratio(const Image& img) {
-  auto jump = [&](int x0, int y0, int x1, int y1) {
-    double s = 0;
-    for (int c = 0; c < img.channels; ++c) s += std::abs(img.at_wrap(x0, y0, c) - img.at_wrap(x1, y1, c));
-    return s;
-  };
-  double seam = 0, inner = 0;
-  long long ns = 0, ni = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      double jx = jump(x, y, x + 1, y), jy = jump(x, y, x, y + 1);
-      if (x == img.width - 1) seam += jx, ++ns; else inner += jx, ++ni;
-      if (y == img.height - 1) seam += jy, ++ns; else inner += jy, ++ni;
-    }
-  return (seam / ns) / std::max(inner / ni, 1e-9);
-}
 
 // Chi-square distance between 16-bin luminance histograms.
 double chi_square(const Image& a, const Image& b) {
