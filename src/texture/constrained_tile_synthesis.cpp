@@ -16,7 +16,10 @@
 //    neighbourhoods already match exactly (the paper's I_0 = identity);
 //  - the coarsest level runs layer after layer (each starts from the previous
 //    one); the finer levels of different layers are independent and run in
-//    parallel, each with its own seeded random stream.
+//    parallel, each with its own seeded random stream;
+//  - speed: at the finer levels only the first `fine_ann_passes` passes query
+//    the kd-tree; later passes choose among the current and coherent
+//    candidates (the map is already mask-consistent after the first pass).
 #include "texture/constrained_tile_synthesis.h"
 
 #include <Eigen/Dense>
@@ -217,7 +220,8 @@ void build_exemplar_level(ExemplarLevel& L, const Image& colour, const Image& ma
 
 // Optimises one indirection map in place at one level (section 1.2 "Optimization").
 void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int passes,
-                  std::uint64_t seed, const ConstrainedSynthesisOptions& opt, double exclude) {
+                  std::uint64_t seed, const ConstrainedSynthesisOptions& opt, double exclude,
+                  int ann_passes) {
   const int w = map.width, h = map.height;
   const std::size_t n_out = std::size_t(w) * h;
   const int raw = (2 * kColR + 1) * (2 * kColR + 1) * L.C;
@@ -256,10 +260,13 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
           mv[k] = static_cast<float>(opt.mask_weight) * target_mask.at(wrap(i + dx, w), wrap(j + dy, h)) -
                   L.mmean[k];
       project(L.mbasis, L.dm, mask_n, mv, q.data() + L.d);
-      nanoflann::KNNResultSet<float, std::uint32_t> rs(k_ann);
-      rs.init(nn_idx.data(), nn_d2.data());
-      L.tree->findNeighbors(rs, q.data(), sp);
-      const std::size_t found = rs.size();
+      std::size_t found = 0;
+      if (pass < ann_passes) {
+        nanoflann::KNNResultSet<float, std::uint32_t> rs(k_ann);
+        rs.init(nn_idx.data(), nn_d2.data());
+        L.tree->findNeighbors(rs, q.data(), sp);
+        found = rs.size();
+      }
       // Candidates: ANN results, the current pixel, the coherent ones.
       std::uint32_t cand[32];
       int nc = 0;
@@ -353,7 +360,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
                               std::to_string(target_masks[k].height) + ", exemplar " + std::to_string(W) +
                               "x" + std::to_string(H));
   if (opt.levels < 0 || opt.coarse_passes < 0 || opt.fine_passes < 0 || opt.pca_dims < 1 ||
-      !(opt.mask_weight >= 0) || !(opt.reuse_penalty >= 0) || opt.candidates < 1 || opt.candidates > 16 ||
+      !(opt.mask_weight >= 0) || !(opt.reuse_penalty >= 0) || opt.candidates < 1 || opt.candidates > 16 || opt.fine_ann_passes < 0 ||
       !(opt.ann_eps >= 0) || !(opt.exclude_radius >= 0))
     throw InvalidInputError(fn + "option out of range (levels " + std::to_string(opt.levels) +
                             ", passes " + std::to_string(opt.coarse_passes) + "/" +
@@ -402,7 +409,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
     }
     if (k > 0 || opt.random_first_layer)
       optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt,
-                   opt.exclude_radius * ex[0].w / W);
+                   opt.exclude_radius * ex[0].w / W, opt.coarse_passes);
     report_progress(opt.progress, "tile synthesis", 0.05 + 0.25 * (k + 1) / K);
   }
   // Finer levels: layers are independent.
@@ -416,7 +423,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
       }
       m = upsample_map(res.maps[k][r - 1], ex[r].w, ex[r].h);
       optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt,
-                   opt.exclude_radius * ex[r].w / W);
+                   opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes);
     }
     int d = ++done;
     report_progress(opt.progress, "tile synthesis", 0.3 + 0.7 * d / K);

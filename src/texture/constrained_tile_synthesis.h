@@ -44,6 +44,10 @@ struct ConstrainedSynthesisOptions {
   int levels = 0;
   int coarse_passes = 20;  ///< passes at the coarsest level (>= 0)
   int fine_passes = 3;     ///< passes at every finer level (>= 0)
+  /// Of the fine passes, how many query the kd-tree (>= 0, default 1); the
+  /// others only compare the current and coherent candidates. The coarsest
+  /// level always queries it in every pass.
+  int fine_ann_passes = 1;
   int pca_dims = 8;        ///< PCA coefficients of the 5x5 colour neighbourhood (1..25*channels)
   double mask_weight = 2;  ///< scale of the 3x3 mask entries in the vector (>= 0)
   /// PCA coefficients kept of the (weighted) 3x3 mask neighbourhood (0..9,
