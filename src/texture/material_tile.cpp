@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "texture/material_tile.h"
+
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/timer.h"
+#include "texture/tileable_tile.h"
+
+namespace surftex {
+
+namespace {
+
+std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t tag) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (tag + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+Image remap(const Image& src, const IndirectionMap& m) {
+  Image out(m.width, m.height, src.channels);
+  for (int j = 0; j < m.height; ++j)
+    for (int i = 0; i < m.width; ++i) {
+      const float* p = src.pixel(m.x(i, j), m.y(i, j));
+      std::copy(p, p + src.channels, out.pixel(i, j));
+    }
+  return out;
+}
+
+struct KeyTile {
+  Image tile, mask;
+};
+
+KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTileOptions& opt) {
+  const std::string what = "key " + std::to_string(index) + (key.name.empty() ? "" : " ('" + key.name + "')");
+  if (key.texture.empty()) throw InvalidInputError(what + ": empty texture");
+  if (!key.mask.empty() && (key.mask.width != key.texture.width || key.mask.height != key.texture.height))
+    throw InvalidInputError(what + ": mask " + std::to_string(key.mask.width) + "x" +
+                            std::to_string(key.mask.height) + " differs from texture " +
+                            std::to_string(key.texture.width) + "x" + std::to_string(key.texture.height));
+  KeyTile k;
+  k.tile = square_resample(key.texture, opt.size);
+  if (!key.mask.empty()) k.mask = binarize_mask(square_resample(binarize_mask(key.mask), opt.size));
+  if (!opt.keys_are_tileable && k.mask.empty()) {
+    // Tileable version: graph-cut textures on the torus (the paper's [KdE*03]).
+    TileOptions to;
+    to.seed = derive_seed(opt.seed, 1000 + index);
+    k.tile = make_tileable(k.tile, opt.size, to);
+  } else if (!opt.keys_are_tileable) {
+    // Tileable version carrying a painted mask: unconstrained toroidal synthesis from the square itself.
+    ConstrainedSynthesisOptions so = opt.synthesis;
+    so.mask_weight = 0;
+    so.random_first_layer = true;
+    so.seed = derive_seed(opt.seed, 1000 + index);
+    so.progress = nullptr;
+    Image carried = k.mask.empty() ? Image(opt.size, opt.size, 1, 0.f) : k.mask;
+    ConstrainedSynthesisResult r = synthesize_constrained_tiles(k.tile, carried, {carried}, so);
+    const IndirectionMap& m = r.maps[0].back();
+    k.tile = std::move(r.layers[0]);
+    if (!k.mask.empty()) k.mask = remap(carried, m);
+  }
+  if (k.mask.empty()) k.mask = compute_feature_mask(k.tile, opt.auto_mask).mask;
+  return k;
+}
+
+}  // namespace
+
+Image square_resample(const Image& img, int size) {
+  if (img.empty()) throw InvalidInputError("square_resample: empty image");
+  if (size < 1) throw InvalidInputError("square_resample: size " + std::to_string(size) + " < 1");
+  const int side = std::min(img.width, img.height);
+  const int x0 = (img.width - side) / 2, y0 = (img.height - side) / 2;
+  Image out(size, size, img.channels);
+  const double scale = double(side) / size;
+  for (int j = 0; j < size; ++j)
+    for (int i = 0; i < size; ++i) {
+      double sx = std::clamp((i + 0.5) * scale - 0.5, 0.0, side - 1.0);
+      double sy = std::clamp((j + 0.5) * scale - 0.5, 0.0, side - 1.0);
+      int ix = std::min(static_cast<int>(sx), side - 2 < 0 ? 0 : side - 2);
+      int iy = std::min(static_cast<int>(sy), side - 2 < 0 ? 0 : side - 2);
+      double fx = side > 1 ? sx - ix : 0, fy = side > 1 ? sy - iy : 0;
+      int ix1 = std::min(ix + 1, side - 1), iy1 = std::min(iy + 1, side - 1);
+      for (int c = 0; c < img.channels; ++c) {
+        double v = (1 - fx) * (1 - fy) * img.at(x0 + ix, y0 + iy, c) + fx * (1 - fy) * img.at(x0 + ix1, y0 + iy, c) +
+                   (1 - fx) * fy * img.at(x0 + ix, y0 + iy1, c) + fx * fy * img.at(x0 + ix1, y0 + iy1, c);
+        out.at(i, j, c) = static_cast<float>(v);
+      }
+    }
+  return out;
+}
+
+MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, const MaterialTileOptions& opt) {
+  if (keys.empty()) throw InvalidInputError("make_material_tile: no key texture");
+  if (opt.size < 16) throw InvalidInputError("make_material_tile: size " + std::to_string(opt.size) + " < 16");
+  if (opt.layers < 1) throw InvalidInputError("make_material_tile: layers " + std::to_string(opt.layers) + " < 1");
+  Timer total, t;
+  MaterialTileResult res;
+  const int M = opt.layers;
+  const std::size_t K = keys.size();
+  // Channel count: the largest among the keys (grey keys are broadcast).
+  int channels = 0;
+  for (const auto& k : keys) channels = std::max(channels, std::min(k.texture.channels, 4));
+  std::vector<KeyTile> tiles(K);
+  tbb::parallel_for(std::size_t(0), K, [&](std::size_t i) {
+    MaterialKey k = keys[i];
+    if (k.texture.channels != channels && !k.texture.empty()) {
+      Image c(k.texture.width, k.texture.height, channels);
+      for (int y = 0; y < c.height; ++y)
+        for (int x = 0; x < c.width; ++x)
+          for (int ch = 0; ch < channels; ++ch)
+            c.at(x, y, ch) = ch < k.texture.channels ? k.texture.at(x, y, ch)
+                             : ch == 3               ? 1.f
+                                                     : k.texture.at(x, y, 0);
+      k.texture = std::move(c);
+    }
+    tiles[i] = prepare_key(k, i, opt);
+  });
+  for (auto& k : tiles) {
+    res.key_tiles.push_back(k.tile);
+    res.key_masks.push_back(k.mask);
+  }
+  res.seconds_keys = t.seconds();
+  report_progress(opt.progress, "material tile: keys", 1.0);
+
+  if (K == 1) {  // same-mask mode (Figure 14)
+    res.layers.assign(M + 1, Image());
+    res.mask_agreement.assign(M + 1, 1.0);
+    res.layers[0] = tiles[0].tile;
+    t.reset();
+    tbb::parallel_for(1, M + 1, [&](int m) {
+      ConstrainedSynthesisOptions so = opt.synthesis;
+      so.random_first_layer = true;
+      // Same mask everywhere would let the synthesis rebuild the key itself;
+      // refusing exemplar pixels near their own position forces a new tile.
+      so.exclude_radius = opt.size / 8.0;
+      so.seed = derive_seed(opt.seed, 2000 + m);
+      so.progress = nullptr;
+      ConstrainedSynthesisResult r = synthesize_constrained_tiles(tiles[0].tile, tiles[0].mask, {tiles[0].mask}, so);
+      res.layers[m] = std::move(r.layers[0]);
+      res.mask_agreement[m] = r.mask_agreement[0];
+    });
+    res.seconds_synthesis = t.seconds();
+    for (int m = 0; m <= M; ++m) {
+      res.masks.push_back(tiles[0].mask);
+      res.material.push_back(double(m) / M);
+      res.sign_changes.push_back(0);
+    }
+    res.seconds_total = total.seconds();
+    return res;
+  }
+
+  for (std::size_t p = 0; p + 1 < K; ++p) {
+    t.reset();
+    MaskMorphOptions mo = opt.morph;
+    mo.progress = nullptr;
+    MaskMorphResult morph = morph_feature_masks(tiles[p].mask, tiles[p + 1].mask, M, mo);
+    res.seconds_morph += t.seconds();
+    report_progress(opt.progress, "material tile: morph", double(p + 1) / (K - 1));
+    t.reset();
+    std::vector<Image> reversed(morph.masks.rbegin(), morph.masks.rend());
+    ConstrainedSynthesisResult ra, rb;
+    ConstrainedSynthesisOptions sa = opt.synthesis, sb = opt.synthesis;
+    sa.seed = derive_seed(opt.seed, 10 * p + 1);
+    sb.seed = derive_seed(opt.seed, 10 * p + 2);
+    sa.progress = [&](std::string_view, double f) {
+      report_progress(opt.progress, "material tile: synthesis", (p + f) / (K - 1));
+    };
+    sb.progress = nullptr;
+    tbb::parallel_invoke(
+        [&] { ra = synthesize_constrained_tiles(tiles[p].tile, tiles[p].mask, morph.masks, sa); },
+        [&] { rb = synthesize_constrained_tiles(tiles[p + 1].tile, tiles[p + 1].mask, reversed, sb); });
+    res.seconds_synthesis += t.seconds();
+    for (int m = (p == 0 ? 0 : 1); m <= M; ++m) {
+      const Image& A = ra.layers[m];
+      const Image& B = rb.layers[M - m];
+      const float wb = static_cast<float>(double(m) / M), wa = 1.f - wb;
+      Image out(A.width, A.height, A.channels);
+      for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] = wa * A.data[i] + wb * B.data[i];
+      res.layers.push_back(std::move(out));
+      res.masks.push_back(morph.masks[m]);
+      res.material.push_back(double(p) + double(m) / M);
+      res.sign_changes.push_back(m == 0 ? 0 : morph.sign_changes[m - 1]);
+      res.mask_agreement.push_back(std::min(ra.mask_agreement[m], rb.mask_agreement[M - m]));
+    }
+  }
+  res.seconds_total = total.seconds();
+  report_progress(opt.progress, "material tile", 1.0);
+  return res;
+}
+
+}  // namespace surftex

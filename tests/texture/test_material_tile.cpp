@@ -1,0 +1,187 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+
+#include "geometry/errors.h"
+#include "geometry/image_io.h"
+#include "test_support.h"
+#include "texture/constrained_tile_synthesis.h"
+#include "texture/material_tile.h"
+#include "texture/procedural_texture.h"
+#include "texture/wrap_seam_ratio.h"
+
+using namespace surftex;
+
+namespace {
+bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+
+// Chi-square distance between 16-bin luminance histograms.
+double chi_square(const Image& a, const Image& b) {
+  auto hist = [](const Image& im) {
+    std::vector<double> h(16, 0);
+    Image l = luminance(im);
+    for (float v : l.data) h[std::clamp(int(v * 16), 0, 15)] += 1.0 / l.data.size();
+    return h;
+  };
+  auto ha = hist(a), hb = hist(b);
+  double c = 0;
+  for (int i = 0; i < 16; ++i)
+    if (ha[i] + hb[i] > 0) c += (ha[i] - hb[i]) * (ha[i] - hb[i]) / (ha[i] + hb[i]);
+  return 0.5 * c;
+}
+
+double cv(const std::vector<long long>& c) {
+  double mean = std::accumulate(c.begin(), c.end(), 0.0) / c.size(), var = 0;
+  for (long long v : c) var += (v - mean) * (v - mean);
+  return std::sqrt(var / c.size()) / mean;
+}
+
+MaterialTileOptions small_options() {
+  MaterialTileOptions o;
+  o.size = sanitized() ? 32 : 64;
+  o.layers = 4;
+  o.keys_are_tileable = true;
+  o.seed = 5;
+  return o;
+}
+
+std::vector<MaterialKey> cells_to_stripes(int size) {
+  return {{make_noise(size, 4, 7), {}, "noise"}, {make_stripes(size, size / 4.0, 30), {}, "stripes"}};
+}
+}  // namespace
+
+TEST(MaterialTile, EveryLayerTilesAndTheEndsAreTheKeys) {
+  MaterialTileOptions o = small_options();
+  MaterialTileResult r = make_material_tile(cells_to_stripes(o.size), o);
+  ASSERT_EQ(r.layers.size(), 5u);
+  for (std::size_t m = 0; m < r.layers.size(); ++m) {
+    EXPECT_LE(wrap_seam_ratio(r.layers[m]), 1.3) << "layer " << m;
+    EXPECT_EQ(r.layers[m].width, o.size);
+  }
+  // Keys are tileable procedural textures: layer 0 / M are exactly the keys, masks F_0 / F_M.
+  EXPECT_EQ(r.layers.front().data, r.key_tiles[0].data);
+  EXPECT_EQ(r.layers.back().data, r.key_tiles[1].data);
+  EXPECT_EQ(r.masks.front().data, r.key_masks[0].data);
+  EXPECT_EQ(r.masks.back().data, r.key_masks[1].data);
+  std::vector<long long> changes(r.sign_changes.begin() + 1, r.sign_changes.end());
+  EXPECT_LE(cv(changes), 0.35);
+  // The intermediate layers follow their masks.
+  for (double a : r.mask_agreement) EXPECT_GE(a, 0.85);
+  // Guard: the seam check fails on a cut (non-tiling) image.
+  Image cut(o.size * 2 / 3, o.size, 3);
+  for (int y = 0; y < cut.height; ++y)
+    for (int x = 0; x < cut.width; ++x)
+      for (int c = 0; c < 3; ++c) cut.at(x, y, c) = r.layers[2].at(x, y, c);
+  EXPECT_GT(wrap_seam_ratio(cut), 1.3);
+}
+
+TEST(MaterialTile, SynthesisedKeyTilesTileAndKeepTheHistogram) {
+  // Real, non-tiling inputs: the key tiles are synthesised toroidally.
+  MaterialTileOptions o = small_options();
+  o.keys_are_tileable = false;
+  std::vector<MaterialKey> keys = {
+      {read_image(test::shared_data("textures/brick_small_96.png")), {}, "brick"},
+      {read_image(test::shared_data("textures/cracked_mud_100.png")), {}, "mud"}};
+  MaterialTileResult r = make_material_tile(keys, o);
+  for (std::size_t m = 0; m < r.layers.size(); ++m) EXPECT_LE(wrap_seam_ratio(r.layers[m]), 1.3) << m;
+  Image in0 = square_resample(keys[0].texture, o.size), in1 = square_resample(keys[1].texture, o.size);
+  EXPECT_LE(chi_square(r.layers.front(), in0), 0.1);
+  EXPECT_LE(chi_square(r.layers.back(), in1), 0.1);
+  EXPECT_GT(chi_square(in0, in1), 0.1);  // guard: the bound separates different textures
+  EXPECT_EQ(r.masks.front().data, r.key_masks[0].data);
+  EXPECT_EQ(r.masks.back().data, r.key_masks[1].data);
+}
+
+TEST(MaterialTile, ConstrainedSynthesisKeepsTheHistogramAndUsesMostPixels) {
+  const int s = sanitized() ? 32 : 64;
+  Image ex = make_cells(s, 4, 11);
+  Image mask = compute_feature_mask(ex).mask;
+  Image other = compute_feature_mask(make_cells(s, 4, 12)).mask;
+  ConstrainedSynthesisOptions o;
+  ConstrainedSynthesisResult r = synthesize_constrained_tiles(ex, mask, {mask, other}, o);
+  EXPECT_EQ(r.layers[0].data, ex.data);  // identity layer
+  EXPECT_GE(r.mask_agreement[1], 0.9);
+  EXPECT_LE(chi_square(r.layers[1], ex), 0.06);
+  EXPECT_LE(r.unused_fraction[1], 0.5);
+  o.reuse_penalty = 0;
+  ConstrainedSynthesisResult r0 = synthesize_constrained_tiles(ex, mask, {mask, other}, o);
+  EXPECT_LE(r.unused_fraction[1], r0.unused_fraction[1]);  // the penalty spreads the usage
+}
+
+TEST(MaterialTile, ChainsThreeKeys) {
+  MaterialTileOptions o = small_options();
+  o.layers = 2;
+  auto keys = cells_to_stripes(o.size);
+  keys.push_back({make_checker(o.size, 4), {}, "checker"});
+  MaterialTileResult r = make_material_tile(keys, o);
+  ASSERT_EQ(r.layers.size(), 5u);
+  EXPECT_EQ(r.layers[2].data, r.key_tiles[1].data);
+  EXPECT_EQ(r.layers[4].data, r.key_tiles[2].data);
+  EXPECT_DOUBLE_EQ(r.material[3], 1.5);
+}
+
+TEST(MaterialTile, SameMaskModeGivesDifferentTilesWithOneMask) {
+  MaterialTileOptions o = small_options();
+  o.layers = 3;
+  MaterialTileResult r = make_material_tile({{make_noise(o.size, 4, 9), {}, "noise"}}, o);
+  ASSERT_EQ(r.layers.size(), 4u);
+  for (std::size_t m = 1; m < r.layers.size(); ++m) {
+    EXPECT_NE(r.layers[m].data, r.layers[0].data);
+    EXPECT_GE(r.mask_agreement[m], 0.85);
+    EXPECT_LE(wrap_seam_ratio(r.layers[m]), 1.3);
+    EXPECT_EQ(r.masks[m].data, r.masks[0].data);
+  }
+}
+
+TEST(MaterialTile, SameSeedSameBytesWhateverTheThreads) {
+  MaterialTileOptions o = small_options();
+  o.layers = 2;
+  MaterialTileResult a = make_material_tile(cells_to_stripes(o.size), o);
+  MaterialTileResult b;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    b = make_material_tile(cells_to_stripes(o.size), o);
+  }
+  for (std::size_t m = 0; m < a.layers.size(); ++m) EXPECT_EQ(a.layers[m].data, b.layers[m].data);
+  o.seed = 6;
+  MaterialTileResult c = make_material_tile(cells_to_stripes(o.size), o);
+  EXPECT_NE(a.layers[1].data, c.layers[1].data);
+}
+
+TEST(MaterialTile, WritesTheFolderFormat) {
+  MaterialTileOptions o = small_options();
+  o.layers = 2;
+  MaterialTileResult r = make_material_tile(cells_to_stripes(o.size), o);
+  std::string dir = test::temp_dir("mattile") + "/tile";
+  MaterialTileInfo info{{"noise", "stripes"}, {"", ""}, 5, 2};
+  write_material_tile(dir, r, info);
+  std::vector<Image> stack = read_image_layers(dir + "/layers.tif");
+  ASSERT_EQ(stack.size(), 3u);
+  Image l1 = read_image(dir + "/layer_001.png");
+  EXPECT_EQ(l1.width, o.size);
+  for (std::size_t i = 0; i < l1.data.size(); ++i) ASSERT_NEAR(l1.data[i], r.layers[1].data[i], 0.5 / 255 + 1e-6);
+  std::ifstream f(dir + "/tile.json");
+  nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["layers"], 3);
+  EXPECT_EQ(j["size"], o.size);
+  EXPECT_EQ(j["layer_list"][2]["mask"], "mask_002.png");
+  EXPECT_EQ(j["layer_list"][1]["sign_changes"], r.sign_changes[1]);
+  EXPECT_THROW(write_material_tile(dir, r, info, false), IOError);
+  EXPECT_NO_THROW(write_material_tile(dir, r, info, true));
+}
+
+TEST(MaterialTile, InvalidInputsThrow) {
+  EXPECT_THROW(make_material_tile({}), InvalidInputError);
+  MaterialTileOptions o = small_options();
+  MaterialKey bad{make_cells(64, 4, 1), Image(10, 10, 1), "bad"};
+  EXPECT_THROW(make_material_tile({bad}, o), InvalidInputError);
+  o.layers = 0;
+  EXPECT_THROW(make_material_tile(cells_to_stripes(64), o), InvalidInputError);
+}
