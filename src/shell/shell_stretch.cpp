@@ -203,16 +203,19 @@ MinimizeStretchResult shell_map_minimize_stretch(ShellSpace& s, const MinimizeSt
           auto E = [&](double t) { return energy(v, u0 + t * du, w0 + t * dw); };
           const double e0 = E(0);
           double best_t = 0, best_e = e0;
-          const int K = opt.line_samples;
-          for (int j = -K; j <= K; ++j) {
-            if (j == 0) continue;
-            const double t = radius * j / K, e = E(t);
-            if (e < best_e) best_e = e, best_t = t;
-          }
+          // Samples at geometric distances radius / 2^k on both sides: the best
+          // step can be far below the neighbour distance (thin texture tets).
+          double t = radius;
+          for (int k = 0; k < opt.line_samples; ++k, t *= 0.5)
+            for (double sgn : {1.0, -1.0}) {
+              const double e = E(sgn * t);
+              if (e < best_e) best_e = e, best_t = sgn * t;
+            }
           tried.fetch_add(1, std::memory_order_relaxed);
           if (!(best_e < e0)) continue;
-          // Golden-section refinement on [best_t - h, best_t + h].
-          double a = best_t - radius / K, b = best_t + radius / K;
+          // Golden-section refinement between half and one and a half times the best sample.
+          double a = 0.5 * best_t, b = 1.5 * best_t;
+          if (a > b) std::swap(a, b);
           double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
           double f1 = E(x1), f2 = E(x2);
           for (int it = 0; it < opt.refine_steps; ++it) {

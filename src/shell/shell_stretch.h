@@ -51,10 +51,12 @@ struct MinimizeStretchOptions {
   int iterations = 40;
   /// Seed of the random search directions.
   std::uint64_t seed = 1;
-  /// Samples on each side of the vertex along the search line; >= 1.
-  int line_samples = 4;
+  /// Samples on each side of the vertex along the search line, at distances
+  /// radius, radius/2, radius/4, ... (multi-scale: the best step in a thin
+  /// shell is often far below the neighbour distance); >= 1.
+  int line_samples = 10;
   /// Golden-section refinements around the best sample; >= 0.
-  int refine_steps = 6;
+  int refine_steps = 8;
   /// Search radius as a fraction of the shortest uv distance from the vertex to
   /// its neighbouring offset-surface vertices; in (0, 1].
   double step_fraction = 0.5;

@@ -10,6 +10,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/self_intersections.h"
 
 namespace surftex {
 
@@ -41,6 +42,12 @@ TetMeshResult tetrahedralize_closed_surface(const Mesh& boundary, const TetGenOp
   for (FaceIndex f : boundary.faces())
     if (boundary.degree(f) != 3)
       throw InvalidInputError("tetgen: boundary face " + std::to_string(f.idx()) + " is not a triangle");
+
+  // TetGen 1.5 crashes (segmentation fault, no throw) on some self-intersecting
+  // PLCs: refuse them first with the exact check.
+  if (const std::size_t n = count_self_intersections(boundary); n > 0)
+    throw InvalidInputError("tetgen: boundary surface self-intersects (" + std::to_string(n) +
+                            " face pairs); TetGen needs a valid PLC");
 
   tetgenio in, out;  // their destructors free the arrays with delete[]
   in.firstnumber = 0;

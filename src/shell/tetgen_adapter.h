@@ -17,7 +17,10 @@
 // tet non-degenerate. Tets are returned positively oriented (CGAL::orientation
 // exact predicate on Epick points; TetGen's own convention is the opposite
 // sign, so most tets are reordered: swap of the first two corners).
-// Throws: InvalidInputError (surface not closed or not triangles, bad switches),
+// The surface is first checked for self-intersections (exact predicates):
+// TetGen 1.5 was seen to crash outright on such input, so it is refused.
+// Throws: InvalidInputError (surface not closed, not triangles or
+//         self-intersecting; bad switches),
 //         SolverError (TetGen failed, or returned a degenerate/invalid mesh).
 
 #include <array>
