@@ -19,17 +19,31 @@ namespace surftex {
 struct PolygonSoup {
   std::vector<std::array<double, 3>> points;
   std::vector<std::vector<std::size_t>> polygons;
-  /// Optional per-corner texture coordinates (OBJ `vt`), parallel to `polygons`
-  /// (same shape) when non-empty.
+  /// Optional per-corner texture coordinates (OBJ `vt`): `polygon_uvs` is
+  /// either empty or parallel to `polygons`; polygon_uvs[i] is then either
+  /// empty (that polygon has no UVs) or has polygons[i].size() indices into `uvs`.
   std::vector<std::array<double, 2>> uvs;
   std::vector<std::vector<std::size_t>> polygon_uvs;
-  /// Optional per-point colours in [0,1] (PLY red/green/blue, OFF COFF).
+  /// Optional per-point colours in [0,1] (PLY red/green/blue, OFF COFF, OBJ
+  /// `v x y z r g b`): either empty or parallel to `points`.
   std::vector<std::array<float, 3>> colors;
+  /// Where the soup came from (the file path), used in error messages.
+  std::string source;
 };
 
-/// Reads any supported format (chosen by extension, then by content). Throws
-/// IOError (unreadable, truncated, malformed: the message names file, line or
-/// element) or InvalidInputError (NaN/inf coordinates, bad indices, no faces).
+/// Reads any supported format (chosen by the extension .off/.obj/.ply/.stl,
+/// case-insensitive; by content for any other extension). Formats: OFF with
+/// the ST/C/N prefixes (COFF colours as 0-255 integers or 0-1 floats), OBJ
+/// (v, vt, f with v/vt/vn forms and negative relative indices, polygons;
+/// `v x y z r g b` colours), PLY ascii / binary little / big endian (x,y,z of
+/// any numeric type, optional red/green/blue, face list vertex_indices or
+/// vertex_index; other elements and properties skipped), STL ascii and binary
+/// (binary when the size is exactly 84 + 50n; welded on exactly equal
+/// positions). Every count in a header is checked against the file size
+/// before anything is allocated. Throws IOError (missing, empty, unreadable,
+/// truncated, malformed, unknown format: the message names file and line or
+/// element) or InvalidInputError (NaN/inf coordinates, out-of-range or
+/// negative indices, no faces).
 PolygonSoup read_polygon_soup(const std::string& path);
 
 struct SoupToMeshOptions {
@@ -44,11 +58,28 @@ struct SoupRepairCounts {
   std::size_t duplicate_polygons_removed = 0;
   std::size_t isolated_points_removed = 0;
   std::size_t points_duplicated_to_orient = 0;  ///< non-manifold splits by orient_polygon_soup
+  std::size_t pinched_polygons_split = 0;  ///< extra polygons from splitting pinched ones
   bool oriented = true;  ///< orient_polygon_soup succeeded without splitting
+  std::size_t output_vertices = 0, output_faces = 0;  ///< after conversion (and triangulation)
+  std::size_t faces_triangulated = 0;  ///< non-triangular faces split into triangles
+  std::size_t uv_corners = 0;          ///< corners that received a kCornerUV value
+  std::size_t uv_corners_dropped = 0;  ///< corners whose UV could not be mapped (or had none)
 };
 
-/// Repairs and orients a soup and builds the mesh. Colours, if present, go to
-/// the kVertexColor property. Throws TopologyError if nothing valid is left.
+/// Repairs and orients a soup and builds the mesh (which is cleared first).
+/// Steps: the steps of CGAL PMP repair_polygon_soup (merge duplicate points,
+/// simplify polygons, split pinched polygons, remove polygons with < 3
+/// vertices, remove duplicate polygons, remove isolated points) run one by one
+/// so that each is counted; orient_polygon_soup (may duplicate points at
+/// non-manifold spots); polygon_soup_to_polygon_mesh; PMP triangulate_faces
+/// when opt.triangulate.
+/// Properties written: kVertexColor (if soup.colors is non-empty; colours are
+/// mapped through the repair by exact position), kCornerUV (if any polygon has
+/// UVs; mapped per corner by position, corners without a UV get (0,0) and are
+/// counted in uv_corners_dropped; diagonals added by triangulation get the UV
+/// of their corner in the original polygon).
+/// Throws InvalidInputError if an index is out of range, TopologyError
+/// (naming soup.source) if no face is left or the result is not a mesh.
 void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt = {},
                   SoupRepairCounts* counts = nullptr);
 

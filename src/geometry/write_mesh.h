@@ -28,7 +28,28 @@ struct WriteMeshOptions {
   bool overwrite = true;
 };
 
-/// Format by extension: .obj, .ply, .glb, .off. Throws IOError / InvalidInputError.
+/// Format by extension (case-insensitive):
+/// - .obj: `v x y z [r g b]` (colours if kVertexColor and write_colors), `vt`
+///   per distinct corner UV of kCornerUV (v as stored: origin bottom-left),
+///   `vn` per vertex, `f v/vt/vn`. With a texture: `mtllib <stem>.mtl`, and
+///   <stem>.mtl (map_Kd <stem>.png) and <stem>.png written beside it. The
+///   three files are renamed into place together at the end.
+/// - .ply: binary little-endian, float x/y/z, optional uchar red/green/blue,
+///   optional float <vertex_scalar_property>, face list uchar (uint if a face
+///   has > 255 corners) int vertex_indices.
+/// - .off: OFF (COFF with 0-255 colours when colours are written), positions
+///   in shortest round-trip decimal.
+/// - .glb: glTF 2.0 binary, one triangle primitive (polygons fanned):
+///   POSITION (with min/max), NORMAL, TEXCOORD_0 (vertices split at UV seams,
+///   one glTF vertex per distinct (vertex, uv); stored as (u, 1 - v) since
+///   glTF's UV origin is top-left), COLOR_0 (float RGB), "_<scalar>"; a PBR
+///   material (metallic 0, roughness 1, double-sided) with the texture
+///   embedded as PNG as its base colour.
+/// Properties read: kVertexColor, kCornerUV, kVertexNormal (else computed,
+/// area-weighted), the named scalar. Throws InvalidInputError (unknown
+/// extension, no faces, non-finite position, missing scalar property) or
+/// IOError (cannot write; output exists and !overwrite). A failed write
+/// leaves no file behind.
 void write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt = {});
 
 }  // namespace surftex

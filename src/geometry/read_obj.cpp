@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// OBJ reader: "v x y z [w]" or "v x y z r g b" (colours), "vt u [v [w]]",
+// "f a b c ..." with corners "v", "v/vt", "v//vn", "v/vt/vn" (1-based, or
+// negative = relative to the elements defined so far). Lines ending in '\'
+// continue on the next. vn, vp, l, p, o, g, s, mtllib, usemtl and unknown
+// keywords are ignored.
+#include <algorithm>
+
+#include "geometry/errors.h"
+#include "geometry/mesh_parsers.h"
+
+namespace surftex::mesh_io {
+
+namespace {
+
+/// Resolves an OBJ index (1-based, or negative relative) against `count`
+/// elements defined so far.
+std::size_t resolve(const std::string& path, const std::string& where, std::string_view tok,
+                    std::size_t count, const char* what) {
+  std::int64_t i = 0;
+  if (!parse_int64(tok, i)) fail_io(path, where, std::string("bad ") + what + " index " + show(tok));
+  if (i == 0) fail_input(path, where, std::string(what) + " index 0 (OBJ indices start at 1)");
+  std::int64_t r = i > 0 ? i - 1 : static_cast<std::int64_t>(count) + i;
+  if (r < 0 || static_cast<std::uint64_t>(r) >= count)
+    fail_input(path, where,
+               std::string(what) + " index " + std::to_string(i) + " out of range (" +
+                   std::to_string(count) + " " + what + "s defined so far)");
+  return static_cast<std::size_t>(r);
+}
+
+}  // namespace
+
+PolygonSoup read_obj(const std::string& path, std::string_view data) {
+  PolygonSoup soup;
+  TextLines lines(path, data);
+  std::string_view raw;
+  std::string joined;  // for continued lines
+  std::vector<std::string_view> tok;
+  bool all_colored = true;
+  std::size_t faces_with_uv = 0;
+  std::vector<std::size_t> poly, puv;
+  while (lines.next(raw)) {
+    std::size_t line_no = lines.line_no();
+    std::string_view line = strip_comment(raw);
+    if (!line.empty() && line.back() == '\\') {
+      joined.assign(line.substr(0, line.size() - 1));
+      std::string_view more;
+      while (lines.next(more)) {
+        std::string_view m = strip_comment(more);
+        bool cont = !m.empty() && m.back() == '\\';
+        joined += ' ';
+        joined.append(cont ? m.substr(0, m.size() - 1) : m);
+        if (!cont) break;
+      }
+      line = joined;
+    }
+    split_blanks(line, tok);
+    if (tok.empty()) continue;
+    const std::string_view kw = tok[0];
+    if (kw == "v") {
+      const std::string where = at_line(line_no);
+      if (tok.size() < 4) fail_io(path, where, "vertex needs 3 coordinates: " + show(raw));
+      std::array<double, 3> p{};
+      for (int k = 0; k < 3; ++k)
+        if (!parse_double(tok[1 + k], p[k])) fail_io(path, where, "bad coordinate " + show(tok[1 + k]));
+      check_finite(path, where, p);
+      soup.points.push_back(p);
+      if (tok.size() >= 7 && all_colored) {
+        std::array<float, 3> col{};
+        for (int k = 0; k < 3; ++k) {
+          double v = 0;
+          if (!parse_double(tok[4 + k], v) || !std::isfinite(v))
+            fail_io(path, where, "bad colour component " + show(tok[4 + k]));
+          col[k] = static_cast<float>(std::clamp(v, 0.0, 1.0));
+        }
+        soup.colors.push_back(col);
+      } else {
+        all_colored = false;
+      }
+    } else if (kw == "vt") {
+      const std::string where = at_line(line_no);
+      if (tok.size() < 2) fail_io(path, where, "texture coordinate without values");
+      std::array<double, 3> uv{0.0, 0.0, 0.0};
+      for (std::size_t k = 0; k < 2 && 1 + k < tok.size(); ++k)
+        if (!parse_double(tok[1 + k], uv[k])) fail_io(path, where, "bad texture coordinate " + show(tok[1 + k]));
+      check_finite(path, where, uv);
+      soup.uvs.push_back({uv[0], uv[1]});
+    } else if (kw == "f") {
+      const std::string where = at_line(line_no);
+      if (tok.size() < 4)
+        fail_io(path, where,
+                "face has " + std::to_string(tok.size() - 1) + " vertices (at least 3 needed): " + show(raw));
+      poly.clear();
+      puv.clear();
+      bool uv_complete = true;
+      for (std::size_t k = 1; k < tok.size(); ++k) {
+        std::string_view c = tok[k];
+        std::size_t s1 = c.find('/');
+        std::string_view vpart = c.substr(0, s1);
+        poly.push_back(resolve(path, where, vpart, soup.points.size(), "vertex"));
+        std::string_view tpart;
+        if (s1 != std::string_view::npos) {
+          std::string_view rest = c.substr(s1 + 1);
+          std::size_t s2 = rest.find('/');
+          tpart = rest.substr(0, s2);
+          if (s2 != std::string_view::npos && rest.substr(s2 + 1).find('/') != std::string_view::npos)
+            fail_io(path, where, "bad face corner " + show(c));
+        }
+        if (tpart.empty()) uv_complete = false;
+        else puv.push_back(resolve(path, where, tpart, soup.uvs.size(), "texture coordinate"));
+      }
+      soup.polygons.push_back(poly);
+      if (uv_complete) {
+        if (soup.polygon_uvs.size() < soup.polygons.size() - 1) soup.polygon_uvs.resize(soup.polygons.size() - 1);
+        soup.polygon_uvs.push_back(puv);
+        ++faces_with_uv;
+      } else if (!soup.polygon_uvs.empty()) {
+        soup.polygon_uvs.emplace_back();
+      }
+    }
+    // vn, vp, l, p, o, g, s, mtllib, usemtl, ...: not needed here.
+  }
+  if (!all_colored || soup.colors.size() != soup.points.size()) soup.colors.clear();
+  if (faces_with_uv == 0) {
+    soup.uvs.clear();
+    soup.polygon_uvs.clear();
+  } else {
+    soup.polygon_uvs.resize(soup.polygons.size());
+  }
+  return soup;
+}
+
+}  // namespace surftex::mesh_io

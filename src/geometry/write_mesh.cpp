@@ -1,0 +1,485 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Mesh output: OBJ (+MTL +PNG), binary little-endian PLY, OFF, glTF 2.0 binary.
+#include "geometry/write_mesh.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "geometry/errors.h"
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/output_file.h"
+#include "geometry/properties.h"
+
+namespace fs = std::filesystem;
+
+namespace surftex {
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// Shortest decimal that reads back to the same double.
+void append_num(std::string& out, double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+/// What every writer needs, gathered once: compact vertex numbering, faces
+/// as vertex lists, optional normals / colours / corner UVs / scalar.
+struct Gathered {
+  std::vector<std::array<double, 3>> pos;
+  std::vector<std::vector<std::size_t>> faces;     // compact vertex ids
+  std::vector<std::vector<HalfedgeIndex>> corners;  // halfedge per face corner
+  std::vector<std::array<float, 3>> normals;        // empty = none
+  std::vector<std::array<float, 3>> colors;         // empty = none
+  std::vector<double> scalar;                       // empty = none
+  PropertyMap<HalfedgeIndex, UV> uv;
+  bool has_uv = false;
+};
+
+Gathered gather(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt, bool want_normals) {
+  Gathered g;
+  if (mesh.number_of_faces() == 0)
+    throw InvalidInputError("cannot write '" + path + "': the mesh has no faces");
+  std::vector<std::size_t> id(mesh.num_vertices(), SIZE_MAX);
+  g.pos.reserve(mesh.number_of_vertices());
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+      throw InvalidInputError("cannot write '" + path + "': vertex " + std::to_string(v.idx()) +
+                              " has a non-finite coordinate");
+    id[v.idx()] = g.pos.size();
+    g.pos.push_back({p.x(), p.y(), p.z()});
+  }
+  g.faces.reserve(mesh.number_of_faces());
+  g.corners.reserve(mesh.number_of_faces());
+  for (FaceIndex f : mesh.faces()) {
+    std::vector<std::size_t> fv;
+    std::vector<HalfedgeIndex> fh;
+    for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
+      fv.push_back(id[mesh.target(h).idx()]);
+      fh.push_back(h);
+    }
+    g.faces.push_back(std::move(fv));
+    g.corners.push_back(std::move(fh));
+  }
+  if (opt.write_uvs) {
+    auto m = find(mesh, kCornerUV);
+    if (m.second) {
+      g.uv = m.first;
+      g.has_uv = true;
+    }
+  }
+  if (opt.write_colors) {
+    auto m = find(mesh, kVertexColor);
+    if (m.second) {
+      g.colors.reserve(g.pos.size());
+      for (VertexIndex v : mesh.vertices()) g.colors.push_back(m.first[v]);
+    }
+  }
+  if (!opt.vertex_scalar_property.empty()) {
+    auto m = mesh.property_map<VertexIndex, double>(opt.vertex_scalar_property);
+    if (!m.second)
+      throw InvalidInputError("cannot write '" + path + "': the mesh has no per-vertex double property '" +
+                              opt.vertex_scalar_property + "' (vertex_scalar_property)");
+    for (VertexIndex v : mesh.vertices()) g.scalar.push_back(m.first[v]);
+  }
+  if (want_normals && opt.write_normals) {
+    g.normals.assign(g.pos.size(), {0.f, 0.f, 0.f});
+    auto m = find(mesh, kVertexNormal);
+    if (m.second) {
+      for (VertexIndex v : mesh.vertices()) {
+        const Vector3& n = m.first[v];
+        g.normals[id[v.idx()]] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
+      }
+    } else {
+      // Area-weighted smooth normals (Newell's method per face: twice the
+      // vector area, so larger faces weigh more).
+      std::vector<std::array<double, 3>> acc(g.pos.size(), {0.0, 0.0, 0.0});
+      for (const auto& f : g.faces) {
+        std::array<double, 3> n{0, 0, 0};
+        for (std::size_t k = 0; k < f.size(); ++k) {
+          const auto& a = g.pos[f[k]];
+          const auto& b = g.pos[f[(k + 1) % f.size()]];
+          n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+          n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+          n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        }
+        for (std::size_t v : f)
+          for (int c = 0; c < 3; ++c) acc[v][c] += n[c];
+      }
+      for (std::size_t i = 0; i < acc.size(); ++i) {
+        double l = std::sqrt(acc[i][0] * acc[i][0] + acc[i][1] * acc[i][1] + acc[i][2] * acc[i][2]);
+        g.normals[i] = l > 0 ? std::array<float, 3>{static_cast<float>(acc[i][0] / l), static_cast<float>(acc[i][1] / l),
+                                                    static_cast<float>(acc[i][2] / l)}
+                             : std::array<float, 3>{0.f, 0.f, 1.f};
+      }
+    }
+  }
+  return g;
+}
+
+void write_bytes(std::ofstream& f, const std::string& path) {
+  f.flush();
+  if (!f) throw IOError("write to '" + path + "' failed (disk full?)");
+}
+
+// ------------------------------------------------------------------ OBJ
+void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  Gathered g = gather(path, mesh, opt, true);
+  fs::path p(path);
+  const std::string stem = p.stem().string();
+  const bool textured = opt.texture != nullptr && !opt.texture->empty();
+  const fs::path dir = p.parent_path();
+  const std::string mtl_name = stem + ".mtl", png_name = stem + ".png";
+  // All three files are prepared as temporaries first and renamed at the end,
+  // so a failure leaves none of them (and !overwrite refuses before writing).
+  AtomicOutputFile obj_out(path, opt.overwrite);
+  std::unique_ptr<AtomicOutputFile> mtl_out, png_out;
+  if (textured) {
+    mtl_out = std::make_unique<AtomicOutputFile>((dir / mtl_name).string(), opt.overwrite);
+    png_out = std::make_unique<AtomicOutputFile>((dir / png_name).string(), opt.overwrite);
+  }
+
+  std::string s;
+  s.reserve(g.pos.size() * 60 + g.faces.size() * 40);
+  s += "# written by surftex\n";
+  if (textured) s += "mtllib " + mtl_name + "\n";
+  for (std::size_t i = 0; i < g.pos.size(); ++i) {
+    s += "v ";
+    append_num(s, g.pos[i][0]);
+    s += ' ';
+    append_num(s, g.pos[i][1]);
+    s += ' ';
+    append_num(s, g.pos[i][2]);
+    if (!g.colors.empty())
+      for (int c = 0; c < 3; ++c) {
+        s += ' ';
+        append_num(s, g.colors[i][c]);
+      }
+    s += '\n';
+  }
+  // Distinct UV values, numbered in first-use order.
+  std::vector<std::vector<std::size_t>> face_vt;
+  if (g.has_uv) {
+    std::map<std::array<double, 2>, std::size_t> vt_id;
+    face_vt.resize(g.faces.size());
+    for (std::size_t f = 0; f < g.faces.size(); ++f)
+      for (HalfedgeIndex h : g.corners[f]) {
+        const UV& uv = g.uv[h];
+        auto [it, inserted] = vt_id.emplace(std::array<double, 2>{uv[0], uv[1]}, vt_id.size());
+        if (inserted) {
+          s += "vt ";
+          append_num(s, uv[0]);
+          s += ' ';
+          append_num(s, uv[1]);
+          s += '\n';
+        }
+        face_vt[f].push_back(it->second);
+      }
+  }
+  for (const auto& n : g.normals) {
+    s += "vn ";
+    append_num(s, n[0]);
+    s += ' ';
+    append_num(s, n[1]);
+    s += ' ';
+    append_num(s, n[2]);
+    s += '\n';
+  }
+  if (textured) s += "usemtl surftex_material\n";
+  for (std::size_t f = 0; f < g.faces.size(); ++f) {
+    s += 'f';
+    for (std::size_t k = 0; k < g.faces[f].size(); ++k) {
+      const std::string v = std::to_string(g.faces[f][k] + 1);
+      s += ' ';
+      s += v;
+      if (g.has_uv) s += "/" + std::to_string(face_vt[f][k] + 1);
+      if (!g.normals.empty()) s += (g.has_uv ? "/" : "//") + v;
+    }
+    s += '\n';
+  }
+
+  if (textured) {
+    write_image(png_out->temp_path(), *opt.texture);
+    std::string m = "# written by surftex\nnewmtl surftex_material\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n";
+    m += "map_Kd " + png_name + "\n";
+    std::ofstream f(mtl_out->temp_path(), std::ios::binary);
+    if (!f) throw IOError("cannot open '" + mtl_out->temp_path() + "' for writing");
+    f << m;
+    write_bytes(f, mtl_out->destination());
+  }
+  {
+    std::ofstream f(obj_out.temp_path(), std::ios::binary);
+    if (!f) throw IOError("cannot open '" + obj_out.temp_path() + "' for writing");
+    f.write(s.data(), static_cast<std::streamsize>(s.size()));
+    write_bytes(f, path);
+  }
+  if (textured) {
+    png_out->commit();
+    mtl_out->commit();
+  }
+  obj_out.commit();
+}
+
+// ------------------------------------------------------------------ PLY
+template <class T>
+void put_le(std::string& s, T v) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  const std::uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  if (first != 1) std::reverse(b, b + sizeof(T));
+  s.append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+void write_ply(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  Gathered g = gather(path, mesh, opt, false);
+  std::size_t max_deg = 0;
+  for (const auto& f : g.faces) max_deg = std::max(max_deg, f.size());
+  const bool wide = max_deg > 255;
+  std::string s = "ply\nformat binary_little_endian 1.0\ncomment written by surftex\n";
+  s += "element vertex " + std::to_string(g.pos.size()) + "\n";
+  s += "property float x\nproperty float y\nproperty float z\n";
+  if (!g.colors.empty()) s += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!g.scalar.empty()) s += "property float " + opt.vertex_scalar_property + "\n";
+  s += "element face " + std::to_string(g.faces.size()) + "\n";
+  s += std::string("property list ") + (wide ? "uint" : "uchar") + " int vertex_indices\nend_header\n";
+  for (std::size_t i = 0; i < g.pos.size(); ++i) {
+    for (int c = 0; c < 3; ++c) put_le<float>(s, static_cast<float>(g.pos[i][c]));
+    if (!g.colors.empty())
+      for (int c = 0; c < 3; ++c)
+        put_le<std::uint8_t>(s, static_cast<std::uint8_t>(std::lround(std::clamp(g.colors[i][c], 0.f, 1.f) * 255.f)));
+    if (!g.scalar.empty()) put_le<float>(s, static_cast<float>(g.scalar[i]));
+  }
+  for (const auto& f : g.faces) {
+    if (wide) put_le<std::uint32_t>(s, static_cast<std::uint32_t>(f.size()));
+    else put_le<std::uint8_t>(s, static_cast<std::uint8_t>(f.size()));
+    for (std::size_t v : f) put_le<std::int32_t>(s, static_cast<std::int32_t>(v));
+  }
+  write_file_atomic(path, s, opt.overwrite);
+}
+
+// ------------------------------------------------------------------ OFF
+void write_off(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  Gathered g = gather(path, mesh, opt, false);
+  const bool col = !g.colors.empty();
+  std::string s = col ? "COFF\n" : "OFF\n";
+  s += std::to_string(g.pos.size()) + " " + std::to_string(g.faces.size()) + " 0\n";
+  for (std::size_t i = 0; i < g.pos.size(); ++i) {
+    append_num(s, g.pos[i][0]);
+    s += ' ';
+    append_num(s, g.pos[i][1]);
+    s += ' ';
+    append_num(s, g.pos[i][2]);
+    if (col) {
+      for (int c = 0; c < 3; ++c)
+        s += " " + std::to_string(std::lround(std::clamp(g.colors[i][c], 0.f, 1.f) * 255.f));
+      s += " 255";
+    }
+    s += '\n';
+  }
+  for (const auto& f : g.faces) {
+    s += std::to_string(f.size());
+    for (std::size_t v : f) s += " " + std::to_string(v);
+    s += '\n';
+  }
+  write_file_atomic(path, s, opt.overwrite);
+}
+
+// ------------------------------------------------------------------ glTF
+std::string png_bytes(const std::string& beside, const Image& img) {
+  // Encoded through OpenImageIO into a temporary that is never committed.
+  AtomicOutputFile tmp((fs::path(beside).parent_path() / "texture.png").string(), true);
+  write_image(tmp.temp_path(), img);
+  std::ifstream f(tmp.temp_path(), std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  if (!f && !f.eof()) throw IOError("cannot read back the encoded texture for '" + beside + "'");
+  return ss.str();
+}
+
+void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  Gathered g = gather(path, mesh, opt, true);
+  const bool textured = opt.texture != nullptr && !opt.texture->empty();
+  // One glTF vertex per distinct (vertex, uv) pair: vertices are split at UV seams.
+  std::vector<std::size_t> src;          // glTF vertex -> mesh vertex (compact id)
+  std::vector<std::array<float, 2>> tc;  // glTF TEXCOORD_0 (v flipped)
+  std::vector<std::uint32_t> indices;
+  std::map<std::pair<std::size_t, std::array<double, 2>>, std::uint32_t> key_to_id;
+  auto vid = [&](std::size_t v, HalfedgeIndex h) -> std::uint32_t {
+    std::array<double, 2> uv{0.0, 0.0};
+    if (g.has_uv) uv = {g.uv[h][0], g.uv[h][1]};
+    auto [it, inserted] = key_to_id.emplace(std::make_pair(v, uv), static_cast<std::uint32_t>(src.size()));
+    if (inserted) {
+      src.push_back(v);
+      // glTF's UV origin is the top-left of the image, OBJ's/ours the bottom-left.
+      tc.push_back({static_cast<float>(uv[0]), static_cast<float>(1.0 - uv[1])});
+    }
+    return it->second;
+  };
+  for (std::size_t f = 0; f < g.faces.size(); ++f) {
+    const auto& fv = g.faces[f];
+    const std::uint32_t a = vid(fv[0], g.corners[f][0]);
+    for (std::size_t k = 1; k + 1 < fv.size(); ++k) {  // fan over polygons
+      indices.push_back(a);
+      indices.push_back(vid(fv[k], g.corners[f][k]));
+      indices.push_back(vid(fv[k + 1], g.corners[f][k + 1]));
+    }
+  }
+  if (src.size() > 0xffffffffu) throw InvalidInputError("cannot write '" + path + "': too many vertices for glTF");
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "surftex";
+  model.buffers.emplace_back();
+  auto& buf = model.buffers[0].data;
+  auto add_view = [&](const void* data, std::size_t bytes, int target) -> int {
+    while (buf.size() % 4) buf.push_back(0);
+    tinygltf::BufferView bv;
+    bv.buffer = 0;
+    bv.byteOffset = buf.size();
+    bv.byteLength = bytes;
+    bv.target = target;
+    const auto* b = static_cast<const unsigned char*>(data);
+    buf.insert(buf.end(), b, b + bytes);
+    model.bufferViews.push_back(bv);
+    return static_cast<int>(model.bufferViews.size() - 1);
+  };
+  auto add_accessor = [&](int view, int comp, int type, std::size_t count, std::vector<double> mn = {},
+                          std::vector<double> mx = {}) -> int {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = comp;
+    a.type = type;
+    a.count = count;
+    a.minValues = std::move(mn);
+    a.maxValues = std::move(mx);
+    model.accessors.push_back(a);
+    return static_cast<int>(model.accessors.size() - 1);
+  };
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  {
+    std::vector<float> p(src.size() * 3);
+    std::vector<double> mn(3, HUGE_VAL), mx(3, -HUGE_VAL);
+    for (std::size_t i = 0; i < src.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        float v = static_cast<float>(g.pos[src[i]][c]);
+        p[3 * i + c] = v;
+        mn[c] = std::min<double>(mn[c], v);
+        mx[c] = std::max<double>(mx[c], v);
+      }
+    int view = add_view(p.data(), p.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["POSITION"] =
+        add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size(), mn, mx);
+  }
+  if (!g.normals.empty()) {
+    std::vector<float> n(src.size() * 3);
+    for (std::size_t i = 0; i < src.size(); ++i)
+      for (int c = 0; c < 3; ++c) n[3 * i + c] = g.normals[src[i]][c];
+    int view = add_view(n.data(), n.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["NORMAL"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
+  }
+  if (g.has_uv) {
+    int view = add_view(tc.data(), tc.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["TEXCOORD_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, src.size());
+  }
+  if (!g.colors.empty()) {
+    std::vector<float> c(src.size() * 3);
+    for (std::size_t i = 0; i < src.size(); ++i)
+      for (int k = 0; k < 3; ++k) c[3 * i + k] = std::clamp(g.colors[src[i]][k], 0.f, 1.f);
+    int view = add_view(c.data(), c.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["COLOR_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
+  }
+  if (!g.scalar.empty()) {
+    std::vector<float> sv(src.size());
+    for (std::size_t i = 0; i < src.size(); ++i) sv[i] = static_cast<float>(g.scalar[src[i]]);
+    int view = add_view(sv.data(), sv.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["_" + opt.vertex_scalar_property] =
+        add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, src.size());
+  }
+  {
+    int view = add_view(indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    prim.indices = add_accessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+  }
+
+  tinygltf::Material mat;
+  mat.name = "surftex_material";
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = 1.0;
+  mat.doubleSided = true;
+  if (textured) {
+    std::string png = png_bytes(path, *opt.texture);
+    int view = add_view(png.data(), png.size(), 0);
+    model.bufferViews[view].target = 0;
+    tinygltf::Image im;
+    im.name = "texture";
+    im.mimeType = "image/png";
+    im.bufferView = view;
+    model.images.push_back(im);
+    tinygltf::Sampler smp;
+    smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    smp.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
+    smp.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
+    model.samplers.push_back(smp);
+    tinygltf::Texture tex;
+    tex.source = 0;
+    tex.sampler = 0;
+    model.textures.push_back(tex);
+    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+  }
+  model.materials.push_back(mat);
+  prim.material = 0;
+  while (buf.size() % 4) buf.push_back(0);
+
+  tinygltf::Mesh gm;
+  gm.name = "surftex_mesh";
+  gm.primitives.push_back(prim);
+  model.meshes.push_back(gm);
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+
+  tinygltf::TinyGLTF writer;
+  std::ostringstream os;
+  if (!writer.WriteGltfSceneToStream(&model, os, false, true))
+    throw IOError("cannot encode glTF for '" + path + "'");
+  write_file_atomic(path, os.str(), opt.overwrite);
+}
+
+}  // namespace
+
+void write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  const std::string ext = lower(fs::path(path).extension().string());
+  if (ext == ".obj") write_obj(path, mesh, opt);
+  else if (ext == ".ply") write_ply(path, mesh, opt);
+  else if (ext == ".off") write_off(path, mesh, opt);
+  else if (ext == ".glb") write_glb(path, mesh, opt);
+  else
+    throw InvalidInputError("cannot write '" + path + "': unknown mesh format '" + ext +
+                            "' (supported: .obj, .ply, .off, .glb)");
+}
+
+}  // namespace surftex

@@ -1,0 +1,627 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "texture/graphcut_synthesis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/graph_cut.h"
+#include "texture/masked_ssd_fft.h"
+
+namespace surftex {
+
+namespace {
+constexpr int kDirs[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// GraphcutCanvas
+
+GraphcutCanvas::GraphcutCanvas(const Image& exemplar, int width, int height, bool periodic,
+                               bool gradient_normalized)
+    : ex_(exemplar), w_(width), h_(height), periodic_(periodic),
+      gradient_normalized_(gradient_normalized) {
+  if (exemplar.empty()) throw InvalidInputError("graph-cut synthesis: the exemplar is empty");
+  if (width <= 0 || height <= 0)
+    throw InvalidInputError("graph-cut synthesis: output size must be positive, got " +
+                            std::to_string(width) + "x" + std::to_string(height));
+  sx_.assign(static_cast<std::size_t>(w_) * h_, -1);
+  sy_.assign(sx_.size(), -1);
+}
+
+bool GraphcutCanvas::complete() const {
+  return std::all_of(sx_.begin(), sx_.end(), [](int v) { return v >= 0; });
+}
+
+bool GraphcutCanvas::neighbour(int x, int y, int dx, int dy, int& nx, int& ny) const {
+  nx = x + dx;
+  ny = y + dy;
+  if (periodic_) {
+    nx = (nx % w_ + w_) % w_;
+    ny = (ny % h_ + h_) % h_;
+    return !(nx == x && ny == y);
+  }
+  return nx >= 0 && ny >= 0 && nx < w_ && ny < h_;
+}
+
+double GraphcutCanvas::pair_cost(int sx, int sy, int tx, int ty, int dx, int dy) const {
+  // s has label A (source (sx,sy)), its neighbour t = s + d has label B
+  // (source (tx,ty)). Same translation: no seam.
+  if (tx == sx + dx && ty == sy + dy) return 0.0;
+  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < ex_.width && y < ex_.height; };
+  auto dist = [&](int ax, int ay, int bx, int by) {
+    const float* a = ex_.pixel(ax, ay);
+    const float* b = ex_.pixel(bx, by);
+    double s = 0.0;
+    for (int c = 0; c < ex_.channels; ++c) {
+      double d = static_cast<double>(a[c]) - b[c];
+      s += d * d;
+    }
+    return std::sqrt(s);
+  };
+  const bool bs_ok = inside(tx - dx, ty - dy);  // B(s)
+  const bool at_ok = inside(sx + dx, sy + dy);  // A(t)
+  double m;
+  if (bs_ok && at_ok)
+    m = dist(sx, sy, tx - dx, ty - dy) + dist(sx + dx, sy + dy, tx, ty);
+  else if (bs_ok)
+    m = 2.0 * dist(sx, sy, tx - dx, ty - dy);
+  else if (at_ok)
+    m = 2.0 * dist(sx + dx, sy + dy, tx, ty);
+  else
+    m = 2.0 * dist(sx, sy, tx, ty);
+  if (gradient_normalized_) {
+    double ga = at_ok ? dist(sx, sy, sx + dx, sy + dy) : -1.0;
+    double gb = bs_ok ? dist(tx - dx, ty - dy, tx, ty) : -1.0;
+    if (ga < 0) ga = gb >= 0 ? gb : 0.0;
+    if (gb < 0) gb = ga;
+    m /= ga + gb + 1e-3;
+  }
+  return m;
+}
+
+void GraphcutCanvas::check_placement(const PatchPlacement& p) const {
+  if (p.width <= 0 || p.height <= 0 || p.ex_x < 0 || p.ex_y < 0 ||
+      p.ex_x + p.width > ex_.width || p.ex_y + p.height > ex_.height)
+    throw InvalidInputError("graph-cut synthesis: patch window (" + std::to_string(p.ex_x) + "," +
+                            std::to_string(p.ex_y) + ") size " + std::to_string(p.width) + "x" +
+                            std::to_string(p.height) + " is not inside the " +
+                            std::to_string(ex_.width) + "x" + std::to_string(ex_.height) +
+                            " exemplar");
+  if (periodic_ && (p.width > w_ - 1 || p.height > h_ - 1))
+    throw InvalidInputError("graph-cut synthesis: a periodic patch must be smaller than the output (" +
+                            std::to_string(p.width) + "x" + std::to_string(p.height) + " vs " +
+                            std::to_string(w_) + "x" + std::to_string(h_) + ")");
+}
+
+namespace {
+// Clips a non-periodic placement to the output; returns false if nothing is left.
+bool clip_placement(PatchPlacement& p, int w, int h) {
+  if (p.out_x < 0) { p.ex_x -= p.out_x; p.width += p.out_x; p.out_x = 0; }
+  if (p.out_y < 0) { p.ex_y -= p.out_y; p.height += p.out_y; p.out_y = 0; }
+  p.width = std::min(p.width, w - p.out_x);
+  p.height = std::min(p.height, h - p.out_y);
+  return p.width > 0 && p.height > 0;
+}
+
+// Footprint of a placement: local (i,j) <-> output (x,y).
+struct Footprint {
+  PatchPlacement p;
+  int w, h;
+  bool periodic;
+  int ox(int i) const { return periodic ? (p.out_x + i) % w : p.out_x + i; }
+  int oy(int j) const { return periodic ? (p.out_y + j) % h : p.out_y + j; }
+  int local(int x, int y) const {
+    int i = x - p.out_x, j = y - p.out_y;
+    if (periodic) {
+      i = (i % w + w) % w;
+      j = (j % h + h) % h;
+    }
+    if (i < 0 || j < 0 || i >= p.width || j >= p.height) return -1;
+    return j * p.width + i;
+  }
+};
+}  // namespace
+
+int GraphcutCanvas::place_graphcut(const PatchPlacement& placement,
+                                   const std::vector<std::pair<int, int>>& forced) {
+  PatchPlacement p = placement;
+  if (periodic_) {
+    p.out_x = (p.out_x % w_ + w_) % w_;
+    p.out_y = (p.out_y % h_ + h_) % h_;
+  }
+  check_placement(p);
+  if (!periodic_ && !clip_placement(p, w_, h_)) return 0;
+  const Footprint fp{p, w_, h_, periodic_};
+  const int n = p.width * p.height;
+  std::vector<char> force(static_cast<std::size_t>(n), 0);
+  for (const auto& f : forced) {
+    if (f.first < 0 || f.second < 0 || f.first >= w_ || f.second >= h_) continue;
+    int l = fp.local(f.first, f.second);
+    if (l >= 0) force[static_cast<std::size_t>(l)] = 1;
+  }
+  struct Term { int u, v; double cuv, cvu; };
+  struct SeamNode { int q, r; double cq, cr, old; };
+  std::vector<Term> edges;
+  std::vector<SeamNode> seams;
+  std::vector<double> tsrc(static_cast<std::size_t>(n), 0.0), tsink(static_cast<std::size_t>(n), 0.0);
+  edges.reserve(static_cast<std::size_t>(2 * n));
+  for (int j = 0; j < p.height; ++j)
+    for (int i = 0; i < p.width; ++i) {
+      const int q = j * p.width + i;
+      const int x = fp.ox(i), y = fp.oy(j);
+      const bool cq = covered(x, y);
+      const int ax = sx_[idx(x, y)], ay = sy_[idx(x, y)];
+      const int bx = p.ex_x + i, by = p.ex_y + j;
+      if (!cq || force[static_cast<std::size_t>(q)]) tsink[static_cast<std::size_t>(q)] = GraphCut::kInfinity;
+      for (const auto& d : kDirs) {
+        int rx, ry;
+        if (!neighbour(x, y, d[0], d[1], rx, ry)) continue;
+        const int r = fp.local(rx, ry);
+        const bool cr = covered(rx, ry);
+        const int arx = sx_[idx(rx, ry)], ary = sy_[idx(rx, ry)];
+        if (r >= 0) {
+          if (d[0] < 0 || d[1] < 0) continue;  // internal pairs once (right, down)
+          const int brx = bx + d[0], bry = by + d[1];
+          if (cq && cr && !(arx == ax + d[0] && ary == ay + d[1])) {
+            // Old seam between two earlier patches: seam node (section 3.3).
+            seams.push_back({q, r, pair_cost(ax, ay, brx, bry, d[0], d[1]),
+                             pair_cost(bx, by, arx, ary, d[0], d[1]),
+                             pair_cost(ax, ay, arx, ary, d[0], d[1])});
+          } else {
+            double c_qr = cq ? pair_cost(ax, ay, brx, bry, d[0], d[1]) : 0.0;  // q old, r new
+            double c_rq = cr ? pair_cost(bx, by, arx, ary, d[0], d[1]) : 0.0;  // q new, r old
+            if (c_qr > 0.0 || c_rq > 0.0) edges.push_back({q, r, c_qr, c_rq});
+          }
+        } else if (cr) {
+          // Neighbour outside the footprint keeps its source: terminal costs.
+          double keep = cq ? pair_cost(ax, ay, arx, ary, d[0], d[1]) : 0.0;
+          double take = pair_cost(bx, by, arx, ary, d[0], d[1]);
+          tsink[static_cast<std::size_t>(q)] += keep;   // paid when q stays old (source side)
+          tsrc[static_cast<std::size_t>(q)] += take;    // paid when q takes the patch (sink side)
+        }
+      }
+    }
+  GraphCut gc(n + static_cast<int>(seams.size()));
+  for (int q = 0; q < n; ++q)
+    if (tsrc[static_cast<std::size_t>(q)] > 0.0 || tsink[static_cast<std::size_t>(q)] > 0.0)
+      gc.add_terminal(q, tsrc[static_cast<std::size_t>(q)], tsink[static_cast<std::size_t>(q)]);
+  for (const Term& e : edges) gc.add_edge(e.u, e.v, e.cuv, e.cvu);
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    const int s = n + static_cast<int>(k);
+    gc.add_edge(seams[k].q, s, seams[k].cq, seams[k].cq);
+    gc.add_edge(s, seams[k].r, seams[k].cr, seams[k].cr);
+    gc.add_terminal(s, 0.0, seams[k].old);
+  }
+  gc.solve();
+  int changed = 0;
+  for (int j = 0; j < p.height; ++j)
+    for (int i = 0; i < p.width; ++i) {
+      if (gc.is_source_side(j * p.width + i)) continue;
+      const std::size_t o = idx(fp.ox(i), fp.oy(j));
+      const int bx = p.ex_x + i, by = p.ex_y + j;
+      if (sx_[o] != bx || sy_[o] != by) ++changed;
+      sx_[o] = bx;
+      sy_[o] = by;
+    }
+  return changed;
+}
+
+void GraphcutCanvas::place_straight(const PatchPlacement& placement) {
+  PatchPlacement p = placement;
+  if (periodic_) {
+    p.out_x = (p.out_x % w_ + w_) % w_;
+    p.out_y = (p.out_y % h_ + h_) % h_;
+  }
+  check_placement(p);
+  if (!periodic_ && !clip_placement(p, w_, h_)) return;
+  const Footprint fp{p, w_, h_, periodic_};
+  for (int j = 0; j < p.height; ++j)
+    for (int i = 0; i < p.width; ++i) {
+      const std::size_t o = idx(fp.ox(i), fp.oy(j));
+      sx_[o] = p.ex_x + i;
+      sy_[o] = p.ex_y + j;
+    }
+}
+
+double GraphcutCanvas::seam_cost() const {
+  double total = 0.0;
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < w_; ++x) {
+      if (!covered(x, y)) continue;
+      for (int k = 0; k < 2; ++k) {
+        int rx, ry;
+        if (!neighbour(x, y, kDirs[k][0], kDirs[k][1], rx, ry) || !covered(rx, ry)) continue;
+        total += pair_cost(sx_[idx(x, y)], sy_[idx(x, y)], sx_[idx(rx, ry)], sy_[idx(rx, ry)],
+                           kDirs[k][0], kDirs[k][1]);
+      }
+    }
+  return total;
+}
+
+double GraphcutCanvas::pixel_seam_error(int x, int y) const {
+  if (!covered(x, y)) return 0.0;
+  double e = 0.0;
+  for (const auto& d : kDirs) {
+    int rx, ry;
+    if (!neighbour(x, y, d[0], d[1], rx, ry) || !covered(rx, ry)) continue;
+    e += pair_cost(sx_[idx(x, y)], sy_[idx(x, y)], sx_[idx(rx, ry)], sy_[idx(rx, ry)], d[0], d[1]);
+  }
+  return e;
+}
+
+double GraphcutCanvas::footprint_cost(const PatchPlacement& placement) const {
+  PatchPlacement p = placement;
+  if (!periodic_ && !clip_placement(p, w_, h_)) return 0.0;
+  const Footprint fp{p, w_, h_, periodic_};
+  double total = 0.0;
+  for (int j = 0; j < p.height; ++j)
+    for (int i = 0; i < p.width; ++i) {
+      const int x = fp.ox(i), y = fp.oy(j);
+      if (!covered(x, y)) continue;
+      for (const auto& d : kDirs) {
+        int rx, ry;
+        if (!neighbour(x, y, d[0], d[1], rx, ry) || !covered(rx, ry)) continue;
+        if (fp.local(rx, ry) >= 0 && (d[0] < 0 || d[1] < 0)) continue;
+        total += pair_cost(sx_[idx(x, y)], sy_[idx(x, y)], sx_[idx(rx, ry)], sy_[idx(rx, ry)],
+                           d[0], d[1]);
+      }
+    }
+  return total;
+}
+
+Image GraphcutCanvas::render() const {
+  Image out(w_, h_, ex_.channels, 0.f);
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < w_; ++x) {
+      if (!covered(x, y)) continue;
+      const float* s = ex_.pixel(sx_[idx(x, y)], sy_[idx(x, y)]);
+      std::copy(s, s + ex_.channels, out.pixel(x, y));
+    }
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// The placement loop.
+
+class GraphcutSynthesizer {
+ public:
+  GraphcutSynthesizer(const Image& ex, int w, int h, const GraphcutOptions& o)
+      : ex_(ex), opt_(o), canvas_(ex, w, h, o.periodic_output, o.gradient_normalized),
+        rng_(o.seed) {
+    const int lim_w = o.periodic_output ? std::max(1, w - 1) : w;
+    const int lim_h = o.periodic_output ? std::max(1, h - 1) : h;
+    if (o.placement == PlacementMode::EntirePatch) {
+      pw_ = std::min(ex.width, lim_w);
+      ph_ = std::min(ex.height, lim_h);
+    } else {
+      const int min_side = std::min(ex.width, ex.height);
+      const int auto_ps = std::min(min_side, std::clamp(min_side / 3, 64, 128));
+      int ps = o.patch_size > 0 ? o.patch_size : auto_ps;
+      pw_ = std::min({ps, ex.width, lim_w});
+      ph_ = std::min({ps, ex.height, lim_h});
+    }
+    int ov = o.overlap > 0 ? o.overlap : std::max(2, std::min(pw_, ph_) / 3);
+    ov_ = std::min(ov, std::min(pw_, ph_) - 1);
+    // sigma^2: summed per-channel variance of the exemplar.
+    const std::size_t np = static_cast<std::size_t>(ex.width) * ex.height;
+    for (int c = 0; c < ex.channels; ++c) {
+      double s = 0, s2 = 0;
+      for (std::size_t i = 0; i < np; ++i) {
+        double v = ex.data[i * ex.channels + c];
+        s += v;
+        s2 += v * v;
+      }
+      double mean = s / np;
+      sigma2_ += std::max(0.0, s2 / np - mean * mean);
+    }
+    sigma2_ = std::max(sigma2_, 1e-8);
+  }
+
+  GraphcutResult run() {
+    GraphcutResult res;
+    if (opt_.placement == PlacementMode::EntirePatch)
+      fill_entire();
+    else
+      fill_grid();
+    res.fill_patches = fill_patches_;
+    res.seam_cost_after_fill = canvas_.seam_cost();
+    refine(res);
+    res.seam_cost_final = canvas_.seam_cost();
+    res.image = canvas_.render();
+    res.source_x = canvas_.sx_;
+    res.source_y = canvas_.sy_;
+    report_progress(opt_.progress, "graphcut", 1.0);
+    return res;
+  }
+
+ private:
+  double uniform01() { return static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
+  int uniform_int(int lo, int hi) {  // inclusive
+    return lo + static_cast<int>(uniform01() * (hi - lo + 1)) % (hi - lo + 1);
+  }
+
+  // Draws an index with probability exp(-(C_i - C_min)/(k sigma^2)).
+  int draw(const std::vector<std::pair<int, double>>& cand) {
+    double cmin = cand.front().second;
+    for (const auto& c : cand) cmin = std::min(cmin, c.second);
+    const double t = opt_.k * sigma2_;
+    std::vector<double> w(cand.size());
+    double total = 0.0;
+    for (std::size_t i = 0; i < cand.size(); ++i) total += w[i] = std::exp(-(cand[i].second - cmin) / t);
+    double r = uniform01() * total;
+    for (std::size_t i = 0; i < cand.size(); ++i) {
+      r -= w[i];
+      if (r < 0.0) return cand[i].first;
+    }
+    return cand.back().first;
+  }
+
+  // The output window at (x0, y0), wrapped or clipped, and its covered mask.
+  void window(int x0, int y0, int ww, int wh, Image& img, std::vector<float>& mask) const {
+    img = Image(ww, wh, ex_.channels, 0.f);
+    mask.assign(static_cast<std::size_t>(ww) * wh, 0.f);
+    const int W = canvas_.w_, H = canvas_.h_;
+    for (int j = 0; j < wh; ++j)
+      for (int i = 0; i < ww; ++i) {
+        int x = x0 + i, y = y0 + j;
+        if (canvas_.periodic_) {
+          x = (x % W + W) % W;
+          y = (y % H + H) % H;
+        } else if (x < 0 || y < 0 || x >= W || y >= H) {
+          continue;
+        }
+        if (!canvas_.covered(x, y)) continue;
+        mask[static_cast<std::size_t>(j) * ww + i] = 1.f;
+        const float* s = ex_.pixel(canvas_.source_x(x, y), canvas_.source_y(x, y));
+        std::copy(s, s + ex_.channels, img.pixel(i, j));
+      }
+  }
+
+  // Exemplar offset for a pw_ x ph_ patch at output (x0, y0).
+  // `fill`: skip offsets that merely continue a patch already in the window
+  // (within overlap/2 pixels of its translation) when any other offset
+  // exists; otherwise a large exemplar is copied verbatim.
+  std::pair<int, int> choose_offset(int x0, int y0, bool fill) {
+    const int mx = ex_.width - pw_, my = ex_.height - ph_;
+    if (opt_.placement == PlacementMode::Random) return {uniform_int(0, mx), uniform_int(0, my)};
+    Image win;
+    std::vector<float> mask;
+    window(x0, y0, pw_, ph_, win, mask);
+    double area = std::accumulate(mask.begin(), mask.end(), 0.0);
+    if (area <= 0.0) return {uniform_int(0, mx), uniform_int(0, my)};
+    if (!matcher_) matcher_ = std::make_unique<MaskedSsdMatcher>(ex_, std::vector<float>{}, false);
+    SsdMap m = matcher_->match(win, mask);
+    std::vector<std::pair<int, int>> continued;  // exemplar offsets of patches in the window
+    if (fill) {
+      for (int j = 0; j < ph_; ++j)
+        for (int i = 0; i < pw_; ++i) {
+          if (mask[static_cast<std::size_t>(j) * pw_ + i] == 0.f) continue;
+          int x = x0 + i, y = y0 + j;
+          if (canvas_.periodic_) {
+            x = (x % canvas_.w_ + canvas_.w_) % canvas_.w_;
+            y = (y % canvas_.h_ + canvas_.h_) % canvas_.h_;
+          }
+          std::pair<int, int> e{canvas_.source_x(x, y) - i, canvas_.source_y(x, y) - j};
+          if (std::find(continued.begin(), continued.end(), e) == continued.end()) continued.push_back(e);
+        }
+    }
+    const int r = std::max(1, ov_ / 2);
+    std::vector<std::pair<int, double>> cand, excluded;
+    cand.reserve(m.ssd.size());
+    for (std::size_t i = 0; i < m.ssd.size(); ++i) {
+      const int ex = static_cast<int>(i) % m.nx, ey = static_cast<int>(i) / m.nx;
+      bool cont = false;
+      for (const auto& e : continued)
+        if (std::abs(ex - e.first) <= r && std::abs(ey - e.second) <= r) cont = true;
+      (cont ? excluded : cand).emplace_back(static_cast<int>(i), m.ssd[i] / area);
+    }
+    int best = draw(cand.empty() ? excluded : cand);
+    return {best % m.nx, best / m.nx};
+  }
+
+  std::vector<int> grid(int size, int patch) const {
+    const int step = std::max(1, patch - ov_);
+    std::vector<int> g;
+    if (opt_.periodic_output) {
+      int n = (size + step - 1) / step;
+      for (int i = 0; i < n; ++i) g.push_back(static_cast<int>(static_cast<long long>(i) * size / n));
+    } else {
+      for (int x = 0;; x += step) {
+        if (x + patch >= size) {
+          g.push_back(std::max(0, size - patch));
+          break;
+        }
+        g.push_back(x);
+      }
+    }
+    return g;
+  }
+
+  void fill_grid() {
+    std::vector<int> gx = grid(canvas_.w_, pw_), gy = grid(canvas_.h_, ph_);
+    const std::size_t total = gx.size() * gy.size();
+    std::size_t done = 0;
+    for (int y0 : gy)
+      for (int x0 : gx) {
+        auto [ex, ey] = choose_offset(x0, y0, true);
+        canvas_.place_graphcut({x0, y0, ex, ey, pw_, ph_});
+        ++fill_patches_;
+        report_progress(opt_.progress, "graphcut fill", static_cast<double>(++done) / total);
+      }
+  }
+
+  // Entire-patch matching: the translation of the exemplar window [0,pw_)x[0,ph_)
+  // over the output that covers `target`, matched against everything covered.
+  PatchPlacement entire_patch_placement(int tx, int ty) {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const bool wrap = canvas_.periodic_;
+    const int padx = wrap ? 0 : pw_ - 1, pady = wrap ? 0 : ph_ - 1;
+    Image big(W + 2 * padx, H + 2 * pady, ex_.channels, 0.f);
+    std::vector<float> bmask(static_cast<std::size_t>(big.width) * big.height, 0.f);
+    bool any = false;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        if (!canvas_.covered(x, y)) continue;
+        any = true;
+        bmask[static_cast<std::size_t>(y + pady) * big.width + x + padx] = 1.f;
+        const float* s = ex_.pixel(canvas_.source_x(x, y), canvas_.source_y(x, y));
+        std::copy(s, s + ex_.channels, big.pixel(x + padx, y + pady));
+      }
+    Image tmpl(pw_, ph_, ex_.channels);
+    for (int j = 0; j < ph_; ++j)
+      for (int i = 0; i < pw_; ++i) std::copy(ex_.pixel(i, j), ex_.pixel(i, j) + ex_.channels, tmpl.pixel(i, j));
+    if (!any) return {tx, ty, 0, 0, pw_, ph_};
+    MaskedSsdMatcher matcher(big, std::move(bmask), wrap);
+    SsdMap m = matcher.match(tmpl, {});
+    // Candidates: top-left x0 in [tx-pw_+1, tx], overlap >= 10% of the patch.
+    std::vector<std::pair<int, double>> cand;
+    const double min_overlap = 0.1 * pw_ * ph_;
+    for (int dy = 0; dy < ph_; ++dy)
+      for (int dx = 0; dx < pw_; ++dx) {
+        int x0 = tx - dx, y0 = ty - dy;
+        int ux = wrap ? ((x0 % W) + W) % W : x0 + padx;
+        int uy = wrap ? ((y0 % H) + H) % H : y0 + pady;
+        if (ux < 0 || uy < 0 || ux >= m.nx || uy >= m.ny) continue;
+        double ov = m.overlap_at(ux, uy);
+        if (ov < min_overlap) continue;
+        cand.emplace_back(dy * pw_ + dx, m.ssd_at(ux, uy) / ov);
+      }
+    if (cand.empty()) return {tx, ty, 0, 0, pw_, ph_};
+    int c = draw(cand);
+    return {tx - c % pw_, ty - c / pw_, 0, 0, pw_, ph_};
+  }
+
+  void fill_entire() {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const std::size_t total = static_cast<std::size_t>(W) * H;
+    std::size_t scan = 0;
+    while (true) {
+      while (scan < total && canvas_.covered(static_cast<int>(scan % W), static_cast<int>(scan / W))) ++scan;
+      if (scan >= total) break;
+      const int tx = static_cast<int>(scan % W), ty = static_cast<int>(scan / W);
+      canvas_.place_graphcut(entire_patch_placement(tx, ty));
+      ++fill_patches_;
+      report_progress(opt_.progress, "graphcut fill", static_cast<double>(scan) / total);
+    }
+  }
+
+  void refine(GraphcutResult& res) {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const int per_pass = std::max(1, fill_patches_);
+    for (int pass = 0; pass < opt_.refinement_passes; ++pass) {
+      std::vector<std::pair<double, int>> err;
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          double e = canvas_.pixel_seam_error(x, y);
+          if (e > 0.0) err.emplace_back(-e, y * W + x);
+        }
+      std::sort(err.begin(), err.end());
+      std::vector<char> visited(static_cast<std::size_t>(W) * H, 0);
+      int placed = 0;
+      for (const auto& e : err) {
+        if (placed >= per_pass) break;
+        const int tx = e.second % W, ty = e.second / W;
+        if (visited[static_cast<std::size_t>(e.second)]) continue;
+        PatchPlacement p;
+        if (opt_.placement == PlacementMode::EntirePatch) {
+          p = entire_patch_placement(tx, ty);
+        } else {
+          int x0 = tx - pw_ / 2, y0 = ty - ph_ / 2;
+          if (!canvas_.periodic_) {
+            x0 = std::clamp(x0, 0, W - pw_);
+            y0 = std::clamp(y0, 0, H - ph_);
+          }
+          auto [ex, ey] = choose_offset(x0, y0, false);
+          p = {x0, y0, ex, ey, pw_, ph_};
+        }
+        if (canvas_.periodic_) {
+          p.out_x = (p.out_x % W + W) % W;
+          p.out_y = (p.out_y % H + H) % H;
+        }
+        // Mark the central half of the footprint as handled for this pass.
+        for (int j = ph_ / 4; j < ph_ - ph_ / 4; ++j)
+          for (int i = pw_ / 4; i < pw_ - pw_ / 4; ++i) {
+            int x = p.out_x + i, y = p.out_y + j;
+            if (canvas_.periodic_) { x %= W; y %= H; }
+            if (x >= 0 && y >= 0 && x < W && y < H) visited[static_cast<std::size_t>(y) * W + x] = 1;
+          }
+        visited[static_cast<std::size_t>(e.second)] = 1;
+        std::vector<std::pair<int, int>> forced;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            int x = tx + dx, y = ty + dy;
+            if (canvas_.periodic_) { x = (x % W + W) % W; y = (y % H + H) % H; }
+            forced.emplace_back(x, y);
+          }
+        const std::vector<int> keep_x = canvas_.sx_, keep_y = canvas_.sy_;
+        const double before = canvas_.footprint_cost(p);
+        canvas_.place_graphcut(p, forced);
+        const double after = canvas_.footprint_cost(p);
+        ++res.refinement_tried;
+        if (after > before) {
+          canvas_.sx_ = keep_x;
+          canvas_.sy_ = keep_y;
+        } else {
+          ++res.refinement_accepted;
+        }
+        ++placed;
+        report_progress(opt_.progress, "graphcut refine",
+                        (pass + static_cast<double>(placed) / per_pass) / opt_.refinement_passes);
+      }
+    }
+  }
+
+  const Image& ex_;
+  const GraphcutOptions& opt_;
+  GraphcutCanvas canvas_;
+  std::mt19937_64 rng_;
+  int pw_ = 0, ph_ = 0, ov_ = 0;
+  double sigma2_ = 0.0;
+  int fill_patches_ = 0;
+  std::unique_ptr<MaskedSsdMatcher> matcher_;
+};
+
+namespace {
+void validate(const Image& exemplar, int width, int height, const GraphcutOptions& o) {
+  if (exemplar.empty()) throw InvalidInputError("graphcut_synthesize: the exemplar is empty");
+  for (float v : exemplar.data)
+    if (!std::isfinite(v)) throw InvalidInputError("graphcut_synthesize: the exemplar holds a non-finite value");
+  if (width <= 0 || height <= 0)
+    throw InvalidInputError("graphcut_synthesize: width and height must be positive, got " +
+                            std::to_string(width) + "x" + std::to_string(height));
+  if (o.periodic_output && (width < 4 || height < 4))
+    throw InvalidInputError("graphcut_synthesize: periodic_output needs width and height >= 4, got " +
+                            std::to_string(width) + "x" + std::to_string(height));
+  if (o.patch_size != 0 && o.patch_size < 4)
+    throw InvalidInputError("graphcut_synthesize: patch_size must be 0 (auto) or >= 4, got " +
+                            std::to_string(o.patch_size));
+  if (o.overlap < 0)
+    throw InvalidInputError("graphcut_synthesize: overlap must be >= 0, got " + std::to_string(o.overlap));
+  if (o.patch_size > 0 && o.overlap >= o.patch_size)
+    throw InvalidInputError("graphcut_synthesize: overlap (" + std::to_string(o.overlap) +
+                            ") must be smaller than patch_size (" + std::to_string(o.patch_size) + ")");
+  if (o.refinement_passes < 0)
+    throw InvalidInputError("graphcut_synthesize: refinement_passes must be >= 0, got " +
+                            std::to_string(o.refinement_passes));
+  if (!(o.k > 0.0) || !std::isfinite(o.k))
+    throw InvalidInputError("graphcut_synthesize: k (temperature) must be > 0, got " + std::to_string(o.k));
+}
+}  // namespace
+
+GraphcutResult graphcut_synthesize_detailed(const Image& exemplar, int width, int height,
+                                            const GraphcutOptions& options) {
+  validate(exemplar, width, height, options);
+  GraphcutSynthesizer s(exemplar, width, height, options);
+  return s.run();
+}
+
+Image graphcut_synthesize(const Image& exemplar, int width, int height, const GraphcutOptions& options) {
+  return graphcut_synthesize_detailed(exemplar, width, height, options).image;
+}
+
+}  // namespace surftex

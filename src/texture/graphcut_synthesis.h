@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Graph-cut texture synthesis (Kwatra, Schoedl, Essa, Turk, Bobick 2003,
+// "Graphcut Textures: Image and Video Synthesis Using Graph Cuts").
+//
+// The output is built from patches of the exemplar. Each new patch is pasted
+// with a seam found by a minimum s-t cut (section 3) over its footprint:
+//  - matching-quality cost of a neighbour pair (s,t) between patches A and B
+//    (eq. 1): M(s,t,A,B) = ||A(s)-B(s)|| + ||A(t)-B(t)|| (Euclidean norm over
+//    channels); optionally divided by the gradient term of eq. 5,
+//    ||A(s)-A(t)|| + ||B(s)-B(t)|| + 1e-3 (GraphcutOptions::gradient_normalized).
+//    A patch is a translation of the exemplar, so A(t) is read from the
+//    exemplar next to A's source of s; where that falls outside the exemplar
+//    the one available term is counted twice.
+//  - old seams are kept (section 3.3): a pair whose two pixels come from
+//    different earlier patches gets a seam node joined to both pixels (costs
+//    M(s,t,A_s,B), M(s,t,B,A_t)) and to the new patch (cost M(s,t,A_s,A_t)),
+//    so a later patch can remove or replace an earlier seam.
+//  - pixels not yet covered are tied to the new patch with infinite links;
+//    pairs between the footprint and untouched pixels around it become
+//    terminal costs (old seam kept vs new seam made).
+// Every cut goes through surftex::GraphCut (Boost.Graph Boykov-Kolmogorov).
+//
+// Placement (section 4): the output is first filled in scan order with
+// patches overlapping by `overlap` pixels; then `refinement_passes` passes
+// place patches over the pixels with the highest seam error (section 4,
+// "we then iterate over regions of high seam cost"), forcing a 3x3 core at
+// the worst seam to take the new patch and keeping the result only if the
+// total seam cost does not increase. Candidate offsets are drawn with
+// probability proportional to exp(-C / (k sigma^2)) (section 4) where C is the
+// SSD over the overlap divided by the overlap area and sigma^2 the summed
+// per-channel variance of the exemplar. Matching costs for every offset come
+// from FFT correlations (section 4.1, texture/masked_ssd_fft.h).
+//
+// Periodic output (Ray et al. 2009 section 1, tileable tiles T_0, T_M): all
+// output indexing is modulo the size, patches wrap across the edges and the
+// seams across the wrap are optimised like any other.
+//
+// Deterministic: every random choice from a std::mt19937_64 seeded with
+// Options::seed; the same inputs give the same bytes for any thread count.
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry/image.h"
+#include "geometry/progress.h"
+
+namespace surftex {
+
+enum class PlacementMode {
+  Random,       ///< random exemplar offset (section 4, "random placement")
+  EntirePatch,  ///< the whole exemplar (clipped to the output) is translated over the
+                ///< output; the translation covering the next target pixel is matched
+                ///< against everything already there (section 4, "entire patch matching")
+  SubPatch      ///< a patch_size window of the output is matched against every exemplar
+                ///< offset (section 4, "sub-patch matching")
+};
+
+struct GraphcutOptions {
+  PlacementMode placement = PlacementMode::SubPatch;
+  /// Side of a (square) patch in pixels, 0 = automatic: s/3 clamped to
+  /// [64, 128], at most s, where s = min(exemplar width, exemplar height)
+  /// (fewer, larger patches on large exemplars); always clipped to the
+  /// exemplar and output sizes. Ignored
+  /// by EntirePatch (the patch is the exemplar). Range 0 or >= 4.
+  int patch_size = 0;
+  /// Overlap between neighbouring patches of the fill pass in pixels, 0 =
+  /// automatic: max(2, patch/3). Must be < patch size. Range >= 0.
+  int overlap = 0;
+  /// Refinement passes after the output is filled (each places as many
+  /// patches as the fill pass did, at the highest-seam-error pixels). Range >= 0.
+  int refinement_passes = 1;
+  /// Temperature k of the placement probability exp(-C/(k sigma^2)): small =
+  /// nearly always the best match, large = nearly random. Range > 0.
+  double k = 0.002;
+  /// Divide the matching cost by the gradient term (Kwatra eq. 5).
+  bool gradient_normalized = false;
+  /// Toroidal output: the result tiles seamlessly left-right and top-bottom.
+  bool periodic_output = false;
+  std::uint64_t seed = 1;
+  ProgressCallback progress;
+};
+
+/// One patch placement: the exemplar window [ex_x, ex_x+width) x [ex_y, ex_y+height)
+/// is pasted with its top-left at output pixel (out_x, out_y) (wrapped when
+/// the output is periodic; clipped to the output otherwise).
+struct PatchPlacement {
+  int out_x = 0, out_y = 0;
+  int ex_x = 0, ex_y = 0;
+  int width = 0, height = 0;
+};
+
+/// The state of a graph-cut synthesis: for every output pixel, the exemplar
+/// pixel it was copied from (or none yet). Exposed as a small class so that
+/// callers (tileable tiles, tests) can place patches one by one.
+class GraphcutCanvas {
+ public:
+  /// Throws InvalidInputError for an empty exemplar or a non-positive size.
+  GraphcutCanvas(const Image& exemplar, int width, int height, bool periodic,
+                 bool gradient_normalized = false);
+
+  int width() const { return w_; }
+  int height() const { return h_; }
+  bool periodic() const { return periodic_; }
+  bool covered(int x, int y) const { return sx_[idx(x, y)] >= 0; }
+  bool complete() const;
+  /// Exemplar coordinates of output pixel (x, y); (-1, -1) if not covered.
+  int source_x(int x, int y) const { return sx_[idx(x, y)]; }
+  int source_y(int x, int y) const { return sy_[idx(x, y)]; }
+
+  /// Pastes `p` with a minimum-cost seam. Uncovered pixels and `forced`
+  /// pixels (output coordinates inside the footprint) take the new patch.
+  /// Returns the number of pixels whose source changed. Throws
+  /// InvalidInputError if the exemplar window is not inside the exemplar.
+  int place_graphcut(const PatchPlacement& p, const std::vector<std::pair<int, int>>& forced = {});
+  /// Pastes `p` over its whole footprint (a straight-boundary paste).
+  void place_straight(const PatchPlacement& p);
+
+  /// Sum of M over all neighbour pairs whose pixels are both covered (zero
+  /// where both come from the same translation); includes the wrap pairs
+  /// when periodic.
+  double seam_cost() const;
+  /// Sum of the seam costs of the pairs touching pixel (x, y) (4 neighbours).
+  double pixel_seam_error(int x, int y) const;
+  /// The output image (uncovered pixels are 0).
+  Image render() const;
+
+ private:
+  friend class GraphcutSynthesizer;
+  std::size_t idx(int x, int y) const { return static_cast<std::size_t>(y) * w_ + x; }
+  double pair_cost(int sx, int sy, int tx, int ty, int dx, int dy) const;
+  bool neighbour(int x, int y, int dx, int dy, int& nx, int& ny) const;
+  double footprint_cost(const PatchPlacement& p) const;
+  void check_placement(const PatchPlacement& p) const;
+
+  Image ex_;
+  int w_, h_;
+  bool periodic_, gradient_normalized_;
+  std::vector<int> sx_, sy_;
+};
+
+struct GraphcutResult {
+  Image image;                       ///< width x height, exemplar channels
+  std::vector<int> source_x, source_y;  ///< exemplar pixel of each output pixel
+  double seam_cost_after_fill = 0;   ///< total seam cost when the output was first full
+  double seam_cost_final = 0;        ///< after the refinement passes
+  int fill_patches = 0;              ///< patches placed by the fill pass
+  int refinement_tried = 0;          ///< refinement patches tried
+  int refinement_accepted = 0;       ///< ... kept (seam cost did not increase)
+};
+
+/// Synthesizes a width x height image from `exemplar`. Throws
+/// InvalidInputError naming the option for an invalid option or size.
+GraphcutResult graphcut_synthesize_detailed(const Image& exemplar, int width, int height,
+                                            const GraphcutOptions& options = {});
+
+/// As graphcut_synthesize_detailed, returning only the image.
+Image graphcut_synthesize(const Image& exemplar, int width, int height,
+                          const GraphcutOptions& options = {});
+
+}  // namespace surftex

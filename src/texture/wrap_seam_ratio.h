@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Wrap-seam ratio: how visible the seams of an image are when it is repeated
+// as a tile. The mean colour jump (Euclidean norm over channels) across the
+// wrap -- between column W-1 and column 0, and between row H-1 and row 0 --
+// divided by the mean jump between horizontal and vertical neighbours inside
+// the image. About 1 for a seamless tile (the wrap looks like any other
+// neighbour pair), clearly above 1 for an image that does not tile.
+// Used to check the tileable tiles of Ray et al. 2009 section 1 (T_0, T_M).
+
+#include "geometry/image.h"
+
+namespace surftex {
+
+struct WrapSeamStats {
+  double wrap_mean = 0.0;    ///< mean jump over the H left-right and W top-bottom wrap pairs
+  double inside_mean = 0.0;  ///< mean jump over the (W-1)H + W(H-1) interior pairs
+  double ratio = 1.0;        ///< wrap_mean / inside_mean (1 if both are 0, +inf if only inside is 0)
+};
+
+/// Throws InvalidInputError if the image is empty or smaller than 2x2.
+WrapSeamStats wrap_seam_stats(const Image& img);
+
+/// wrap_seam_stats(img).ratio.
+double wrap_seam_ratio(const Image& img);
+
+}  // namespace surftex

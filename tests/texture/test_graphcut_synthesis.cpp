@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <random>
+#include <set>
+#include <string>
+#include <tuple>
+
+#include "geometry/errors.h"
+#include "geometry/image_io.h"
+#include "test_support.h"
+#include "texture/graphcut_synthesis.h"
+#include "texture/masked_ssd_fft.h"
+
+using namespace surftex;
+
+namespace {
+
+bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+
+Image random_image(std::mt19937_64& rng, int w, int h, int c) {
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  Image img(w, h, c);
+  for (float& v : img.data) v = u(rng);
+  return img;
+}
+
+std::vector<float> random_mask(std::mt19937_64& rng, int w, int h, double p_one) {
+  std::bernoulli_distribution b(p_one);
+  std::vector<float> m(static_cast<std::size_t>(w) * h);
+  for (float& v : m) v = b(rng) ? 1.f : 0.f;
+  return m;
+}
+
+Image crop(const Image& img, int x0, int y0, int w, int h) {
+  Image out(w, h, img.channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < img.channels; ++c) out.at(x, y, c) = img.at(x0 + x, y0 + y, c);
+  return out;
+}
+
+Image texture(const std::string& name, int size) {
+  Image img = read_image(test::shared_data("textures/" + name));
+  return crop(img, 0, 0, std::min(size, img.width), std::min(size, img.height));
+}
+
+}  // namespace
+
+TEST(MaskedSsdFft, EqualsBruteForceForRandomImagesMasksAndOffsets) {
+  std::mt19937_64 rng(99);
+  for (int trial = 0; trial < 24; ++trial) {
+    const bool wrap = trial % 2 == 1;
+    const int c = 1 + trial % 3;
+    const int bw = 7 + static_cast<int>(rng() % 14), bh = 5 + static_cast<int>(rng() % 14);
+    const int tw = 1 + static_cast<int>(rng() % static_cast<unsigned>(bw)),
+              th = 1 + static_cast<int>(rng() % static_cast<unsigned>(bh));
+    Image big = random_image(rng, bw, bh, c), tmpl = random_image(rng, tw, th, c);
+    std::vector<float> bmask = trial % 4 < 2 ? std::vector<float>{} : random_mask(rng, bw, bh, 0.7);
+    std::vector<float> tmask = random_mask(rng, tw, th, 0.6);
+    MaskedSsdMatcher matcher(big, bmask, wrap);
+    SsdMap fast = matcher.match(tmpl, tmask);
+    SsdMap ref = masked_ssd_brute_force(big, bmask, tmpl, tmask, wrap);
+    ASSERT_EQ(fast.nx, ref.nx);
+    ASSERT_EQ(fast.ny, ref.ny);
+    ASSERT_EQ(fast.nx, wrap ? bw : bw - tw + 1);
+    for (std::size_t i = 0; i < ref.ssd.size(); ++i) {
+      ASSERT_NEAR(fast.ssd[i], ref.ssd[i], 1e-9 * (1.0 + ref.ssd[i])) << "trial " << trial << " at " << i;
+      ASSERT_NEAR(fast.overlap[i], ref.overlap[i], 1e-9 * (1.0 + ref.overlap[i])) << "trial " << trial;
+    }
+  }
+}
+
+TEST(MaskedSsdFft, ZeroAtTheTemplatesOwnPosition) {
+  std::mt19937_64 rng(5);
+  Image big = random_image(rng, 40, 33, 3);
+  Image tmpl = crop(big, 11, 7, 9, 12);
+  SsdMap m = MaskedSsdMatcher(big, {}, false).match(tmpl, {});
+  EXPECT_NEAR(m.ssd_at(11, 7), 0.0, 1e-9);
+  for (std::size_t i = 0; i < m.ssd.size(); ++i)
+    if (i != static_cast<std::size_t>(7 * m.nx + 11)) {
+      EXPECT_GT(m.ssd[i], 1e-3);
+    }
+}
+
+TEST(GraphcutSynthesis, EveryOutputPixelIsAnExemplarPixel) {
+  Image ex = texture("coffee_beans_64.png", 64);
+  std::set<std::vector<float>> values;
+  for (int y = 0; y < ex.height; ++y)
+    for (int x = 0; x < ex.width; ++x) values.insert(std::vector<float>(ex.pixel(x, y), ex.pixel(x, y) + ex.channels));
+  for (PlacementMode mode : {PlacementMode::SubPatch, PlacementMode::Random, PlacementMode::EntirePatch})
+    for (bool periodic : {false, true}) {
+      GraphcutOptions o;
+      o.placement = mode;
+      o.patch_size = 24;
+      o.periodic_output = periodic;
+      const int W = 61, H = 50;
+      GraphcutResult r = graphcut_synthesize_detailed(ex, W, H, o);
+      ASSERT_EQ(r.image.width, W);
+      ASSERT_EQ(r.image.height, H);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const int sx = r.source_x[static_cast<std::size_t>(y) * W + x];
+          const int sy = r.source_y[static_cast<std::size_t>(y) * W + x];
+          ASSERT_TRUE(sx >= 0 && sy >= 0 && sx < ex.width && sy < ex.height) << x << "," << y;
+          for (int c = 0; c < ex.channels; ++c) ASSERT_EQ(r.image.at(x, y, c), ex.at(sx, sy, c));
+          ASSERT_TRUE(values.count(std::vector<float>(r.image.pixel(x, y), r.image.pixel(x, y) + ex.channels)));
+        }
+    }
+}
+
+TEST(GraphcutSynthesis, CutSeamNoHigherThanStraightPaste) {
+  Image ex = texture("pebbles_256.png", 96);
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 10; ++trial) {
+    const bool periodic = trial % 2 == 1;
+    GraphcutCanvas cut(ex, 80, 64, periodic), straight(ex, 80, 64, periodic);
+    auto rnd = [&](int n) { return static_cast<int>(rng() % static_cast<unsigned>(n)); };
+    PatchPlacement a{0, 0, rnd(64), rnd(64), 32, 32};
+    cut.place_straight(a);
+    straight.place_straight(a);
+    // A second patch overlapping the first: no old seams yet.
+    PatchPlacement b{20, 4, rnd(64), rnd(64), 32, 32};
+    cut.place_graphcut(b);
+    straight.place_straight(b);
+    EXPECT_LE(cut.seam_cost(), straight.seam_cost() + 1e-9) << "trial " << trial;
+    // A third patch over the seam between the first two (seam nodes): from the
+    // same state, the cut is no worse than pasting straight.
+    GraphcutCanvas straight3 = cut;
+    PatchPlacement c{10, 10, rnd(64), rnd(64), 32, 32};
+    const double before = cut.seam_cost();
+    cut.place_graphcut(c);
+    straight3.place_straight(c);
+    EXPECT_LE(cut.seam_cost(), straight3.seam_cost() + 1e-9) << "trial " << trial;
+    EXPECT_GT(before, 0.0);  // there was an old seam for the third patch to meet
+  }
+}
+
+TEST(GraphcutSynthesis, SeamNodeLetsALaterPatchRemoveAnOldSeam) {
+  // Two patches side by side from unrelated exemplar places leave a seam; a
+  // third patch whose translation continues the left one over the whole seam
+  // region (forced) removes it exactly: the cost drops to the seam(s) the third
+  // patch makes, and the old seam is gone.
+  Image ex = texture("pebbles_256.png", 128);
+  GraphcutCanvas cv(ex, 64, 32, false);
+  cv.place_straight({0, 0, 0, 0, 32, 32});
+  cv.place_straight({32, 0, 70, 50, 32, 32});
+  const double old = cv.seam_cost();
+  ASSERT_GT(old, 0.0);
+  // Continue the left patch across the whole canvas: seams vanish entirely.
+  std::vector<std::pair<int, int>> forced;
+  for (int y = 0; y < 32; ++y) forced.emplace_back(48, y);
+  cv.place_graphcut({16, 0, 16, 0, 48, 32}, forced);
+  EXPECT_LT(cv.seam_cost(), old);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x <= 48; ++x) EXPECT_EQ(cv.source_x(x, y), x) << x << "," << y;
+}
+
+TEST(GraphcutSynthesis, RefinementRepairsSeams) {
+  Image ex = texture("pebbles_256.png", sanitized() ? 64 : 128);
+  GraphcutOptions o;
+  o.patch_size = 32;
+  o.refinement_passes = 0;
+  const int n = sanitized() ? 64 : 128;
+  GraphcutResult r0 = graphcut_synthesize_detailed(ex, n, n, o);
+  o.refinement_passes = 2;
+  GraphcutResult r2 = graphcut_synthesize_detailed(ex, n, n, o);
+  EXPECT_DOUBLE_EQ(r0.seam_cost_after_fill, r2.seam_cost_after_fill);  // same fill
+  EXPECT_DOUBLE_EQ(r0.seam_cost_final, r0.seam_cost_after_fill);
+  EXPECT_LE(r2.seam_cost_final, r2.seam_cost_after_fill);
+  EXPECT_GT(r2.refinement_tried, 0);
+  EXPECT_GT(r2.refinement_accepted, 0);
+  EXPECT_LT(r2.seam_cost_final, 0.99 * r2.seam_cost_after_fill);  // repairs really happen
+}
+
+TEST(GraphcutSynthesis, SameSeedSameBytesOtherSeedDiffers) {
+  Image ex = texture("leather_64.png", 64);
+  GraphcutOptions o;
+  o.patch_size = 24;
+  o.seed = 42;
+  Image a = graphcut_synthesize(ex, 70, 60, o), b = graphcut_synthesize(ex, 70, 60, o);
+  EXPECT_EQ(a.data, b.data);
+  o.seed = 43;
+  Image c = graphcut_synthesize(ex, 70, 60, o);
+  EXPECT_NE(a.data, c.data);
+}
+
+TEST(GraphcutSynthesis, InvalidOptionsThrowNamingTheOption) {
+  Image ex(16, 16, 3, 0.5f);
+  auto msg = [&](GraphcutOptions o, int w = 32, int h = 32) {
+    try {
+      graphcut_synthesize(ex, w, h, o);
+    } catch (const InvalidInputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no throw");
+  };
+  GraphcutOptions o;
+  o.patch_size = 2;
+  EXPECT_NE(msg(o).find("patch_size"), std::string::npos);
+  o = {};
+  o.overlap = -1;
+  EXPECT_NE(msg(o).find("overlap"), std::string::npos);
+  o = {};
+  o.patch_size = 8;
+  o.overlap = 8;
+  EXPECT_NE(msg(o).find("overlap"), std::string::npos);
+  o = {};
+  o.k = 0.0;
+  EXPECT_NE(msg(o).find("k (temperature)"), std::string::npos);
+  o = {};
+  o.refinement_passes = -1;
+  EXPECT_NE(msg(o).find("refinement_passes"), std::string::npos);
+  EXPECT_NE(msg({}, 0, 10).find("width"), std::string::npos);
+  EXPECT_THROW(graphcut_synthesize(Image(), 8, 8, {}), InvalidInputError);
+}
