@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/feature_mask.h"
 
+#include "texture/image_ops.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -67,17 +69,6 @@ double otsu_threshold(const std::vector<float>& values, double lo, double hi) {
 }
 
 }  // namespace
-
-Image luminance(const Image& img) {
-  if (img.empty()) throw InvalidInputError("luminance: empty image");
-  Image out(img.width, img.height, 1);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      const float* p = img.pixel(x, y);
-      out.at(x, y) = img.channels >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
-    }
-  return out;
-}
 
 Image mask_from_painted(const Image& painted, double threshold) {
   if (painted.empty()) throw InvalidInputError("mask_from_painted: empty mask image");

@@ -11,14 +11,11 @@
 #include <string>
 
 #include "geometry/image.h"
+#include "texture/image_ops.h"
 
 namespace surftex {
 
-/// Luminance of every pixel (1 channel). 1 channel: the value; 2 channels
-/// (grey + alpha): the grey value; 3 or more: Rec. 709 weights on the first
-/// three channels (0.2126 R + 0.7152 G + 0.0722 B); further channels ignored.
-/// Throws InvalidInputError on an empty image.
-Image luminance(const Image& img);
+// luminance() lives in texture/image_ops.h.
 
 /// A user-painted mask from any image: feature where luminance >= `threshold`
 /// (default 0.5, luminance in [0,1] for 8-bit files). Throws InvalidInputError
