@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// The shell map (Zhou et al. 2006, section 3.2; Porumbescu et al. 2005): the
+// piecewise-linear bijection between shell space and texture space defined by
+// barycentric coordinates in corresponding tetrahedra of a ShellSpace.
+//
+// A point is located in one space with a uniform grid over the tets' bounding
+// boxes (texture space gridded in metric units (u, v, w * w_scale), so the
+// thin texture slab gets a flat grid), its barycentric coordinates in the
+// containing tet are computed in double precision, and the same coordinates
+// applied to the corresponding tet of the other space. A point lies in a tet
+// when every barycentric coordinate is >= -tolerance; if several tets qualify
+// (shared faces, coincident chart borders in shell space), the one with the
+// largest smallest coordinate wins, ties to the lower tet index
+// (deterministic). Shell-space points on a chart border belong to two charts;
+// either image is a valid answer.
+//
+// The map copies what it needs from the ShellSpace at construction: rebuild it
+// after shell_map_minimize_stretch changes texture coordinates.
+// Throws: InvalidInputError (empty shell; a point outside the shell for the
+// throwing accessors).
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+#include "shell/shell_space.h"
+
+namespace surftex {
+
+struct ShellMapOptions {
+  /// Barycentric slack for "inside" (relative, unitless); >= 0.
+  double tolerance = 1e-10;
+};
+
+class ShellMap {
+ public:
+  explicit ShellMap(const ShellSpace& shell, const ShellMapOptions& opt = {});
+  ~ShellMap();
+  ShellMap(ShellMap&&) noexcept;
+  ShellMap& operator=(ShellMap&&) noexcept;
+
+  /// A tet and barycentric coordinates in it (sum to 1).
+  struct Location {
+    int tet = -1;
+    std::array<double, 4> bary{};
+    bool inside = false;  ///< every coordinate >= -tolerance
+  };
+
+  /// Locates (u, v, w) (w in [0,1]) in texture space. `nearest` = when no tet
+  /// contains the point, return the tet of the nearest grid cells whose
+  /// smallest barycentric coordinate is largest (extrapolation), inside = false.
+  Location locate_texture(const Vec3& uvw, bool nearest = false) const;
+  /// Locates a 3D point in shell space (same rules).
+  Location locate_shell(const Vec3& p, bool nearest = false) const;
+
+  /// Image of a texture-space location in shell space / of a shell location in texture space.
+  Vec3 shell_point(const Location& texture_loc) const;
+  Vec3 texture_point(const Location& shell_loc) const;
+
+  /// texture (u,v,w) -> shell space. Throws InvalidInputError if outside the texture space.
+  Point3 texture_to_shell(const Vec3& uvw) const;
+  /// shell space -> texture (u,v,w). Throws InvalidInputError if outside the shell.
+  Vec3 shell_to_texture(const Point3& p) const;
+
+  std::size_t num_tets() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace surftex

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Helpers shared by the shell tests (header-only, included by test .cpp files).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "shell/shell_space.h"
+
+namespace surftex::test {
+
+inline bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+
+/// One chart whose uv is the planar (x, y) position scaled by `s` and shifted by `off`.
+inline void set_planar_uv(Mesh& m, double s, double off) {
+  auto uv = get_or_add(m, kCornerUV, UV{0, 0});
+  auto patch = get_or_add(m, kFacePatch, -1);
+  for (FaceIndex f : m.faces()) {
+    patch[f] = 0;
+    for (HalfedgeIndex h : m.halfedges_around_face(m.halfedge(f))) {
+      const Point3& p = m.point(m.target(h));
+      uv[h] = {p.x() * s + off, p.y() * s + off};
+    }
+  }
+}
+
+inline Point3 to_point(const Vec3& p) { return Point3(p[0], p[1], p[2]); }
+
+/// Independent exact check: counts tets not POSITIVE in shell and texture space.
+inline std::pair<std::size_t, std::size_t> count_not_positive(const ShellSpace& s) {
+  std::size_t a = 0, b = 0;
+  for (const Tet& t : s.tets) {
+    if (CGAL::orientation(to_point(s.shell_points[t[0]]), to_point(s.shell_points[t[1]]),
+                          to_point(s.shell_points[t[2]]), to_point(s.shell_points[t[3]])) != CGAL::POSITIVE)
+      ++a;
+    if (CGAL::orientation(to_point(s.texture_points[t[0]]), to_point(s.texture_points[t[1]]),
+                          to_point(s.texture_points[t[2]]), to_point(s.texture_points[t[3]])) != CGAL::POSITIVE)
+      ++b;
+  }
+  return {a, b};
+}
+
+}  // namespace surftex::test
