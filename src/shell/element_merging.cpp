@@ -1,0 +1,305 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/element_merging.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "geometry/errors.h"
+#include "geometry/graph_cut.h"
+#include "shell/element_deformation.h"
+#include "shell/triangle_distance.h"
+
+namespace surftex {
+namespace {
+double dist(const P3& a, const P3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+P3 centroid(const ElementMesh& m, const Tri& t) {
+  P3 c;
+  for (int d = 0; d < 3; ++d) c[d] = (m.points[t[0]][d] + m.points[t[1]][d] + m.points[t[2]][d]) / 3.0;
+  return c;
+}
+std::uint64_t ukey(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+}
+double mean_edge(const ElementMesh& m) {
+  double s = 0;
+  std::size_t n = 0;
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) s += dist(m.points[t[k]], m.points[t[(k + 1) % 3]]), ++n;
+  return n ? s / static_cast<double>(n) : 0;
+}
+/// Interior edges: (tri1, tri2, v_i, v_j) for every edge shared by two triangles.
+struct DualEdge {
+  int t1, t2, vi, vj;
+};
+std::vector<DualEdge> dual_edges(const ElementMesh& m) {
+  std::unordered_map<std::uint64_t, int> first;
+  std::vector<DualEdge> out;
+  for (std::size_t t = 0; t < m.tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.tris[t][k], b = m.tris[t][(k + 1) % 3];
+      auto [it, inserted] = first.emplace(ukey(a, b), static_cast<int>(t));
+      if (!inserted && it->second >= 0) {
+        out.push_back({it->second, static_cast<int>(t), a, b});
+        it->second = -1;
+      }
+    }
+  return out;
+}
+double auto_match(const ElementMesh& a, const ElementMesh& b, const MergeOptions& opt) {
+  return opt.match_distance > 0 ? opt.match_distance : 1.5 * (mean_edge(a) + mean_edge(b));
+}
+}  // namespace
+
+double cut_cost(const ElementMesh& a, const ElementMesh& b, const std::vector<char>& keep) {
+  TriangleDistance tb(b);
+  std::vector<double> d(a.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) d[i] = tb.closest(a.points[i]).distance;
+  double c = 0;
+  for (const DualEdge& e : dual_edges(a))
+    if (keep[e.t1] != keep[e.t2]) c += (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + d[e.vi] + d[e.vj]);
+  return c;
+}
+
+namespace {
+bool owns(Side side, Region r) {
+  return side == Region::kOverlap ? (r == Region::kOld || r == Region::kNew) : r == side;
+}
+}  // namespace
+
+ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                       const MergeOptions& opt, const std::vector<char>* b_keep) {
+  auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
+  ElementCut res;
+  const double match = auto_match(a, b, opt);
+  TriangleDistance tb(b), ta(a);
+  const int nt = static_cast<int>(a.tris.size());
+  std::vector<TriangleDistance::Hit> hit(a.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
+  // Faces of B "with a corresponding vertex in A": within `match` of A.
+  std::vector<char> covered(b.tris.size());
+  std::vector<char> b_in(b.tris.size());
+  for (std::size_t g = 0; g < b.tris.size(); ++g) {
+    const P3 c = centroid(b, b.tris[g]);
+    covered[g] = ta.closest(c).distance <= match;
+    b_in[g] = !owns(side_b, region(c));  // not in B's own outside
+  }
+  // Edge-neighbours of B's faces.
+  std::vector<std::vector<int>> b_nb(b.tris.size());
+  for (const DualEdge& e : dual_edges(b)) b_nb[e.t1].push_back(e.t2), b_nb[e.t2].push_back(e.t1);
+
+  GraphCut gc(nt);
+  const auto edges = dual_edges(a);
+  double wmax = 0;
+  for (const DualEdge& e : edges) {
+    const double w = (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
+    wmax = std::max(wmax, w);
+    gc.add_edge(e.t1, e.t2, w, w);
+  }
+  std::vector<char> force_keep(nt, 0), force_del(nt, 0);
+  for (int t = 0; t < nt; ++t)
+    if (owns(side_a, region(centroid(a, a.tris[t])))) force_keep[t] = 1;
+  std::vector<std::vector<int>> vtris(a.points.size());
+  for (int t = 0; t < nt; ++t)
+    for (int v : a.tris[t]) vtris[v].push_back(t);
+  for (std::size_t v = 0; v < a.points.size(); ++v) {
+    const auto& h = hit[v];
+    if (h.tri < 0 || h.distance > match || !in_overlap(a.points[v])) continue;
+    bool del = !b_in[h.tri];
+    for (int g : b_nb[h.tri]) del = del || !covered[g];
+    // Keep wins over delete where both rules hit one triangle (at the rim of
+    // the overlap region an element can reach just past it): the paper's two
+    // infinite rules would otherwise make every cut infinite.
+    if (del)
+      for (int t : vtris[v]) force_del[t] = !force_keep[t];
+  }
+  res.terminal.assign(nt, 0);
+  for (int t = 0; t < nt; ++t) {
+    res.terminal[t] = force_keep[t] && force_del[t] ? 2 : force_keep[t] ? 1 : force_del[t] ? -1 : 0;
+    if (force_keep[t]) gc.add_terminal(t, GraphCut::kInfinity, 0), ++res.forced_keep;
+    if (force_del[t]) gc.add_terminal(t, 0, GraphCut::kInfinity), ++res.forced_delete;
+  }
+  if (b_keep) {
+    const double g = opt.guide_factor * std::max(wmax, 1.0);
+    for (int t = 0; t < nt; ++t) {
+      if (force_keep[t] || force_del[t]) continue;
+      const auto h = tb.closest(centroid(a, a.tris[t]));
+      if (h.tri < 0 || h.distance > match) continue;
+      if ((*b_keep)[h.tri])
+        gc.add_terminal(t, 0, g);
+      else
+        gc.add_terminal(t, g, 0);
+    }
+  }
+  const double flow = gc.solve();
+  res.feasible = flow < GraphCut::kInfinity * 0.5;
+  res.keep.resize(nt);
+  for (int t = 0; t < nt; ++t) res.keep[t] = gc.is_source_side(t) ? 1 : 0;
+  res.cost = 0;
+  for (const DualEdge& e : edges)
+    if (res.keep[e.t1] != res.keep[e.t2])
+      res.cost += (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
+  return res;
+}
+
+namespace {
+/// Kept part of `m` and the loops opened by the cut (loops made of edges that
+/// were interior in `m`), in the kept part's vertex numbering.
+void kept_part(const ElementMesh& m, const std::vector<char>& keep, ElementMesh& part,
+               std::vector<std::vector<int>>& cut_loops, bool& ok) {
+  std::vector<int> tris;
+  for (std::size_t t = 0; t < m.tris.size(); ++t)
+    if (keep[t]) tris.push_back(static_cast<int>(t));
+  part = extract_triangles(m, tris);
+  // Original border edges (directed, in the original numbering) mapped by position.
+  std::unordered_set<std::uint64_t> orig_border;
+  {
+    std::unordered_map<std::uint64_t, int> cnt;
+    for (const Tri& t : m.tris)
+      for (int k = 0; k < 3; ++k) ++cnt[ukey(t[k], t[(k + 1) % 3])];
+    for (auto& e : cnt)
+      if (e.second == 1) orig_border.insert(e.first);
+  }
+  // Map part vertices back to original ids (extract_triangles numbers in first-use order).
+  std::vector<int> back(part.points.size(), -1);
+  {
+    std::unordered_map<int, int> seen;
+    int n = 0;
+    for (int t : tris)
+      for (int v : m.tris[t])
+        if (!seen.count(v)) seen[v] = n, back[n++] = v;
+  }
+  std::vector<std::vector<int>> loops;
+  ok = boundary_loops(part, loops);
+  cut_loops.clear();
+  for (auto& l : loops) {
+    const bool original = orig_border.count(ukey(back[l[0]], back[l[1 % l.size()]])) > 0;
+    if (!original) cut_loops.push_back(l);
+  }
+}
+
+P3 loop_centroid(const ElementMesh& m, const std::vector<int>& l) {
+  P3 c{0, 0, 0};
+  for (int v : l)
+    for (int d = 0; d < 3; ++d) c[d] += m.points[v][d] / static_cast<double>(l.size());
+  return c;
+}
+}  // namespace
+
+MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                           const MergeOptions& opt) {
+  MergeResult r;
+  auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
+  ElementCut ca = cut_element(a, side_a, b, side_b, region, opt);
+  r.cost_a = ca.cost;
+  if (!ca.feasible) {
+    r.reason = "cut of A infeasible";
+    return r;
+  }
+  ElementCut cb = cut_element(b, side_b, a, side_a, region, opt, &ca.keep);
+  r.cost_b = cb.cost;
+  if (!cb.feasible) {
+    r.reason = "cut of B infeasible";
+    return r;
+  }
+  ElementMesh pa, pb;
+  std::vector<std::vector<int>> la, lb;
+  bool oka = false, okb = false;
+  kept_part(a, ca.keep, pa, la, oka);
+  kept_part(b, cb.keep, pb, lb, okb);
+  if (!oka || !okb) {
+    r.reason = "cut border is not a set of simple loops";
+    return r;
+  }
+  if (la.empty() || la.size() != lb.size()) {
+    r.reason = "cuts opened " + std::to_string(la.size()) + " and " + std::to_string(lb.size()) + " loops";
+    return r;
+  }
+  // Pair loops greedily by centroid distance.
+  std::vector<std::tuple<double, int, int>> cand;
+  for (std::size_t i = 0; i < la.size(); ++i)
+    for (std::size_t j = 0; j < lb.size(); ++j)
+      cand.emplace_back(dist(loop_centroid(pa, la[i]), loop_centroid(pb, lb[j])), static_cast<int>(i),
+                        static_cast<int>(j));
+  std::sort(cand.begin(), cand.end());
+  std::vector<int> pair_of(la.size(), -1);
+  std::vector<char> bused(lb.size(), 0);
+  for (auto& [d, i, j] : cand)
+    if (pair_of[i] < 0 && !bused[j]) pair_of[i] = j, bused[j] = 1;
+  ElementMesh merged = pa;
+  const int off = static_cast<int>(pa.points.size());
+  append(merged, pb);
+  std::vector<DeformConstraint> cons;
+  for (std::size_t i = 0; i < la.size(); ++i) {
+    const std::vector<int>& A = la[i];
+    std::vector<int> B(lb[pair_of[i]].rbegin(), lb[pair_of[i]].rend());
+    for (int& v : B) v += off;
+    const int na = static_cast<int>(A.size()), nb = static_cast<int>(B.size());
+    auto P = [&](int v) { return merged.points[v]; };
+    int j0 = 0;
+    for (int j = 1; j < nb; ++j)
+      if (dist(P(A[0]), P(B[j])) < dist(P(A[0]), P(B[j0]))) j0 = j;
+    int ia = 0, ib = 0;
+    auto a_at = [&](int k) { return A[k % na]; };
+    auto b_at = [&](int k) { return B[(j0 + k) % nb]; };
+    while (ia < na || ib < nb) {
+      bool adv_a;
+      if (ia == na)
+        adv_a = false;
+      else if (ib == nb)
+        adv_a = true;
+      else
+        adv_a = dist(P(a_at(ia + 1)), P(b_at(ib))) <= dist(P(a_at(ia)), P(b_at(ib + 1)));
+      if (adv_a) {
+        merged.tris.push_back({a_at(ia + 1), a_at(ia), b_at(ib)});
+        ++ia;
+      } else {
+        merged.tris.push_back({b_at(ib), b_at(ib + 1), a_at(ia)});
+        ++ib;
+      }
+    }
+    // "Average boundary points" as position constraints (eq. 5).
+    auto nearest = [&](int v, const std::vector<int>& L) {
+      int best = L[0];
+      for (int u : L)
+        if (dist(P(v), P(u)) < dist(P(v), P(best))) best = u;
+      return best;
+    };
+    for (int v : A) {
+      const P3 q = P(nearest(v, B)), p = P(v);
+      cons.push_back({{v, v, v}, {1, 0, 0}, {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2}});
+    }
+    for (int v : B) {
+      const P3 q = P(nearest(v, A)), p = P(v);
+      cons.push_back({{v, v, v}, {1, 0, 0}, {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2}});
+    }
+  }
+  const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
+  if (count_border_edges(merged) > border_before) {
+    r.reason = "stitching would open new borders";
+    return r;
+  }
+  if (border_before == 0 && !is_closed_oriented(merged)) {
+    r.reason = "stitched element is not closed and consistently oriented";
+    return r;
+  }
+  std::vector<char> locked(merged.points.size(), 0);
+  for (std::size_t v = 0; v < merged.points.size(); ++v) locked[v] = !in_overlap(merged.points[v]);
+  try {
+    LaplacianDeformOptions lo;
+    lo.mu = opt.mu;
+    merged.points = laplacian_deform(merged, cons, locked, lo);
+  } catch (const SolverError&) {
+    // A component without constraint or lock: keep the undeformed zip.
+  }
+  r.stitched = true;
+  r.loops = static_cast<int>(la.size());
+  r.merged = std::move(merged);
+  return r;
+}
+
+}  // namespace surftex

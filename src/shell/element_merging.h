@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Element merging (Zhou et al. 2006, section 2.7): two partially overlapping
+// elements A (e.g. C_out) and B (C_in) are cut by graph cuts on their dual
+// graphs and stitched into one connected element.
+//
+// Cut of A against B (cut_element): one node per triangle of A; for two
+// triangles sharing the edge (v_i, v_j) an n-link of weight (eq. 7)
+//   (1 + |v_i - v_j|)(1 + Dist(v_i, B) + Dist(v_j, B)).
+// SOURCE (kept) with infinite weight: triangles of A whose centroid lies
+// outside the overlap region. SINK (deleted) with infinite weight: all
+// triangles around a vertex v of A (with Dist(v, B) <= match_distance and v in
+// the overlap region) whose closest face f of B lies outside the overlap
+// region, or has an edge-neighbour face with "no corresponding vertex in A".
+// "Outside the overlap region" is made precise with a Region function and a
+// side per element: region(p) = kOld (processed before this step, outside the
+// new patch), kOverlap, kNew (not processed yet); A's own outside is its side
+// (output elements: kOld, input elements: kNew, a merged element: both).
+// Elements are kept whole, so an element can poke a little past the cell-
+// rounded overlap region into the other side; such triangles are not forced
+// either way. Where both infinite rules hit one triangle, keeping wins (the
+// paper's rules would otherwise make every such cut infinite).
+// The paper's correspondence is per vertex; with meshes of similar resolution
+// most faces are nobody's closest face, so we read "has a corresponding
+// vertex" as "lies within match_distance of A" (face centroid to A), which is
+// what the rule is after: B continues where A does not.
+// The cut of B is "found using the exact same approach"; to make the two cut
+// paths meet (the paper only asks that they be close) the cut of B also gets
+// finite guide links: a triangle of B within match_distance of A is pulled to
+// SINK if its closest face of A was kept and to SOURCE if it was deleted, with
+// weight guide_factor * the largest n-link weight.
+// Stitching: the boundary loops the cuts opened are paired (nearest
+// centroids), each pair zipped by a triangle strip (advancing on the loop
+// whose next diagonal is shorter, orientations consistent with both sides),
+// then the merged element is deformed with eq. 5 constraints "average boundary
+// points" (each loop vertex pulled to the midpoint with its nearest vertex on
+// the paired loop), vertices outside the overlap region locked.
+// Every graph cut goes through geometry/graph_cut.h.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "shell/element_mesh.h"
+
+namespace surftex {
+
+/// Where a point lies with respect to the current quilting step.
+enum class Region { kOld = -1, kOverlap = 0, kNew = 1, kNone = 2 };
+using RegionFn = std::function<Region(const P3&)>;
+/// Which outside region an element owns: kOld (output), kNew (input), kOverlap = both.
+using Side = Region;
+
+struct MergeOptions {
+  /// Distance under which surfaces count as corresponding (mesh units); 0 =
+  /// automatic: 3 x the mean edge length of A and B. >= 0.
+  double match_distance = 0;
+  /// Weight of B's guide links, in units of the largest n-link weight; >= 0.
+  double guide_factor = 100;
+  /// mu of the stitching deformation (eq. 5); > 0.
+  double mu = 1.0;
+};
+
+struct ElementCut {
+  std::vector<char> keep;  ///< per triangle of A: 1 = kept (SOURCE side)
+  double cost = 0;         ///< sum of eq. 7 weights of the n-links cut
+  bool feasible = false;   ///< false if the infinite links conflict
+  std::size_t forced_keep = 0, forced_delete = 0;  ///< triangles with infinite links
+  /// Per triangle: +1 infinite link to SOURCE, -1 to SINK, 2 both (conflict), 0 none.
+  std::vector<signed char> terminal;
+};
+
+/// Graph cut of A against B (see header). `b_keep` (optional, per triangle of
+/// B) adds the guide links. match_distance 0 = automatic.
+ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                       const MergeOptions& opt = {}, const std::vector<char>* b_keep = nullptr);
+
+/// Sum of eq. 7 weights over the edges of A whose two triangles have different
+/// `keep` labels (the cost of any labelling, for comparisons).
+double cut_cost(const ElementMesh& a, const ElementMesh& b, const std::vector<char>& keep);
+
+struct MergeResult {
+  bool stitched = false;   ///< true: `merged` is the stitched element
+  ElementMesh merged;
+  int loops = 0;           ///< boundary loops zipped
+  double cost_a = 0, cost_b = 0;
+  std::string reason;      ///< why stitching was refused (stitched == false)
+};
+
+/// Cuts A and B and stitches them. Refuses (stitched = false, reason set,
+/// `merged` empty) when a cut is infeasible, the cuts open different numbers of
+/// loops or none, or the result would have more border edges than A and B had
+/// (so elements closed in the swatch stay closed).
+MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                           const MergeOptions& opt = {});
+
+}  // namespace surftex

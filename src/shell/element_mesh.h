@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// ElementMesh: a plain indexed triangle mesh (points + triangles) used as the
+// working representation of geometric-texture elements during mesh quilting
+// (Zhou et al. 2006, section 2: every connected component of M_in / M_out is a
+// "geometric element"). Quilting cuts, deletes and zips triangles of single
+// elements many times; index arrays make these edits cheap and local, and the
+// result is turned into the one mesh type (surftex::Mesh) at the end.
+//
+// Also here: the small topological helpers quilting needs (connected
+// components, border edges, boundary loops, vertex normals, 1-rings) and the
+// conversions Mesh <-> ElementMesh (writing/reading kFaceElement).
+// Throws: InvalidInputError (non-triangle faces, indices out of range),
+//         TopologyError (mesh_from_elements: a face Surface_mesh refuses).
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+using P3 = std::array<double, 3>;
+using Tri = std::array<int, 3>;
+
+struct ElementMesh {
+  std::vector<P3> points;
+  std::vector<Tri> tris;
+};
+
+/// Connected components over shared vertices: component id per triangle,
+/// numbered 0.. in order of first triangle. Returns the number of components.
+int triangle_components(const ElementMesh& m, std::vector<int>& tri_component);
+/// Undirected edges used by exactly one triangle (border edges of the element).
+std::size_t count_border_edges(const ElementMesh& m);
+/// True if every undirected edge is used exactly twice, once in each direction
+/// (closed, consistently oriented, edge-manifold).
+bool is_closed_oriented(const ElementMesh& m);
+/// Boundary loops: each a vertex sequence following the direction the border
+/// edges have in their triangles (a -> b for triangle (a, b, c) with border edge
+/// ab). Returns false if the border is not a set of simple loops (a vertex with
+/// more than one outgoing border edge).
+bool boundary_loops(const ElementMesh& m, std::vector<std::vector<int>>& loops);
+/// Unit area-weighted vertex normals (zero for isolated vertices).
+std::vector<P3> vertex_normals(const ElementMesh& m);
+/// Unit face normals (zero for degenerate triangles).
+std::vector<P3> face_normals(const ElementMesh& m);
+/// Sorted, unique 1-ring neighbours of every vertex.
+std::vector<std::vector<int>> vertex_neighbours(const ElementMesh& m);
+/// Copies the triangles `tris` of `m` (indices into m.tris) into a compact ElementMesh.
+ElementMesh extract_triangles(const ElementMesh& m, const std::vector<int>& tris);
+/// Appends `b` to `a` (indices of b shifted).
+void append(ElementMesh& a, const ElementMesh& b);
+
+/// Mesh -> ElementMesh (vertices renumbered densely in iteration order).
+/// Throws InvalidInputError for a non-triangle face.
+ElementMesh element_mesh_from(const Mesh& mesh);
+/// Builds `out` (cleared first) from the elements, one after the other, and
+/// writes kFaceElement = the index of the element in `elements`.
+/// Throws TopologyError naming the element if Surface_mesh refuses a face
+/// (non-manifold vertex or edge).
+void mesh_from_elements(const std::vector<ElementMesh>& elements, Mesh& out);
+
+}  // namespace surftex

@@ -1,0 +1,295 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/quilt_step.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/timer.h"
+#include "shell/element_correspondence.h"
+#include "shell/element_deformation.h"
+#include "shell/element_merging.h"
+
+namespace surftex {
+
+int QuiltGrid::cell_of(double x, double y) const {
+  const double fx = std::floor((x - x0) / cell), fy = std::floor((y - y0) / cell);
+  if (!(fx >= 0 && fy >= 0 && fx < nx && fy < ny)) return -1;
+  return static_cast<int>(fy) * nx + static_cast<int>(fx);
+}
+
+void QuiltStepStats::add(const QuiltStepStats& o) {
+  candidates += o.candidates;
+  best_cost += o.best_cost;
+  pairs += o.pairs;
+  related += o.related;
+  pruned_normal += o.pruned_normal;
+  pruned_distance += o.pruned_distance;
+  pruned_projection += o.pruned_projection;
+  stitched += o.stitched;
+  stitch_refused += o.stitch_refused;
+  out_replaced += o.out_replaced;
+  in_dropped += o.in_dropped;
+  in_added += o.in_added;
+  seconds_match += o.seconds_match;
+  seconds_correspond += o.seconds_correspond;
+  seconds_deform += o.seconds_deform;
+  seconds_merge += o.seconds_merge;
+}
+
+namespace {
+int find_root(std::vector<int>& p, int x) {
+  while (p[x] != x) x = p[x] = p[p[x]];
+  return x;
+}
+}  // namespace
+
+std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
+                               std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
+                               const QuiltStepOptions& opt, QuiltStepStats& stats) {
+  Timer timer;
+  const double c = grid.cell;
+  const int sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
+  const int sy = std::max(1, static_cast<int>(std::ceil(swatch.width() / c - 1e-9)));
+  int pi0 = grid.nx, pi1 = -1, pj0 = grid.ny, pj1 = -1;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i)
+      if (grid.subpatch[j * grid.nx + i]) pi0 = std::min(pi0, i), pi1 = std::max(pi1, i), pj0 = std::min(pj0, j), pj1 = std::max(pj1, j);
+  if (pi1 < 0) throw InvalidInputError("quilt_step: empty output sub-patch");
+  if (pi1 - pi0 + 1 > sx || pj1 - pj0 + 1 > sy)
+    throw InvalidInputError("quilt_step: the output sub-patch (" + std::to_string(pi1 - pi0 + 1) + "x" +
+                            std::to_string(pj1 - pj0 + 1) + " cells) is larger than the swatch (" +
+                            std::to_string(sx) + "x" + std::to_string(sy) + " cells)");
+
+  // --- 2.4 Geometry matching: output vertices in P_out, with normals.
+  std::vector<P3> mv, mn;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    if (!alive[e]) continue;
+    const ElementMesh& m = elements[e];
+    std::vector<P3> vn;
+    for (std::size_t v = 0; v < m.points.size(); ++v) {
+      const int cc = grid.cell_of(m.points[v][0], m.points[v][1]);
+      if (cc < 0 || !grid.subpatch[cc]) continue;
+      if (vn.empty()) vn = vertex_normals(m);
+      mv.push_back(m.points[v]);
+      mn.push_back(vn[v]);
+    }
+  }
+  if (static_cast<int>(mv.size()) > opt.max_match_vertices) {
+    std::vector<P3> a, b;
+    const double step = static_cast<double>(mv.size()) / opt.max_match_vertices;
+    for (int k = 0; k < opt.max_match_vertices; ++k) {
+      const std::size_t idx = static_cast<std::size_t>(k * step);
+      a.push_back(mv[idx]);
+      b.push_back(mn[idx]);
+    }
+    mv.swap(a);
+    mn.swap(b);
+  }
+  const auto fn = face_normals(swatch.mesh);
+  std::vector<std::pair<int, int>> cand;
+  for (int oj = pj1 - sy + 1; oj <= pj0; ++oj)
+    for (int oi = pi1 - sx + 1; oi <= pi0; ++oi) cand.emplace_back(oi, oj);
+  auto translation = [&](int oi, int oj) {
+    return P3{grid.x0 + oi * c - swatch.bbox_min[0], grid.y0 + oj * c - swatch.bbox_min[1], 0.0};
+  };
+  std::vector<double> cost(cand.size(), 0.0);
+  if (!mv.empty()) {
+    tbb::parallel_for(std::size_t(0), cand.size(), [&](std::size_t k) {
+      const P3 t = translation(cand[k].first, cand[k].second);
+      double e = 0;
+      for (std::size_t v = 0; v < mv.size(); ++v) {
+        // Eq. 2 with the closest face (see element_correspondence.h), eq. 1, summed as eq. 3.
+        const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]});
+        const P3& nf = fn[h.tri];
+        const double dn = std::sqrt((mn[v][0] - nf[0]) * (mn[v][0] - nf[0]) + (mn[v][1] - nf[1]) * (mn[v][1] - nf[1]) +
+                                    (mn[v][2] - nf[2]) * (mn[v][2] - nf[2]));
+        e += (1 + opt.lambda * h.distance) * (1 + dn);
+      }
+      cost[k] = e;
+    });
+  }
+  const double best = *std::min_element(cost.begin(), cost.end());
+  std::vector<std::size_t> eligible;
+  for (std::size_t k = 0; k < cand.size(); ++k)
+    if (cost[k] <= best * (1 + opt.choice_tolerance) + 1e-12) eligible.push_back(k);
+  const std::size_t pick = eligible[static_cast<std::size_t>(rng() % eligible.size())];
+  const int oi = cand[pick].first, oj = cand[pick].second;
+  const P3 t = translation(oi, oj);
+  stats.candidates += cand.size();
+  stats.best_cost = cost[pick];
+  stats.seconds_match += timer.seconds();
+  timer.reset();
+
+  // Placed input elements M_in(t).
+  std::vector<std::vector<int>> etris(swatch.elements.size());
+  for (std::size_t f = 0; f < swatch.face_element.size(); ++f) etris[swatch.face_element[f]].push_back(static_cast<int>(f));
+  std::vector<ElementMesh> placed(swatch.elements.size());
+  for (std::size_t e = 0; e < placed.size(); ++e) {
+    placed[e] = extract_triangles(swatch.mesh, etris[e]);
+    for (P3& p : placed[e].points)
+      for (int d = 0; d < 3; ++d) p[d] += t[d];
+  }
+  const std::vector<char> processed_before = grid.processed;
+  auto in_footprint_cell = [&](int cc) {
+    const int i = cc % grid.nx, j = cc / grid.nx;
+    return i >= oi && i < oi + sx && j >= oj && j < oj + sy;
+  };
+  auto in_overlap = [&](const P3& p) {
+    const int cc = grid.cell_of(p[0], p[1]);
+    return cc >= 0 && processed_before[cc] && in_footprint_cell(cc);
+  };
+  auto region = [&](const P3& p) {
+    const int cc = grid.cell_of(p[0], p[1]);
+    if (cc < 0) return Region::kNone;
+    if (!processed_before[cc]) return Region::kNew;
+    return in_footprint_cell(cc) ? Region::kOverlap : Region::kOld;
+  };
+  auto entirely_in_overlap = [&](const ElementMesh& m) {
+    for (const P3& p : m.points)
+      if (!in_overlap(p)) return false;
+    return true;
+  };
+  // Output elements near the footprint.
+  const double fx0 = grid.x0 + oi * c, fy0 = grid.y0 + oj * c, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
+  std::vector<int> near;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    if (!alive[e]) continue;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const P3& p : elements[e].points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
+    if (hi[0] >= fx0 && lo[0] <= fx1 && hi[1] >= fy0 && lo[1] <= fy1) near.push_back(static_cast<int>(e));
+  }
+
+  // --- 2.5 Element correspondences.
+  std::vector<std::pair<int, int>> related;
+  ElementCorrespondences corr;
+  if (!near.empty()) {
+    CorrespondenceOptions co;
+    co.lambda = opt.lambda;
+    co.prune_factor = opt.prune_factor;
+    corr = find_element_correspondences(elements, near, placed, in_overlap, co);
+    related = corr.related;
+  }
+  stats.pairs += corr.pairs.size();
+  stats.related += related.size();
+  stats.pruned_normal += corr.pruned_normal;
+  stats.pruned_distance += corr.pruned_distance;
+  stats.pruned_projection += corr.pruned_projection;
+  stats.seconds_correspond += timer.seconds();
+  timer.reset();
+
+  // Groups of related elements: nodes = output elements, then input elements.
+  const int no = static_cast<int>(elements.size()), ni = static_cast<int>(placed.size());
+  std::vector<int> parent(no + ni);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (auto& r : related) {
+    int a = find_root(parent, r.first), b = find_root(parent, no + r.second);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::map<int, std::pair<std::vector<int>, std::vector<int>>> groups;  // root -> (outs, ins)
+  std::vector<char> in_related(ni, 0), out_related(no, 0);
+  for (auto& r : related) out_related[r.first] = 1, in_related[r.second] = 1;
+  for (int e = 0; e < no; ++e)
+    if (out_related[e]) groups[find_root(parent, e)].first.push_back(e);
+  for (int e = 0; e < ni; ++e)
+    if (in_related[e]) groups[find_root(parent, no + e)].second.push_back(e);
+
+  std::vector<char> add_in(ni, 1);
+  std::vector<std::pair<int, ElementMesh>> replacements;
+  double t_deform = 0, t_merge = 0;
+  for (auto& [root, g] : groups) {
+    auto& [outs, ins] = g;
+    bool outs_inside = true, ins_inside = true;
+    for (int e : outs) outs_inside = outs_inside && entirely_in_overlap(elements[e]);
+    for (int e : ins) ins_inside = ins_inside && entirely_in_overlap(placed[e]);
+    if (outs_inside) {  // 2.7: C_out entirely within the overlap: C_in instead
+      for (int e : outs) alive[e] = 0;
+      stats.out_replaced += outs.size();
+      continue;
+    }
+    if (ins_inside) {  // C_in entirely within the overlap: keep C_out
+      for (int e : ins) add_in[e] = 0;
+      stats.in_dropped += ins.size();
+      continue;
+    }
+    // --- 2.6 Element deformation of both sides (eq. 5 and 6).
+    Timer td;
+    std::map<int, std::vector<DeformConstraint>> cout_, cin_;
+    for (const VertexFacePair& p : corr.pairs) {
+      if (find_root(parent, p.out_element) != root) continue;
+      const P3& v = elements[p.out_element].points[p.vertex];
+      const P3 cpt{(v[0] + p.closest[0]) / 2, (v[1] + p.closest[1]) / 2, (v[2] + p.closest[2]) / 2};
+      cout_[p.out_element].push_back({{p.vertex, p.vertex, p.vertex}, {1, 0, 0}, cpt});
+      const Tri& f = placed[p.in_element].tris[p.face];
+      cin_[p.in_element].push_back({{f[0], f[1], f[2]}, {p.bary[0], p.bary[1], p.bary[2]}, cpt});
+    }
+    LaplacianDeformOptions lo;
+    lo.mu = opt.mu;
+    std::map<int, ElementMesh> deformed_out;
+    for (auto& [e, cons] : cout_) {
+      ElementMesh m = elements[e];
+      std::vector<char> locked(m.points.size());
+      for (std::size_t v = 0; v < m.points.size(); ++v) locked[v] = !in_overlap(m.points[v]);
+      try {
+        m.points = laplacian_deform(m, cons, locked, lo);
+      } catch (const SolverError&) {
+      }
+      deformed_out[e] = std::move(m);
+    }
+    for (auto& [e, cons] : cin_) {
+      try {
+        placed[e].points = laplacian_deform(placed[e], cons, {}, lo);
+      } catch (const SolverError&) {
+      }
+    }
+    t_deform += td.seconds();
+    // --- 2.7 Merging: the first output element absorbs the others one by one.
+    Timer tm;
+    const int first = outs.front();
+    ElementMesh acc = deformed_out.count(first) ? deformed_out[first] : elements[first];
+    Side acc_side = Region::kOld;
+    std::vector<std::pair<bool, int>> others;  // (is_out, index)
+    for (int e : ins) others.emplace_back(false, e);
+    for (std::size_t k = 1; k < outs.size(); ++k) others.emplace_back(true, outs[k]);
+    for (auto& [is_out, e] : others) {
+      const ElementMesh& x = is_out ? (deformed_out.count(e) ? deformed_out[e] : elements[e]) : placed[e];
+      MergeOptions mo;
+      mo.mu = opt.mu;
+      MergeResult r = merge_elements(acc, acc_side, x, is_out ? Region::kOld : Region::kNew, region, mo);
+      if (r.stitched) {
+        acc = std::move(r.merged);
+        if (!is_out) acc_side = Region::kOverlap;  // now owns old and new parts
+        ++stats.stitched;
+        if (is_out)
+          alive[e] = 0;
+        else
+          add_in[e] = 0;
+      } else {
+        ++stats.stitch_refused;
+        if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
+      }
+    }
+    replacements.emplace_back(first, std::move(acc));
+    t_merge += tm.seconds();
+  }
+  for (auto& [e, m] : replacements) elements[e] = std::move(m);
+  for (int e = 0; e < ni; ++e)
+    if (add_in[e]) {
+      elements.push_back(std::move(placed[e]));
+      alive.push_back(1);
+      ++stats.in_added;
+    }
+  for (int j = std::max(0, oj); j < std::min(grid.ny, oj + sy); ++j)
+    for (int i = std::max(0, oi); i < std::min(grid.nx, oi + sx); ++i) grid.processed[j * grid.nx + i] = 1;
+  stats.seconds_deform += t_deform;
+  stats.seconds_merge += t_merge;
+  return {oi, oj};
+}
+
+}  // namespace surftex

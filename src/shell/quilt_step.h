@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// One iteration of mesh quilting in a planar frame (Zhou et al. 2006, section
+// 2.2 steps 2-5): geometry matching (2.4), element correspondences (2.5),
+// element deformation (2.6) and element merging (2.7). Shared by planar
+// quilting (mesh_quilting.h), where the frame is the output plane, and by
+// quilting on surfaces (surface_quilting.h), where it is the LSCM plane of a
+// surface patch. Seed finding (2.3) is the caller's.
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "shell/element_mesh.h"
+#include "shell/swatch.h"
+#include "shell/triangle_distance.h"
+
+namespace surftex {
+
+/// The 2D grid of the frame: cell (i, j) covers [x0 + i c, x0 + (i+1) c) x [y0 + j c, ...).
+struct QuiltGrid {
+  double x0 = 0, y0 = 0, cell = 1;
+  int nx = 0, ny = 0;
+  std::vector<char> processed;  ///< nx*ny, row-major (j * nx + i)
+  std::vector<char> subpatch;   ///< nx*ny: the output sub-patch P_out
+  /// Cell of a point, or -1 outside the grid.
+  int cell_of(double x, double y) const;
+};
+
+struct QuiltStepOptions {
+  double lambda = 1.0;        ///< eq. 1, >= 0
+  double mu = 1.0;            ///< eq. 5-6, > 0
+  double prune_factor = 3.0;  ///< section 2.5 distance pruning, in local edge lengths
+  /// Translations whose cost E(t) is within this relative margin of the best
+  /// are equally good; one of them is drawn with the step's generator (the
+  /// paper takes the minimum; with (near-)periodic swatches many translations
+  /// tie and a random pick among them avoids visible repetition). >= 0.
+  double choice_tolerance = 0.02;
+  /// Output vertices in P_out used for eq. 3 (evenly subsampled above this); >= 1.
+  int max_match_vertices = 600;
+};
+
+struct QuiltStepStats {
+  std::size_t candidates = 0;       ///< translations evaluated
+  double best_cost = 0;             ///< E(t) of the chosen translation (eq. 3)
+  std::size_t pairs = 0, related = 0, pruned_normal = 0, pruned_distance = 0, pruned_projection = 0;
+  std::size_t stitched = 0, stitch_refused = 0;  ///< merges (2.7)
+  std::size_t out_replaced = 0, in_dropped = 0, in_added = 0;
+  double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
+  void add(const QuiltStepStats& o);
+};
+
+/// Places the swatch (its bbox min at the origin of a cell) so that it covers
+/// every P_out cell, choosing the grid translation minimising eq. 3 over the
+/// output vertices in P_out; merges it into `elements` (entries of `alive` set
+/// to 0 for elements consumed, new elements appended with alive = 1; `z`
+/// coordinates are the swatch's). Marks the covered grid cells processed.
+/// Returns the chosen cell offset of the swatch origin (i, j).
+std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
+                               std::vector<ElementMesh>& elements, std::vector<char>& alive,
+                               std::mt19937_64& rng, const QuiltStepOptions& opt, QuiltStepStats& stats);
+
+}  // namespace surftex

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Closest-point queries against the triangles of an ElementMesh, accelerated
+// with CGAL's AABB tree (Zhou et al. 2006, section 2.4: "we obtained a
+// significant speed-up ... by building an octree data structure for the input
+// texture"; an AABB tree over the triangles plays that role here).
+// Queries are const and thread-safe once built (the tree is built eagerly).
+#include <memory>
+
+#include "shell/element_mesh.h"
+
+namespace surftex {
+
+class TriangleDistance {
+ public:
+  /// Builds the tree over `mesh.tris` (copied; the mesh need not outlive this).
+  /// An empty mesh gives an object whose queries return tri = -1.
+  explicit TriangleDistance(const ElementMesh& mesh);
+  ~TriangleDistance();
+  TriangleDistance(TriangleDistance&&) noexcept;
+  TriangleDistance& operator=(TriangleDistance&&) noexcept;
+
+  struct Hit {
+    int tri = -1;          ///< index into mesh.tris, -1 if the mesh is empty
+    double distance = 0;   ///< Euclidean distance to the closest point
+    P3 point{0, 0, 0};     ///< the closest point
+    P3 bary{0, 0, 0};      ///< its barycentric coordinates in tri (alpha, beta, gamma)
+  };
+  Hit closest(const P3& q) const;
+  bool empty() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace surftex

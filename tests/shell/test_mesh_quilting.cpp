@@ -1,0 +1,334 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Mesh quilting (Zhou et al. 2006, section 2): swatches, generators, planar
+// quilting, correspondences, Laplacian deformation, graph-cut merging.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/errors.h"
+#include "geometry/properties.h"
+#include "shell/element_correspondence.h"
+#include "shell/element_deformation.h"
+#include "shell/element_merging.h"
+#include "shell/element_mesh.h"
+#include "shell/mesh_quilting.h"
+#include "shell/swatch.h"
+#include "shell/swatch_generators.h"
+
+namespace surftex {
+namespace {
+
+bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+
+Swatch small_chainmail(std::uint64_t seed = 1) {
+  ChainmailOptions o;
+  o.rings_x = o.rings_y = 3;
+  o.segments = 12;
+  o.sides = 6;
+  o.seed = seed;
+  Mesh m;
+  make_chainmail_swatch(m, o);
+  return make_swatch(m);
+}
+Swatch small_weave(std::uint64_t seed = 1) {
+  WeaveOptions o;
+  o.threads_x = o.threads_y = 4;
+  o.segments_per_spacing = 6;
+  o.sides = 6;
+  o.seed = seed;
+  Mesh m;
+  make_weave_swatch(m, o);
+  return make_swatch(m);
+}
+Swatch small_scatter(std::uint64_t seed = 1) {
+  ScatterOptions o;
+  o.size = 6;
+  o.subdivisions = 1;
+  o.seed = seed;
+  Mesh m;
+  make_scatter_swatch(m, o);
+  return make_swatch(m);
+}
+
+/// Every connected component of `m` is closed; returns the number of border edges.
+std::size_t border_edges(const Mesh& m) {
+  std::size_t n = 0;
+  for (EdgeIndex e : m.edges()) n += m.is_border(e);
+  return n;
+}
+
+TEST(SwatchGenerators, DefaultSizesClosedElementsDeterministic) {
+  Mesh a, b, c, a2;
+  make_chainmail_swatch(a);
+  make_weave_swatch(b);
+  make_scatter_swatch(c);
+  for (const Mesh* m : {&a, &b, &c}) {
+    Swatch s = make_swatch(*m);
+    EXPECT_GE(m->number_of_faces(), 2000u);
+    EXPECT_LE(m->number_of_faces(), 15500u);
+    EXPECT_GT(s.elements.size(), 5u);
+    for (const SwatchElement& e : s.elements) EXPECT_TRUE(e.closed);
+    EXPECT_EQ(border_edges(*m), 0u);
+    EXPECT_LT(s.height(), 0.5 * std::min(s.length(), s.width()));  // z is the thin axis
+  }
+  // 16 flat + 24 standing rings.
+  EXPECT_EQ(make_swatch(a).elements.size(), 40u);
+  EXPECT_EQ(make_swatch(b).elements.size(), 12u);
+  make_chainmail_swatch(a2);
+  ASSERT_EQ(a.number_of_vertices(), a2.number_of_vertices());
+  for (VertexIndex v : a.vertices()) EXPECT_EQ(a.point(v), a2.point(v));
+  ChainmailOptions o;
+  o.seed = 7;
+  make_chainmail_swatch(a2, o);
+  bool differ = false;
+  for (VertexIndex v : a.vertices()) differ = differ || a.point(v) != a2.point(v);
+  EXPECT_TRUE(differ);
+}
+
+TEST(SwatchGenerators, RejectsBadOptions) {
+  Mesh m;
+  WeaveOptions w;
+  w.amplitude = 0.05;  // below the radius: threads would intersect
+  EXPECT_THROW(make_weave_swatch(m, w), InvalidInputError);
+  ChainmailOptions c;
+  c.wire_radius = 0.5;
+  EXPECT_THROW(make_chainmail_swatch(m, c), InvalidInputError);
+}
+
+TEST(Swatch, ElementsAreComponentsWithBoxes) {
+  Mesh m;
+  make_chainmail_swatch(m);
+  const Swatch s = make_swatch(m);
+  ASSERT_EQ(s.face_element.size(), m.number_of_faces());
+  for (const SwatchElement& e : s.elements) {
+    EXPECT_EQ(e.faces, 2u * 20 * 8);
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_LE(e.bbox_min[d], e.centroid[d]);
+      EXPECT_GE(e.bbox_max[d], e.centroid[d]);
+    }
+  }
+  Mesh copy = m;
+  EXPECT_EQ(label_elements(copy), 40);
+}
+
+TEST(LaplacianDeform, TranslationIsReproducedExactly) {
+  Mesh ico;
+  make_icosphere(ico, 2);
+  const ElementMesh m = element_mesh_from(ico);
+  const P3 d{0.3, -0.2, 0.5};
+  std::vector<DeformConstraint> cons;
+  for (int v = 0; v < static_cast<int>(m.points.size()); v += 7)
+    cons.push_back({{v, v, v}, {1, 0, 0}, {m.points[v][0] + d[0], m.points[v][1] + d[1], m.points[v][2] + d[2]}});
+  const auto w = laplacian_deform(m, cons, {});
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(w[v][k], m.points[v][k] + d[k], 1e-9);
+}
+
+TEST(LaplacianDeform, LockedVerticesStayAndTheRestMovesSmoothly) {
+  Mesh grid;
+  make_grid(grid, 20, 20, 1.0, 1.0);
+  const ElementMesh m = element_mesh_from(grid);
+  std::vector<char> locked(m.points.size(), 0);
+  int centre = -1;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    if (m.points[v][0] < 0.3) locked[v] = 1;
+    if (std::abs(m.points[v][0] - 0.75) < 1e-9 && std::abs(m.points[v][1] - 0.5) < 1e-9) centre = static_cast<int>(v);
+  }
+  ASSERT_GE(centre, 0);
+  const double lift = 0.2;
+  std::vector<DeformConstraint> cons{{{centre, centre, centre}, {1, 0, 0},
+                                      {m.points[centre][0], m.points[centre][1], lift}}};
+  const auto w = laplacian_deform(m, cons, locked);
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    if (locked[v]) {
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(w[v][k], m.points[v][k]);
+    }
+  }
+  EXPECT_GT(w[centre][2], 0.1 * lift);  // the constraint pulls
+  // Smooth: no edge changes its height by more than a fraction of the lift.
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(w[t[k]][2] - w[t[(k + 1) % 3]][2]), 0.5 * lift);
+}
+
+TEST(LaplacianDeform, RejectsBadInput) {
+  Mesh ico;
+  make_icosphere(ico, 1);
+  const ElementMesh m = element_mesh_from(ico);
+  std::vector<DeformConstraint> cons{{{0, 0, 1000000}, {1, 0, 0}, {0, 0, 0}}};
+  EXPECT_THROW(laplacian_deform(m, cons, {}), InvalidInputError);
+  LaplacianDeformOptions o;
+  o.mu = 0;
+  EXPECT_THROW(laplacian_deform(m, {}, {}, o), InvalidInputError);
+}
+
+ElementMesh sphere_at(double x, double y, double z, double r, bool flip = false) {
+  Mesh ico;
+  make_icosphere(ico, 2, r);
+  ElementMesh m = element_mesh_from(ico);
+  for (P3& p : m.points) p = {p[0] + x, p[1] + y, p[2] + z};
+  if (flip)
+    for (Tri& t : m.tris) std::swap(t[1], t[2]);
+  return m;
+}
+
+TEST(ElementCorrespondence, PrunesOppositeNormalsFarPairsAndDisjointProjections) {
+  const auto everywhere = [](const P3&) { return true; };
+  std::vector<ElementMesh> out{sphere_at(0, 0, 0, 1)};
+  // A close copy: related, nothing pruned.
+  {
+    std::vector<ElementMesh> in{sphere_at(0.02, 0, 0, 1)};
+    auto c = find_element_correspondences(out, {}, in, everywhere);
+    EXPECT_EQ(c.related.size(), 1u);
+    EXPECT_EQ(c.pruned_normal, 0u);
+    EXPECT_EQ(c.pairs.size(), out[0].points.size());
+    for (const auto& p : c.pairs) EXPECT_LT(p.distance, 0.05);
+  }
+  // The same sphere turned inside out: every normal opposite -> no relation.
+  {
+    std::vector<ElementMesh> in{sphere_at(0.02, 0, 0, 1, true)};
+    auto c = find_element_correspondences(out, {}, in, everywhere);
+    EXPECT_TRUE(c.related.empty());
+    EXPECT_EQ(c.pruned_normal, out[0].points.size());
+  }
+  // Far above: every pair much longer than the local edge length.
+  {
+    std::vector<ElementMesh> in{sphere_at(0, 0, 10, 1)};
+    auto c = find_element_correspondences(out, {}, in, everywhere);
+    EXPECT_TRUE(c.related.empty());
+    EXPECT_GT(c.pruned_distance, 0u);
+  }
+  // Projection check: a prune factor that keeps every pair, a sphere beside
+  // (disjoint xy projection) -> the relation is removed.
+  {
+    std::vector<ElementMesh> in{sphere_at(2.5, 0, 0, 1)};
+    CorrespondenceOptions o;
+    o.prune_factor = 1e6;
+    auto c = find_element_correspondences(out, {}, in, everywhere, o);
+    EXPECT_TRUE(c.related.empty());
+    EXPECT_GT(c.pruned_projection, 0u);
+    EXPECT_FALSE(projections_overlap(out[0], in[0]));
+    EXPECT_TRUE(projections_overlap(out[0], sphere_at(1.5, 0, 0, 1)));
+  }
+}
+
+/// A capped tube along x from x0 to x1 (a weave thread).
+ElementMesh thread(double shift) {
+  WeaveOptions o;
+  o.threads_x = 4;
+  o.threads_y = 1;
+  o.sides = 8;
+  o.segments_per_spacing = 8;
+  Mesh m;
+  make_weave_swatch(m, o);
+  const Swatch s = make_swatch(m);
+  ElementMesh t = swatch_element(s, 0);  // the thread along x, x in [-0.5, 3.5]
+  for (P3& p : t.points) p[0] += shift;
+  return t;
+}
+
+/// Old territory x < 1.5, overlap [1.5, 3.5], new x > 3.5.
+Region band(const P3& p) { return p[0] < 1.5 ? Region::kOld : p[0] <= 3.5 ? Region::kOverlap : Region::kNew; }
+
+TEST(ElementMerging, GraphCutNoWorseThanStraightCuts) {
+  const ElementMesh a = thread(0), b = thread(2.0);
+  const ElementCut cut = cut_element(a, Region::kOld, b, Region::kNew, band);
+  ASSERT_TRUE(cut.feasible);
+  EXPECT_GT(cut.forced_keep, 0u);
+  EXPECT_GT(cut.forced_delete, 0u);
+  int compared = 0;
+  for (double x0 = 1.5; x0 <= 3.5; x0 += 0.05) {
+    std::vector<char> keep(a.tris.size());
+    bool compatible = true;
+    for (std::size_t t = 0; t < a.tris.size(); ++t) {
+      double cx = (a.points[a.tris[t][0]][0] + a.points[a.tris[t][1]][0] + a.points[a.tris[t][2]][0]) / 3;
+      keep[t] = cx < x0;
+      if ((cut.terminal[t] == 1 && !keep[t]) || (cut.terminal[t] == -1 && keep[t])) compatible = false;
+    }
+    if (!compatible) continue;
+    ++compared;
+    EXPECT_LE(cut.cost, cut_cost(a, b, keep) + 1e-9) << "x0 = " << x0;
+  }
+  EXPECT_GT(compared, 0);
+  EXPECT_NEAR(cut.cost, cut_cost(a, b, cut.keep), 1e-9 * (1 + cut.cost));
+}
+
+TEST(ElementMerging, StitchedThreadIsOneClosedComponent) {
+  ElementMesh a = thread(0), b = thread(2.0);
+  for (P3& p : b.points) p[1] += 0.01;  // slightly misaligned
+  const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band);
+  ASSERT_TRUE(r.stitched) << r.reason;
+  EXPECT_EQ(r.loops, 1);
+  std::vector<int> comp;
+  EXPECT_EQ(triangle_components(r.merged, comp), 1);
+  EXPECT_TRUE(is_closed_oriented(r.merged));
+  double lo = 1e9, hi = -1e9;
+  for (const P3& p : r.merged.points) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+  EXPECT_LT(lo, -0.4);
+  EXPECT_GT(hi, 5.4);
+}
+
+struct QuiltCase {
+  const char* name;
+  Swatch (*make)(std::uint64_t);
+};
+
+class PlanarQuilting : public ::testing::TestWithParam<QuiltCase> {};
+
+TEST_P(PlanarQuilting, ElementsStayClosedAndWhole) {
+  const Swatch s = GetParam().make(1);
+  const double size = (sanitized() ? 1.3 : 2.0);
+  Mesh out;
+  const QuiltResult r = quilt_plane(s, size * s.length(), size * s.width(), out);
+  EXPECT_GT(r.steps, 1);
+  EXPECT_EQ(border_edges(out), 0u);  // the swatch's elements were all closed
+  auto elem = find(out, kFaceElement);
+  ASSERT_TRUE(elem.second);
+  int maxe = -1;
+  for (FaceIndex f : out.faces()) maxe = std::max(maxe, elem.first[f]);
+  EXPECT_EQ(maxe + 1, r.elements);
+  EXPECT_GT(r.elements, static_cast<int>(s.elements.size()));
+  EXPECT_GT(r.stats.related, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Generated, PlanarQuilting,
+                         ::testing::Values(QuiltCase{"chainmail", small_chainmail}, QuiltCase{"weave", small_weave},
+                                           QuiltCase{"scatter", small_scatter}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(PlanarQuiltingScale, ElementCountGrowsWithArea) {
+  const Swatch s = small_chainmail();
+  Mesh a, b;
+  const double k = sanitized() ? 1.5 : 2.0;
+  const QuiltResult ra = quilt_plane(s, s.length(), s.width(), a);
+  const QuiltResult rb = quilt_plane(s, k * s.length(), k * s.width(), b);
+  EXPECT_GT(rb.elements, ra.elements);
+  EXPECT_GT(static_cast<double>(rb.faces), 1.5 * static_cast<double>(ra.faces));
+}
+
+TEST(PlanarQuiltingScale, SameSeedSameOutput) {
+  const Swatch s = small_weave();
+  Mesh a, b, c;
+  PlanarQuiltOptions o;
+  o.seed = 5;
+  quilt_plane(s, 1.5 * s.length(), 1.5 * s.width(), a, o);
+  quilt_plane(s, 1.5 * s.length(), 1.5 * s.width(), b, o);
+  ASSERT_EQ(a.number_of_vertices(), b.number_of_vertices());
+  ASSERT_EQ(a.number_of_faces(), b.number_of_faces());
+  auto va = a.vertices().begin();
+  for (VertexIndex v : b.vertices()) EXPECT_EQ(a.point(*va++), b.point(v));
+}
+
+TEST(PlanarQuiltingScale, RejectsBadSizes) {
+  const Swatch s = small_chainmail();
+  Mesh out;
+  EXPECT_THROW(quilt_plane(s, -1, 5, out), InvalidInputError);
+  PlanarQuiltOptions o;
+  o.cell_size = s.length();  // one cell per swatch
+  EXPECT_THROW(quilt_plane(s, 5, 5, out, o), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace surftex
