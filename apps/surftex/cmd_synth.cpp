@@ -14,6 +14,7 @@
 #include "surftex/command.h"
 #include "texture/bidirectional_similarity.h"
 #include "texture/efros_leung.h"
+#include "texture/graphcut_synthesis.h"
 #include "texture/histogram_distance.h"
 #include "texture/image_ops.h"
 
@@ -59,22 +60,8 @@ Image load_angle_field(const std::string& path, int w, int h) {
   return field;
 }
 
-int run(const SynthArgs& a) {
-  require_input_file(a.exemplar, "exemplar");
-  std::vector<std::string> inputs{a.exemplar};
-  if (!a.angle_field.empty()) {
-    require_input_file(a.angle_field, "angle field");
-    inputs.push_back(a.angle_field);
-  }
-  check_output(a.output, inputs, a.common.force);
-  int w = 0, h = 0;
-  parse_size(a.size, w, h);
-  if (a.method == "graphcut") {
-    // TODO(lead): wire graphcut_synthesize (texture/graphcut_synthesis.h) here.
-    throw InvalidInputError("method 'graphcut' is not built in this version");
-  }
-  auto limit = apply_thread_limit(a.common.threads);
-  const Image exemplar = read_image(a.exemplar);
+// Two-pass Efros-Leung (Gorla 3.3), optionally oriented (3.3.2).
+ElResult run_el2pass(const SynthArgs& a, const Image& exemplar, int w, int h) {
   ElInput in;
   in.exemplars = {exemplar};
   in.target = Image(w, h, exemplar.channels);
@@ -90,8 +77,34 @@ int run(const SynthArgs& a) {
   opt.periodic_exemplar = a.periodic;
   opt.seed = a.common.seed;
   opt.progress = terminal_progress(a.common.quiet);
+  return efros_leung_synthesize(in, opt);
+}
+
+int run(const SynthArgs& a) {
+  require_input_file(a.exemplar, "exemplar");
+  std::vector<std::string> inputs{a.exemplar};
+  if (!a.angle_field.empty()) {
+    require_input_file(a.angle_field, "angle field");
+    inputs.push_back(a.angle_field);
+  }
+  check_output(a.output, inputs, a.common.force);
+  int w = 0, h = 0;
+  parse_size(a.size, w, h);
+  if (a.method == "graphcut" && (!a.angle_field.empty() || a.has_angle))
+    throw InvalidInputError("--angle / --angle-field need --method el2pass (graph-cut synthesis is not oriented)");
+  auto limit = apply_thread_limit(a.common.threads);
+  const Image exemplar = read_image(a.exemplar);
   Timer timer;
-  const ElResult r = efros_leung_synthesize(in, opt);
+  ElResult r;
+  if (a.method == "graphcut") {
+    // Kwatra et al. 2003 (texture/graphcut_synthesis.h), sub-patch matching by default.
+    GraphcutOptions gopt;
+    gopt.seed = a.common.seed;
+    gopt.progress = terminal_progress(a.common.quiet);
+    r.image = graphcut_synthesize(exemplar, w, h, gopt);
+  } else {
+    r = run_el2pass(a, exemplar, w, h);
+  }
   const double seconds = timer.seconds();
   write_image(a.output, r.image, {true, true});
   Timer mt;
@@ -107,13 +120,15 @@ int run(const SynthArgs& a) {
   rep["output"] = a.output;
   rep["width"] = w;
   rep["height"] = h;
-  rep["window"] = r.window;
-  rep["first_pass_window"] = r.first_pass_window;
-  rep["preselect"] = a.preselect > 0 ? a.preselect : exemplar.width;
-  rep["orientations_searched"] = r.rotations_used;
+  if (a.method == "el2pass") {
+    rep["window"] = r.window;
+    rep["first_pass_window"] = r.first_pass_window;
+    rep["preselect"] = a.preselect > 0 ? a.preselect : exemplar.width;
+    rep["orientations_searched"] = r.rotations_used;
+    rep["seeded_pixels"] = r.seeded;
+  }
   rep["seconds"] = seconds;
   rep["texels_per_second"] = (w * static_cast<double>(h)) / std::max(seconds, 1e-9);
-  rep["seeded_pixels"] = r.seeded;
   rep["bidirectional_similarity"] = {{"patch", bo.patch},
                                      {"stride", bo.stride},
                                      {"approximate_max_candidates", bo.max_candidates},

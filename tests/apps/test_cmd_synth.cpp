@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// `surftex synth`: output and report written, graphcut refused for now,
+// `surftex synth`: output and report written for both methods,
 // existing outputs protected.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -35,11 +35,26 @@ TEST(CmdSynth, WritesImageAndReport) {
   r = test::run_surftex("synth '" + dir + "/ex.png' -o '" + dir + "/out.png' --size 8x8 --window 5 -q");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(read_image(dir + "/out.png").width, 24);
-  // graphcut is not on this branch yet.
-  r = test::run_surftex("synth '" + dir + "/ex.png' -o '" + dir + "/g.png' --method graphcut -q");
+  // Graph-cut synthesis: every output pixel is an exemplar colour.
+  r = test::run_surftex("synth '" + dir + "/ex.png' -o '" + dir + "/g.png' --method graphcut --size 40x40 -q "
+                        "--report '" + dir + "/g.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image g = read_image(dir + "/g.png");
+  const Image ex8 = read_image(dir + "/ex.png");  // as quantised on disk
+  EXPECT_EQ(g.width, 40);
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      bool found = false;
+      for (int v = 0; v < 16 && !found; ++v)
+        for (int u = 0; u < 16 && !found; ++u)
+          found = g.at(x, y, 0) == ex8.at(u, v, 0) && g.at(x, y, 1) == ex8.at(u, v, 1) && g.at(x, y, 2) == ex8.at(u, v, 2);
+      ASSERT_TRUE(found) << "pixel " << x << "," << y << " is not an exemplar colour";
+    }
+  // Graph-cut is not oriented: an angle is refused, nothing written.
+  r = test::run_surftex("synth '" + dir + "/ex.png' -o '" + dir + "/ga.png' --method graphcut --angle 30 -q");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("method 'graphcut' is not built in this version"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir + "/g.png"));
+  EXPECT_NE(r.err.find("--angle"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/ga.png"));
   // Bad size names the option.
   r = test::run_surftex("synth '" + dir + "/ex.png' -o '" + dir + "/b.png' --size 0x4 -q");
   EXPECT_EQ(r.exit_code, 2);
