@@ -68,34 +68,47 @@ void save_render(const Mesh& mesh, const std::string& path, const RenderMeshOpti
 // Step 1: image synthesis from a generated exemplar by the three 2D engines.
 nlohmann::json step_synthesis(DemoContext& ctx) {
   nlohmann::json j;
-  Image cells = make_cells(64, 4, ctx.seed);
+  // A structured exemplar cut from a larger generated texture (not itself
+  // periodic, so graph-cut cannot simply re-tile it).
+  Image cells(80, 80, 3);
+  {
+    Image big = make_cells(160, 7, ctx.seed);
+    for (int y = 0; y < 80; ++y)
+      for (int x = 0; x < 80; ++x)
+        for (int c = 0; c < 3; ++c) cells.at(x, y, c) = big.at(x + 13, y + 29, c);
+  }
   write_image(ctx.path("exemplar_cells.png"), cells);
   Image stripes = make_stripes(64, 8, 0);
   write_image(ctx.path("exemplar_stripes.png"), stripes);
   ctx.exemplar = cells;
 
+  // Efros-Leung suits stochastic textures: flat regions wider than the window
+  // (the cells) make it grow flat areas, a known limit of the method.
+  Image noise = make_noise(64, 4, ctx.seed + 1);
+  write_image(ctx.path("exemplar_noise.png"), noise);
   Timer t;
   ElOptions el;
   el.window = 11;
   el.seed = ctx.seed;
   el.progress = ctx.progress;
-  Image el_out = efros_leung_synthesize(cells, 128, 128, el);
+  Image el_out = efros_leung_synthesize(noise, 128, 128, el);
   write_image(ctx.path("synth_el2pass.png"), el_out);
   j["el2pass"] = {{"seconds", t.seconds()},
                   {"size", "128x128"},
-                  {"bidirectional_similarity", bidirectional_similarity(el_out, cells, {.patch = 7, .periodic_exemplar = true, .stride = 2}).total},
-                  {"histogram_chi2", histogram_chi_square(el_out, cells)}};
+                  {"bidirectional_similarity", bidirectional_similarity(el_out, noise, {.patch = 7, .periodic_exemplar = true, .stride = 2}).total},
+                  {"histogram_chi2", histogram_chi_square(el_out, noise)}};
 
-  // Oriented synthesis (Gorla 3.3.2): stripes turned by a radial angle field.
+  // Oriented synthesis (Gorla 3.3.2): stripes following a smooth wavy angle
+  // field (no singularity: a singular field seeded at its centre only grows rays).
   t.reset();
   ElInput in;
   in.exemplars = {stripes};
   in.target = Image(128, 128, 3);
-  in.angle_fn = [](int x, int y) { return std::atan2(64.0 - y, x - 64.0); };
+  in.angle_fn = [](int x, int) { return 0.7 * std::sin(2 * 3.14159265358979 * x / 128.0); };
   ElOptions eo = el;
   eo.rotations = 32;
   Image oriented = efros_leung_synthesize(in, eo).image;
-  write_image(ctx.path("synth_oriented_radial.png"), oriented);
+  write_image(ctx.path("synth_oriented_wavy.png"), oriented);
   j["oriented"] = {{"seconds", t.seconds()}, {"rotations", eo.rotations}};
 
   t.reset();
@@ -106,7 +119,7 @@ nlohmann::json step_synthesis(DemoContext& ctx) {
   write_image(ctx.path("synth_graphcut.png"), gc_out);
   j["graphcut"] = {{"seconds", t.seconds()},
                    {"size", "256x256"},
-                   {"bidirectional_similarity", bidirectional_similarity(gc_out, cells, {.patch = 7, .periodic_exemplar = true, .stride = 4}).total}};
+                   {"bidirectional_similarity", bidirectional_similarity(gc_out, cells, {.patch = 7, .periodic_exemplar = false, .stride = 4}).total}};
 
   t.reset();
   TileOptions to;
