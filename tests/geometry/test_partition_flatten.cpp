@@ -123,8 +123,11 @@ TEST(TrianglesOverlap2d, ExactCases) {
 TEST(FlattenPatches, NoOverlapsAndRasterStates) {
   for (int shape = 0; shape < 2; ++shape) {
     Mesh m;
-    if (shape == 0) make_icosphere(m, 3);
-    else make_torus(m, 1.0, 0.4, 36, 18);
+    if (shape == 0) {
+      make_icosphere(m, 3);
+    } else {
+      make_torus(m, 1.0, 0.4, 36, 18);
+    }
     PartitionOptions po;
     po.max_faces = 50;
     const PartitionResult pr = partition_near_planar(m, po);
@@ -152,8 +155,9 @@ TEST(FlattenPatches, NoOverlapsAndRasterStates) {
           EXPECT_GE(fp.pixel_face[i], 0);
           EXPECT_EQ(find(m, kFacePatch).first[FaceIndex(fp.pixel_face[i])], fp.id);
         }
-        if (fp.pixel[i] == PatchPixel::Boundary)
+        if (fp.pixel[i] == PatchPixel::Boundary) {
           EXPECT_NE(find(m, kFacePatch).first[FaceIndex(fp.pixel_face[i])], fp.id);
+        }
       }
       EXPECT_GT(inside, 0u);
       // Patch triangles stay inside the raster (margin).

@@ -191,8 +191,11 @@ TEST(PatchSynthesis, DeterministicAndResynthesisKeepsOthers) {
       if (fp.pixel[i] == PatchPixel::Inside)
         for (int ch = 0; ch < 3; ++ch)
           same = same && a.first.images[p].data[i * 3 + ch] == d.first.images[p].data[i * 3 + ch];
-    if (static_cast<int>(p) == k) EXPECT_FALSE(same) << "patch " << p;
-    else EXPECT_TRUE(same) << "patch " << p;
+    if (static_cast<int>(p) == k) {
+      EXPECT_FALSE(same) << "patch " << p;
+    } else {
+      EXPECT_TRUE(same) << "patch " << p;
+    }
   }
 }
 
