@@ -10,7 +10,7 @@
 // Pixels that are neither Inside nor Boundary (Boundary pixels hold the
 // neighbour's texture, patch_synthesis.h step 7) and the gutter are filled by
 // dilation (each pass gives an empty pixel the mean of its filled
-// 4-neighbours; margin + gutter passes, the rest stays at the mean colour),
+// 4-neighbours; gutter + 8 passes, the rest gets the mean colour),
 // so bilinear lookups near patch edges do not bleed in unrelated texels.
 // UV of a corner: its flat (u, v) -> patch pixel -> atlas pixel -> (x / W,
 // 1 - y / H) (v up, as write_mesh and the rasterizer expect).

@@ -11,18 +11,32 @@
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/write_mesh.h"
-#include "texture/procedural_texture.h"
 #include "test_support.h"
 
 using namespace surftex;
 namespace fs = std::filesystem;
+
+namespace {
+// A small periodic stochastic exemplar (test_apps links the geometry module only).
+Image noise_exemplar(int n) {
+  Image img(n, n, 3);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      unsigned h = static_cast<unsigned>(x * 73856093u) ^ static_cast<unsigned>(y * 19349663u);
+      h = (h ^ (h >> 13)) * 0x5bd1e995u;
+      const float v = static_cast<float>((h >> 8) & 255u) / 255.f;
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = 0.3f + 0.4f * v * (c + 1) / 3.f;
+    }
+  return img;
+}
+}  // namespace
 
 TEST(CmdPatches, WritesAtlasMeshRenderReport) {
   const std::string dir = test::temp_dir("patches");
   Mesh m;
   make_icosphere(m, 2);
   write_mesh(dir + "/sphere.obj", m);
-  write_image(dir + "/ex.png", make_noise(32, 4, 2));
+  write_image(dir + "/ex.png", noise_exemplar(32));
   const std::string out = dir + "/out";
   const std::string cmd = "patches '" + dir + "/sphere.obj' '" + dir + "/ex.png' -o '" + out +
                           "' --patch-res 24 --max-patch-faces 40 --window 7 --rotations 16 "
@@ -53,7 +67,7 @@ TEST(CmdPatches, RefusesBadInput) {
   Mesh m;
   make_icosphere(m, 1);
   write_mesh(dir + "/s.obj", m);
-  write_image(dir + "/ex.png", make_noise(32, 4, 2));
+  write_image(dir + "/ex.png", noise_exemplar(32));
   auto missing = test::run_surftex("patches '" + dir + "/nope.obj' '" + dir + "/ex.png' -o '" + dir + "/o' -q");
   EXPECT_EQ(missing.exit_code, 2);
   auto field = test::run_surftex("patches '" + dir + "/s.obj' '" + dir + "/ex.png' -o '" + dir +
