@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Flattening of near-planar patches into fixed-resolution rasters with
+// boundary conditions (Gorla, Interrante & Sapiro 2003, section 3.2).
+//
+// For each patch (kFacePatch, e.g. from partition_near_planar):
+//  - the plane: the paper projects "onto their common reference plane", the
+//    plane of the seed triangle (Figure 4: "the normal of the grey-shaded
+//    triangle defines the plane"); we follow it: origin = seed centroid,
+//    e1 = the seed's first edge, e2 = n x e1, coordinates (u, v) in world units;
+//  - patch triangles are projected orthogonally onto that plane;
+//  - neighbouring triangles of other patches are ROTATED about their shared
+//    edge into the plane (the paper: rotation, not projection, to minimise
+//    distortion). The shared edge is already in the plane as the projection
+//    of the patch's edge; the third vertex is placed from its 3D position
+//    relative to the edge (distance along it, distance from it), scaled by
+//    the projected/3D length ratio of the edge, on the side away from the
+//    patch triangle. Ring 1 = triangles sharing an edge with the patch;
+//    ring r+1 = triangles outside the patch sharing an edge with a ring-r
+//    triangle, unfolded about that edge (a careful extension: ring 1 alone
+//    leaves gaps at patch corners); rings up to boundary_rings;
+//  - the paper checks that rotated neighbours do not overlap: a boundary
+//    triangle that overlaps (interiors intersect, exact orientation
+//    predicates on the 2D coordinates) a patch triangle or an earlier
+//    boundary triangle is dropped (it then gives no boundary condition);
+//  - a patch whose own projection overlaps itself (possible for a patch that
+//    curls, even within the normal cone) is split by split_overlapping_patches:
+//    the later-reached triangle of each overlapping pair (breadth-first from
+//    the seed) leaves the patch, and the triangles that left form new patches
+//    (their own seed = lowest face index) by the same connected growth.
+//
+// Raster: every patch gets a res x res image with a common texel size for all
+// patches (so the texture has the same scale everywhere, as the paper's
+// equal-size patches intend): texel = (largest patch extent over all patches)
+// / (res - 2 * margin), the patch centred. A pixel is Inside if its centre
+// lies in a patch triangle, Boundary if in a (kept) boundary triangle, else
+// Outside; Inside and Boundary pixels store the 3D face and barycentrics of
+// their centre (for Boundary: in that neighbour's face).
+//
+// Reads kFacePatch. split_overlapping_patches writes kFacePatch. Throws
+// InvalidInputError (missing kFacePatch, a face without patch, bad options,
+// non-triangle faces).
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+enum class PatchPixel : std::uint8_t { Inside = 0, Boundary = 1, Outside = 2 };
+
+struct FlattenOptions {
+  int resolution = 128;     ///< raster side, pixels, 8..4096
+  int margin = 4;           ///< pixels kept around the largest patch, 0..resolution/4
+  int boundary_rings = 2;   ///< rings of neighbour triangles unfolded, 0..4
+};
+
+using Uv2 = std::array<double, 2>;
+
+struct FlatTriangle {
+  int face = -1;                  ///< mesh face index
+  std::array<Uv2, 3> corner{};    ///< plane coordinates of face_vertices order (world units)
+  int ring = 0;                   ///< 0 = patch triangle, >= 1 = boundary ring
+};
+
+struct FlatPatch {
+  int id = -1;
+  int seed_face = -1;
+  std::array<double, 3> origin{}, e1{}, e2{}, normal{};  ///< plane frame
+  std::vector<FlatTriangle> triangles;  ///< patch triangles (ring 0)
+  std::vector<FlatTriangle> boundary;   ///< kept rotated neighbour triangles
+  std::size_t dropped_boundary = 0;     ///< neighbour triangles dropped for overlap
+  // Raster: pixel (x, y) centre is at (u0 + (x + 0.5) * texel, v0 - (y + 0.5) * texel).
+  int res = 0;
+  double texel = 0, u0 = 0, v0 = 0;
+  std::vector<PatchPixel> pixel;                  ///< res*res, row-major
+  std::vector<int> pixel_face;                    ///< mesh face, -1 for Outside
+  std::vector<std::array<float, 3>> pixel_bary;   ///< barycentrics in that face
+  /// Image position (pixel units, continuous: texel centres at +0.5) of plane point (u, v).
+  std::array<double, 2> to_pixel(double u, double v) const {
+    return {(u - u0) / texel, (v0 - v) / texel};
+  }
+};
+
+struct FlattenResult {
+  std::vector<FlatPatch> patches;  ///< indexed by patch id
+  double texel = 0;                ///< common texel size, world units
+  std::size_t inside_pixels = 0, boundary_pixels = 0;
+  std::size_t dropped_boundary = 0;
+};
+
+/// Exact test: do the interiors of 2D triangles a and b intersect? (Touching
+/// along edges or at vertices is not an overlap; degenerate triangles never
+/// overlap.) Uses CGAL's exact orientation predicate.
+bool triangles_overlap_2d(const std::array<Uv2, 3>& a, const std::array<Uv2, 3>& b);
+
+/// Pairs (face a, face b) of patch triangles whose projections overlap.
+std::vector<std::array<int, 2>> patch_overlaps(const FlatPatch& patch);
+
+/// Flattens one patch (plane, triangles, boundary rings) without raster.
+/// `seed_face` is the patch's reference triangle.
+FlatPatch flatten_patch_geometry(const Mesh& mesh, int patch, int seed_face, int boundary_rings);
+
+/// Splits patches whose projection overlaps itself (see above): new patches
+/// grow from their lowest face index over connected leaving triangles within
+/// max_angle_deg of that seed's normal. `seed_faces` (per patch id) is
+/// updated with the seeds of new patches. Returns the number of patches split.
+/// Writes kFacePatch.
+int split_overlapping_patches(Mesh& mesh, std::vector<int>& seed_faces, double max_angle_deg,
+                              int max_rounds = 8);
+
+/// Flattens and rasterises every patch of kFacePatch. seed_faces[p] is the
+/// reference triangle of patch p (partition_near_planar's seed_face); it must
+/// belong to patch p.
+FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seed_faces,
+                              const FlattenOptions& options = {});
+
+}  // namespace surftex
