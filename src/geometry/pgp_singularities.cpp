@@ -71,11 +71,9 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
     if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
     bool sing = false;
     for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) {
-      if (mesh.is_border(h)) continue;
-      const FaceIndex f = mesh.face(h);
-      if (out.distorted_face[f.idx()]) sing = true;
-      for (HalfedgeIndex k : CGAL::halfedges_around_face(h, mesh))
-        if (out.mismatched_edge[mesh.edge(k).idx()]) sing = true;
+      // Spokes (v, j) only: the rim edges of the ring do not touch v's chart.
+      if (out.mismatched_edge[mesh.edge(h).idx()]) sing = true;
+      if (!mesh.is_border(h) && out.distorted_face[mesh.face(h).idx()]) sing = true;
     }
     out.singular_vertex[v.idx()] = sing;
   }
