@@ -125,13 +125,15 @@ int main(int argc, char** argv) {
 
     // Singular fraction against the period (in mean edge lengths), the field
     // interpolated from the 5% most anisotropic faces' principal directions.
-    interpolate_direction_field(mesh, curv, {});
-    for (double k : {4.0, 6.0, 8.0, 12.0, 16.0, 24.0}) {
+    for (int field = 0; field < 2; ++field)
+    for (double k : {4.0, 8.0, 16.0}) {
+      interpolate_direction_field(mesh, field ? curv : strokes, {});
       interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
       PeriodicGlobalParameterization p2(mesh);
       p2.initialize();
       nlohmann::json fig = singularity_figures(detect_pgp_singularities(mesh));
       fig["edges_per_period"] = k;
+      fig["field"] = field ? "curvature" : "strokes";
       emit(name, nf, "singular_fraction_vs_period", 0.0, fig);
     }
   }
