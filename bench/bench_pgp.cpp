@@ -48,6 +48,18 @@ void emit(const std::string& mesh, std::size_t faces, const std::string& step, d
   std::cout << extra.dump() << std::endl;
 }
 
+nlohmann::json singularity_figures(const PgpSingularities& s) {
+  std::size_t distorted = 0, mismatched = 0, sv = 0;
+  for (char x : s.distorted_face) distorted += x;
+  for (char x : s.mismatched_edge) mismatched += x;
+  for (char x : s.singular_vertex) sv += x;
+  return {{"singular_fraction", s.singular_fraction},
+          {"distorted_faces", distorted},
+          {"mismatched_edges", mismatched},
+          {"singular_vertices", sv},
+          {"faces", s.singular_face.size()}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -77,23 +89,16 @@ int main(int argc, char** argv) {
          best_of_3([&] { interpolate_direction_field(mesh, curv, {}); }),
          {{"constraints", curv.size()}});
     interpolate_scalar_field(mesh, {{0, 1.0}}, scale_field_options());
-    // Scale: 40 periods across the bounding box diagonal.
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (VertexIndex v : mesh.vertices())
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], mesh.point(v)[k]);
-        hi[k] = std::max(hi[k], mesh.point(v)[k]);
-      }
-    const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    interpolate_scalar_field(mesh, {{0, diag / 40}}, scale_field_options());
+    // Scale: the default period, 8 mean edge lengths (pgp_default_scale).
+    const double period = pgp_default_scale(mesh, 8.0);
+    interpolate_scalar_field(mesh, {{0, period}}, scale_field_options());
     interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
                              material_field_options());
     PeriodicGlobalParameterization pgp(mesh);
     emit(name, nf, "pgp_initialize", best_of_3([&] { pgp.initialize(); }));
     PgpSingularities sing;
     const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
-    emit(name, nf, "detect_singularities", t_sing, {{"singular_fraction", sing.singular_fraction}});
+    emit(name, nf, "detect_singularities", t_sing, singularity_figures(sing));
 
     // Local update: effect area of 25% of the faces around a vertex.
     EffectAreaOptions eo;
@@ -110,13 +115,27 @@ int main(int argc, char** argv) {
     double t_dir = 0, t_scale = 0, t_pgp = 0;
     PgpResult last;
     t_dir = best_of_3([&] { interpolate_direction_field(mesh, {{cf, {0.0, 1.0, 1.0}}}, dopt); });
-    t_scale = best_of_3([&] { interpolate_scalar_field(mesh, {{seed, diag / 60}}, sopt); });
+    t_scale = best_of_3([&] { interpolate_scalar_field(mesh, {{seed, 0.7 * period}}, sopt); });
     t_pgp = best_of_3([&] { last = pgp.update(area); });
     emit(name, nf, "local_update_orientation", t_dir, {{"area_faces", area.free_faces}});
     emit(name, nf, "local_update_scale", t_scale, {{"area_faces", area.free_faces}});
     emit(name, nf, "local_update_pgp", t_pgp,
          {{"area_faces", area.free_faces}, {"reused_analysis", last.reused_analysis}});
     emit(name, nf, "local_update_total", t_dir + t_scale + t_pgp, {{"area_faces", area.free_faces}});
+
+    // Singular fraction against the period (in mean edge lengths), the field
+    // interpolated from the 5% most anisotropic faces' principal directions.
+    for (int field = 0; field < 2; ++field)
+    for (double k : {4.0, 8.0, 16.0}) {
+      interpolate_direction_field(mesh, field ? curv : strokes, {});
+      interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
+      PeriodicGlobalParameterization p2(mesh);
+      p2.initialize();
+      nlohmann::json fig = singularity_figures(detect_pgp_singularities(mesh));
+      fig["edges_per_period"] = k;
+      fig["field"] = field ? "curvature" : "strokes";
+      emit(name, nf, "singular_fraction_vs_period", 0.0, fig);
+    }
   }
   return 0;
 }

@@ -127,7 +127,42 @@ struct PeriodicGlobalParameterization::Impl {
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {}
 
   PgpResult solve(const std::vector<char>& free_vertex, const std::vector<char>* free_face);
+  void write_corners(const std::vector<std::array<double, 2>>& alpha, const std::vector<char>* free_face);
 };
+
+void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::array<double, 2>>& alpha,
+                                                        const std::vector<char>* free_face) {
+  // Corner coordinates, equation (4): from corner 0 (i = target(halfedge(f)))
+  // along the two edges (i,j) and (i,k), the integer jump chosen so that the
+  // difference is nearest to the edge's alpha_ij, which both faces of the edge
+  // share: two faces whose three edge differences close (no zero of z inside)
+  // then agree on their common edge exactly.
+  auto stm = mesh.add_property_map<HalfedgeIndex, STM>(opt.stm_map, STM{0, 0, 0}).first;
+  auto mat = mesh.property_map<VertexIndex, double>(opt.material_map);
+  for (FaceIndex f : mesh.faces()) {
+    if (free_face && !(*free_face)[f.idx()]) continue;
+    const HalfedgeIndex h0 = mesh.halfedge(f);
+    const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
+    const VertexIndex vi = mesh.target(h0);
+    const double si = std::arg(zs[vi.idx()]) / (2 * M_PI);
+    const double ti = std::arg(zt[vi.idx()]) / (2 * M_PI);
+    // alpha along i -> corner c: c = 1 via hs[1] (i -> j); c = 2 against hs[0] (k -> i).
+    const std::array<double, 2> a1 = alpha[hs[1].idx()];
+    const std::array<double, 2> a2{-alpha[hs[0].idx()][0], -alpha[hs[0].idx()][1]};
+    for (int c = 0; c < 3; ++c) {
+      const VertexIndex v = mesh.target(hs[c]);
+      const double m = mat.second ? mat.first[v] : 0.0;
+      if (c == 0) {
+        stm[hs[c]] = {si, ti, m};
+        continue;
+      }
+      const std::array<double, 2>& a = c == 1 ? a1 : a2;
+      const double sj = std::arg(zs[v.idx()]) / (2 * M_PI);
+      const double tj = std::arg(zt[v.idx()]) / (2 * M_PI);
+      stm[hs[c]] = {sj + std::round(si + a[0] - sj), tj + std::round(ti + a[1] - tj), m};
+    }
+  }
+}
 
 PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& free_vertex,
                                                       const std::vector<char>* free_face) {
@@ -224,32 +259,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     res.energy_t += w * std::norm(zt[j] - std::polar(1.0, 2 * M_PI * alpha[h.idx()][1]) * zt[i]);
   }
 
-  // Corner coordinates, equation (4).
-  auto stm = mesh.add_property_map<HalfedgeIndex, STM>(opt.stm_map, STM{0, 0, 0}).first;
-  auto mat = mesh.property_map<VertexIndex, double>(opt.material_map);
-  for (FaceIndex f : mesh.faces()) {
-    if (free_face && !(*free_face)[f.idx()]) continue;
-    const HalfedgeIndex h0 = mesh.halfedge(f);
-    const VertexIndex vi = mesh.target(h0);
-    const Point3& pi = mesh.point(vi);
-    const double si = std::arg(zs[vi.idx()]) / (2 * M_PI);
-    const double ti = std::arg(zt[vi.idx()]) / (2 * M_PI);
-    HalfedgeIndex h = h0;
-    for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
-      const VertexIndex v = mesh.target(h);
-      const double m = mat.second ? mat.first[v] : 0.0;
-      if (c == 0) {
-        stm[h] = {si, ti, m};
-        continue;
-      }
-      const Vector3 e = mesh.point(v) - pi;
-      const double sj = std::arg(zs[v.idx()]) / (2 * M_PI);
-      const double tj = std::arg(zt[v.idx()]) / (2 * M_PI);
-      const double ps = std::round(si + e * g[f.idx()].gs - sj);
-      const double pt = std::round(ti + e * g[f.idx()].gt - tj);
-      stm[h] = {sj + ps, tj + pt, m};
-    }
-  }
+  write_corners(alpha, free_face);
   res.seconds = timer.seconds();
   return res;
 }
@@ -325,6 +335,30 @@ void PeriodicGlobalParameterization::set_state(std::vector<std::complex<double>>
   impl_->zt = std::move(zt);
   impl_->initialized = true;
   impl_->analyzed = false;
+}
+
+void PeriodicGlobalParameterization::write_corners() {
+  if (!impl_->initialized)
+    throw InvalidInputError("PeriodicGlobalParameterization::write_corners called before initialize()/set_state()");
+  check_options(impl_->opt);
+  require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
+  std::vector<FaceFrame> frames;
+  const auto g = face_gradients(impl_->mesh, impl_->opt, &frames);
+  impl_->write_corners(halfedge_alphas(impl_->mesh, impl_->opt, g, frames), nullptr);
+}
+
+double pgp_default_scale(const Mesh& mesh, double edges_per_period) {
+  if (!(edges_per_period > 0) || !std::isfinite(edges_per_period))
+    throw InvalidInputError("pgp_default_scale: edges_per_period must be > 0, got " + std::to_string(edges_per_period));
+  double sum = 0;
+  std::size_t n = 0;
+  for (EdgeIndex e : mesh.edges()) {
+    const HalfedgeIndex h = mesh.halfedge(e);
+    sum += norm(mesh.point(mesh.target(h)) - mesh.point(mesh.source(h)));
+    ++n;
+  }
+  if (n == 0 || !(sum > 0)) throw InvalidInputError("pgp_default_scale: the mesh has no edge of positive length");
+  return edges_per_period * sum / static_cast<double>(n);
 }
 
 PgpResult periodic_global_parameterization(Mesh& mesh, const PgpOptions& options) {

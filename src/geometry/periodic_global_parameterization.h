@@ -27,7 +27,11 @@
 //     to its previous z; only the free vertices are solved.
 // Corner coordinates (equation 4): in face T = (i,j,k) (i = target of
 // halfedge(T)), s_i = Arg(z_i)/2pi, s_j = Arg(z_j)/2pi + p_j with the integer
-// p_j = round(s_i + e_ij.g^T - Arg(z_j)/2pi) (T's own gradient, eq. 1), same for k.
+// p_j = round(s_i + alpha_ij - Arg(z_j)/2pi), alpha_ij the edge's shared
+// expected increase (as the paper writes it; an earlier version used T's own
+// gradient, which let the two faces of an edge round differently and doubled
+// the mismatched edges), same for k along (i,k). Two adjacent faces around which
+// the jumps close agree exactly on their shared edge.
 // The material m of a corner is the vertex material.
 //
 // Reads the face map direction_map (Vector3 d_s), the vertex maps scale_map
@@ -100,11 +104,20 @@ class PeriodicGlobalParameterization {
   const std::vector<std::complex<double>>& z_t() const;
   /// Restores a previous state (e.g. loaded from disk for `--update`).
   void set_state(std::vector<std::complex<double>> zs, std::vector<std::complex<double>> zt);
+  /// Rewrites the corners of every face from the current state and the
+  /// current direction/scale/material maps (e.g. after set_state on a freshly
+  /// loaded mesh). Throws InvalidInputError before initialize()/set_state().
+  void write_corners();
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Default texture period S for a mesh: `edges_per_period` times the mean
+/// edge length (mesh units). Throws InvalidInputError for a value <= 0 or a
+/// mesh without edges of positive length.
+double pgp_default_scale(const Mesh& mesh, double edges_per_period = 8.0);
 
 /// One-shot: initialise and write the corners.
 PgpResult periodic_global_parameterization(Mesh& mesh, const PgpOptions& options = {});

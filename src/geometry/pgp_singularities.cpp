@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/pgp_singularities.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "geometry/errors.h"
@@ -52,9 +54,25 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
     }
     const auto& g = grads[f.idx()];
     const Vector3 es(g[0][0], g[0][1], g[0][2]), et(g[1][0], g[1][1], g[1][2]);
-    const double ds = (gs - es).squared_length(), dt = (gt - et).squared_length();
-    if (ds > opt.distortion_threshold * es.squared_length() ||
-        dt > opt.distortion_threshold * et.squared_length() || !std::isfinite(ds + dt))
+    // The target is the cross of the N-symmetric field: (g_s, g_t) rotated by
+    // any multiple of 2 pi / N in the face (the PGP matches representatives
+    // across edges, so a region may follow another representative than the
+    // face's stored one; the texture then still follows the field).
+    double best_s = std::numeric_limits<double>::infinity(), best_t = best_s;
+    const int N = opt.pgp.symmetry;
+    for (int r = 0; r < N; ++r) {
+      // rotation by r * 2pi/N of the pair (g_s, g_t) (g_t = n x g_s, same length).
+      const int q = r * (4 / N);  // quarter turns
+      const Vector3 rs = q == 0 ? es : q == 1 ? et : q == 2 ? -es : -et;
+      const Vector3 rt = q == 0 ? et : q == 1 ? -es : q == 2 ? -et : es;
+      const double ds = (gs - rs).squared_length(), dt = (gt - rt).squared_length();
+      if (std::max(ds, dt) < std::max(best_s, best_t)) {
+        best_s = ds;
+        best_t = dt;
+      }
+    }
+    if (best_s > opt.distortion_threshold * es.squared_length() ||
+        best_t > opt.distortion_threshold * et.squared_length() || !std::isfinite(best_s + best_t))
       out.distorted_face[f.idx()] = 1;
   }
   for (EdgeIndex e : mesh.edges()) {
@@ -71,11 +89,9 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
     if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
     bool sing = false;
     for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) {
-      if (mesh.is_border(h)) continue;
-      const FaceIndex f = mesh.face(h);
-      if (out.distorted_face[f.idx()]) sing = true;
-      for (HalfedgeIndex k : CGAL::halfedges_around_face(h, mesh))
-        if (out.mismatched_edge[mesh.edge(k).idx()]) sing = true;
+      // Spokes (v, j) only: the rim edges of the ring do not touch v's chart.
+      if (out.mismatched_edge[mesh.edge(h).idx()]) sing = true;
+      if (!mesh.is_border(h) && out.distorted_face[mesh.face(h).idx()]) sing = true;
     }
     out.singular_vertex[v.idx()] = sing;
   }

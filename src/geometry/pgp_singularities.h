@@ -11,7 +11,12 @@
 //     what a scale-independent test must mean;
 //   - or a mismatched edge: s_j^T - s_i^T != s_j^T' - s_i^T' (or t), beyond
 //     `mismatch_tolerance` periods.
-// A face is singular when one of its vertices is.
+// "An edge (i,j)" of the neighbourhood of i is read as a spoke from i (the
+// rim edges of the ring do not affect i's chart): the fix below is continuous
+// across every edge as soon as each regular endpoint's spokes match, so a
+// mismatched edge makes its two endpoints singular, not the whole 2-ring (an
+// earlier version also counted rim edges, which roughly doubled the singular
+// faces). A face is singular when one of its vertices is.
 //
 // Fix. Each singular vertex i gets its own 1-ring chart: s'_{i,i} = s_i^T (T =
 // the face of halfedge(i)), s'_{i,j} = s'_{i,i} + alpha_ij (alpha of eq. 3, in

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Reading a material-space 3D tile back from the folder written by
+// write_material_tile (material_tile.h), and the trilinear (s,t,m) lookup a
+// renderer uses (Ray et al. 2009, section 3: "one 3D texture lookup").
+//
+// Folder format (see material_tile_write.cpp): tile.json with "format" =
+// "surftex material tile", "size", "channels", "layers" (count),
+// "layers_per_pair" (M), and "layer_list": per layer {index, m, file, mask,
+// ...}; the layers are read from their PNG files (layer_NNN.png), which are
+// authoritative (layers.tif is a convenience copy and is not read).
+//
+// Lookup convention: layer texel (x, y) is centred at s = (x + 0.5) / size,
+// t = (y + 0.5) / size (row y = 0 at the top of the image, t grows downwards
+// in the image); s and t wrap with period 1. The material coordinate m in
+// [0,1] (clamped) spans the whole stack: layer k sits at m = k / (L - 1)
+// (L layers; with one layer m is ignored).
+
+#include <string>
+#include <vector>
+
+#include "geometry/image.h"
+#include "geometry/rasterizer.h"
+
+namespace surftex {
+
+/// A 3D tile in memory: L layers, each size x size, same channel count.
+struct MaterialTile {
+  std::vector<Image> layers;
+  std::vector<double> material;  ///< m recorded per layer in tile.json (key index + fraction)
+  int size = 0;
+  int layers_per_pair = 0;  ///< M
+};
+
+/// Reads `dir`/tile.json and every layer file it lists. Throws IOError (no
+/// tile.json, unreadable or missing layer file: names the file) and
+/// InvalidInputError (malformed JSON with its byte offset, wrong format tag, a
+/// missing or ill-typed field: names it, a layer whose size or channel count
+/// differs from the declared size/channels, a layer count that differs from
+/// "layers").
+MaterialTile read_material_tile(const std::string& dir);
+
+/// Checks a tile made in memory the same way (non-empty, square, equal sizes
+/// and channels >= 1). Throws InvalidInputError.
+void validate_material_tile(const MaterialTile& tile);
+
+/// Trilinear lookup: bilinear in (s,t) with wrap-around (period 1) in each of
+/// the two layers nearest to m (clamped to [0,1]), linear between them.
+/// 1 channel = grey, >= 3 = the first three. Assumes a valid tile.
+Vec3f sample_material_tile(const MaterialTile& tile, double s, double t, double m);
+
+}  // namespace surftex

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// `surftex material-map`: outputs, and the local update through the CLI path.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "geometry/effect_area.h"
+#include "geometry/material_constraints.h"
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/read_mesh.h"
+#include "geometry/write_mesh.h"
+#include "test_support.h"
+#include "texture/material_tile.h"
+
+using namespace surftex;
+
+namespace {
+
+std::string make_inputs(const std::string& dir) {
+  Mesh m;
+  make_torus(m, 3.0, 1.0, 48, 20);
+  write_mesh(dir + "/torus.ply", m);
+  MaterialTileResult r;
+  for (int l = 0; l < 2; ++l) {
+    Image img(16, 16, 3), mask(16, 16, 1, 0.f);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        img.at(x, y, 0) = ((x / 4 + y / 4) % 2) ? 1.f : 0.f;
+        img.at(x, y, 1) = static_cast<float>(l);
+        img.at(x, y, 2) = 0.5f;
+      }
+    r.layers.push_back(img);
+    r.masks.push_back(mask);
+    r.material.push_back(l);
+    r.sign_changes.push_back(0);
+    r.mask_agreement.push_back(1);
+  }
+  MaterialTileInfo info;
+  info.sources = {"a", "b"};
+  info.masks = {"", ""};
+  info.layers_per_pair = 1;
+  write_material_tile(dir + "/tile", r, info, true);
+  std::ofstream(dir + "/c1.json") << R"({"strokes": [{"polyline": [[4, 0, 1], [0, 4, 1], [-4, 0, 1]]}],
+    "material": [{"point": [4, 0, 0], "value": 1}, {"point": [-4, 0, 0], "value": 0}]})";
+  std::ofstream(dir + "/c2.json") << R"({"effect_radius": 1.5,
+    "strokes": [{"faces": [10], "direction": [0, 0, 1]}],
+    "scale": [{"point": [0, -4, 0], "value": 0.4}], "material": [{"point": [0, -4, 0], "value": 0.2}]})";
+  return dir;
+}
+
+std::vector<double> arr(const nlohmann::json& j, const char* k) { return j.at(k).get<std::vector<double>>(); }
+
+}  // namespace
+
+TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
+  const std::string dir = make_inputs(test::temp_dir("cmd-matmap"));
+  const std::string base = "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 96 -q ";
+  test::RunResult r = test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/out1'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"mesh.obj", "mesh.glb", "mesh.ply", "render_plain.png", "render_fixed.png",
+                        "render_normalmap.png", "report.json", "state.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/out1/" + f)) << f;
+  nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir + "/out1/report.json"));
+  EXPECT_EQ(rep["faces"], 48 * 20 * 2);
+  EXPECT_EQ(rep["field_source"], "strokes");
+  EXPECT_GE(rep["singular_fraction"].get<double>(), 0.0);
+  EXPECT_LT(rep["singular_fraction"].get<double>(), 1.0);
+  EXPECT_TRUE(rep["seconds"].contains("pgp"));
+  // Refuses to overwrite without --force.
+  EXPECT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/out1'").exit_code, 2);
+
+  r = test::run_surftex(base + "--update '" + dir + "/c2.json' --state '" + dir + "/out1/state.json' -o '" + dir + "/out2'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json s1 = nlohmann::json::parse(std::ifstream(dir + "/out1/state.json"));
+  const nlohmann::json s2 = nlohmann::json::parse(std::ifstream(dir + "/out2/state.json"));
+  Mesh m;
+  read_mesh(dir + "/torus.ply", m);
+  const MaterialConstraints c2 = read_material_constraints(dir + "/c2.json", m);
+  EffectAreaOptions eo;
+  eo.radius = c2.effect_radius;
+  const EffectArea area = compute_effect_area(m, c2.seed_vertices, eo);
+  ASSERT_GT(area.free_vertices, 10u);
+  ASSERT_LT(area.free_vertices, m.number_of_vertices() / 2);
+  const auto zs1 = arr(s1, "z_s"), zs2 = arr(s2, "z_s"), zt1 = arr(s1, "z_t"), zt2 = arr(s2, "z_t");
+  const auto sc1 = arr(s1, "scale"), sc2 = arr(s2, "scale"), m1 = arr(s1, "material"), m2 = arr(s2, "material");
+  const auto d1 = arr(s1, "direction"), d2 = arr(s2, "direction");
+  std::size_t changed_inside = 0;
+  for (std::size_t v = 0; v < m.num_vertices(); ++v) {
+    if (area.vertex_free[v]) {
+      changed_inside += zs1[2 * v] != zs2[2 * v] || sc1[v] != sc2[v];
+      continue;
+    }
+    ASSERT_EQ(zs1[2 * v], zs2[2 * v]) << v;
+    ASSERT_EQ(zs1[2 * v + 1], zs2[2 * v + 1]) << v;
+    ASSERT_EQ(zt1[2 * v], zt2[2 * v]) << v;
+    ASSERT_EQ(zt1[2 * v + 1], zt2[2 * v + 1]) << v;
+    ASSERT_EQ(sc1[v], sc2[v]) << v;
+    ASSERT_EQ(m1[v], m2[v]) << v;
+  }
+  for (std::size_t f = 0; f < m.num_faces(); ++f)
+    if (!area.face_free[f]) {
+      for (int k = 0; k < 3; ++k) ASSERT_EQ(d1[3 * f + k], d2[3 * f + k]) << f;
+    }
+  EXPECT_GT(changed_inside, area.free_vertices / 2);
+  nlohmann::json rep2 = nlohmann::json::parse(std::ifstream(dir + "/out2/report.json"));
+  EXPECT_EQ(rep2["mode"], "update");
+  EXPECT_EQ(rep2["effect_area"]["vertices"], area.free_vertices);
+
+  // Errors: --update without --state, a bad constraints file.
+  EXPECT_EQ(test::run_surftex(base + "--update '" + dir + "/c2.json' -o '" + dir + "/out3'").exit_code, 2);
+  std::ofstream(dir + "/bad.json") << "{\n \"strokes\": 3}";
+  r = test::run_surftex(base + "--constraints '" + dir + "/bad.json' -o '" + dir + "/out4'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bad.json:2: strokes: must be an array"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out4/report.json"));
+}
