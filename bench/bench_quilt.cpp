@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"

@@ -243,7 +243,7 @@ int run_quilt(QuiltArgs& a) {
   write_report(a.common, "quilt", rep);
   if (!a.common.quiet) {
     std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
-                 out.number_of_faces(), total.seconds(), a.output.c_str());
+                 static_cast<std::size_t>(out.number_of_faces()), total.seconds(), a.output.c_str());
     if (rep.contains("stretch_before"))
       std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n", rep["stretch_before"].get<double>(),
                    rep["stretch_after"].get<double>(), rep["self_intersections"].dump().c_str());
