@@ -1,19 +1,27 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// `surftex quilt`: mesh quilting of a swatch over a plane (Zhou et al. 2006,
-// section 2) and `surftex elements`: edit the elements of a result by id.
+// `surftex quilt`: mesh quilting of a swatch over a base mesh (Zhou et al.
+// 2006, section 3: surface quilting, shell-map embedding) or a plane (section
+// 2); `surftex elements`: edit the elements of a result by id; the demo step
+// "quilt".
+#include <cctype>
 #include <cstdio>
 #include <sstream>
 #include <string>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
+#include "geometry/primitive_meshes.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
+#include "shell/embed_surface_quilt.h"
 #include "shell/mesh_quilting.h"
+#include "shell/surface_quilting.h"
+#include "shell/swatch_generators.h"
+#include "surftex/demo_steps.h"
 #include "shell/swatch.h"
 #include "surftex/command.h"
 
@@ -28,94 +36,254 @@ std::string render_path_for(const std::string& out) {
 }
 
 struct QuiltArgs {
-  std::string base, swatch, output, plane, render;
-  bool no_render = false;
-  double scale = 1.0, cell = 0;
-  int subpatch = 0;
+  std::string base, swatch, output, plane, render, field = "up";
+  bool no_render = false, no_check = false;
+  double scale = 0, cell = 0, shell_height = 1.0;
+  std::vector<double> up{0, 0, 1};
+  int subpatch = 0, stretch_iterations = 20;
   CommonOptions common;
 };
+
+bool is_generated_swatch(const std::string& s) { return s == "chainmail" || s == "weave" || s == "scatter"; }
+
+// The swatch: a file, or one the project generates (seeded by --seed).
+Mesh load_or_generate_swatch(const std::string& name, std::uint64_t seed) {
+  Mesh sm;
+  if (name == "chainmail") {
+    ChainmailOptions o;
+    o.seed = seed;
+    make_chainmail_swatch(sm, o);
+  } else if (name == "weave") {
+    WeaveOptions o;
+    o.seed = seed;
+    make_weave_swatch(sm, o);
+  } else if (name == "scatter") {
+    ScatterOptions o;
+    o.seed = seed;
+    make_scatter_swatch(sm, o);
+  } else {
+    read_mesh(name, sm);
+  }
+  return sm;
+}
+
+std::string sibling(const std::string& out, const std::string& ext) {
+  const auto dot = out.find_last_of('.');
+  const auto slash = out.find_last_of('/');
+  const std::string stem = (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? out : out.substr(0, dot);
+  return stem + ext;
+}
+
+std::string lower_ext(const std::string& path) {
+  const auto dot = path.find_last_of('.');
+  if (dot == std::string::npos) return "";
+  std::string e = path.substr(dot);
+  for (char& ch : e) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return e;
+}
 
 int run_quilt(QuiltArgs& a) {
   // With --plane the positional arguments are just the swatch.
   if (!a.plane.empty() && !a.base.empty() && a.swatch.empty()) std::swap(a.base, a.swatch);
-  if (a.plane.empty())
-    throw InvalidInputError("quilt: quilting over a base mesh is not available in this build; use --plane WxH");
-  if (a.swatch.empty()) throw InvalidInputError("quilt: missing SWATCH");
-  require_input_file(a.swatch, "swatch");
-  check_output(a.output, {a.swatch}, a.common.force);
+  if (!a.plane.empty() && !a.base.empty())
+    throw InvalidInputError("quilt: give either a base MESH or --plane WxH, not both");
+  if (a.plane.empty() && a.base.empty()) throw InvalidInputError("quilt: missing MESH (or --plane WxH)");
+  if (a.swatch.empty()) throw InvalidInputError("quilt: missing SWATCH (a mesh file or chainmail|weave|scatter)");
+  if (!is_generated_swatch(a.swatch)) require_input_file(a.swatch, "swatch");
+  std::vector<std::string> inputs;
+  if (!is_generated_swatch(a.swatch)) inputs.push_back(a.swatch);
+  if (!a.base.empty()) {
+    require_input_file(a.base, "base mesh");
+    inputs.push_back(a.base);
+  }
+  if (a.field != "up" && a.field != "none")
+    throw InvalidInputError("quilt: --field must be up or none (got '" + a.field + "')");
+  if (a.up.size() != 3 || !(a.up[0] * a.up[0] + a.up[1] * a.up[1] + a.up[2] * a.up[2] > 0))
+    throw InvalidInputError("quilt: --up must be three numbers, not all zero");
+  const std::string ext = lower_ext(a.output);
+  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".glb" && ext != ".gltf" && ext != ".stl")
+    throw InvalidInputError("quilt: unknown output format '" + a.output + "' (use .obj, .ply, .off, .glb)");
+  // Outputs: OUT, its .ply and .glb siblings (mesh mode), the render.
+  std::vector<std::string> outputs{a.output};
+  if (!a.base.empty())
+    for (const std::string& e : {std::string(".ply"), std::string(".glb")})
+      if (ext != e) outputs.push_back(sibling(a.output, e));
   if (a.render.empty() && !a.no_render) a.render = render_path_for(a.output);
-  if (!a.render.empty()) check_output(a.render, {a.swatch, a.output}, a.common.force);
+  if (!a.render.empty()) outputs.push_back(a.render);
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    std::vector<std::string> others = inputs;
+    others.insert(others.end(), outputs.begin(), outputs.begin() + static_cast<long>(i));
+    check_output(outputs[i], others, a.common.force);
+  }
   double w = 0, h = 0;
-  {
+  if (!a.plane.empty()) {
     char x = 0;
     std::istringstream is(a.plane);
     if (!(is >> w >> x >> h) || (x != 'x' && x != 'X') || !(w > 0) || !(h > 0))
       throw InvalidInputError("quilt: --plane must be WxH with positive numbers in swatch sizes (got '" + a.plane + "')");
   }
   auto limit = apply_thread_limit(a.common.threads);
-  Mesh sm;
-  read_mesh(a.swatch, sm);
-  // --scale: size of the swatch relative to the output (the paper's s).
-  for (VertexIndex v : sm.vertices()) {
-    const Point3 p = sm.point(v);
-    sm.point(v) = Point3(p.x() * a.scale, p.y() * a.scale, p.z() * a.scale);
-  }
-  const Swatch s = make_swatch(sm);
-  PlanarQuiltOptions o;
-  o.seed = a.common.seed;
-  o.cell_size = a.cell;
-  o.subpatch_radius = a.subpatch;
-  o.progress = terminal_progress(a.common.quiet);
-  Mesh out;
-  const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
+  Timer total;
   Timer t;
-  color_by_element(out, a.common.seed);
-  WriteMeshOptions wo;
-  wo.overwrite = a.common.force;
-  write_mesh(a.output, out, wo);
-  if (!a.render.empty()) {
-    WriteImageOptions io;
-    io.overwrite = a.common.force;
-    write_image(a.render, render_preview(out), io);
-  }
+  Mesh sm = load_or_generate_swatch(a.swatch, a.common.seed);
+  const double swatch_seconds = t.seconds();
   nlohmann::json rep;
   rep["swatch"] = a.swatch;
   rep["output"] = a.output;
-  if (!a.render.empty()) rep["render"] = a.render;
-  rep["plane"] = {w, h};
-  rep["swatch_faces"] = s.mesh.tris.size();
-  rep["swatch_elements"] = s.elements.size();
-  rep["elements"] = r.elements;
-  rep["faces"] = r.faces;
-  rep["vertices"] = r.vertices;
-  rep["steps"] = r.steps;
-  rep["stitched"] = r.stats.stitched;
-  rep["stitch_refused"] = r.stats.stitch_refused;
-  rep["seconds"] = {{"total", r.seconds}, {"match", r.stats.seconds_match}, {"correspond", r.stats.seconds_correspond},
-                    {"deform", r.stats.seconds_deform}, {"merge", r.stats.seconds_merge}, {"write", t.seconds()}};
+  Mesh out, scene;
+  if (!a.plane.empty()) {
+    // --scale: factor applied to the swatch (the paper's s); the plane is in swatch sizes.
+    const double sc = a.scale > 0 ? a.scale : 1.0;
+    for (VertexIndex v : sm.vertices()) {
+      const Point3 p = sm.point(v);
+      sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
+    }
+    const Swatch s = make_swatch(sm);
+    PlanarQuiltOptions o;
+    o.seed = a.common.seed;
+    o.cell_size = a.cell * sc;
+    o.subpatch_radius = a.subpatch;
+    o.progress = terminal_progress(a.common.quiet);
+    const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
+    color_by_element(out, a.common.seed);
+    rep["plane"] = {w, h};
+    rep["swatch_faces"] = s.mesh.tris.size();
+    rep["swatch_elements"] = s.elements.size();
+    rep["elements"] = r.elements;
+    rep["faces"] = r.faces;
+    rep["vertices"] = r.vertices;
+    rep["steps"] = r.steps;
+    rep["stitched"] = r.stats.stitched;
+    rep["stitch_refused"] = r.stats.stitch_refused;
+    rep["seconds"] = {{"swatch", swatch_seconds}, {"quilt", r.seconds}, {"match", r.stats.seconds_match},
+                      {"correspond", r.stats.seconds_correspond}, {"deform", r.stats.seconds_deform},
+                      {"merge", r.stats.seconds_merge}};
+    scene = out;
+  } else {
+    t.reset();
+    Mesh base;
+    read_mesh(a.base, base);
+    base.collect_garbage();
+    const double read_seconds = t.seconds();
+    const Swatch s = make_swatch(sm);
+    SurfaceQuiltOptions o;
+    o.relative_size = a.scale > 0 ? a.scale : 0.25;
+    if (!(o.relative_size <= 10)) throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
+    o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
+    o.up = {a.up[0], a.up[1], a.up[2]};
+    o.cell_size = a.cell;
+    o.subpatch_radius = a.subpatch;
+    o.seed = a.common.seed;
+    o.progress = terminal_progress(a.common.quiet);
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    EmbedSurfaceQuiltOptions eo;
+    eo.shell_height = a.shell_height;
+    eo.stretch.iterations = a.stretch_iterations;
+    eo.stretch.seed = a.common.seed;
+    eo.check_self_intersections = !a.no_check;
+    eo.progress = o.progress;
+    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+    color_by_element(out, a.common.seed);
+    rep["mesh"] = a.base;
+    rep["base_faces"] = base.number_of_faces();
+    rep["swatch_faces"] = s.mesh.tris.size();
+    rep["swatch_elements"] = s.elements.size();
+    rep["scale"] = o.relative_size;
+    rep["field"] = a.field;
+    rep["elements"] = r.elements;
+    rep["faces"] = out.number_of_faces();
+    rep["vertices"] = out.number_of_vertices();
+    rep["steps"] = r.steps;
+    rep["patches_shrunk"] = r.patches_shrunk;
+    rep["stitched"] = r.stats.stitched;
+    rep["stitch_refused"] = r.stats.stitch_refused;
+    rep["charts"] = er.atlas.num_charts;
+    rep["tets"] = er.tets;
+    rep["shell_height"] = er.shell_height;
+    rep["clamped_vertices"] = er.clamped_vertices;
+    rep["stretch_before"] = er.stretch.stretch_before;
+    rep["stretch_after"] = er.stretch.stretch_after;
+    rep["outside_vertices"] = er.embed.outside;
+    if (er.embed.checked)
+      rep["self_intersections"] = er.embed.self_intersecting_pairs;
+    else
+      rep["self_intersections"] = nullptr;
+    rep["seconds"] = {{"swatch", swatch_seconds},
+                      {"read", read_seconds},
+                      {"quilt", r.seconds},
+                      {"patches", r.seconds_patch},
+                      {"match", r.stats.seconds_match},
+                      {"correspond", r.stats.seconds_correspond},
+                      {"deform", r.stats.seconds_deform},
+                      {"merge", r.stats.seconds_merge},
+                      {"atlas", er.seconds_atlas},
+                      {"shell", er.seconds_shell},
+                      {"stretch", er.seconds_stretch},
+                      {"shell_map", er.seconds_map},
+                      {"embed", er.seconds_embed}};
+    scene = base;
+    get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+    scene.join(out);
+  }
+  t.reset();
+  WriteMeshOptions wo;
+  wo.overwrite = a.common.force;
+  wo.write_uvs = false;
+  for (std::size_t i = 0; i + (a.render.empty() ? 0 : 1) < outputs.size(); ++i) write_mesh(outputs[i], out, wo);
+  if (!a.render.empty()) {
+    WriteImageOptions io;
+    io.overwrite = a.common.force;
+    write_image(a.render, render_preview(scene), io);
+    rep["render"] = a.render;
+  }
+  rep["files"] = outputs;
+  rep["seconds"]["write"] = t.seconds();
+  rep["seconds"]["total"] = total.seconds();
   write_report(a.common, "quilt", rep);
-  if (!a.common.quiet)
-    std::fprintf(stderr, "quilt: %d elements, %zu faces in %d steps (%.1f s), %zu stitched, %zu refused -> %s\n",
-                 r.elements, r.faces, r.steps, r.seconds, r.stats.stitched, r.stats.stitch_refused, a.output.c_str());
+  if (!a.common.quiet) {
+    std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
+                 static_cast<std::size_t>(out.number_of_faces()), total.seconds(), a.output.c_str());
+    if (rep.contains("stretch_before"))
+      std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n", rep["stretch_before"].get<double>(),
+                   rep["stretch_after"].get<double>(), rep["self_intersections"].dump().c_str());
+  }
   return 0;
 }
 
 SubcommandRegistrar reg_quilt{
-    {"quilt", "Mesh quilting: grow a geometric texture from a mesh swatch over a plane",
+    {"quilt", "Mesh quilting: grow a geometric texture from a mesh swatch over a base mesh or a plane",
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<QuiltArgs>();
-       app.add_option("mesh", a->base, "Base mesh (not available yet) or, with --plane, the swatch");
-       app.add_option("swatch", a->swatch, "Swatch mesh (any format read_mesh reads); elements = connected components");
-       app.add_option("--plane", a->plane, "Quilt over a plane of W x H swatch sizes, e.g. 4x4 (required for now)");
+       app.add_option("mesh", a->base, "Base mesh (OFF/OBJ/PLY/STL) or, with --plane, the swatch");
+       app.add_option("swatch", a->swatch,
+                      "Swatch: a mesh file (elements = connected components, z = thin axis) or chainmail, "
+                      "weave or scatter to generate one (seeded by --seed)");
+       app.add_option("--plane", a->plane, "Quilt over a plane of W x H swatch sizes, e.g. 4x4, instead of a mesh");
        app.add_option("-o,--output", a->output,
-                      "Output mesh; format by extension: .obj (+ vertex colours), .ply (binary, colours), .off, "
-                      ".glb. Element colours are written as vertex colours; element ids are the connected "
-                      "components (surftex elements recomputes them)")
+                      "Output mesh; format by extension: .obj, .ply (binary), .off, .glb; element colours as vertex "
+                      "colours. On a base mesh the .ply and .glb siblings (same stem) are written too")
            ->required();
        app.add_option("--render", a->render, "Render PNG (default: <output stem>_render.png)");
        app.add_flag("--no-render", a->no_render, "Do not write a render");
-       app.add_option("--scale", a->scale, "Scale applied to the swatch (the paper's s), > 0 (default 1)")
+       app.add_option("--scale", a->scale,
+                      "The paper's s. On a mesh: the swatch's larger side as a fraction of the base mesh's "
+                      "bounding-box diagonal, (0, 10], 0 = 0.25. On a plane: factor applied to the swatch, "
+                      "0 = 1 (default 0)")
+           ->check(CLI::NonNegativeNumber);
+       app.add_option("--field", a->field,
+                      "Guidance field aligning the swatch's +y on a mesh: up (the projected --up vector) or none "
+                      "(each patch's own flattening) (default up)")
+           ->check(CLI::IsMember({"up", "none"}));
+       app.add_option("--up", a->up, "The up vector of --field up, three numbers (default 0 0 1)")->expected(3);
+       app.add_option("--shell-height", a->shell_height,
+                      "Shell thickness in scaled swatch heights, > 0 (default 1); clamped locally where the "
+                      "shell would fold")
            ->check(CLI::PositiveNumber);
+       app.add_option("--stretch-iterations", a->stretch_iterations,
+                      "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
+           ->check(CLI::Range(0, 1000));
+       app.add_flag("--no-check", a->no_check, "Skip the exact self-intersection count of the embedded result");
        app.add_option("--cell", a->cell, "Grid cell size in swatch units; 0 = swatch extent / 10 (default 0)")
            ->check(CLI::NonNegativeNumber);
        app.add_option("--subpatch", a->subpatch, "Output sub-patch half-size in cells; 0 = automatic (0..100, default 0)")
@@ -198,6 +366,62 @@ SubcommandRegistrar reg_elements{
        add_common_options(app, a->common);
        return [a] { return run_elements(*a); };
      }}};
+
+// Demo step: chain mail quilted over a small plane and over an icosphere
+// (surface quilting + shell-map embedding), meshes and renders written.
+nlohmann::json step_quilt(DemoContext& ctx) {
+  ChainmailOptions co;
+  co.rings_x = co.rings_y = 3;
+  co.segments = 12;
+  co.sides = 6;
+  co.seed = ctx.seed;
+  Mesh sm;
+  make_chainmail_swatch(sm, co);
+  const Swatch s = make_swatch(sm);
+  nlohmann::json j;
+  Timer t;
+  PlanarQuiltOptions po;
+  po.seed = ctx.seed;
+  Mesh plane;
+  const QuiltResult pr = quilt_plane(s, 2 * s.length(), 2 * s.width(), plane, po);
+  color_by_element(plane, ctx.seed);
+  write_mesh(ctx.path("quilt_plane_chainmail.ply"), plane);
+  write_image(ctx.path("quilt_plane_chainmail.png"), render_preview(plane));
+  j["plane"] = {{"elements", pr.elements}, {"faces", pr.faces}, {"seconds", t.seconds()},
+                {"files", {"quilt_plane_chainmail.ply", "quilt_plane_chainmail.png"}}};
+  t.reset();
+  Mesh base;
+  make_icosphere(base, 2);
+  SurfaceQuiltOptions so;
+  so.relative_size = 0.45;
+  so.seed = ctx.seed;
+  so.progress = ctx.progress;
+  SurfaceQuilt q;
+  const SurfaceQuiltResult sr = quilt_surface(base, s, q, so);
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 10;
+  eo.stretch.seed = ctx.seed;
+  Mesh out;
+  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+  color_by_element(out, ctx.seed);
+  write_mesh(ctx.path("quilt_sphere_chainmail.ply"), out);
+  write_mesh(ctx.path("quilt_sphere_chainmail.glb"), out);
+  Mesh scene = base;
+  get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+  scene.join(out);
+  write_image(ctx.path("quilt_sphere_chainmail.png"), render_preview(scene));
+  j["sphere"] = {{"elements", sr.elements},
+                 {"faces", out.number_of_faces()},
+                 {"stretch_before", er.stretch.stretch_before},
+                 {"stretch_after", er.stretch.stretch_after},
+                 {"self_intersections", er.embed.self_intersecting_pairs},
+                 {"seconds", t.seconds()},
+                 {"files", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
+  return j;
+}
+
+DemoStepRegistrar reg_demo_quilt{
+    {60, "quilt", "mesh quilting: chain mail on a plane and on an icosphere (shell-map embedding)", step_quilt}};
 
 }  // namespace
 }  // namespace surftex::cli

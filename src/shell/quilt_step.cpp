@@ -273,6 +273,10 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
       } else {
         ++stats.stitch_refused;
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
+        if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
+          add_in[e] = 0;
+          ++stats.in_dropped;
+        }
       }
     }
     replacements.emplace_back(first, std::move(acc));

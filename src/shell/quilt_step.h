@@ -37,6 +37,11 @@ struct QuiltStepOptions {
   double choice_tolerance = 0.02;
   /// Output vertices in P_out used for eq. 3 (evenly subsampled above this); >= 1.
   int max_match_vertices = 600;
+  /// An input element whose stitching to its related output element is
+  /// refused is dropped (the output element is kept) instead of being added
+  /// on top of it: overlapping duplicates are worse than a small gap. The
+  /// paper has no refusals (its merge always succeeds).
+  bool drop_refused_inputs = true;
 };
 
 struct QuiltStepStats {

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Benchmark of mesh quilting over a curved surface (Zhou et al. 2006, section
+// 3; the paper's bunny run: 86 minutes, 700K output faces, stretch 1.14 ->
+// 1.08). CGAL's bunny00.off (extracted from Debian's libcgal-demo tarball into
+// a temporary folder) is decimated to about 5K faces (CGAL
+// Surface_mesh_simplification, edge collapse with a face-count stop
+// predicate), then quilted with the generated weave swatch (about 15K faces),
+// the quilt embedded through the stretch-minimised shell map. Prints one JSON
+// object per stage (times, output faces, stretch before/after,
+// self-intersections).
+// Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
+#include <CGAL/Surface_mesh_simplification/edge_collapse.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/timer.h"
+#include "geometry/write_mesh.h"
+#include "shell/element_colors.h"
+#include "shell/embed_surface_quilt.h"
+#include "shell/surface_quilting.h"
+#include "shell/swatch.h"
+#include "shell/swatch_generators.h"
+
+using namespace surftex;
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+namespace SMS = CGAL::Surface_mesh_simplification;
+
+namespace {
+void line(const json& j) { std::cout << j.dump() << std::endl; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string tarball = argc > 1 && argv[1][0] ? argv[1] : SURFTEX_CGAL_DATA_TARBALL;
+  const std::string outdir = argc > 2 ? argv[2] : "";
+  const double rel = argc > 3 ? std::atof(argv[3]) : 0.12;
+  const fs::path dir = fs::temp_directory_path() / ("surftex-bench-quilt-" + std::to_string(::getpid()));
+  try {
+    fs::create_directories(dir);
+    const std::string cmd = "tar xzf '" + tarball + "' -C '" + dir.string() + "' data/meshes/bunny00.off";
+    if (std::system(cmd.c_str()) != 0) throw IOError("cannot extract bunny00.off from " + tarball);
+    Timer total, t;
+    Mesh base;
+    read_mesh((dir / "data" / "meshes" / "bunny00.off").string(), base);
+    const std::size_t faces_in = base.number_of_faces();
+    // CGAL 5.5's Count_stop_predicate counts edges: E = 1.5 F on a closed mesh.
+    SMS::Count_stop_predicate<Mesh> stop(7500);
+    const int removed = SMS::edge_collapse(base, stop);
+    base.collect_garbage();
+    line({{"stage", "decimate"}, {"faces_in", faces_in}, {"faces", base.number_of_faces()}, {"edges_removed", removed},
+          {"seconds", t.seconds()}});
+    t.reset();
+    Mesh sm;
+    make_weave_swatch(sm);
+    const Swatch s = make_swatch(sm);
+    line({{"stage", "swatch"}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()}, {"seconds", t.seconds()}});
+    SurfaceQuiltOptions qo;
+    qo.relative_size = rel;
+    qo.up = {0, 1, 0};  // the bunny's up axis
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
+    line({{"stage", "quilt"}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
+          {"patches_shrunk", r.patches_shrunk}, {"max_patch_distortion", r.max_patch_distortion},
+          {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused}, {"dropped_new", r.dropped_new},
+          {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
+          {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
+          {"seconds_merge", r.stats.seconds_merge}});
+    EmbedSurfaceQuiltOptions eo;
+    eo.stretch.iterations = 40;
+    Mesh out;
+    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+    line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"clamped_vertices", er.clamped_vertices},
+          {"stretch_before", er.stretch.stretch_before}, {"stretch_after", er.stretch.stretch_after},
+          {"faces", out.number_of_faces()}, {"outside_vertices", er.embed.outside},
+          {"self_intersections", er.embed.self_intersecting_pairs}, {"seconds_atlas", er.seconds_atlas},
+          {"seconds_shell", er.seconds_shell}, {"seconds_stretch", er.seconds_stretch},
+          {"seconds_map", er.seconds_map}, {"seconds_embed", er.seconds_embed}});
+    line({{"stage", "total"}, {"seconds", total.seconds()}, {"paper_minutes", 86}, {"paper_faces", 700000},
+          {"paper_stretch", {1.14, 1.08}}});
+    if (!outdir.empty()) {
+      color_by_element(out, 1);
+      write_mesh(outdir + "/bunny_weave.ply", out);
+      Mesh scene = base;
+      get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+      scene.join(out);
+      write_image(outdir + "/bunny_weave.png", render_preview(scene, 30.f, 20.f, 1000));
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    fs::remove_all(dir);
+    return 2;
+  }
+  fs::remove_all(dir);
+  return 0;
+}

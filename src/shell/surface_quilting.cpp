@@ -1,0 +1,708 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/surface_quilting.h"
+
+#ifndef CGAL_EIGEN3_ENABLED
+#define CGAL_EIGEN3_ENABLED  // LSCM's default solver is the Eigen one
+#endif
+
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Surface_mesh_parameterization/Error_code.h>
+#include <CGAL/Surface_mesh_parameterization/LSCM_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/parameterize.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <unordered_map>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/timer.h"
+#include "shell/triangle_distance.h"
+
+namespace surftex {
+
+namespace {
+namespace PMP = CGAL::Polygon_mesh_processing;
+namespace SMP = CGAL::Surface_mesh_parameterization;
+using V2 = std::array<double, 2>;
+constexpr double kPi = 3.14159265358979323846;
+
+P3 sub3(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double dot3(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+P3 cross3(const P3& a, const P3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double norm3(const P3& a) { return std::sqrt(dot3(a, a)); }
+double area2(const V2& a, const V2& b, const V2& c) {
+  return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+}
+// Barycentric (b0, b1, b2) of p in the 2D triangle (a, b, c); false if degenerate.
+bool bary2(const V2& p, const V2& a, const V2& b, const V2& c, std::array<double, 3>& w) {
+  const double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+  if (!(std::abs(d) > 0)) return false;
+  w[1] = ((p[0] - a[0]) * (c[1] - a[1]) - (p[1] - a[1]) * (c[0] - a[0])) / d;
+  w[2] = ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])) / d;
+  w[0] = 1 - w[1] - w[2];
+  return true;
+}
+
+// The base mesh as arrays (face index order, vertices of each face in
+// vertices_around_face(halfedge(f)) order).
+struct Base {
+  std::vector<P3> pts;
+  std::vector<std::array<int, 3>> faces;
+  std::vector<P3> centroid, normal;
+  std::vector<double> area;
+  std::vector<std::array<int, 3>> edge_nb;      // face across the edge (v_k, v_k+1), -1 = border
+  std::vector<std::vector<int>> vertex_nb;      // faces sharing a vertex (excluding itself)
+};
+
+Base make_base(const Mesh& m) {
+  if (m.has_garbage()) throw InvalidInputError("quilt_surface: the base mesh has garbage (call collect_garbage)");
+  if (m.number_of_faces() == 0) throw InvalidInputError("quilt_surface: the base mesh has no face");
+  Base b;
+  b.pts.resize(m.number_of_vertices());
+  for (VertexIndex v : m.vertices()) {
+    const Point3& p = m.point(v);
+    b.pts[v.idx()] = {p.x(), p.y(), p.z()};
+  }
+  const std::size_t nf = m.number_of_faces();
+  b.faces.resize(nf);
+  b.edge_nb.assign(nf, {-1, -1, -1});
+  for (FaceIndex f : m.faces()) {
+    int k = 0;
+    for (HalfedgeIndex h : m.halfedges_around_face(m.halfedge(f))) {
+      if (k == 3) throw InvalidInputError("quilt_surface: base face " + std::to_string(f.idx()) + " is not a triangle");
+      b.faces[f.idx()][k] = static_cast<int>(m.target(h).idx());
+      // edge (v_k, v_k+1) is the next halfedge's
+      const HalfedgeIndex hn = m.next(h);
+      const FaceIndex g = m.face(m.opposite(hn));
+      b.edge_nb[f.idx()][k] = g == Mesh::null_face() ? -1 : static_cast<int>(g.idx());
+      ++k;
+    }
+    if (k != 3) throw InvalidInputError("quilt_surface: base face " + std::to_string(f.idx()) + " is not a triangle");
+  }
+  b.centroid.resize(nf);
+  b.normal.resize(nf);
+  b.area.resize(nf);
+  std::vector<std::vector<int>> vf(b.pts.size());
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& t = b.faces[f];
+    const P3 &a = b.pts[t[0]], &c1 = b.pts[t[1]], &c2 = b.pts[t[2]];
+    b.centroid[f] = {(a[0] + c1[0] + c2[0]) / 3, (a[1] + c1[1] + c2[1]) / 3, (a[2] + c1[2] + c2[2]) / 3};
+    P3 n = cross3(sub3(c1, a), sub3(c2, a));
+    const double l = norm3(n);
+    b.area[f] = 0.5 * l;
+    b.normal[f] = l > 0 ? P3{n[0] / l, n[1] / l, n[2] / l} : P3{0, 0, 0};
+    for (int v : t) vf[v].push_back(static_cast<int>(f));
+  }
+  b.vertex_nb.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto& nb = b.vertex_nb[f];
+    for (int v : b.faces[f])
+      for (int g : vf[v])
+        if (g != static_cast<int>(f)) nb.push_back(g);
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  return b;
+}
+
+// Disc-preserving breadth-first growth (rule of base_mesh_atlas.h).
+std::vector<int> grow_patch(const Base& b, int seed, double radius, double cos_max, int max_faces,
+                            std::vector<int>& stamp, int stamp_id, std::vector<int>& vstamp) {
+  std::vector<int> patch{seed};
+  stamp[seed] = stamp_id;
+  for (int v : b.faces[seed]) vstamp[v] = stamp_id;
+  std::deque<int> q;
+  for (int g : b.edge_nb[seed])
+    if (g >= 0) q.push_back(g);
+  const P3& c0 = b.centroid[seed];
+  const P3& n0 = b.normal[seed];
+  const double r2 = radius * radius;
+  while (!q.empty() && static_cast<int>(patch.size()) < max_faces) {
+    const int f = q.front();
+    q.pop_front();
+    if (stamp[f] == stamp_id) continue;
+    const P3 d = sub3(b.centroid[f], c0);
+    if (dot3(d, d) > r2 || dot3(b.normal[f], n0) < cos_max) continue;
+    int shared = 0, apex = -1;
+    for (int k = 0; k < 3; ++k) {
+      const int g = b.edge_nb[f][k];
+      if (g >= 0 && stamp[g] == stamp_id) {
+        ++shared;
+        apex = b.faces[f][(k + 2) % 3];  // vertex opposite edge (v_k, v_k+1)
+      }
+    }
+    if (!(shared == 2 || (shared == 1 && vstamp[apex] != stamp_id))) continue;
+    stamp[f] = stamp_id;
+    patch.push_back(f);
+    for (int v : b.faces[f]) vstamp[v] = stamp_id;
+    for (int g : b.edge_nb[f])
+      if (g >= 0 && stamp[g] != stamp_id) q.push_back(g);
+  }
+  return patch;
+}
+
+struct Flat {
+  std::vector<int> faces;
+  std::unordered_map<int, int> local;  // base vertex -> flat vertex
+  std::vector<V2> uv;                  // per flat vertex (mesh units)
+  double max_distortion = 0;
+};
+
+// LSCM of the patch, oriented and scaled to the 3D area.
+bool flatten_patch(const Base& b, const std::vector<int>& faces, Flat& out, std::string& err) {
+  out.faces = faces;
+  out.local.clear();
+  Mesh sub;
+  std::vector<int> verts;
+  for (int f : faces)
+    for (int v : b.faces[f])
+      if (out.local.emplace(v, static_cast<int>(verts.size())).second) {
+        verts.push_back(v);
+        sub.add_vertex(Point3(b.pts[v][0], b.pts[v][1], b.pts[v][2]));
+      }
+  double a3 = 0;
+  for (int f : faces) {
+    const auto& t = b.faces[f];
+    if (sub.add_face(VertexIndex(static_cast<Mesh::size_type>(out.local[t[0]])), VertexIndex(static_cast<Mesh::size_type>(out.local[t[1]])),
+                     VertexIndex(static_cast<Mesh::size_type>(out.local[t[2]]))) ==
+        Mesh::null_face()) {
+      err = "patch is not manifold";
+      return false;
+    }
+    a3 += b.area[f];
+  }
+  std::vector<HalfedgeIndex> borders;
+  PMP::extract_boundary_cycles(sub, std::back_inserter(borders));
+  if (borders.size() != 1) {
+    err = "patch has " + std::to_string(borders.size()) + " border loops";
+    return false;
+  }
+  auto uvmap = sub.add_property_map<VertexIndex, Point2>("v:patch_uv", Point2(0, 0)).first;
+  const SMP::Error_code code = SMP::parameterize(sub, SMP::LSCM_parameterizer_3<Mesh>(), borders.front(), uvmap);
+  if (code != SMP::OK) {
+    err = std::string("LSCM failed: ") + SMP::get_error_message(code);
+    return false;
+  }
+  out.uv.resize(verts.size());
+  for (VertexIndex v : sub.vertices()) {
+    const Point2& p = uvmap[v];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) {
+      err = "LSCM gave a non-finite uv";
+      return false;
+    }
+    out.uv[v.idx()] = {p.x(), p.y()};
+  }
+  double auv = 0;
+  for (int f : faces) {
+    const auto& t = b.faces[f];
+    auv += area2(out.uv[out.local[t[0]]], out.uv[out.local[t[1]]], out.uv[out.local[t[2]]]);
+  }
+  if (!(std::abs(auv) > 0)) {
+    err = "LSCM gave a zero-area patch";
+    return false;
+  }
+  if (auv < 0)
+    for (auto& p : out.uv) p[0] = -p[0];
+  const double s = std::sqrt(a3 / std::abs(auv));
+  for (auto& p : out.uv) p = {p[0] * s, p[1] * s};
+  out.max_distortion = 1;
+  for (int f : faces) {
+    const auto& t = b.faces[f];
+    const double a = area2(out.uv[out.local[t[0]]], out.uv[out.local[t[1]]], out.uv[out.local[t[2]]]);
+    const double r = a > 0 && b.area[f] > 0 ? std::max(a / b.area[f], b.area[f] / a) : std::numeric_limits<double>::infinity();
+    out.max_distortion = std::max(out.max_distortion, r);
+  }
+  return true;
+}
+
+// Point location over the frame triangles of a patch.
+class PatchLocator {
+ public:
+  PatchLocator(std::vector<std::array<V2, 3>> tris, double cell) : tris_(std::move(tris)) {
+    lo_ = {1e300, 1e300};
+    V2 hi{-1e300, -1e300};
+    for (auto& t : tris_)
+      for (auto& p : t) lo_ = {std::min(lo_[0], p[0]), std::min(lo_[1], p[1])}, hi = {std::max(hi[0], p[0]), std::max(hi[1], p[1])};
+    cell_ = cell;
+    nx_ = std::max(1, static_cast<int>(std::ceil((hi[0] - lo_[0]) / cell_)) + 1);
+    ny_ = std::max(1, static_cast<int>(std::ceil((hi[1] - lo_[1]) / cell_)) + 1);
+    if (static_cast<double>(nx_) * ny_ > 4e6) {  // keep the bucket grid small
+      const double f = std::sqrt(static_cast<double>(nx_) * ny_ / 4e6);
+      cell_ *= f;
+      nx_ = std::max(1, static_cast<int>(std::ceil((hi[0] - lo_[0]) / cell_)) + 1);
+      ny_ = std::max(1, static_cast<int>(std::ceil((hi[1] - lo_[1]) / cell_)) + 1);
+    }
+    buckets_.resize(static_cast<std::size_t>(nx_) * ny_);
+    for (std::size_t k = 0; k < tris_.size(); ++k) {
+      double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+      for (auto& p : tris_[k]) x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+      const int i0 = cx(x0), i1 = cx(x1), j0 = cy(y0), j1 = cy(y1);
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) buckets_[static_cast<std::size_t>(j) * nx_ + i].push_back(static_cast<int>(k));
+    }
+  }
+  // Triangle containing p (largest smallest barycentric coordinate >= -eps), or -1.
+  int locate(const V2& p, std::array<double, 3>& w) const {
+    const double fx = (p[0] - lo_[0]) / cell_, fy = (p[1] - lo_[1]) / cell_;
+    if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return -1;
+    const auto& bk = buckets_[static_cast<std::size_t>(fy) * nx_ + static_cast<std::size_t>(fx)];
+    int best = -1;
+    double best_min = -1e-9;
+    for (int k : bk) {
+      std::array<double, 3> b;
+      if (!bary2(p, tris_[k][0], tris_[k][1], tris_[k][2], b)) continue;
+      const double m = std::min({b[0], b[1], b[2]});
+      if (m >= best_min) best_min = m, best = k, w = b;
+    }
+    return best;
+  }
+  // The triangle whose barycentric coordinates of p have the largest minimum (extrapolation).
+  int nearest(const V2& p, std::array<double, 3>& w) const {
+    const int k = locate(p, w);
+    if (k >= 0) return k;
+    int best = -1;
+    double best_min = -1e300;
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      std::array<double, 3> b;
+      if (!bary2(p, tris_[t][0], tris_[t][1], tris_[t][2], b)) continue;
+      const double m = std::min({b[0], b[1], b[2]});
+      if (m > best_min) best_min = m, best = static_cast<int>(t), w = b;
+    }
+    return best;
+  }
+
+ private:
+  int cx(double x) const { return std::clamp(static_cast<int>((x - lo_[0]) / cell_), 0, nx_ - 1); }
+  int cy(double y) const { return std::clamp(static_cast<int>((y - lo_[1]) / cell_), 0, ny_ - 1); }
+  std::vector<std::array<V2, 3>> tris_;
+  V2 lo_{0, 0};
+  double cell_ = 1;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::vector<int>> buckets_;
+};
+
+struct Element {
+  ElementMesh mesh;                     // triangles (points unused between steps)
+  std::vector<SurfaceQuiltVertex> loc;  // per vertex
+  bool alive = true;
+};
+
+P3 base_point(const Base& b, const SurfaceQuiltVertex& v) {
+  const auto& t = b.faces[v.face];
+  const double b0 = 1 - v.b1 - v.b2;
+  P3 p;
+  for (int d = 0; d < 3; ++d) p[d] = b0 * b.pts[t[0]][d] + v.b1 * b.pts[t[1]][d] + v.b2 * b.pts[t[2]][d];
+  return p;
+}
+
+// Barycentric coordinates of the projection of p on the plane of face f.
+std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
+  const auto& t = b.faces[f];
+  const P3 e1 = sub3(b.pts[t[1]], b.pts[t[0]]), e2 = sub3(b.pts[t[2]], b.pts[t[0]]), dp = sub3(p, b.pts[t[0]]);
+  const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2), det = g11 * g22 - g12 * g12;
+  if (!(det > 0)) return {1.0 / 3, 1.0 / 3, 1.0 / 3};
+  const double r1 = dot3(dp, e1), r2 = dot3(dp, e2);
+  const double w1 = (r1 * g22 - r2 * g12) / det, w2 = (g11 * r2 - g12 * r1) / det;
+  return {1 - w1 - w2, w1, w2};
+}
+
+// Moves a location with negative barycentric coordinates (a vertex beyond the
+// patch it was made on) onto the face that contains it: walks across the edge
+// opposite the most negative coordinate, projecting the point onto each new
+// face's plane; at a border edge (or after 64 steps) the coordinates are
+// clamped to the face.
+void settle_location(const Base& b, SurfaceQuiltVertex& v) {
+  constexpr double kEps = 1e-9;
+  for (int it = 0; it < 64; ++it) {
+    const std::array<double, 3> w{1 - v.b1 - v.b2, v.b1, v.b2};
+    int j = 0;
+    for (int k = 1; k < 3; ++k)
+      if (w[k] < w[j]) j = k;
+    if (w[j] >= -kEps) return;
+    const int g = b.edge_nb[v.face][(j + 1) % 3];
+    if (g < 0) break;
+    const P3 p = base_point(b, v);
+    const auto wg = project_bary(b, g, p);
+    v.face = g;
+    v.b1 = wg[1];
+    v.b2 = wg[2];
+  }
+  std::array<double, 3> w{std::max(0.0, 1 - v.b1 - v.b2), std::max(0.0, v.b1), std::max(0.0, v.b2)};
+  const double sum = w[0] + w[1] + w[2];
+  if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
+  else v.b1 = v.b2 = 1.0 / 3;
+}
+
+void check_options(const SurfaceQuiltOptions& o) {
+  auto bad = [](const std::string& what, double v) {
+    throw InvalidInputError("quilt_surface: " + what + " (" + std::to_string(v) + ")");
+  };
+  if (!(o.relative_size > 0 && o.relative_size <= 10)) bad("relative_size must be in (0, 10]", o.relative_size);
+  if (!(o.patch_radius > 0) || !std::isfinite(o.patch_radius)) bad("patch_radius must be > 0", o.patch_radius);
+  if (!(o.max_normal_angle_deg > 0 && o.max_normal_angle_deg <= 180))
+    bad("max_normal_angle_deg must be in (0, 180]", o.max_normal_angle_deg);
+  if (o.max_patch_faces < 1) bad("max_patch_faces must be >= 1", o.max_patch_faces);
+  if (!(o.max_area_distortion > 1)) bad("max_area_distortion must be > 1", o.max_area_distortion);
+  if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
+  if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
+  if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
+    throw InvalidInputError("quilt_surface: the up vector must be non-zero");
+}
+
+}  // namespace
+
+SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, SurfaceQuilt& out,
+                                 const SurfaceQuiltOptions& opt) {
+  check_options(opt);
+  Timer timer;
+  SurfaceQuiltResult res;
+  const Base b = make_base(mesh);
+  const int nf = static_cast<int>(b.faces.size());
+  P3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const P3& p : b.pts)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
+  const double diag = norm3(sub3(hi, lo));
+  if (!(diag > 0)) throw InvalidInputError("quilt_surface: the base mesh has a zero-size bounding box");
+  const double S = opt.relative_size * diag / std::max(swatch.length(), swatch.width());  // mesh units per swatch unit
+  const double c = opt.cell_size > 0 ? opt.cell_size : std::max(swatch.length(), swatch.width()) / 10.0;
+  const int sx = static_cast<int>(std::ceil(swatch.length() / c - 1e-9));
+  const int sy = static_cast<int>(std::ceil(swatch.width() / c - 1e-9));
+  if (std::min(sx, sy) < 3)
+    throw InvalidInputError("quilt_surface: the swatch covers only " + std::to_string(sx) + "x" + std::to_string(sy) +
+                            " cells of size " + std::to_string(c) + " (need >= 3)");
+  const int r_full = opt.subpatch_radius > 0 ? opt.subpatch_radius : std::max(1, std::min(sx, sy) / 4);
+  if (2 * r_full + 1 > std::min(sx, sy))
+    throw InvalidInputError("quilt_surface: subpatch_radius " + std::to_string(r_full) + " too large for a swatch of " +
+                            std::to_string(sx) + "x" + std::to_string(sy) + " cells");
+  const double swatch_diag = std::hypot(swatch.length(), swatch.width()) * S;
+  const double cos_max = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
+  P3 up = opt.up;
+  {
+    const double l = norm3(up);
+    if (l > 0) up = {up[0] / l, up[1] / l, up[2] / l};
+  }
+
+  TriangleDistance tree(swatch.mesh);
+  std::mt19937_64 rng(opt.seed);
+  std::vector<Element> elements;
+  std::vector<char> processed(nf, 0);
+  std::vector<int> constrained(nf, 0);  // processed vertex-neighbours
+  std::vector<int> stamp(nf, -1), vstamp(b.pts.size(), -1);
+  std::vector<int> patch_slot(nf, -1);  // face -> index in the current patch
+  // Faces -> elements with a vertex on them (rebuilt lazily).
+  int done = 0, step_id = 0;
+  auto mark = [&](int f) {
+    if (processed[f]) return;
+    processed[f] = 1;
+    ++done;
+    for (int g : b.vertex_nb[f]) ++constrained[g];
+  };
+
+  while (done < nf) {
+    // 1. Seed.
+    int seed = -1, best = -1;
+    for (int f = 0; f < nf; ++f)
+      if (!processed[f] && constrained[f] > best) best = constrained[f], seed = f;
+    report_progress(opt.progress, "quilt", static_cast<double>(done) / nf);
+    Timer tp;
+    // 2-3. Patch and flattening, shrunk for distortion.
+    double R = opt.patch_radius * swatch_diag;
+    Flat flat;
+    bool ok = false;
+    std::string err;
+    for (int attempt = 0; attempt < 9; ++attempt) {
+      const std::vector<int> faces =
+          grow_patch(b, seed, R, cos_max, opt.max_patch_faces, stamp, step_id * 16 + attempt, vstamp);
+      ok = flatten_patch(b, faces, flat, err);
+      if (ok && (flat.max_distortion <= opt.max_area_distortion || faces.size() == 1)) break;
+      if (faces.size() == 1) break;
+      R *= 0.7;
+      ++res.patches_shrunk;
+    }
+    if (!ok) throw SolverError("quilt_surface: cannot flatten the patch around face " + std::to_string(seed) + ": " + err);
+    res.max_patch_distortion = std::max(res.max_patch_distortion, flat.max_distortion);
+    const int r = std::max(1, std::min(r_full, static_cast<int>(std::lround(r_full * R / (opt.patch_radius * swatch_diag)))));
+    // 4. Orientation, 5. frame (swatch units, seed centroid at the origin).
+    const auto& st = b.faces[seed];
+    const V2 q0 = flat.uv[flat.local[st[0]]], q1 = flat.uv[flat.local[st[1]]], q2 = flat.uv[flat.local[st[2]]];
+    double rot_c = 1, rot_s = 0;
+    if (opt.field == SurfaceQuiltOptions::Field::kUp) {
+      const P3& n = b.normal[seed];
+      const double un = dot3(up, n);
+      const P3 d{up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
+      if (norm3(d) > 0.2) {
+        // d = alpha e1 + beta e2 in the seed triangle, mapped to uv.
+        const P3 e1 = sub3(b.pts[st[1]], b.pts[st[0]]), e2 = sub3(b.pts[st[2]], b.pts[st[0]]);
+        const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2);
+        const double r1 = dot3(d, e1), r2 = dot3(d, e2), det = g11 * g22 - g12 * g12;
+        if (det > 0) {
+          const double al = (r1 * g22 - r2 * g12) / det, be = (g11 * r2 - g12 * r1) / det;
+          const V2 du{al * (q1[0] - q0[0]) + be * (q2[0] - q0[0]), al * (q1[1] - q0[1]) + be * (q2[1] - q0[1])};
+          const double l = std::hypot(du[0], du[1]);
+          if (l > 0) {  // rotate du onto +y
+            const double ang = std::atan2(du[1], du[0]);
+            const double target = kPi / 2 - ang;
+            rot_c = std::cos(target), rot_s = std::sin(target);
+          }
+        }
+      }
+    }
+    const V2 oc{(q0[0] + q1[0] + q2[0]) / 3, (q0[1] + q1[1] + q2[1]) / 3};
+    for (auto& p : flat.uv) {
+      const double x = (p[0] - oc[0]) / S, y = (p[1] - oc[1]) / S;
+      p = {rot_c * x - rot_s * y, rot_s * x + rot_c * y};
+    }
+    std::vector<std::array<V2, 3>> ftris(flat.faces.size());
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      patch_slot[flat.faces[k]] = static_cast<int>(k);
+      for (int j = 0; j < 3; ++j) ftris[k][j] = flat.uv[flat.local[b.faces[flat.faces[k]][j]]];
+    }
+    const PatchLocator locator(ftris, c);
+    // Grid over the patch plus one swatch on each side.
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (auto& p : flat.uv) x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+    QuiltGrid grid;
+    grid.cell = c;
+    // Align the grid so that the origin (seed centroid) is a cell centre.
+    const int ilo = static_cast<int>(std::floor(x0 / c - 0.5)) - sx, ihi = static_cast<int>(std::ceil(x1 / c + 0.5)) + sx;
+    const int jlo = static_cast<int>(std::floor(y0 / c - 0.5)) - sy, jhi = static_cast<int>(std::ceil(y1 / c + 0.5)) + sy;
+    grid.x0 = (ilo - 0.5) * c;
+    grid.y0 = (jlo - 0.5) * c;
+    grid.nx = ihi - ilo + 1;
+    grid.ny = jhi - jlo + 1;
+    const std::size_t ncell = static_cast<std::size_t>(grid.nx) * grid.ny;
+    grid.processed.assign(ncell, 0);
+    grid.subpatch.assign(ncell, 0);
+    std::vector<char> on_patch(ncell, 0);
+    for (int j = 0; j < grid.ny; ++j)
+      for (int i = 0; i < grid.nx; ++i) {
+        const V2 ctr{grid.x0 + (i + 0.5) * c, grid.y0 + (j + 0.5) * c};
+        std::array<double, 3> w;
+        const int k = locator.locate(ctr, w);
+        if (k < 0) continue;
+        on_patch[j * grid.nx + i] = 1;
+        grid.processed[j * grid.nx + i] = processed[flat.faces[k]];
+      }
+    const int si = -ilo, sj = -jlo;  // the origin's cell
+    for (int j = sj - r; j <= sj + r; ++j)
+      for (int i = si - r; i <= si + r; ++i)
+        if (i >= 0 && j >= 0 && i < grid.nx && j < grid.ny && on_patch[j * grid.nx + i]) grid.subpatch[j * grid.nx + i] = 1;
+    grid.subpatch[sj * grid.nx + si] = 1;
+    res.seconds_patch += tp.seconds();
+
+    // 6. Output elements touching the patch, in the frame.
+    Timer ts;
+    auto frame_of_loc = [&](const SurfaceQuiltVertex& v, std::unordered_map<int, int>& near_cache) -> P3 {
+      int k = patch_slot[v.face];
+      if (k >= 0) {
+        const auto& t = ftris[k];
+        const double b0 = 1 - v.b1 - v.b2;
+        return {b0 * t[0][0] + v.b1 * t[1][0] + v.b2 * t[2][0], b0 * t[0][1] + v.b1 * t[1][1] + v.b2 * t[2][1], v.z};
+      }
+      // Off the patch: project onto the plane of the patch face with the nearest centroid.
+      auto it = near_cache.find(v.face);
+      if (it == near_cache.end()) {
+        double bd = 1e300;
+        int bk = 0;
+        for (std::size_t q = 0; q < flat.faces.size(); ++q) {
+          const P3 dd = sub3(b.centroid[flat.faces[q]], b.centroid[v.face]);
+          const double d2 = dot3(dd, dd);
+          if (d2 < bd) bd = d2, bk = static_cast<int>(q);
+        }
+        it = near_cache.emplace(v.face, bk).first;
+      }
+      k = it->second;
+      const int g = flat.faces[k];
+      const P3 p = base_point(b, v);
+      const auto& tg = b.faces[g];
+      const P3 e1 = sub3(b.pts[tg[1]], b.pts[tg[0]]), e2 = sub3(b.pts[tg[2]], b.pts[tg[0]]), dp = sub3(p, b.pts[tg[0]]);
+      const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2), det = g11 * g22 - g12 * g12;
+      double w1 = 0, w2 = 0;
+      if (det > 0) {
+        const double r1 = dot3(dp, e1), r2 = dot3(dp, e2);
+        w1 = (r1 * g22 - r2 * g12) / det;
+        w2 = (g11 * r2 - g12 * r1) / det;
+      }
+      const auto& t = ftris[k];
+      const double w0 = 1 - w1 - w2;
+      return {w0 * t[0][0] + w1 * t[1][0] + w2 * t[2][0], w0 * t[0][1] + w1 * t[1][1] + w2 * t[2][1], v.z};
+    };
+    std::vector<int> ids;  // global element ids in the frame
+    std::vector<ElementMesh> frame;
+    std::map<P3, SurfaceQuiltVertex> keep_loc;  // frame point -> local coordinates it came from
+    std::unordered_map<int, int> near_cache;
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      Element& el = elements[e];
+      if (!el.alive) continue;
+      bool touches = false;
+      for (const auto& v : el.loc)
+        if (patch_slot[v.face] >= 0) {
+          touches = true;
+          break;
+        }
+      if (!touches) continue;
+      ElementMesh m;
+      m.tris = el.mesh.tris;
+      m.points.resize(el.loc.size());
+      for (std::size_t v = 0; v < el.loc.size(); ++v) {
+        m.points[v] = frame_of_loc(el.loc[v], near_cache);
+        keep_loc.emplace(m.points[v], el.loc[v]);
+      }
+      ids.push_back(static_cast<int>(e));
+      frame.push_back(std::move(m));
+    }
+    const std::size_t n_in = frame.size();
+    std::vector<ElementMesh> before = frame;
+    std::vector<char> alive(n_in, 1);
+    QuiltStepStats stats;
+    const auto [oi, oj] = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
+    res.stats.add(stats);
+
+    auto to_loc = [&](const P3& p) {
+      auto it = keep_loc.find(p);
+      if (it != keep_loc.end()) return it->second;
+      std::array<double, 3> w{1, 0, 0};
+      const int k = locator.nearest({p[0], p[1]}, w);
+      SurfaceQuiltVertex v;
+      v.face = flat.faces[std::max(0, k)];
+      v.b1 = w[1];
+      v.b2 = w[2];
+      v.z = p[2];
+      return v;
+    };
+    for (std::size_t k = 0; k < frame.size(); ++k) {
+      if (k < n_in) {
+        Element& el = elements[ids[k]];
+        if (!alive[k]) {
+          el.alive = false;
+          continue;
+        }
+        if (frame[k].tris == before[k].tris && frame[k].points == before[k].points) continue;
+        el.mesh.tris = frame[k].tris;
+        el.loc.resize(frame[k].points.size());
+        for (std::size_t v = 0; v < frame[k].points.size(); ++v) el.loc[v] = to_loc(frame[k].points[v]);
+      } else {
+        if (!alive[k] || frame[k].tris.empty()) continue;
+        double cxs = 0, cys = 0;
+        for (const P3& p : frame[k].points) cxs += p[0], cys += p[1];
+        const double inv = 1.0 / static_cast<double>(frame[k].points.size());
+        std::array<double, 3> w;
+        if (locator.locate({cxs * inv, cys * inv}, w) < 0) {
+          ++res.dropped_new;
+          continue;
+        }
+        Element el;
+        el.mesh.tris = frame[k].tris;
+        el.loc.resize(frame[k].points.size());
+        for (std::size_t v = 0; v < frame[k].points.size(); ++v) el.loc[v] = to_loc(frame[k].points[v]);
+        elements.push_back(std::move(el));
+      }
+    }
+    // Processed: patch faces whose frame centroid lies in the footprint, and the seed.
+    const double fx0 = grid.x0 + oi * c, fy0 = grid.y0 + oj * c, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      const double cxp = (ftris[k][0][0] + ftris[k][1][0] + ftris[k][2][0]) / 3;
+      const double cyp = (ftris[k][0][1] + ftris[k][1][1] + ftris[k][2][1]) / 3;
+      if (cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1) mark(flat.faces[k]);
+    }
+    mark(seed);
+    for (int f : flat.faces) patch_slot[f] = -1;
+    res.seconds_step += ts.seconds();
+    ++res.steps;
+    ++step_id;
+  }
+  // Output.
+  out = SurfaceQuilt{};
+  out.scale = S;
+  out.z_min = swatch.bbox_min[2];
+  out.z_max = swatch.bbox_max[2];
+  for (const Element& el : elements) {
+    if (!el.alive || el.mesh.tris.empty()) continue;
+    const int base_index = static_cast<int>(out.vertices.size());
+    for (SurfaceQuiltVertex v : el.loc) {
+      settle_location(b, v);
+      out.vertices.push_back(v);
+    }
+    for (const Tri& t : el.mesh.tris) {
+      out.tris.push_back({t[0] + base_index, t[1] + base_index, t[2] + base_index});
+      out.tri_element.push_back(out.elements);
+    }
+    ++out.elements;
+  }
+  res.elements = out.elements;
+  res.faces = out.tris.size();
+  res.vertices = out.vertices.size();
+  res.seconds = timer.seconds();
+  report_progress(opt.progress, "quilt", 1.0);
+  return res;
+}
+
+namespace {
+std::vector<ElementMesh> quilt_elements(const SurfaceQuilt& q, const std::function<P3(const SurfaceQuiltVertex&)>& pos) {
+  std::vector<ElementMesh> els(static_cast<std::size_t>(q.elements));
+  std::vector<int> local(q.vertices.size(), -1);
+  for (std::size_t t = 0; t < q.tris.size(); ++t) {
+    ElementMesh& m = els[static_cast<std::size_t>(q.tri_element[t])];
+    Tri tri;
+    for (int k = 0; k < 3; ++k) {
+      const int v = q.tris[t][k];
+      if (local[v] < 0) {
+        local[v] = static_cast<int>(m.points.size());
+        m.points.push_back(pos(q.vertices[v]));
+      }
+      tri[k] = local[v];
+    }
+    m.tris.push_back(tri);
+  }
+  return els;
+}
+}  // namespace
+
+void surface_quilt_to_texture(const Mesh& base, const SurfaceQuilt& q, Mesh& out) {
+  auto [uv, found] = base.property_map<HalfedgeIndex, UV>(kCornerUV.name);
+  if (!found) throw InvalidInputError("surface_quilt_to_texture: the base mesh has no kCornerUV (compute an atlas first)");
+  const double dz = q.z_max - q.z_min;
+  if (!(dz > 0)) throw InvalidInputError("surface_quilt_to_texture: the swatch has zero height");
+  const std::size_t nf = base.number_of_faces();
+  auto pos = [&](const SurfaceQuiltVertex& v) -> P3 {
+    if (v.face < 0 || static_cast<std::size_t>(v.face) >= nf)
+      throw InvalidInputError("surface_quilt_to_texture: face index " + std::to_string(v.face) + " out of range");
+    const FaceIndex f(static_cast<Mesh::size_type>(v.face));
+    UV c[3];
+    int k = 0;
+    for (HalfedgeIndex h : base.halfedges_around_face(base.halfedge(f))) {
+      if (k < 3) c[k] = uv[h];
+      ++k;
+    }
+    const double b0 = 1 - v.b1 - v.b2;
+    return {b0 * c[0][0] + v.b1 * c[1][0] + v.b2 * c[2][0], b0 * c[0][1] + v.b1 * c[1][1] + v.b2 * c[2][1],
+            (v.z - q.z_min) / dz};
+  };
+  mesh_from_elements(quilt_elements(q, pos), out);
+}
+
+void surface_quilt_displaced(const Mesh& base, const SurfaceQuilt& q, double height, Mesh& out) {
+  const Base b = make_base(base);
+  const double dz = q.z_max - q.z_min;
+  if (!(dz > 0)) throw InvalidInputError("surface_quilt_displaced: the swatch has zero height");
+  auto pos = [&](const SurfaceQuiltVertex& v) -> P3 {
+    if (v.face < 0 || static_cast<std::size_t>(v.face) >= b.faces.size())
+      throw InvalidInputError("surface_quilt_displaced: face index " + std::to_string(v.face) + " out of range");
+    const P3& n = b.normal[v.face];
+    const P3 p = base_point(b, v);
+    const double w = (v.z - q.z_min) / dz * height;
+    return {p[0] + w * n[0], p[1] + w * n[1], p[2] + w * n[2]};
+  };
+  mesh_from_elements(quilt_elements(q, pos), out);
+}
+
+}  // namespace surftex

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Mesh quilting over a curved base mesh (Zhou et al. 2006, section 3.1).
+//
+// The planar grid of section 2.3 is replaced by the base mesh's triangles:
+// 1. Seed: the unprocessed base triangle with the most processed triangles
+//    among its vertex neighbours (ties: lowest face index).
+// 2. Surface patch: breadth-first growth over edges from the seed, accepting a
+//    triangle while its centroid lies within R of the seed's centroid (3D),
+//    its normal within max_normal_angle_deg of the seed's, the patch stays a
+//    topological disc (as in base_mesh_atlas.h) and has fewer than
+//    max_patch_faces faces. R = patch_radius * (diagonal of the scaled
+//    swatch's xy rectangle), so that the swatch placed anywhere around the
+//    seed lies on the patch.
+// 3. Flattening: LSCM (CGAL Surface_mesh_parameterization), mirrored if
+//    needed, scaled so that the uv area equals the 3D area. If a patch face's
+//    area distortion max(A_uv/A_3d, A_3d/A_uv) exceeds max_area_distortion
+//    (the paper's factor 4), R is multiplied by 0.7 and the patch regrown
+//    (at most 8 times); P_out shrinks with it.
+// 4. Orientation: with Field::kUp the projection of `up` on the seed
+//    triangle is mapped through the seed's flattening and the patch rotated so
+//    that it points along +y of the swatch (the paper's guidance vector field,
+//    here a projected constant vector); where the projection is shorter than
+//    0.2 (|up| = 1) or with Field::kNone the LSCM orientation is kept.
+// 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
+//    seed centroid at the origin; a grid of cells (as in mesh_quilting.h)
+//    over it; a cell is processed when the base triangle under its centre is.
+//    P_out = cells within subpatch_radius (Chebyshev) of the seed cell whose
+//    centre lies on the patch.
+// 6. Output elements with a vertex on a patch triangle are expressed in the
+//    frame (vertices on other triangles: projected onto the plane of the
+//    patch triangle with the nearest centroid, barycentric coordinates
+//    extrapolated), quilt_step (quilt_step.h) runs, and new or changed
+//    vertices are expressed again in local coordinates: base triangle +
+//    barycentric coordinates of the orthogonal projection (the flattening's
+//    triangle containing the frame point; outside the patch the triangle whose
+//    extrapolated barycentric coordinates are least negative) + height (the
+//    swatch z). Vertices that did not move keep their local coordinates
+//    exactly. New elements whose vertex centroid falls outside the patch are
+//    dropped (their base triangles are quilted later). Patch triangles whose
+//    centroid lies in the placed swatch's footprint, and the seed, become
+//    processed.
+// Finally surface_quilt_to_texture expresses every vertex in the base mesh
+// atlas's texture space (u, v, w), w = (z - z_min) / (z_max - z_min) of the
+// swatch, ready for embed_in_shell (section 3.2); surface_quilt_displaced is
+// the naive normal-displacement embedding (for comparison).
+//
+// Reads: the base mesh's points and faces (triangles, no garbage);
+// surface_quilt_to_texture reads kCornerUV. Writes: kFaceElement on outputs.
+// Throws: InvalidInputError (empty or non-triangle base, bad options, a
+// swatch covering fewer than 3 cells), SolverError (LSCM failure on a patch
+// that cannot be shrunk further).
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+#include "geometry/progress.h"
+#include "shell/quilt_step.h"
+#include "shell/swatch.h"
+
+namespace surftex {
+
+struct SurfaceQuiltOptions {
+  /// The paper's s: the swatch's larger xy side as a fraction of the base
+  /// mesh's bounding-box diagonal; in (0, 10].
+  double relative_size = 0.25;
+  enum class Field { kNone, kUp };
+  /// Guidance field aligning the grid (see header).
+  Field field = Field::kUp;
+  /// The constant "up" vector of Field::kUp (normalised here; non-zero).
+  std::array<double, 3> up{0, 0, 1};
+  /// Patch radius in swatch diagonals (scaled); > 0.
+  double patch_radius = 1.0;
+  /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
+  double max_normal_angle_deg = 80.0;
+  /// Largest number of triangles in a patch; >= 1.
+  int max_patch_faces = 4000;
+  /// Largest per-triangle area distortion of a patch's flattening (the paper's 4); > 1.
+  double max_area_distortion = 4.0;
+  /// Grid cell side in swatch units; 0 = max(l_in, w_in) / 10. >= 0.
+  double cell_size = 0;
+  /// P_out half-size in cells; 0 = a quarter of the swatch's smaller side in cells.
+  int subpatch_radius = 0;
+  QuiltStepOptions step;
+  std::uint64_t seed = 1;
+  ProgressCallback progress;
+};
+
+/// Local coordinates of an output vertex (section 3.1): base face, barycentric
+/// coordinates (1 - b1 - b2, b1, b2) >= -1e-9 of its orthogonal projection for
+/// the face's vertices in vertices_around_face(halfedge(f)) order, height z in
+/// swatch units. (A vertex made beyond its patch is moved, at the end, onto the
+/// face containing it by walking across edges, projecting onto each face's
+/// plane; at the mesh border it is clamped to the face.)
+struct SurfaceQuiltVertex {
+  int face = -1;
+  double b1 = 0, b2 = 0;
+  double z = 0;
+};
+
+/// The quilted texture in local coordinates.
+struct SurfaceQuilt {
+  std::vector<SurfaceQuiltVertex> vertices;
+  std::vector<Tri> tris;
+  std::vector<int> tri_element;  ///< element id per triangle, 0..elements-1
+  int elements = 0;
+  double scale = 0;              ///< mesh units per swatch unit
+  double z_min = 0, z_max = 0;   ///< the swatch's z range (swatch units)
+};
+
+struct SurfaceQuiltResult {
+  int steps = 0;
+  int elements = 0;
+  std::size_t faces = 0, vertices = 0;
+  int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
+  double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
+  std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
+  QuiltStepStats stats;
+  double seconds = 0, seconds_patch = 0, seconds_step = 0;
+};
+
+/// Quilts `swatch` over `base`; writes `out`. See the header comment.
+SurfaceQuiltResult quilt_surface(const Mesh& base, const Swatch& swatch, SurfaceQuilt& out,
+                                 const SurfaceQuiltOptions& opt = {});
+
+/// Mesh whose vertex points are atlas texture coordinates (u, v, w) (kCornerUV
+/// of the base faces interpolated; w as in the header); kFaceElement written.
+/// Throws InvalidInputError if base lacks kCornerUV or a face index is out of range.
+void surface_quilt_to_texture(const Mesh& base, const SurfaceQuilt& quilt, Mesh& out);
+
+/// Naive embedding in the local frame of each vertex's base triangle (the
+/// paper's figure 8, left): p = sum b_i x_i + w * height * n_f, n_f the unit
+/// normal of the base face (mesh units). kFaceElement written.
+void surface_quilt_displaced(const Mesh& base, const SurfaceQuilt& quilt, double height, Mesh& out);
+
+}  // namespace surftex

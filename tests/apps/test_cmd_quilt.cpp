@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// `surftex quilt`: planar and surface mesh quilting from the command line
+// (outputs, report figures, refusals that write nothing).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/read_mesh.h"
+#include "geometry/write_mesh.h"
+#include "test_support.h"
+
+using namespace surftex;
+namespace fs = std::filesystem;
+
+namespace {
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+}  // namespace
+
+TEST(CmdQuilt, PlaneWithGeneratedSwatchWritesMeshRenderAndReport) {
+  const std::string dir = test::temp_dir("quilt-plane");
+  const std::string args = "quilt --plane 1.6x1.6 scatter -o '" + dir + "/p.ply' --seed 3 --report '" + dir +
+                           "/r.json' --quiet";
+  test::RunResult r = test::run_surftex(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(dir + "/p.ply"));
+  ASSERT_TRUE(fs::exists(dir + "/p_render.png"));
+  const nlohmann::json j = read_json(dir + "/r.json");
+  EXPECT_GT(j["elements"].get<int>(), 5);
+  Mesh m;
+  read_mesh(dir + "/p.ply", m);
+  EXPECT_EQ(m.number_of_faces(), j["faces"].get<std::size_t>());
+  // Same seed, same bytes.
+  test::RunResult again = test::run_surftex("quilt --plane 1.6x1.6 scatter -o '" + dir + "/p2.ply' --seed 3 --quiet --no-render");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  std::ifstream a(dir + "/p.ply", std::ios::binary), b(dir + "/p2.ply", std::ios::binary);
+  const std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
+  EXPECT_EQ(sa, sb);
+  // Existing output: refused without --force.
+  EXPECT_EQ(test::run_surftex(args).exit_code, 2);
+}
+
+TEST(CmdQuilt, SphereWritesSiblingsAndReportsStretchAndSelfIntersections) {
+  const std::string dir = test::temp_dir("quilt-sphere");
+  Mesh base;
+  make_icosphere(base, 1);
+  write_mesh(dir + "/sphere.off", base);
+  const std::string args = "quilt '" + dir + "/sphere.off' scatter -o '" + dir + "/q.obj' --scale 0.5 --field none " +
+                           "--shell-height 1 --stretch-iterations 5 --report '" + dir + "/r.json' --quiet";
+  test::RunResult r = test::run_surftex(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"/q.obj", "/q.ply", "/q.glb", "/q_render.png"}) EXPECT_TRUE(fs::exists(dir + f)) << f;
+  const nlohmann::json j = read_json(dir + "/r.json");
+  EXPECT_GT(j["elements"].get<int>(), 5);
+  EXPECT_GT(j["faces"].get<std::size_t>(), 100u);
+  EXPECT_GE(j["stretch_before"].get<double>(), 1.0 - 1e-9);
+  EXPECT_LE(j["stretch_after"].get<double>(), j["stretch_before"].get<double>());
+  EXPECT_TRUE(j["self_intersections"].is_number_unsigned());
+  EXPECT_GE(j["seconds"]["quilt"].get<double>(), 0.0);
+  EXPECT_GE(j["seconds"]["embed"].get<double>(), 0.0);
+  Mesh m;
+  read_mesh(dir + "/q.ply", m);
+  EXPECT_EQ(m.number_of_faces(), j["faces"].get<std::size_t>());
+}
+
+TEST(CmdQuilt, BadInputExitsTwoAndWritesNothing) {
+  const std::string dir = test::temp_dir("quilt-bad");
+  // Unknown swatch file.
+  test::RunResult r = test::run_surftex("quilt --plane 2x2 '" + dir + "/nope.obj' -o '" + dir + "/o.ply' --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  // Bad plane size.
+  r = test::run_surftex("quilt --plane 2by2 chainmail -o '" + dir + "/o.ply' --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--plane"), std::string::npos) << r.err;
+  // A base mesh that is not a mesh file.
+  {
+    std::ofstream bad(dir + "/bad.off");
+    bad << "OFF\n3 1 0\n0 0 0\n1 0 0\n";
+  }
+  r = test::run_surftex("quilt '" + dir + "/bad.off' chainmail -o '" + dir + "/o.ply' --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  // Bad field.
+  r = test::run_surftex("quilt '" + dir + "/bad.off' chainmail -o '" + dir + "/o.ply' --field sideways --quiet");
+  EXPECT_NE(r.exit_code, 0);
+  for (const char* f : {"/o.ply", "/o.glb", "/o_render.png"}) EXPECT_FALSE(fs::exists(dir + f)) << f;
+}
