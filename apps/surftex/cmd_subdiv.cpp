@@ -193,7 +193,7 @@ int run_subdiv(const SubdivArgs& a) {
   }
   write_report(ro, "subdiv", rep);
   if (!a.common.quiet)
-    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, %.1f s -> %s\n", mesh.number_of_vertices(), a.levels,
+    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, %.1f s -> %s\n", static_cast<std::size_t>(mesh.number_of_vertices()), a.levels,
                  total.seconds(), a.outdir.c_str());
   return 0;
 }
