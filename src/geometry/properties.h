@@ -21,6 +21,7 @@
 // | kVertexSweep      | v:sweep        | vertex   | double    | sweep value ordering vertices along a field|
 // | kFaceElement      | f:element      | face     | int       | geometric-texture element id               |
 // | kVertexLocked     | v:locked       | vertex   | bool      | vertex fixed by a constraint               |
+// | kVertexDirection  | v:dir          | vertex   | Vector3   | unit tangent orientation (Turk field)      |
 //
 // A halfedge h stands for the corner of face(h) at target(h).
 
@@ -57,6 +58,7 @@ inline constexpr PropertyName<FaceIndex, int> kFacePatch{"f:patch"};
 inline constexpr PropertyName<VertexIndex, double> kVertexSweep{"v:sweep"};
 inline constexpr PropertyName<FaceIndex, int> kFaceElement{"f:element"};
 inline constexpr PropertyName<VertexIndex, bool> kVertexLocked{"v:locked"};
+inline constexpr PropertyName<VertexIndex, Vector3> kVertexDirection{"v:dir"};
 
 template <class Index, class T>
 using PropertyMap = typename Mesh::template Property_map<Index, T>;

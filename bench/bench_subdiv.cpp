@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Benchmark: one k-region matching pass (Bangay & Morkel 2006, Table 1) on a
+// mesh of about 65K vertices: shared/data/meshes/elephant.off (2775 vertices)
+// after four uniform sqrt(2) steps = 66,680 vertices (the paper: donkey,
+// 65,858 vertices, 752 / 478 / 326 s at r_scale 30 / 100 / 200 with averaging,
+// Pentium 4 3 GHz). Exemplar: shared/data/textures/brick_small_96.png (Gaussian
+// stack, 7 levels). Units: r_scale per object unit = the longest bounding-box
+// side (as `surftex subdiv`). Every vertex starts with a random texel colour
+// (seed 1), then one pass in random order matches every vertex (no skipping),
+// with averaging and anti-aliasing, transfer to the vertex alone (as Table 1
+// times matching); a second line per r_scale runs the same pass with the
+// graph-cut transfer.
+//
+// Usage: bench_subdiv [MESH] [TEXTURE]. One JSON line per run.
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/polygon_util.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/sqrt2_subdivide.h"
+#include "geometry/timer.h"
+#include "geometry/turk_orientation_field.h"
+#include "texture/k_region_matching.h"
+#include "texture/subdivision_synthesis.h"
+
+using namespace surftex;
+
+int main(int argc, char** argv) {
+  const std::string mesh_path = argc > 1 ? argv[1] : std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/elephant.off";
+  const std::string tex_path =
+      argc > 2 ? argv[2] : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/brick_small_96.png";
+  Mesh mesh;
+  SoupToMeshOptions so;
+  so.triangulate = false;
+  read_mesh(mesh_path, mesh, so);
+  Timer t;
+  while (mesh.number_of_vertices() < 60000) sqrt2_subdivide(mesh);
+  const double t_sub = t.seconds();
+  t.reset();
+  turk_orientation_field(mesh, {{0, {1, 0, 0}}});
+  const double t_field = t.seconds();
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (VertexIndex v : mesh.vertices())
+    for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], mesh.point(v)[i]), hi[i] = std::max(hi[i], mesh.point(v)[i]);
+  const double unit = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  double esum = 0;
+  for (EdgeIndex e : mesh.edges())
+    esum += std::sqrt((mesh.point(mesh.vertex(e, 0)) - mesh.point(mesh.vertex(e, 1))).squared_length());
+  const double ebar = esum / mesh.number_of_edges() / unit;
+  const ExemplarLevels ex = make_exemplar_levels(read_image(tex_path), false);
+  const std::size_t nv = mesh.number_of_vertices();
+  for (double rs : {30.0, 100.0, 200.0}) {
+    for (bool cut : {false, true}) {
+      std::mt19937_64 rng(1);
+      auto col = get_or_add(mesh, kVertexColor);
+      std::uniform_int_distribution<int> ux(0, ex.width(0) - 1), uy(0, ex.height(0) - 1);
+      for (VertexIndex v : mesh.vertices()) {
+        const auto c = texel(ex, 0, ux(rng), uy(rng));
+        col[v] = {c[0], c[1], c[2]};
+      }
+      std::vector<char> colored(nv, 1);
+      std::vector<std::size_t> order(nv);
+      std::iota(order.begin(), order.end(), std::size_t(0));
+      std::shuffle(order.begin(), order.end(), rng);
+      SubdivisionSynthesisOptions o;
+      o.graph_cut = cut;
+      o.skip_patched = false;
+      Timer tp;
+      const SynthesisPassStats st = synthesis_pass(mesh, ex, order, colored, rs / unit, 0, o, rng);
+      const double secs = tp.seconds();
+      nlohmann::json j{{"mesh", mesh_path}, {"texture", tex_path}, {"vertices", nv}, {"inv_mean_edge", 1.0 / ebar},
+                       {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs},
+                       {"seconds_region", st.seconds_region}, {"seconds_match", st.seconds_match},
+                       {"seconds_transfer", st.seconds_transfer}, {"matched", st.matched},
+                       {"mean_k", st.mean_k}, {"mean_region_vertices", st.mean_region},
+                       {"mean_groups_compared", st.mean_groups},
+                       {"vertex_comparisons_with_averaging", st.mean_groups * st.matched},
+                       {"seconds_subdivide", t_sub}, {"seconds_field", t_field}};
+      std::printf("%s\n", j.dump().c_str());
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}

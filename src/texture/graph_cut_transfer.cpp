@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Graph-cut transfer (Bangay & Morkel 2006, section 3.4). See graph_cut_transfer.h.
+#include "texture/graph_cut_transfer.h"
+
+#include <cmath>
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/graph_cut.h"
+
+namespace surftex {
+namespace {
+
+double mismatch(const TransferNode& n) {
+  if (!n.colored) return 0.0;
+  double s = 0;
+  for (int c = 0; c < 3; ++c) s += (double(n.surface[c]) - n.texture[c]) * (double(n.surface[c]) - n.texture[c]);
+  return std::sqrt(s);
+}
+
+double edge_weight(const TransferNode& a, const TransferNode& b, double r, double sigma) {
+  const double m = mismatch(a) + mismatch(b);
+  return m * std::exp(-(a.distance * a.distance + b.distance * b.distance) / (sigma * r * r));
+}
+
+void check(const std::vector<TransferNode>& nodes, const std::vector<std::array<int, 2>>& edges, double r,
+           double sigma) {
+  if (!(r > 0) || !(sigma > 0) || !std::isfinite(r) || !std::isfinite(sigma))
+    throw InvalidInputError("graph_cut_transfer: r and sigma must be > 0 (got r=" + std::to_string(r) +
+                            ", sigma=" + std::to_string(sigma) + ")");
+  const int n = static_cast<int>(nodes.size());
+  for (const auto& e : edges)
+    if (e[0] < 0 || e[1] < 0 || e[0] >= n || e[1] >= n || e[0] == e[1])
+      throw InvalidInputError("graph_cut_transfer: edge (" + std::to_string(e[0]) + "," + std::to_string(e[1]) +
+                              ") out of range for " + std::to_string(n) + " nodes");
+}
+
+}  // namespace
+
+double transfer_seam_cost(const std::vector<TransferNode>& nodes, const std::vector<std::array<int, 2>>& edges,
+                          const std::vector<char>& take, double r, double sigma) {
+  check(nodes, edges, r, sigma);
+  double c = 0;
+  for (const auto& e : edges)
+    if (take[e[0]] != take[e[1]]) c += edge_weight(nodes[e[0]], nodes[e[1]], r, sigma);
+  return c;
+}
+
+GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes,
+                                          const std::vector<std::array<int, 2>>& edges, int center,
+                                          int border_hops, double r, const GraphCutTransferOptions& opt) {
+  check(nodes, edges, r, opt.sigma);
+  const int n = static_cast<int>(nodes.size());
+  if (center < 0 || center >= n)
+    throw InvalidInputError("graph_cut_transfer: center " + std::to_string(center) + " out of range");
+  GraphCut gc(n);
+  std::vector<char> paste(n, 1);
+  for (int i = 0; i < n; ++i) {
+    const TransferNode& a = nodes[i];
+    if (i == center || !a.colored) {
+      gc.add_terminal(i, GraphCut::kInfinity, 0);
+    } else if (a.hops >= border_hops) {
+      gc.add_terminal(i, 0, GraphCut::kInfinity);
+      paste[i] = 0;
+    }
+  }
+  for (const auto& e : edges) {
+    const double w = edge_weight(nodes[e[0]], nodes[e[1]], r, opt.sigma);
+    if (w > 0) gc.add_edge(e[0], e[1], w, w);
+  }
+  gc.solve();
+  GraphCutTransferResult res;
+  res.take_texture.resize(n);
+  for (int i = 0; i < n; ++i) {
+    res.take_texture[i] = gc.is_source_side(i) ? 1 : 0;
+    res.taken += res.take_texture[i];
+  }
+  res.cut_cost = transfer_seam_cost(nodes, edges, res.take_texture, r, opt.sigma);
+  res.paste_cost = transfer_seam_cost(nodes, edges, paste, r, opt.sigma);
+  return res;
+}
+
+}  // namespace surftex

@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
+#include "geometry/turk_orientation_field.h"
+#include "texture/graph_cut_transfer.h"
+#include "texture/k_region_matching.h"
+#include "texture/procedural_texture.h"
+#include "texture/subdivision_synthesis.h"
+
+using namespace surftex;
+
+namespace {
+Image random_image(int w, int h, std::mt19937_64& rng) {
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  Image im(w, h, 3);
+  for (float& v : im.data) v = u(rng);
+  return im;
+}
+}  // namespace
+
+// Section 3.3.3: the averaged metric differs from the naive one by a constant
+// independent of Q, so both pick the same texel. Random exemplars, random
+// oversampled regions (many samples per texel), several levels, many seeds.
+TEST(KRegionMatching, AveragedMetricPicksTheSameTexelAsTheNaiveOne) {
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    std::mt19937_64 rng(seed);
+    const bool pyramid = seed % 3 == 0;
+    const ExemplarLevels ex = make_exemplar_levels(random_image(24, 20, rng), pyramid, 3);
+    std::uniform_real_distribution<double> off(-3.0, 3.0);
+    std::uniform_real_distribution<float> c(0.f, 1.f);
+    std::uniform_int_distribution<int> lv(0, 2), n(1, 40);
+    std::vector<RegionSample> s(n(rng));
+    for (auto& x : s) x = RegionSample{off(rng), off(rng), lv(rng), {c(rng), c(rng), c(rng)}};
+    const int cl = pyramid ? lv(rng) : 0;
+    const auto groups = group_samples(ex, s, cl);
+    ASSERT_LE(groups.size(), s.size());
+    // constant difference
+    const double c0 = naive_distance(ex, s, cl, 0, 0) - grouped_distance(ex, groups, cl, 0, 0);
+    int best_naive = -1, best_grouped = -1;
+    double bn = 1e300, bg = 1e300;
+    const int W = ex.width(cl), H = ex.height(cl);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const double dn = naive_distance(ex, s, cl, x, y), dg = grouped_distance(ex, groups, cl, x, y);
+        EXPECT_NEAR(dn - dg, c0, 1e-6 * (1 + dn));
+        if (dn < bn) bn = dn, best_naive = y * W + x;
+        if (dg < bg) bg = dg, best_grouped = y * W + x;
+      }
+    EXPECT_EQ(best_naive, best_grouped) << "seed " << seed;
+    // The fast float matcher agrees with both (with and without averaging).
+    MatchOptions mo;
+    const MatchResult m = match_region(ex, s, cl, mo);
+    ASSERT_TRUE(m.found);
+    EXPECT_EQ(m.qy * W + m.qx, best_naive) << "seed " << seed;
+    mo.averaging = false;
+    const MatchResult m2 = match_region(ex, s, cl, mo);
+    EXPECT_EQ(m2.qy * W + m2.qx, best_naive) << "seed " << seed;
+    EXPECT_EQ(m.comparisons, groups.size());
+    EXPECT_EQ(m2.comparisons, s.size());
+  }
+}
+
+TEST(KRegionMatching, FindsAPlantedNeighbourhoodAndIsThreadIndependent) {
+  std::mt19937_64 rng(7);
+  const ExemplarLevels ex = make_exemplar_levels(random_image(40, 33, rng), false, 1);
+  std::vector<RegionSample> s;
+  for (int dy = -2; dy <= 2; ++dy)
+    for (int dx = -2; dx <= 2; ++dx)
+      if (dx || dy) s.push_back(RegionSample{double(dx), double(-dy), 0, texel(ex, 0, 31 + dx, 5 + dy)});
+  MatchOptions a, b;
+  a.rows_per_block = 1;
+  b.rows_per_block = 64;
+  const auto m1 = match_region(ex, s, 0, a), m2 = match_region(ex, s, 0, b);
+  EXPECT_EQ(m1.qx, 31);
+  EXPECT_EQ(m1.qy, 5);
+  EXPECT_EQ(m2.qx, m1.qx);
+  EXPECT_EQ(m2.qy, m1.qy);
+  EXPECT_NEAR(m1.distance, 0.0, 1e-9);
+}
+
+TEST(KRegionMatching, RegionSizeFormulaAndRegions) {
+  // (k+1)^2 + k^2 = N: N = 13 -> k = 2 exactly, N = 14 -> k = 3.
+  EXPECT_EQ(region_k(std::sqrt(13.0), 0, false, 1.0, 1.0), 2);
+  EXPECT_EQ(region_k(std::sqrt(14.0), 0, false, 1.0, 1.0), 3);
+  EXPECT_EQ(region_k(std::sqrt(13.0) / 2, 1, true, 1.0, 1.0), 2);  // a^m n with a = 2, m = 1
+  EXPECT_EQ(region_k(0.1, 0, false, 1.0, 1.0), 1);
+  EXPECT_THROW(region_k(3, 0, false, 0.0, 1.0), InvalidInputError);
+
+  // On a flat quad-like grid the k-region of an interior vertex is the
+  // diamond of 2k^2 + 2k + 1 vertices when the grid is 4-connected: use the
+  // triangle grid's count instead (hexagon: 3k^2 + 3k + 1).
+  Mesh m;
+  make_grid(m, 10, 10, 10.0, 10.0);
+  turk_orientation_field(m, {{0, {1, 0, 0}}});
+  const SurfaceFrames fr = compute_surface_frames(m);
+  KRegion r;
+  const std::size_t center = 5 * 11 + 5;
+  for (int k = 1; k <= 3; ++k) {
+    k_region(m, fr, center, k, LocalCoordinates::kUnfolding, r);
+    EXPECT_EQ(r.vertices.size(), std::size_t(3 * k * k + 3 * k + 1));
+    // Flat and constant field: unfolding reproduces the exact planar offsets.
+    for (std::size_t i = 0; i < r.vertices.size(); ++i) {
+      const Point3 p = m.point(VertexIndex(r.vertices[i])), c = m.point(VertexIndex(center));
+      EXPECT_NEAR(r.uv[i][0], p.x() - c.x(), 1e-9);
+      EXPECT_NEAR(r.uv[i][1], p.y() - c.y(), 1e-9);
+    }
+  }
+  EXPECT_THROW(k_region(m, fr, m.number_of_vertices(), 1, LocalCoordinates::kUnfolding, r), InvalidInputError);
+}
+
+// Section 3.4: the min cut's seam cost is never above pasting the whole patch.
+TEST(GraphCutTransfer, SeamCostNoHigherThanPastingAndTargetTakesTexture) {
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> c(0.f, 1.f);
+    // A 7x7 grid region, centre in the middle, hop = Chebyshev-ish ring index.
+    const int R = 3;
+    std::vector<TransferNode> nodes;
+    std::vector<std::array<int, 2>> edges;
+    auto id = [&](int x, int y) { return (y + R) * (2 * R + 1) + (x + R); };
+    for (int y = -R; y <= R; ++y)
+      for (int x = -R; x <= R; ++x) {
+        TransferNode n;
+        n.hops = std::abs(x) + std::abs(y);
+        n.colored = c(rng) < 0.8f;
+        n.surface = {c(rng), c(rng), c(rng)};
+        n.texture = {c(rng), c(rng), c(rng)};
+        n.distance = std::sqrt(double(x * x + y * y));
+        nodes.push_back(n);
+      }
+    for (int y = -R; y <= R; ++y)
+      for (int x = -R; x <= R; ++x) {
+        if (x < R) edges.push_back({id(x, y), id(x + 1, y)});
+        if (y < R) edges.push_back({id(x, y), id(x, y + 1)});
+      }
+    const auto r = graph_cut_transfer(nodes, edges, id(0, 0), R, 2.0 * R + 1);
+    EXPECT_LE(r.cut_cost, r.paste_cost + 1e-9);
+    EXPECT_TRUE(r.take_texture[id(0, 0)]);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (!nodes[i].colored) {
+        EXPECT_TRUE(r.take_texture[i]);
+      }
+      if (nodes[i].colored && nodes[i].hops >= R) {
+        EXPECT_FALSE(r.take_texture[i]);
+      }
+    }
+  }
+  EXPECT_THROW(graph_cut_transfer({TransferNode{}}, {}, 2, 1, 1.0), InvalidInputError);
+  EXPECT_THROW(graph_cut_transfer({TransferNode{}}, {}, 0, 1, 0.0), InvalidInputError);
+}
+
+TEST(SubdivisionSynthesis, SameSeedSameColoursAndEveryVertexColoured) {
+  const Image ex = make_cells(32, 3, 5);
+  auto run = [&](std::uint64_t seed) {
+    Mesh m;
+    make_icosphere(m, 1);
+    SubdivisionSynthesisOptions o;
+    o.r_scale = 40;
+    o.levels = 3;
+    o.passes = 2;
+    o.seed = seed;
+    const auto r = synthesize_on_subdivision(m, ex, o);
+    EXPECT_EQ(r.levels.size(), 4u);
+    std::vector<float> c;
+    auto col = find(m, kVertexColor);
+    EXPECT_TRUE(col.second);
+    for (VertexIndex v : m.vertices())
+      for (int k = 0; k < 3; ++k) c.push_back(col.first[v][k]);
+    return c;
+  };
+  const auto a = run(3), b = run(3), c = run(4);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  // Colours come from the exemplar's stack: all within its range, and varied.
+  float lo = 1, hi = 0;
+  for (float v : a) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_GE(lo, 0.f);
+  EXPECT_LE(hi, 1.f);
+  EXPECT_GT(hi - lo, 0.2f);
+}
+
+TEST(SubdivisionSynthesis, BadInputErrors) {
+  Mesh m;
+  make_icosphere(m, 0);
+  const Image ex = make_cells(16, 2, 1);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 0;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.passes = 0;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  EXPECT_THROW(synthesize_on_subdivision(m, Image(), o), InvalidInputError);
+  o.keys = {{100000, {1, 0, 0}}};
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  Mesh empty;
+  EXPECT_THROW(synthesize_on_subdivision(empty, ex, {}), InvalidInputError);
+}
