@@ -3,31 +3,30 @@
 // `syntexturize_matchpatch` on every texture of shared/data/textures, 256x256
 // output; plus a 128x128 periodic tile per texture and its wrap-seam ratio.
 //
-// Similarity: texture/bidirectional_similarity.h was not on main when this was
-// written, so a simple bidirectional patch distance is computed here: 7x7
-// patches, queries on a subsampled grid (stride 16 in the queried image),
-// exact nearest neighbour over EVERY position of the other image (no
-// approximation), mean squared difference per pixel and channel. coherence =
-// output queries against the exemplar, completeness = exemplar queries against
-// the output; bds = coherence + completeness (lower is better).
+// Similarity: texture/bidirectional_similarity.h (Simakov et al. 2008) with a
+// fixed setting for every texture and both methods: 7x7 patches, output
+// patches at stride 2, exemplar patches at every position (non-periodic),
+// exact nearest neighbours (max_candidates = 0). bds = coherence +
+// completeness, mean squared difference per value (lower is better).
+// Alpha is kept: both outputs are compared with the exemplar's channels.
 //
-// Usage: bench_graphcut [TEXTURE_DIR] [WORK_DIR]  (gmic from PATH; if it is
+// Usage: bench_graphcut [TEXTURE_DIR] [WORK_DIR] [NAME,NAME,...]  (the optional
+// list keeps only the textures whose file stem is listed)  (gmic from PATH; if it is
 // missing the G'MIC fields are null). One JSON line per texture, then a summary.
 #include <sys/resource.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "geometry/image_io.h"
 #include "geometry/timer.h"
+#include "texture/bidirectional_similarity.h"
 #include "texture/graphcut_synthesis.h"
 #include "texture/tileable_tile.h"
 #include "texture/wrap_seam_ratio.h"
@@ -37,49 +36,26 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kPatch = 7, kHalf = 3, kStride = 16;
-
-// Mean over query positions of min over all positions of `ref` of the
-// per-pixel, per-channel squared patch difference.
-double directed_patch_distance(const Image& query, const Image& ref, int channels) {
-  std::vector<std::pair<int, int>> qs;
-  for (int y = kHalf; y + kHalf < query.height; y += kStride)
-    for (int x = kHalf; x + kHalf < query.width; x += kStride) qs.emplace_back(x, y);
-  std::vector<double> best(qs.size());
-  tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t q) {
-    const auto [qx, qy] = qs[q];
-    double b = std::numeric_limits<double>::infinity();
-    for (int ry = kHalf; ry + kHalf < ref.height; ++ry)
-      for (int rx = kHalf; rx + kHalf < ref.width; ++rx) {
-        double s = 0.0;
-        for (int dy = -kHalf; dy <= kHalf && s < b; ++dy)
-          for (int dx = -kHalf; dx <= kHalf; ++dx) {
-            const float* a = query.pixel(qx + dx, qy + dy);
-            const float* r = ref.pixel(rx + dx, ry + dy);
-            for (int c = 0; c < channels; ++c) {
-              double d = static_cast<double>(a[c]) - r[c];
-              s += d * d;
-            }
-          }
-        b = std::min(b, s);
-      }
-    best[q] = b / (kPatch * kPatch * channels);
-  });
-  double sum = 0.0;
-  for (double v : best) sum += v;
-  return qs.empty() ? 0.0 : sum / qs.size();
+// The one similarity setting of this benchmark (see the header comment).
+BidirectionalResult bidirectional(const Image& out, const Image& ex) {
+  BidirectionalOptions o;
+  o.patch = 7;
+  o.stride = 2;
+  o.max_candidates = 0;  // exact
+  return bidirectional_similarity(out, ex, o);
 }
 
-struct Bds {
-  double coherence, completeness, total;
-};
-Bds bidirectional(const Image& out, const Image& ex) {
-  const int c = std::min(out.channels, ex.channels);
-  Bds b;
-  b.coherence = directed_patch_distance(out, ex, c);
-  b.completeness = directed_patch_distance(ex, out, c);
-  b.total = b.coherence + b.completeness;
-  return b;
+// G'MIC may write a different channel count (e.g. drops or adds alpha): match the exemplar.
+Image match_channels(const Image& img, int channels) {
+  if (img.channels == channels) return img;
+  Image r(img.width, img.height, channels, 1.f);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < channels; ++c) {
+        const int sc = img.channels == 1 ? 0 : std::min(c, img.channels - 1);
+        r.at(x, y, c) = (c == 3 && img.channels < 4) ? 1.f : img.at(x, y, sc);
+      }
+  return r;
 }
 
 double children_cpu_seconds() {
@@ -102,7 +78,12 @@ int main(int argc, char** argv) {
   const bool have_gmic = std::system("command -v gmic >/dev/null 2>&1") == 0;
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().extension() == ".png") files.push_back(e.path().string());
+    if (e.path().extension() == ".png") {
+      if (argc > 3 && ("," + std::string(argv[3]) + ",").find("," + e.path().stem().string() + ",") ==
+                          std::string::npos)
+        continue;
+      files.push_back(e.path().string());
+    }
   std::sort(files.begin(), files.end());
 
   int compared = 0, no_worse = 0, tiles_ok = 0;
@@ -122,7 +103,7 @@ int main(int argc, char** argv) {
     const double ours_s = tm.seconds(), ours_cpu = self_cpu_seconds() - c0;
     const std::string ours_png = work + "/" + name + "_graphcut.png";
     write_image(ours_png, r.image);
-    Bds bo = bidirectional(r.image, ex);
+    BidirectionalResult bo = bidirectional(r.image, ex);
     j["surftex_seconds"] = ours_s;
     j["surftex_cpu_seconds"] = ours_cpu;
     j["surftex_bds"] = bo.total;
@@ -139,8 +120,8 @@ int main(int argc, char** argv) {
       int rc = std::system(cmd.c_str());
       const double gm_s = tm.seconds(), gm_cpu = children_cpu_seconds() - g0;
       if (rc == 0 && fs::exists(gm_png)) {
-        Image g = read_image(gm_png);
-        Bds bg = bidirectional(g, ex);
+        Image g = match_channels(read_image(gm_png), ex.channels);
+        BidirectionalResult bg = bidirectional(g, ex);
         j["gmic_seconds"] = gm_s;
         j["gmic_cpu_seconds"] = gm_cpu;
         j["gmic_bds"] = bg.total;
@@ -163,6 +144,9 @@ int main(int argc, char** argv) {
     TileResult t = make_tileable_detailed(ex, 128, to);
     j["tile128_seconds"] = tm.seconds();
     j["tile128_wrap_seam_ratio"] = t.wrap_seam_ratio;
+    const WrapSeamStats ws = wrap_seam_stats(t.tile);
+    j["tile128_wrap_mean_jump"] = ws.wrap_mean;
+    j["tile128_inside_mean_jump"] = ws.inside_mean;
     j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
     if (t.wrap_seam_ratio <= 1.3) ++tiles_ok;
     Image rep(256, 256, t.tile.channels);

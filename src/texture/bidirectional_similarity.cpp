@@ -49,6 +49,26 @@ double ssd(const float* a, const float* b, int dim) {
   return s;
 }
 
+// As ssd, but stops once the running sum exceeds `bound` and returns that
+// partial sum (> bound): min(bound, result) is unchanged, so exact searches
+// stay exact while rejected candidates cost a fraction of the full distance.
+double ssd_bounded(const float* a, const float* b, int dim, double bound) {
+  double s = 0;
+  int i = 0;
+  for (; i + 16 <= dim; i += 16) {
+    for (int j = i; j < i + 16; ++j) {
+      const double d = static_cast<double>(a[j]) - b[j];
+      s += d * d;
+    }
+    if (s > bound) return s;
+  }
+  for (; i < dim; ++i) {
+    const double d = static_cast<double>(a[i]) - b[i];
+    s += d * d;
+  }
+  return s;
+}
+
 struct Cloud {
   const std::vector<double>* pts;
   int dim;
@@ -109,6 +129,32 @@ std::vector<double> project(const Patches& p, const Pca& pca) {
   return out;
 }
 
+// nanoflann result set doing a branch-and-bound nearest-neighbour search in
+// the full patch space: the tree's squared distance in the PCA subspace is a
+// lower bound of the full SSD (orthonormal projection), so every point whose
+// bound reaches the best full SSD found so far is pruned, and each point the
+// tree offers is re-ranked with the full SSD. The result is the exact minimum
+// (the visiting order only changes the speed). With max_candidates > 0 the
+// search stops after that many full evaluations (approximate, an upper bound).
+struct NearestByBound {
+  const float* query;
+  const Patches* base;
+  std::size_t max_candidates;
+  double best = std::numeric_limits<double>::infinity();
+  std::size_t evaluated = 0;
+  std::size_t size() const { return evaluated; }
+  bool full() const { return true; }
+  // Slack for the float rounding of the projection (the bound is exact in
+  // exact arithmetic).
+  double worstDist() const { return best * (1.0 + 1e-9); }
+  bool addPoint(double lower_bound, std::uint32_t index) {
+    if (lower_bound > worstDist()) return true;
+    best = std::min(best, ssd_bounded(query, base->row(index), base->dim, best));
+    ++evaluated;
+    return max_candidates == 0 || evaluated < max_candidates;
+  }
+};
+
 // Mean over `queries` of the distance to the nearest patch of `base`.
 double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
                     const std::vector<double>& qproj, const std::vector<double>& bproj,
@@ -125,33 +171,9 @@ double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
     Cloud cloud{&bproj, d, base.count};
     Tree tree(d, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
-      std::size_t k = std::min<std::size_t>(16, base.count);
-      std::vector<std::uint32_t> idx;
-      std::vector<double> lb;
-      while (true) {
-        idx.resize(k);
-        lb.resize(k);
-        const std::size_t got = tree.knnSearch(qproj.data() + i * d, k, idx.data(), lb.data());
-        double b = std::numeric_limits<double>::infinity();
-        for (std::size_t j = 0; j < got; ++j) b = std::min(b, ssd(queries.row(i), base.row(idx[j]), base.dim));
-        // Unvisited patches are at least lb[got-1] away (projection lower bound).
-        if (got >= base.count || lb[got - 1] >= b * (1.0 - 1e-9)) {
-          best[i] = b;
-          break;
-        }
-        if (max_candidates > 0 && k >= max_candidates) {  // approximate: accept the best seen
-          best[i] = b;
-          break;
-        }
-        k = std::min(base.count, k * 2);
-        if (max_candidates > 0) k = std::min(k, max_candidates);
-        if (k > base.count / 8 && max_candidates == 0) {  // the subspace does not separate: scan all
-          for (std::size_t j = 0; j < base.count; ++j)
-            b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
-          best[i] = b;
-          break;
-        }
-      }
+      NearestByBound r{queries.row(i), &base, max_candidates};
+      tree.findNeighbors(r, qproj.data() + i * d, nanoflann::SearchParams());
+      best[i] = r.best;
     });
   }
   double sum = 0;

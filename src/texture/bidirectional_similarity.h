@@ -15,11 +15,11 @@
 // image and patch sizes.
 //
 // Nearest neighbours are exact (up to float rounding): patches are projected
-// on the leading principal components (Eigen), a nanoflann kd-tree returns the
-// nearest candidates in that subspace, and they are re-ranked with the full
-// distance; since the subspace distance is a lower bound of the full one, the
-// candidate list is doubled until its farthest lower bound is no smaller than
-// the best full distance found, which proves the nearest one was seen.
+// on the leading principal components (Eigen) and a nanoflann kd-tree over the
+// projections runs a branch-and-bound search in which every point the tree
+// offers is re-ranked with the full distance; since the subspace distance is
+// a lower bound of the full one, a subtree or point whose bound reaches the
+// best full distance found so far cannot hold the nearest patch and is pruned.
 //
 // Throws InvalidInputError on empty images, different channel counts,
 // patch outside 1..31 or larger than an image, or stride < 1.
@@ -43,7 +43,7 @@ struct BidirectionalOptions {
   /// clamped), default 16. Affects speed only, not the result.
   int pca_dims = 16;
   /// 0 (default) = exact search as described above. > 0 = approximate: stop
-  /// growing the re-ranked list at this many candidates and take the best
+  /// after this many full-distance evaluations per query and take the best
   /// seen (an upper bound of the true distance; figures can only be too
   /// high). Bounds the time on exemplars whose patches PCA separates poorly
   /// (large, regular ones such as stripes).

@@ -300,7 +300,11 @@ class GraphcutSynthesizer {
       ph_ = std::min(ex.height, lim_h);
     } else {
       const int min_side = std::min(ex.width, ex.height);
-      const int auto_ps = std::min(min_side, std::clamp(min_side / 3, 64, 128));
+      // Large patches (section 4.1: with FFT matching their size costs
+      // nothing): 3/4 of the exemplar side, so that several offsets remain
+      // to choose from, but at most 192 (a 256 output still gets seams to
+      // mix exemplar regions) and at least 64 (or the whole exemplar).
+      const int auto_ps = std::min(min_side, std::clamp(min_side * 3 / 4, 64, 192));
       int ps = o.patch_size > 0 ? o.patch_size : auto_ps;
       pw_ = std::min({ps, ex.width, lim_w});
       ph_ = std::min({ps, ex.height, lim_h});

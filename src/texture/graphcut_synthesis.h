@@ -58,9 +58,10 @@ enum class PlacementMode {
 
 struct GraphcutOptions {
   PlacementMode placement = PlacementMode::SubPatch;
-  /// Side of a (square) patch in pixels, 0 = automatic: s/3 clamped to
-  /// [64, 128], at most s, where s = min(exemplar width, exemplar height)
-  /// (fewer, larger patches on large exemplars); always clipped to the
+  /// Side of a (square) patch in pixels, 0 = automatic: 3s/4 clamped to
+  /// [64, 192], at most s, where s = min(exemplar width, exemplar height)
+  /// (few, large patches: fewer seams, larger verbatim regions; FFT matching
+  /// makes their size free, section 4.1); always clipped to the
   /// exemplar and output sizes. Ignored
   /// by EntirePatch (the patch is the exemplar). Range 0 or >= 4.
   int patch_size = 0;
