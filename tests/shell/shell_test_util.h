@@ -8,6 +8,8 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "shell/shell_space.h"
+#include "shell/swatch.h"
+#include "shell/swatch_generators.h"
 
 namespace surftex::test {
 
@@ -24,6 +26,29 @@ inline void set_planar_uv(Mesh& m, double s, double off) {
       uv[h] = {p.x() * s + off, p.y() * s + off};
     }
   }
+}
+
+/// A small generated chain-mail swatch (3x3 rings) for fast tests.
+inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, int sides = 6) {
+  ChainmailOptions o;
+  o.rings_x = o.rings_y = 3;
+  o.segments = segments;
+  o.sides = sides;
+  o.seed = seed;
+  Mesh m;
+  make_chainmail_swatch(m, o);
+  return make_swatch(m);
+}
+
+/// A small generated scatter swatch for fast tests.
+inline Swatch small_scatter_swatch(std::uint64_t seed = 1) {
+  ScatterOptions o;
+  o.size = 6;
+  o.subdivisions = 1;
+  o.seed = seed;
+  Mesh m;
+  make_scatter_swatch(m, o);
+  return make_swatch(m);
 }
 
 inline Point3 to_point(const Vec3& p) { return Point3(p[0], p[1], p[2]); }

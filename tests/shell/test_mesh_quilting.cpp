@@ -18,21 +18,13 @@
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
 
+#include "shell_test_util.h"
+
 namespace surftex {
 namespace {
 
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
 
-Swatch small_chainmail(std::uint64_t seed = 1) {
-  ChainmailOptions o;
-  o.rings_x = o.rings_y = 3;
-  o.segments = 12;
-  o.sides = 6;
-  o.seed = seed;
-  Mesh m;
-  make_chainmail_swatch(m, o);
-  return make_swatch(m);
-}
+Swatch small_chainmail(std::uint64_t seed = 1) { return test::small_chainmail_swatch(seed); }
 Swatch small_weave(std::uint64_t seed = 1) {
   WeaveOptions o;
   o.threads_x = o.threads_y = 4;
@@ -43,15 +35,7 @@ Swatch small_weave(std::uint64_t seed = 1) {
   make_weave_swatch(m, o);
   return make_swatch(m);
 }
-Swatch small_scatter(std::uint64_t seed = 1) {
-  ScatterOptions o;
-  o.size = 6;
-  o.subdivisions = 1;
-  o.seed = seed;
-  Mesh m;
-  make_scatter_swatch(m, o);
-  return make_swatch(m);
-}
+Swatch small_scatter(std::uint64_t seed = 1) { return test::small_scatter_swatch(seed); }
 
 /// Every connected component of `m` is closed; returns the number of border edges.
 std::size_t border_edges(const Mesh& m) {
@@ -279,7 +263,7 @@ class PlanarQuilting : public ::testing::TestWithParam<QuiltCase> {};
 
 TEST_P(PlanarQuilting, ElementsStayClosedAndWhole) {
   const Swatch s = GetParam().make(1);
-  const double size = (sanitized() ? 1.3 : 2.0);
+  const double size = (test::sanitized() ? 1.3 : 2.0);
   Mesh out;
   const QuiltResult r = quilt_plane(s, size * s.length(), size * s.width(), out);
   EXPECT_GT(r.steps, 1);
@@ -301,7 +285,7 @@ INSTANTIATE_TEST_SUITE_P(Generated, PlanarQuilting,
 TEST(PlanarQuiltingScale, ElementCountGrowsWithArea) {
   const Swatch s = small_chainmail();
   Mesh a, b;
-  const double k = sanitized() ? 1.5 : 2.0;
+  const double k = test::sanitized() ? 1.5 : 2.0;
   const QuiltResult ra = quilt_plane(s, s.length(), s.width(), a);
   const QuiltResult rb = quilt_plane(s, k * s.length(), k * s.width(), b);
   EXPECT_GT(rb.elements, ra.elements);

@@ -24,25 +24,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Swatch tiny_chainmail(std::uint64_t seed = 1) {
-  ChainmailOptions o;
-  o.rings_x = o.rings_y = 3;
-  o.segments = 10;
-  o.sides = 5;
-  o.seed = seed;
-  Mesh m;
-  make_chainmail_swatch(m, o);
-  return make_swatch(m);
-}
-Swatch tiny_scatter(std::uint64_t seed = 1) {
-  ScatterOptions o;
-  o.size = 6;
-  o.subdivisions = 1;
-  o.seed = seed;
-  Mesh m;
-  make_scatter_swatch(m, o);
-  return make_swatch(m);
-}
+Swatch tiny_chainmail(std::uint64_t seed = 1) { return test::small_chainmail_swatch(seed, 10, 5); }
+Swatch tiny_scatter(std::uint64_t seed = 1) { return test::small_scatter_swatch(seed); }
 
 // Fraction of elements (connected components) of `m` that are closed and consistently oriented.
 double closed_fraction(const Mesh& m, int* count = nullptr) {
