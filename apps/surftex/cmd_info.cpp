@@ -89,11 +89,11 @@ SubcommandRegistrar reg{
          std::printf("repair:          %zu duplicate points merged, %zu degenerate polygons removed,\n"
                      "                 %zu duplicate polygons removed, %zu isolated points removed,\n"
                      "                 %zu polygons simplified, %zu pinched polygons split, %zu points duplicated to orient (%s),\n"
-                     "                 %zu faces triangulated\n",
+                     "                 %zu faces triangulated (%zu as fans), %zu faces with < 3 vertices dropped\n",
                      c.duplicate_points_merged, c.degenerate_polygons_removed, c.duplicate_polygons_removed,
                      c.isolated_points_removed, c.polygons_simplified, c.pinched_polygons_split, c.points_duplicated_to_orient,
                      c.oriented ? "orientable as given" : "non-manifold or non-orientable spots split",
-                     c.faces_triangulated);
+                     c.faces_triangulated, c.faces_fan_triangulated, c.short_polygons_dropped);
          if (c.uv_corners + c.uv_corners_dropped > 0)
            std::printf("uv corners:      %zu mapped, %zu without a UV\n", c.uv_corners, c.uv_corners_dropped);
          std::printf("read time:       %.3f s\n", seconds);
@@ -119,6 +119,8 @@ SubcommandRegistrar reg{
                         {"points_duplicated_to_orient", c.points_duplicated_to_orient},
                         {"oriented", c.oriented},
                         {"faces_triangulated", c.faces_triangulated},
+                        {"faces_fan_triangulated", c.faces_fan_triangulated},
+                        {"short_polygons_dropped", c.short_polygons_dropped},
                         {"uv_corners", c.uv_corners},
                         {"uv_corners_dropped", c.uv_corners_dropped}};
          r["timings"] = {{"read_seconds", seconds}};

@@ -39,6 +39,8 @@ nlohmann::json soup_json(const SoupRepairCounts& c) {
           {"points_duplicated_to_orient", c.points_duplicated_to_orient},
           {"oriented", c.oriented},
           {"faces_triangulated", c.faces_triangulated},
+          {"faces_fan_triangulated", c.faces_fan_triangulated},
+          {"short_polygons_dropped", c.short_polygons_dropped},
           {"output_vertices", c.output_vertices},
           {"output_faces", c.output_faces}};
 }
@@ -94,9 +96,10 @@ int run_repair(const RepairArgs& a) {
     const RepairDone& d = r.done;
     std::fprintf(stderr,
                  "loaded %zu points, %zu polygons (%zu duplicate points merged, %zu degenerate and "
-                 "%zu duplicate polygons removed)\n",
+                 "%zu duplicate polygons removed, %zu faces with < 3 vertices dropped, %zu fan-triangulated)\n",
                  counts.input_points, counts.input_polygons, counts.duplicate_points_merged,
-                 counts.degenerate_polygons_removed, counts.duplicate_polygons_removed);
+                 counts.degenerate_polygons_removed, counts.duplicate_polygons_removed,
+                 counts.short_polygons_dropped, counts.faces_fan_triangulated);
     std::fprintf(stderr,
                  "found: %zu zero-area, %zu needle, %zu cap faces; %zu non-manifold vertices; %zu "
                  "boundary loops; %zu components; %zu inward components\n",

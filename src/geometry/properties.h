@@ -27,6 +27,7 @@
 
 #include <array>
 #include <string>
+#include <type_traits>
 
 #include "geometry/mesh.h"
 
@@ -63,9 +64,19 @@ inline constexpr PropertyName<VertexIndex, Vector3> kVertexDirection{"v:dir"};
 template <class Index, class T>
 using PropertyMap = typename Mesh::template Property_map<Index, T>;
 
-/// The map named by `p`, created with `init` for every element if absent.
+/// A zero value of T for new map entries. CGAL's Vector_3 default
+/// constructor leaves its coordinates uninitialised, so T() is not enough.
+template <class T>
+T zero_value() {
+  if constexpr (std::is_same_v<T, Vector3>) return Vector3(0.0, 0.0, 0.0);
+  else if constexpr (std::is_same_v<T, Point3>) return Point3(0.0, 0.0, 0.0);
+  else return T{};
+}
+
+/// The map named by `p`, created with `init` for every element if absent
+/// (default: zero, see zero_value).
 template <class Index, class T>
-PropertyMap<Index, T> get_or_add(Mesh& mesh, PropertyName<Index, T> p, const T& init = T()) {
+PropertyMap<Index, T> get_or_add(Mesh& mesh, PropertyName<Index, T> p, const T& init = zero_value<T>()) {
   return mesh.template add_property_map<Index, T>(p.name, init).first;
 }
 

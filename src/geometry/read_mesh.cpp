@@ -229,8 +229,12 @@ PolygonSoup read_polygon_soup(const std::string& path) {
   }
   soup.source = path;
   if (soup.polygons.empty())
-    throw InvalidInputError("'" + path + "' has no faces (" + std::to_string(soup.points.size()) +
-                            " points)");
+    throw InvalidInputError("'" + path + "' has no faces (" + std::to_string(soup.points.size()) + " points" +
+                            (soup.short_polygons_dropped
+                                 ? ", " + std::to_string(soup.short_polygons_dropped) +
+                                       " shorter faces with < 3 vertices, first at " + soup.first_short_polygon
+                                 : std::string()) +
+                            ")");
   return soup;
 }
 
@@ -274,7 +278,13 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
   const std::string& src = soup.source.empty() ? std::string("polygon soup") : soup.source;
   c.input_points = soup.points.size();
   c.input_polygons = soup.polygons.size();
-  if (soup.polygons.empty()) throw TopologyError("'" + src + "' has no faces");
+  c.short_polygons_dropped = soup.short_polygons_dropped;
+  if (soup.polygons.empty())
+    throw TopologyError("'" + src + "' has no faces" +
+                        (soup.short_polygons_dropped
+                             ? " with 3 or more vertices (" + std::to_string(soup.short_polygons_dropped) +
+                                   " shorter ones, first at " + soup.first_short_polygon + ")"
+                             : std::string()));
   for (std::size_t i = 0; i < soup.polygons.size(); ++i)
     for (std::size_t v : soup.polygons[i])
       if (v >= soup.points.size())
@@ -402,8 +412,27 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
           list.emplace_back(mesh.target(h), uvm.first[h]);
       }
     OriginVisitor vis{&origin, &current, &split};
-    if (!PMP::triangulate_faces(mesh, CGAL::parameters::visitor(vis)))
-      throw TopologyError("'" + src + "': a polygon could not be triangulated");
+    if (!PMP::triangulate_faces(mesh, CGAL::parameters::visitor(vis))) {
+      // triangulate_faces tries every face and leaves the ones it cannot
+      // split (degenerate projection). Those get a fan from their first
+      // corner: possibly folded geometry, but valid topology, and counted so
+      // that repair reports it.
+      std::vector<FaceIndex> left;
+      for (FaceIndex f : mesh.faces())
+        if (mesh.degree(f) > 3) left.push_back(f);
+      for (FaceIndex f : left) {
+        vis.before_subface_creations(f);
+        HalfedgeIndex h0 = mesh.halfedge(f);
+        while (mesh.next(mesh.next(mesh.next(h0))) != h0) {
+          // Cut the triangle (h0's source, target(h0), target(next(h0))) off.
+          HalfedgeIndex cut = CGAL::Euler::split_face(mesh.prev(h0), mesh.next(h0), mesh);
+          vis.after_subface_created(mesh.face(h0));
+          h0 = cut;  // split_face keeps the rest of the polygon on the new halfedge
+        }
+        vis.after_subface_created(mesh.face(h0));
+        ++c.faces_fan_triangulated;
+      }
+    }
     c.faces_triangulated = split;
     if (uvm.second)
       for (FaceIndex f : mesh.faces()) {

@@ -29,6 +29,12 @@ struct PolygonSoup {
   std::vector<std::array<float, 3>> colors;
   /// Where the soup came from (the file path), used in error messages.
   std::string source;
+  /// Faces with fewer than 3 vertices in the file (e.g. OBJ `f 1 2`): their
+  /// indices are validated like any other, then the face is left out of
+  /// `polygons` (it bounds no area) and counted here; `first_short_polygon`
+  /// names where the first one was (file line or face number).
+  std::size_t short_polygons_dropped = 0;
+  std::string first_short_polygon;
 };
 
 /// Reads any supported format (chosen by the extension .off/.obj/.ply/.stl,
@@ -63,6 +69,11 @@ struct SoupRepairCounts {
   bool oriented = true;  ///< orient_polygon_soup succeeded without splitting
   std::size_t output_vertices = 0, output_faces = 0;  ///< after conversion (and triangulation)
   std::size_t faces_triangulated = 0;  ///< non-triangular faces split into triangles
+  std::size_t short_polygons_dropped = 0;  ///< faces with < 3 vertices in the file, left out (PolygonSoup)
+  /// Faces PMP::triangulate_faces could not triangulate (its constrained
+  /// triangulation fails on polygons whose projection is degenerate): split
+  /// as a fan from their first corner instead, which keeps the topology.
+  std::size_t faces_fan_triangulated = 0;
   std::size_t uv_corners = 0;          ///< corners that received a kCornerUV value
   std::size_t uv_corners_dropped = 0;  ///< corners whose UV could not be mapped (or had none)
 };
@@ -81,6 +92,8 @@ struct SoupRepairCounts {
 /// of their corner in the original polygon).
 /// Throws InvalidInputError if an index is out of range, TopologyError
 /// (naming soup.source) if no face is left or the result is not a mesh.
+/// A polygon that triangulate_faces cannot split is fan-triangulated and
+/// counted (faces_fan_triangulated) rather than failing the whole file.
 void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt = {},
                   SoupRepairCounts* counts = nullptr);
 

@@ -87,9 +87,6 @@ PolygonSoup read_obj(const std::string& path, std::string_view data) {
       soup.uvs.push_back({uv[0], uv[1]});
     } else if (kw == "f") {
       const std::string where = at_line(line_no);
-      if (tok.size() < 4)
-        fail_io(path, where,
-                "face has " + std::to_string(tok.size() - 1) + " vertices (at least 3 needed): " + show(raw));
       poly.clear();
       puv.clear();
       bool uv_complete = true;
@@ -108,6 +105,11 @@ PolygonSoup read_obj(const std::string& path, std::string_view data) {
         }
         if (tpart.empty()) uv_complete = false;
         else puv.push_back(resolve(path, where, tpart, soup.uvs.size(), "texture coordinate"));
+      }
+      if (poly.size() < 3) {  // validated, but bounds no area: dropped and counted
+        if (soup.short_polygons_dropped++ == 0)
+          soup.first_short_polygon = where + ": " + std::to_string(poly.size()) + "-vertex face " + show(raw);
+        continue;
       }
       soup.polygons.push_back(poly);
       if (uv_complete) {

@@ -58,9 +58,10 @@ PolygonSoup read_off(const std::string& path, std::string_view data) {
     fail_io(path, at_line(count_line),
             "expected the vertex and face counts, got " + show(line));
   // Every vertex line holds at least "0 0 0\n" (6 bytes), every face line
-  // "3 0 0 0\n" (8 bytes): refuse counts the file cannot hold before allocating.
+  // "0\n" (2 bytes; faces with < 3 vertices are read, then dropped): refuse
+  // counts the file cannot hold before allocating.
   const std::uint64_t rest = lines.remaining() + 1;
-  if (nv > rest / 6 || nf > rest / 8 || nv * 6 + nf * 8 > rest)
+  if (nv > rest / 6 || nf > rest / 2 || nv * 6 + nf * 2 > rest)
     fail_io(path, at_line(count_line),
             "header claims " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
                 " faces, but only " + std::to_string(lines.remaining()) +
@@ -108,7 +109,6 @@ PolygonSoup read_off(const std::string& path, std::string_view data) {
     const std::string where = at_line(lines.line_no()) + " (face " + std::to_string(j) + ")";
     std::uint64_t n = 0;
     if (!parse_uint64(tok[0], n)) fail_io(path, where, "bad vertex count " + show(tok[0]));
-    if (n < 3) fail_io(path, where, "face has " + std::to_string(n) + " vertices (at least 3 needed)");
     if (n > tok.size() - 1)
       fail_io(path, where,
               "face claims " + std::to_string(n) + " vertices but lists " + std::to_string(tok.size() - 1));
@@ -120,6 +120,11 @@ PolygonSoup read_off(const std::string& path, std::string_view data) {
         fail_input(path, where,
                    "vertex index " + std::to_string(idx) + " out of range [0, " + std::to_string(nv) + ")");
       poly[k] = static_cast<std::size_t>(idx);
+    }
+    if (n < 3) {  // validated, but bounds no area: dropped and counted
+      if (soup.short_polygons_dropped++ == 0)
+        soup.first_short_polygon = where + ": " + std::to_string(n) + "-vertex face";
+      continue;
     }
     soup.polygons.push_back(std::move(poly));
   }

@@ -260,14 +260,20 @@ PolygonSoup read_ply(const std::string& path, std::string_view data) {
                   "list of " + std::to_string(n) + " values does not fit in the " +
                       std::to_string(in.remaining()) + " bytes left (truncated or corrupt)");
         if (static_cast<int>(k) == ilist) {
-          if (n < 3)
-            fail_io(path, where_count, "face has " + std::to_string(n) + " vertices (at least 3 needed)");
           std::vector<std::size_t> poly(n);
           for (std::uint64_t m = 0; m < n; ++m) {
             double v = in.read(p.type, e.name, i);
             if (!(v >= 0) || v != std::floor(v) || v >= 18446744073709551616.0)
               fail_input(path, where_count, "vertex index " + std::to_string(v) + " is negative or not an integer");
             poly[m] = static_cast<std::size_t>(v);
+          }
+          if (n < 3) {  // bounds no area: dropped and counted (indices checked below only for kept faces)
+            for (std::size_t v : poly)
+              if (v >= nv)
+                fail_input(path, where_count, "vertex index " + std::to_string(v) + " out of range");
+            if (soup.short_polygons_dropped++ == 0)
+              soup.first_short_polygon = where_count + ": " + std::to_string(n) + "-vertex face";
+            continue;
           }
           soup.polygons.push_back(std::move(poly));
           if (enc == Encoding::Ascii) face_where.push_back(where_count);

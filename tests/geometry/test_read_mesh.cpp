@@ -261,12 +261,51 @@ TEST(ReadMesh, ObjQuadsNegativeIndicesAndCornerForms) {
   EXPECT_GE(checked, 1);
 }
 
-TEST(ReadMesh, ObjFaceWithTwoVerticesIsRefusedNamingTheLine) {
+TEST(ReadMesh, FacesWithFewerThanThreeVerticesAreDroppedAndCountedInEveryFormat) {
   auto d = test::temp_dir("rm");
-  auto msg = expect_throw<IOError>(
-      [&] { read_polygon_soup(write_file(d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1// 2//\n")); });
-  EXPECT_NE(msg.find("line 4"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("bad.obj"), std::string::npos) << msg;
+  // A triangle plus a 2-vertex face: the short face is left out and counted,
+  // with its location, in OBJ, OFF and PLY alike.
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1// 2//\nf 1 2 3\n";
+  const std::string off = "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n3 0 1 2\n";
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n3 0 1 2\n";
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"s.obj", obj}, {"s.off", off}, {"s.ply", ply}}) {
+    PolygonSoup soup = read_polygon_soup(write_file(d, name, text));
+    EXPECT_EQ(soup.polygons.size(), 1u) << name;
+    EXPECT_EQ(soup.short_polygons_dropped, 1u) << name;
+    EXPECT_FALSE(soup.first_short_polygon.empty()) << name;
+    Mesh m;
+    SoupRepairCounts c;
+    soup_to_mesh(soup, m, {}, &c);
+    EXPECT_EQ(c.short_polygons_dropped, 1u) << name;
+    EXPECT_EQ(m.number_of_faces(), 1u) << name;
+  }
+  EXPECT_NE(read_polygon_soup(write_file(d, "line.obj", obj)).first_short_polygon.find("line 4"), std::string::npos);
+  // Out-of-range indices in a short face are still refused.
+  expect_throw<InvalidInputError>(
+      [&] { read_polygon_soup(write_file(d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 9\nf 1 2 3\n")); });
+  // Only short faces: no face left, and the error says why.
+  Mesh m;
+  auto msg = expect_throw<InvalidInputError>(
+      [&] { read_mesh(write_file(d, "only.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n"), m); });
+  EXPECT_NE(msg.find("shorter"), std::string::npos) << msg;
+}
+
+TEST(SoupToMesh, UntriangulablePolygonIsFanTriangulatedNotRefused) {
+  // triangulate_faces refuses a polygon whose normal is null (all corners
+  // collinear); a valid square next to it must still come through.
+  PolygonSoup s;
+  s.source = "collinear.off";
+  s.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}, {0, 5, 0}, {1, 5, 0}, {1, 6, 0}, {0, 6, 0}};
+  s.polygons = {{0, 1, 2, 3, 4}, {5, 6, 7, 8}};
+  Mesh m;
+  SoupRepairCounts c;
+  soup_to_mesh(s, m, {}, &c);
+  EXPECT_EQ(c.faces_fan_triangulated, 1u);
+  EXPECT_EQ(m.number_of_faces(), 3u + 2u);
+  for (FaceIndex f : m.faces()) EXPECT_EQ(m.degree(f), 3u);
+  EXPECT_TRUE(m.is_valid(false));
 }
 
 TEST(ReadMesh, ObjVertexColours) {
@@ -461,8 +500,11 @@ TEST(ReadMeshRealData, BrokenFilesWithKnownDefects) {
   expect_throw<Error>([] { read_polygon_soup(test::shared_data("broken/truncated.off")); });
   msg = expect_throw<InvalidInputError>([] { read_polygon_soup(test::shared_data("broken/malformed_indices.obj")); });
   EXPECT_NE(msg.find("12"), std::string::npos) << msg;
-  msg = expect_throw<IOError>([] { read_polygon_soup(test::shared_data("broken/not_enough_indices.obj")); });
-  EXPECT_NE(msg.find("line"), std::string::npos) << msg;
+  // "f 1// 2//" is dropped and counted; the file's one real triangle loads.
+  PolygonSoup short_face = read_polygon_soup(test::shared_data("broken/not_enough_indices.obj"));
+  EXPECT_EQ(short_face.short_polygons_dropped, 1u);
+  EXPECT_EQ(short_face.polygons.size(), 1u);
+  EXPECT_NE(short_face.first_short_polygon.find("line"), std::string::npos) << short_face.first_short_polygon;
 }
 
 // ------------------------------------------------------------------ item 9: hostile input
