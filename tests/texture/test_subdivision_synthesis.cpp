@@ -12,6 +12,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "geometry/turk_orientation_field.h"
+#include "texture/displace_by_vertex_color.h"
 #include "texture/graph_cut_transfer.h"
 #include "texture/k_region_matching.h"
 #include "texture/procedural_texture.h"
@@ -321,4 +322,39 @@ TEST(SubdivisionSynthesis, PassIsIndependentOfTheThreadCount) {
     const auto a = run(1), b = run(2);
     EXPECT_EQ(a, b) << "graph cut " << cut;
   }
+}
+
+// --displace: a flat grid (normals +z) with grey colours g moves to z = H g.
+TEST(DisplaceByVertexColor, FlatGridMovesAlongTheNormalByHeightTimesGrey) {
+  Mesh m;
+  std::vector<VertexIndex> v;
+  const int n = 9;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) v.push_back(m.add_vertex(Point3(i, j, 0)));
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i)
+      m.add_face(v[j * n + i], v[j * n + i + 1], v[(j + 1) * n + i + 1], v[(j + 1) * n + i]);
+  EXPECT_THROW(displace_by_vertex_color(m, 1.0), InvalidInputError);
+  auto col = get_or_add(m, kVertexColor, Color3f{0.f, 0.f, 0.f});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::vector<double> grey(m.number_of_vertices());
+  for (VertexIndex x : m.vertices()) {
+    const float g = u(rng);
+    col[x] = {g, g, g};
+    grey[x.idx()] = g;
+  }
+  const double H = 0.37;
+  const auto r = displace_by_vertex_color(m, H);
+  double lo = 1e300, hi = -1e300;
+  for (VertexIndex x : m.vertices()) {
+    const Point3 p = m.point(x);
+    EXPECT_NEAR(p.z(), H * grey[x.idx()], 1e-9);
+    EXPECT_EQ(p.x(), double(x.idx() % n));
+    EXPECT_EQ(p.y(), double(x.idx() / n));
+    lo = std::min(lo, H * grey[x.idx()]), hi = std::max(hi, H * grey[x.idx()]);
+  }
+  EXPECT_NEAR(r.min_offset, lo, 1e-9);
+  EXPECT_NEAR(r.max_offset, hi, 1e-9);
+  EXPECT_THROW(displace_by_vertex_color(m, std::nan("")), InvalidInputError);
 }
