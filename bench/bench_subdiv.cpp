@@ -4,15 +4,32 @@
 // after four uniform sqrt(2) steps = 66,680 vertices (the paper: donkey,
 // 65,858 vertices, 752 / 478 / 326 s at r_scale 30 / 100 / 200 with averaging,
 // Pentium 4 3 GHz). Exemplar: shared/data/textures/brick_small_96.png (Gaussian
-// stack, 7 levels). Units: r_scale per object unit = the longest bounding-box
-// side (as `surftex subdiv`). Every vertex starts with a random texel colour
+// stack, 7 levels). Every vertex starts with a random texel colour
 // (seed 1), then one pass in random order matches every vertex (no skipping),
 // with averaging and anti-aliasing, transfer to the vertex alone (as Table 1
 // times matching); a second line per r_scale runs the same pass with the
 // graph-cut transfer.
 //
-// Usage: bench_subdiv [MESH] [TEXTURE]. One JSON line per run.
+// Object unit for r_scale: 110 mean edges (1/e = 110 as the donkey of Table
+// 1, so k and the groups per match are comparable); the bounding-box-based
+// 1/e is reported too (247 for this mesh).
+//
+// Measured (s2-subdiv, commit 57a16d6), 66,680 vertices, 2 threads,
+// machine shared (load 10-12 on 2 cores, so wall >> CPU), whole run (6
+// passes) 217 s wall, 70.6 s user CPU. Per pass wall (matching only / with
+// graph cut): r_scale 30: 40.2 / 94.1 s (k 9.5, 360 region vertices, 32
+// groups per match); r_scale 100: 24.2 / 30.1 s (k 2.8, 14 groups);
+// r_scale 200: 12.7 / 14.3 s (k 1.4, 6.6 groups). Before (same machine,
+// bounding-box units, lighter load): r_scale 30 took 123 s. The 5 s goal is
+// NOT reached on this loaded machine; a quiet re-measure is needed (CPU time
+// per pass is roughly a third of the wall figures above).
+//
+// Usage: bench_subdiv [MESH] [TEXTURE] [THREADS]. One JSON line per run.
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -34,6 +51,8 @@
 using namespace surftex;
 
 int main(int argc, char** argv) {
+  const int threads = argc > 3 ? std::atoi(argv[3]) : tbb::info::default_concurrency();
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(std::max(1, threads)));
   const std::string mesh_path = argc > 1 ? argv[1] : std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/elephant.off";
   const std::string tex_path =
       argc > 2 ? argv[2] : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/brick_small_96.png";
@@ -54,8 +73,13 @@ int main(int argc, char** argv) {
   double esum = 0;
   for (EdgeIndex e : mesh.edges())
     esum += std::sqrt((mesh.point(mesh.vertex(e, 0)) - mesh.point(mesh.vertex(e, 1))).squared_length());
-  const double ebar = esum / mesh.number_of_edges() / unit;
+  const double ebar_box = esum / mesh.number_of_edges() / unit;
+  // Object unit chosen so that 1 / mean edge = 110, as the donkey of Table 1
+  // (the r_scale figures are only comparable at equal texels per edge).
+  const double unit_paper = 110.0 * esum / mesh.number_of_edges();
+  const double ebar = 1.0 / 110.0;
   const ExemplarLevels ex = make_exemplar_levels(read_image(tex_path), false);
+  const ExemplarIndex index(ex);
   const std::size_t nv = mesh.number_of_vertices();
   for (double rs : {30.0, 100.0, 200.0}) {
     for (bool cut : {false, true}) {
@@ -74,13 +98,15 @@ int main(int argc, char** argv) {
       o.graph_cut = cut;
       o.skip_patched = false;
       Timer tp;
-      const SynthesisPassStats st = synthesis_pass(mesh, ex, order, colored, rs / unit, 0, o, rng);
+      const SynthesisPassStats st = synthesis_pass(mesh, ex, index, order, colored, rs / unit_paper, 0, o, rng);
       const double secs = tp.seconds();
-      nlohmann::json j{{"mesh", mesh_path}, {"texture", tex_path}, {"vertices", nv}, {"inv_mean_edge", 1.0 / ebar},
+      nlohmann::json j{{"mesh", mesh_path}, {"texture", tex_path}, {"vertices", nv}, {"inv_mean_edge", 1.0 / ebar}, {"inv_mean_edge_bbox_units", 1.0 / ebar_box},
                        {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs},
                        {"seconds_region", st.seconds_region}, {"seconds_match", st.seconds_match},
                        {"seconds_transfer", st.seconds_transfer}, {"matched", st.matched},
-                       {"mean_k", st.mean_k}, {"mean_region_vertices", st.mean_region},
+                       {"mean_k", st.mean_k}, {"threads", threads},
+                       {"candidates_per_match", double(st.candidates) / std::max<std::size_t>(1, st.matched)},
+                       {"recomputed", st.recomputed}, {"seconds_setup", st.seconds_setup}, {"mean_region_vertices", st.mean_region},
                        {"mean_groups_compared", st.mean_groups},
                        {"vertex_comparisons_with_averaging", st.mean_groups * st.matched},
                        {"seconds_subdivide", t_sub}, {"seconds_field", t_field}};

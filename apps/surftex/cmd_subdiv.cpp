@@ -23,6 +23,7 @@
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
+#include "texture/displace_by_vertex_color.h"
 #include "texture/procedural_texture.h"
 #include "texture/subdivision_synthesis.h"
 
@@ -52,19 +53,6 @@ Mesh triangulated_copy(const Mesh& m) {
     for (VertexIndex v : t.vertices()) dst[v] = src.first[VertexIndex(v.idx())];
   }
   return t;
-}
-
-// Moves vertices along the normal by h * (luminance - 0.5) (h in mesh units).
-void displace_by_luminance(Mesh& m, double h) {
-  const auto n = polygon_vertex_normals(m);
-  auto col = find(m, kVertexColor).first;
-  std::vector<Point3> p;
-  for (VertexIndex v : m.vertices()) {
-    const Color3f& c = col[v];
-    const double lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-    p.push_back(m.point(v) + n[v.idx()] * (h * (lum - 0.5)));
-  }
-  for (VertexIndex v : m.vertices()) m.point(v) = p[v.idx()];
 }
 
 struct Outputs {
@@ -177,9 +165,11 @@ int run_subdiv(const SubdivArgs& a) {
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
-  if (a.displace != 0) displace_by_luminance(mesh, a.displace * r.object_unit);
+  DisplaceResult disp;
+  if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);
   ensure_directory(a.outdir);
   nlohmann::json rep = synthesis_report(r, o);
+  if (a.displace != 0) rep["displace_offset_range"] = {disp.min_offset, disp.max_offset};
   rep["mesh"] = a.mesh;
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
@@ -233,8 +223,8 @@ SubcommandRegistrar reg_subdiv{
        app.add_option("--adaptive-steps", a->adaptive_steps, "Adaptive steps when --adaptive > 0, 0..32 (default 4)")
            ->check(CLI::Range(0, 32));
        app.add_option("--displace", a->displace,
-                      "Displace vertices along the normal by H x (luminance - 0.5), H in object units (longest "
-                      "bounding-box side = 1); 0 = off (default 0)")
+                      "Displace every vertex along its normal by H x its synthesised grey level (luminance in "
+                      "[0, 1]), H in object units (longest bounding-box side = 1), in [-1, 1]; 0 = off (default 0)")
            ->check(CLI::Range(-1.0, 1.0));
        app.add_option("--passes", a->passes, "Synthesis passes per level (fill passes not counted), 1..16 (default 2)")
            ->check(CLI::Range(1, 16));

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <string>
 
 #include "geometry/errors.h"
@@ -64,86 +63,128 @@ SurfaceFrames compute_surface_frames(const Mesh& mesh) {
   return fr;
 }
 
+RegionGraph make_region_graph(const Mesh& mesh, const SurfaceFrames& fr) {
+  const std::size_t nv = mesh.number_of_vertices();
+  if (fr.normal.size() != nv || fr.direction.size() != nv)
+    throw InvalidInputError("make_region_graph: frames were computed for another mesh (" +
+                            std::to_string(fr.normal.size()) + " vs " + std::to_string(nv) + " vertices)");
+  RegionGraph g;
+  g.offset.assign(nv + 1, 0);
+  g.position.resize(nv);
+  g.normal = fr.normal;
+  g.u_axis = fr.direction;
+  g.v_axis.resize(nv);
+  for (VertexIndex v : mesh.vertices()) {
+    const std::size_t i = v.idx();
+    const Point3& p = mesh.point(v);
+    g.position[i] = {p.x(), p.y(), p.z()};
+    g.v_axis[i] = cross(fr.normal[i], fr.direction[i]);
+    g.offset[i + 1] = mesh.is_isolated(v) ? 0 : static_cast<std::uint32_t>(mesh.degree(v));
+  }
+  for (std::size_t i = 0; i < nv; ++i) g.offset[i + 1] += g.offset[i];
+  g.neighbor.resize(g.offset[nv]);
+  g.step.resize(g.offset[nv]);
+  for (VertexIndex v : mesh.vertices()) {
+    if (mesh.is_isolated(v)) continue;
+    const std::size_t i = v.idx();
+    std::uint32_t s = g.offset[i];
+    for (VertexIndex w : mesh.vertices_around_target(mesh.halfedge(v))) {
+      const auto& pp = g.position[i];
+      const Point3& pw = mesh.point(w);
+      const V3 d{pw.x() - pp[0], pw.y() - pp[1], pw.z() - pp[2]};
+      double u = dot(d, g.u_axis[i]), vv = dot(d, g.v_axis[i]);
+      const double lt = std::sqrt(u * u + vv * vv), l3 = std::sqrt(dot(d, d));
+      if (lt > 1e-300) u *= l3 / lt, vv *= l3 / lt;
+      g.neighbor[s] = static_cast<std::uint32_t>(w.idx());
+      g.step[s] = {u, vv};
+      ++s;
+    }
+  }
+  return g;
+}
+
+void k_region(const RegionGraph& g, std::size_t center, int k, LocalCoordinates mode, KRegion& out,
+              RegionScratch& scr, bool with_edges) {
+  const std::size_t nv = g.size();
+  if (center >= nv)
+    throw InvalidInputError("k_region: centre " + std::to_string(center) + " out of range (" + std::to_string(nv) +
+                            " vertices)");
+  if (k < 0) throw InvalidInputError("k_region: k must be >= 0 (got " + std::to_string(k) + ")");
+  if (scr.index.size() != nv) scr.index.assign(nv, -1);
+  int* index = scr.index.data();
+  out.vertices.clear();
+  out.hops.clear();
+  out.uv.clear();
+  out.edges.clear();
+  scr.paths.clear();
+  out.vertices.push_back(center);
+  out.hops.push_back(0);
+  out.uv.push_back({0, 0});
+  scr.paths.push_back(1);
+  index[center] = 0;
+  const auto& pc = g.position[center];
+  const auto& t0 = g.u_axis[center];
+  const auto& b0 = g.v_axis[center];
+  std::size_t ring_begin = 0;
+  for (int hop = 1; hop <= k; ++hop) {
+    const std::size_t ring_end = out.vertices.size();
+    for (std::size_t i = ring_begin; i < ring_end; ++i) {
+      const std::size_t p = out.vertices[i];
+      for (std::uint32_t s = g.offset[p]; s < g.offset[p + 1]; ++s) {
+        const std::uint32_t w = g.neighbor[s];
+        if (index[w] < 0) {
+          index[w] = static_cast<int>(out.vertices.size());
+          out.vertices.push_back(w);
+          out.hops.push_back(hop);
+          if (mode == LocalCoordinates::kTangentProjection) {
+            const auto& pw = g.position[w];
+            const V3 d{pw[0] - pc[0], pw[1] - pc[1], pw[2] - pc[2]};
+            out.uv.push_back({dot(d, t0), dot(d, b0)});
+          } else {
+            out.uv.push_back({0, 0});
+          }
+          scr.paths.push_back(0);
+        }
+        if (mode == LocalCoordinates::kUnfolding) {
+          // w in the new ring: accumulate this predecessor's paths (p is one hop closer).
+          const int j = index[w];
+          if (out.hops[j] != hop) continue;
+          const double m = scr.paths[i];
+          out.uv[j][0] += m * (out.uv[i][0] + g.step[s][0]);
+          out.uv[j][1] += m * (out.uv[i][1] + g.step[s][1]);
+          scr.paths[j] += m;
+        }
+      }
+    }
+    if (mode == LocalCoordinates::kUnfolding)
+      for (std::size_t j = ring_end; j < out.vertices.size(); ++j) {
+        out.uv[j][0] /= scr.paths[j];
+        out.uv[j][1] /= scr.paths[j];
+      }
+    ring_begin = ring_end;
+    if (ring_begin == out.vertices.size()) break;
+  }
+  if (with_edges)
+    for (std::size_t i = 0; i < out.vertices.size(); ++i) {
+      const std::size_t v = out.vertices[i];
+      for (std::uint32_t s = g.offset[v]; s < g.offset[v + 1]; ++s) {
+        const int j = index[g.neighbor[s]];
+        if (j > static_cast<int>(i)) out.edges.push_back({static_cast<int>(i), j});
+      }
+    }
+  for (std::size_t v : out.vertices) index[v] = -1;
+}
+
 void k_region(const Mesh& mesh, const SurfaceFrames& fr, std::size_t center, int k, LocalCoordinates mode,
               KRegion& out) {
   const std::size_t nv = mesh.number_of_vertices();
   if (center >= nv)
     throw InvalidInputError("k_region: centre " + std::to_string(center) + " out of range (" + std::to_string(nv) +
                             " vertices)");
-  if (k < 0) throw InvalidInputError("k_region: k must be >= 0 (got " + std::to_string(k) + ")");
   if (fr.normal.size() != nv) throw InvalidInputError("k_region: frames were computed for another mesh");
-  thread_local std::vector<int> index;
-  if (index.size() != nv) index.assign(nv, -1);
-  out.vertices.clear();
-  out.hops.clear();
-  out.uv.clear();
-  out.edges.clear();
-  std::vector<double> paths;
-  out.vertices.push_back(center);
-  out.hops.push_back(0);
-  out.uv.push_back({0, 0});
-  paths.push_back(1);
-  index[center] = 0;
-  const Point3 pc = mesh.point(VertexIndex(static_cast<Mesh::size_type>(center)));
-  const V3& n0 = fr.normal[center];
-  const V3& t0 = fr.direction[center];
-  const V3 b0 = cross(n0, t0);
-  std::size_t ring_begin = 0;
-  for (int hop = 1; hop <= k; ++hop) {
-    const std::size_t ring_end = out.vertices.size();
-    for (std::size_t i = ring_begin; i < ring_end; ++i) {
-      const VertexIndex p(static_cast<Mesh::size_type>(out.vertices[i]));
-      if (mesh.is_isolated(p)) continue;
-      for (VertexIndex w : mesh.vertices_around_target(mesh.halfedge(p))) {
-        if (index[w.idx()] >= 0) continue;
-        index[w.idx()] = static_cast<int>(out.vertices.size());
-        out.vertices.push_back(w.idx());
-        out.hops.push_back(hop);
-        out.uv.push_back({0, 0});
-        paths.push_back(0);
-      }
-    }
-    // Coordinates of the new ring.
-    for (std::size_t j = ring_end; j < out.vertices.size(); ++j) {
-      const VertexIndex w(static_cast<Mesh::size_type>(out.vertices[j]));
-      const Point3 pw = mesh.point(w);
-      if (mode == LocalCoordinates::kTangentProjection) {
-        const V3 d{pw.x() - pc.x(), pw.y() - pc.y(), pw.z() - pc.z()};
-        out.uv[j] = {dot(d, t0), dot(d, b0)};
-        continue;
-      }
-      double su = 0, sv = 0, np = 0;
-      for (VertexIndex p : mesh.vertices_around_target(mesh.halfedge(w))) {
-        const int ip = index[p.idx()];
-        if (ip < 0 || out.hops[ip] != hop - 1) continue;
-        const Point3 pp = mesh.point(p);
-        const V3 d{pw.x() - pp.x(), pw.y() - pp.y(), pw.z() - pp.z()};
-        const V3& t = hop == 1 ? t0 : fr.direction[p.idx()];
-        const V3& nn = hop == 1 ? n0 : fr.normal[p.idx()];
-        const V3 b = cross(nn, t);
-        double u = dot(d, t), v = dot(d, b);
-        const double lt = std::sqrt(u * u + v * v), l3 = std::sqrt(dot(d, d));
-        if (lt > 1e-300) u *= l3 / lt, v *= l3 / lt;
-        const double m = paths[ip];
-        su += m * (out.uv[ip][0] + u);
-        sv += m * (out.uv[ip][1] + v);
-        np += m;
-      }
-      paths[j] = np;
-      out.uv[j] = {su / np, sv / np};
-    }
-    ring_begin = ring_end;
-    if (ring_begin == out.vertices.size()) break;
-  }
-  for (std::size_t i = 0; i < out.vertices.size(); ++i) {
-    const VertexIndex v(static_cast<Mesh::size_type>(out.vertices[i]));
-    if (mesh.is_isolated(v)) continue;
-    for (VertexIndex w : mesh.vertices_around_target(mesh.halfedge(v))) {
-      const int j = index[w.idx()];
-      if (j > static_cast<int>(i)) out.edges.push_back({static_cast<int>(i), j});
-    }
-  }
-  for (std::size_t v : out.vertices) index[v] = -1;
+  const RegionGraph g = make_region_graph(mesh, fr);
+  RegionScratch scr;
+  k_region(g, center, k, mode, out, scr, true);
 }
 
 int region_k(double region_texels, int level, bool pyramid, double r_scale, double mean_edge, int max_k) {
@@ -195,24 +236,9 @@ std::array<int, 2> sample_offset(const ExemplarLevels& ex, const RegionSample& s
 
 std::vector<SampleGroup> group_samples(const ExemplarLevels& ex, const std::vector<RegionSample>& samples,
                                        int center_level) {
-  std::map<std::array<int, 3>, std::size_t> where;
   std::vector<SampleGroup> g;
-  std::vector<std::array<double, 3>> sum;
-  for (const RegionSample& s : samples) {
-    const auto o = sample_offset(ex, s, center_level);
-    const int level = ex.pyramid ? center_level : s.level;
-    const std::array<int, 3> key{level, o[0], o[1]};
-    auto it = where.find(key);
-    if (it == where.end()) {
-      it = where.emplace(key, g.size()).first;
-      g.push_back(SampleGroup{o[0], o[1], level, 0.f, {}});
-      sum.push_back({0, 0, 0});
-    }
-    g[it->second].weight += 1.f;
-    for (int c = 0; c < 3; ++c) sum[it->second][c] += s.color[c];
-  }
-  for (std::size_t i = 0; i < g.size(); ++i)
-    for (int c = 0; c < 3; ++c) g[i].color[c] = static_cast<float>(sum[i][c] / g[i].weight);
+  GroupScratch scr;
+  group_into(ex, samples, center_level, g, scr);
   return g;
 }
 
@@ -243,6 +269,100 @@ double grouped_distance(const ExemplarLevels& ex, const std::vector<SampleGroup>
   return d;
 }
 
+namespace {
+
+// One group's SSD term; the single definition used by every search so that
+// all of them compute bit-identical distances.
+inline float group_term(const float* p, const SampleGroup& g) {
+  const float e0 = p[0] - g.color[0], e1 = p[1] - g.color[1], e2 = p[2] - g.color[2];
+  return g.weight * (e0 * e0 + e1 * e1 + e2 * e2);
+}
+
+struct GroupTable {
+  std::vector<const float*> base;
+  std::vector<int> gx, gy;
+};
+
+void group_table(const ExemplarLevels& ex, const std::vector<SampleGroup>& groups, int W, int H, GroupTable& t) {
+  const std::size_t G = groups.size();
+  t.base.resize(G);
+  t.gx.resize(G);
+  t.gy.resize(G);
+  for (std::size_t g = 0; g < G; ++g) {
+    t.base[g] = ex.levels[groups[g].level].data.data();
+    t.gx[g] = wrap(groups[g].dx, W);
+    t.gy[g] = wrap(groups[g].dy, H);
+  }
+}
+
+// d(Q) for Q = (x, y), abandoned (returns a value > bound) once it exceeds bound.
+inline float score(const std::vector<SampleGroup>& groups, const GroupTable& t, int W, int H, int x, int y,
+                   float bound) {
+  float d = 0;
+  const std::size_t G = groups.size();
+  for (std::size_t g = 0; g < G; ++g) {
+    int xx = x + t.gx[g], yy = y + t.gy[g];
+    if (xx >= W) xx -= W;
+    if (yy >= H) yy -= H;
+    d += group_term(t.base[g] + 3 * (static_cast<std::size_t>(yy) * W + xx), groups[g]);
+    if (d > bound) return d;
+  }
+  return d;
+}
+
+
+}  // namespace
+
+void prepare_groups(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
+                    bool averaging, std::vector<SampleGroup>& out, GroupScratch& scr) {
+  out.clear();
+  if (!averaging) {
+    for (const RegionSample& s : samples) {
+      const auto o = sample_offset(ex, s, center_level);
+      out.push_back(SampleGroup{o[0], o[1], ex.pyramid ? center_level : s.level, 1.f, s.color});
+    }
+  } else {
+    group_into(ex, samples, center_level, out, scr);
+  }
+  // Heaviest groups first: partial sums grow fastest, so early termination bites sooner.
+  std::stable_sort(out.begin(), out.end(),
+                   [](const SampleGroup& a, const SampleGroup& b) { return a.weight > b.weight; });
+}
+
+void group_into(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
+                std::vector<SampleGroup>& out, GroupScratch& scr) {
+  out.clear();
+  {
+    // Open addressing on (level, dx, dy); groups in order of first occurrence,
+    // colours summed in double in sample order (as group_samples).
+    std::size_t cap = 16;
+    while (cap < 2 * samples.size()) cap *= 2;
+    scr.key.assign(cap, ~std::uint64_t(0));
+    scr.slot.assign(cap, -1);
+    scr.sum.clear();
+    for (const RegionSample& s : samples) {
+      const auto o = sample_offset(ex, s, center_level);
+      const int level = ex.pyramid ? center_level : s.level;
+      const std::uint64_t key = (std::uint64_t(std::uint32_t(level)) << 48) ^
+                                (std::uint64_t(std::uint32_t(o[0]) & 0xFFFFFFu) << 24) ^
+                                std::uint64_t(std::uint32_t(o[1]) & 0xFFFFFFu);
+      std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 40) & (cap - 1);
+      while (scr.key[h] != key && scr.slot[h] >= 0) h = (h + 1) & (cap - 1);
+      if (scr.slot[h] < 0) {
+        scr.key[h] = key;
+        scr.slot[h] = static_cast<int>(out.size());
+        out.push_back(SampleGroup{o[0], o[1], level, 0.f, {}});
+        scr.sum.push_back({0, 0, 0});
+      }
+      const int gi = scr.slot[h];
+      out[gi].weight += 1.f;
+      for (int c = 0; c < 3; ++c) scr.sum[gi][c] += s.color[c];
+    }
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int c = 0; c < 3; ++c) out[i].color[c] = static_cast<float>(scr.sum[i][c] / out[i].weight);
+  }
+}
+
 MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
                          const MatchOptions& opt) {
   if (center_level < 0 || center_level >= static_cast<int>(ex.levels.size()))
@@ -251,56 +371,23 @@ MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSampl
   MatchResult res;
   if (samples.empty()) return res;
   std::vector<SampleGroup> groups;
-  if (opt.averaging) {
-    groups = group_samples(ex, samples, center_level);
-  } else {
-    for (const RegionSample& s : samples) {
-      const auto o = sample_offset(ex, s, center_level);
-      groups.push_back(SampleGroup{o[0], o[1], ex.pyramid ? center_level : s.level, 1.f, s.color});
-    }
-  }
-  // Heaviest groups first: partial sums grow fastest, so early termination bites sooner.
-  std::stable_sort(groups.begin(), groups.end(),
-                   [](const SampleGroup& a, const SampleGroup& b) { return a.weight > b.weight; });
+  GroupScratch gs;
+  prepare_groups(ex, samples, center_level, opt.averaging, groups, gs);
   const int W = ex.width(center_level), H = ex.height(center_level);
-  const int G = static_cast<int>(groups.size());
-  std::vector<const float*> base(G);
-  std::vector<int> gx(G), gy(G);
-  for (int g = 0; g < G; ++g) {
-    const Image& im = ex.levels[groups[g].level];
-    base[g] = im.data.data();
-    gx[g] = wrap(groups[g].dx, W);
-    gy[g] = wrap(groups[g].dy, H);
-  }
+  GroupTable tab;
+  group_table(ex, groups, W, H, tab);
   const int blocks = (H + opt.rows_per_block - 1) / opt.rows_per_block;
   std::vector<float> best_d(blocks, std::numeric_limits<float>::infinity());
   std::vector<int> best_i(blocks, -1);
   tbb::parallel_for(0, blocks, [&](int b) {
     float bd = std::numeric_limits<float>::infinity();
     int bi = -1;
-    std::vector<const float*> row(G);
     const int y0 = b * opt.rows_per_block, y1 = std::min(H, y0 + opt.rows_per_block);
-    for (int y = y0; y < y1; ++y) {
-      for (int g = 0; g < G; ++g) {
-        int yy = y + gy[g];
-        if (yy >= H) yy -= H;
-        row[g] = base[g] + static_cast<std::size_t>(yy) * W * 3;
-      }
+    for (int y = y0; y < y1; ++y)
       for (int x = 0; x < W; ++x) {
-        float d = 0;
-        int g = 0;
-        for (; g < G; ++g) {
-          int xx = x + gx[g];
-          if (xx >= W) xx -= W;
-          const float* p = row[g] + 3 * xx;
-          const float* c = groups[g].color.data();
-          const float e0 = p[0] - c[0], e1 = p[1] - c[1], e2 = p[2] - c[2];
-          d += groups[g].weight * (e0 * e0 + e1 * e1 + e2 * e2);
-          if (d > bd) break;
-        }
-        if (g == G && d < bd) bd = d, bi = y * W + x;
+        const float d = score(groups, tab, W, H, x, y, bd);
+        if (d < bd) bd = d, bi = y * W + x;  // row-major: the first of equal minima is kept
       }
-    }
     best_d[b] = bd;
     best_i[b] = bi;
   });
@@ -314,6 +401,94 @@ MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSampl
   res.qy = bi / W;
   res.distance = bd;
   res.comparisons = groups.size();
+  return res;
+}
+
+ExemplarIndex::ExemplarIndex(const ExemplarLevels& ex) : ex_(&ex) {
+  levels_.resize(ex.levels.size());
+  for (std::size_t l = 0; l < ex.levels.size(); ++l) {
+    const Image& im = ex.levels[l];
+    const std::size_t n = static_cast<std::size_t>(im.width) * im.height;
+    for (int c = 0; c < 3; ++c) {
+      levels_[l].plane[c].resize(n);
+      for (std::size_t i = 0; i < n; ++i) levels_[l].plane[c][i] = im.data[3 * i + c];
+    }
+  }
+}
+
+namespace {
+
+// d[x] += m |I(x + sx) - c|^2 over x in [0, n): the same arithmetic, in the
+// same order, as group_term (so sums are bit-identical to the scalar scan).
+inline void accumulate(float* d, const float* r, const float* g, const float* b, int n, const SampleGroup& grp) {
+  const float c0 = grp.color[0], c1 = grp.color[1], c2 = grp.color[2], m = grp.weight;
+  for (int x = 0; x < n; ++x) {
+    const float e0 = r[x] - c0, e1 = g[x] - c1, e2 = b[x] - c2;
+    d[x] += m * (e0 * e0 + e1 * e1 + e2 * e2);
+  }
+}
+
+}  // namespace
+
+MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int center_level) const {
+  const ExemplarLevels& ex = *ex_;
+  if (center_level < 0 || center_level >= static_cast<int>(ex.levels.size()))
+    throw InvalidInputError("ExemplarIndex::match: centre level " + std::to_string(center_level) + " out of range");
+  MatchResult res;
+  if (groups.empty()) return res;
+  for (const SampleGroup& g : groups)
+    if (g.level < 0 || g.level >= static_cast<int>(ex.levels.size()))
+      throw InvalidInputError("ExemplarIndex::match: group level " + std::to_string(g.level) + " out of range");
+  const int W = ex.width(center_level), H = ex.height(center_level);
+  const std::size_t G = groups.size();
+  thread_local std::vector<float> d;
+  thread_local std::vector<int> gx, gy;
+  d.resize(W);
+  gx.resize(G);
+  gy.resize(G);
+  for (std::size_t g = 0; g < G; ++g) gx[g] = wrap(groups[g].dx, W), gy[g] = wrap(groups[g].dy, H);
+  float bd = std::numeric_limits<float>::infinity();
+  int bi = -1;
+  std::size_t scored = 0;
+  // Row by row, the region as a sparse stencil: each group adds its term to
+  // all W candidates of the row from one contiguous (wrapped in two pieces)
+  // run of its level's planes. The row is dropped as soon as every partial
+  // sum exceeds the best distance so far (terms are >= 0).
+  for (int y = 0; y < H; ++y) {
+    std::fill(d.begin(), d.end(), 0.0f);
+    bool dropped = false;
+    std::size_t next_check = 1;
+    for (std::size_t g = 0; g < G; ++g) {
+      const Level& L = levels_[groups[g].level];
+      int yy = y + gy[g];
+      if (yy >= H) yy -= H;
+      const std::size_t row = static_cast<std::size_t>(yy) * W;
+      const float* r = L.plane[0].data() + row;
+      const float* gg = L.plane[1].data() + row;
+      const float* b = L.plane[2].data() + row;
+      const int s = gx[g];  // candidate x reads texel x + s (mod W)
+      accumulate(d.data(), r + s, gg + s, b + s, W - s, groups[g]);
+      accumulate(d.data() + (W - s), r, gg, b, s, groups[g]);
+      if (g + 1 == next_check && g + 1 < G) {
+        next_check *= 2;
+        if (*std::min_element(d.begin(), d.end()) > bd) {
+          dropped = true;
+          break;
+        }
+      }
+    }
+    if (dropped) continue;
+    scored += static_cast<std::size_t>(W);
+    for (int x = 0; x < W; ++x)
+      if (d[x] < bd) bd = d[x], bi = y * W + x;  // row-major: the first of equal minima is kept
+  }
+  if (bi < 0) bi = 0, bd = 0;  // only NaN colours: degenerate, take texel 0
+  res.found = true;
+  res.qx = bi % W;
+  res.qy = bi / W;
+  res.distance = bd;
+  res.comparisons = G;
+  res.candidates = scored;
   return res;
 }
 

@@ -74,8 +74,38 @@ struct KRegion {
   std::vector<std::array<int, 2>> edges;      ///< mesh edges inside the region (indices into vertices)
 };
 
-/// The k-region of `center` with local coordinates (see the header comment).
+/// Flat adjacency of a mesh level for fast region building: CSR neighbour
+/// lists, positions, and per directed edge p->w its unfolding step (the edge
+/// in p's frame, u along p's field direction, v = n x u, rescaled to the 3D
+/// edge length). Built once per pass; O(vertices + edges).
+struct RegionGraph {
+  std::vector<std::uint32_t> offset;                ///< nv + 1
+  std::vector<std::uint32_t> neighbor;              ///< CSR targets
+  std::vector<std::array<double, 2>> step;          ///< per CSR slot, object units
+  std::vector<std::array<double, 3>> position;      ///< per vertex
+  std::vector<std::array<double, 3>> normal, u_axis, v_axis;  ///< per-vertex frame
+  std::size_t size() const { return position.size(); }
+};
+
+/// Throws InvalidInputError if `frames` do not belong to `mesh`.
+RegionGraph make_region_graph(const Mesh& mesh, const SurfaceFrames& frames);
+
+/// Per-thread scratch of k_region (an index per vertex, reset after use).
+struct RegionScratch {
+  std::vector<int> index;
+  std::vector<double> paths;
+};
+
+/// The k-region of `center` (bounded BFS ring by ring, no allocation once the
+/// buffers have grown) with local coordinates (see the header comment); the
+/// unfolding is one pass from the centre: each new ring's uv from its
+/// predecessors' uv and the precomputed edge steps, weighted by path counts.
+/// `with_edges` = false skips KRegion::edges (only the graph cut needs them).
 /// Throws InvalidInputError for center out of range or k < 0.
+void k_region(const RegionGraph& graph, std::size_t center, int k, LocalCoordinates mode, KRegion& out,
+              RegionScratch& scratch, bool with_edges = true);
+
+/// Convenience overload (builds the RegionGraph: O(mesh) per call; tests).
 void k_region(const Mesh& mesh, const SurfaceFrames& frames, std::size_t center, int k, LocalCoordinates mode,
               KRegion& out);
 
@@ -143,11 +173,52 @@ struct MatchResult {
   int qx = 0, qy = 0;   ///< best texel at the centre's level
   double distance = 0;  ///< d(Q_best) (without the constant C when averaging)
   std::size_t comparisons = 0;  ///< samples or groups compared per candidate
+  std::size_t candidates = 0;   ///< candidates in rows not abandoned at once (ExemplarIndex::match)
 };
 
-/// Exhaustive best match (Algorithm 1) of the samples at `center_level`.
+/// Exhaustive best match (Algorithm 1) of the samples at `center_level`:
+/// every texel is scored (the reference implementation).
 MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
                          const MatchOptions& opt = {});
+
+/// The groups compared by match_region: grouped (averaging) or one per
+/// sample, then stably sorted by decreasing weight (the order the SSD is
+/// summed in). Uses a hash table in `scratch` (no std::map).
+struct GroupScratch {
+  std::vector<std::uint64_t> key;
+  std::vector<int> slot;
+  std::vector<std::array<double, 3>> sum;
+};
+/// The oversampling groups in order of first occurrence (group_samples
+/// without allocation once `out` and `scratch` have grown).
+void group_into(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
+                std::vector<SampleGroup>& out, GroupScratch& scratch);
+void prepare_groups(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
+                    bool averaging, std::vector<SampleGroup>& out, GroupScratch& scratch);
+
+/// Exact best match (same result as match_region, bit for bit, ties to the
+/// lowest texel index), single-threaded and allocation-free so that many
+/// vertices can be matched concurrently. The exemplar levels are kept as
+/// separate R, G, B planes; candidates are scanned row by row with the region
+/// as a sparse stencil: each group adds m_g |I(Q + o_g) - c_g|^2 to the whole
+/// row of candidates from one contiguous run of texels (vectorisable), the
+/// heaviest groups first; a row is abandoned once all its partial sums exceed
+/// the best distance so far (checked after 1, 2, 4, ... groups).
+/// Immutable after construction: match() may run concurrently.
+class ExemplarIndex {
+ public:
+  explicit ExemplarIndex(const ExemplarLevels& ex);
+  /// `groups` as from prepare_groups (heaviest first). Throws
+  /// InvalidInputError for a level out of range.
+  MatchResult match(const std::vector<SampleGroup>& groups, int center_level) const;
+
+ private:
+  const ExemplarLevels* ex_;
+  struct Level {
+    std::array<std::vector<float>, 3> plane;  ///< R, G, B, row-major
+  };
+  std::vector<Level> levels_;
+};
 
 /// Texel colour of level l at (x, y), wrapping.
 std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y);

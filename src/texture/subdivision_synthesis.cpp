@@ -3,6 +3,10 @@
 // See subdivision_synthesis.h.
 #include "texture/subdivision_synthesis.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -34,8 +38,97 @@ void validate(const SubdivisionSynthesisOptions& o) {
   if (o.max_k < 1 || o.max_k > 64) bad("max_k", o.max_k, "in 1..64");
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+}  // namespace
+
+namespace {
+
+// One vertex's speculative work (region, samples, match, cut): a pure
+// function of the geometry and of the colour state it reads.
+struct VertexJob {
+  std::size_t p = 0;
+  int k = 0;
+  bool has_samples = false;
+  KRegion reg;
+  MatchResult m;
+  std::size_t groups = 0;
+  std::vector<std::pair<std::size_t, std::array<float, 3>>> writes;  ///< (vertex, colour), centre first
+  double t_region = 0, t_match = 0, t_transfer = 0;
+};
+
+struct JobScratch {
+  RegionScratch region;
+  GroupScratch group;
+  std::vector<RegionSample> samples;
+  std::vector<SampleGroup> groups;
+  std::vector<TransferNode> nodes;
+};
+
+struct PassContext {
+  const RegionGraph& graph;
+  const SurfaceFrames& fr;
+  const ExemplarLevels& ex;
+  const ExemplarIndex& index;
+  const std::vector<int>& level;
+  const std::vector<char>& colored;
+  const std::vector<Color3f>& color;
+  double r_scale;
+  const SubdivisionSynthesisOptions& opt;
+};
+
+void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s) {
+  const SubdivisionSynthesisOptions& opt = c.opt;
+  auto t0 = std::chrono::steady_clock::now();
+  job.p = p;
+  job.writes.clear();
+  job.has_samples = false;
+  const int lp = c.level[p];
+  const double e = c.fr.mean_edge[p] > 0 ? c.fr.mean_edge[p] : c.fr.mean_edge_length;
+  job.k = region_k(opt.region_texels, lp, c.ex.pyramid, c.r_scale, e, opt.max_k);
+  k_region(c.graph, p, job.k, opt.coordinates, job.reg, s.region, opt.graph_cut);
+  const KRegion& reg = job.reg;
+  s.samples.clear();
+  for (std::size_t i = 1; i < reg.vertices.size(); ++i) {
+    const std::size_t v = reg.vertices[i];
+    if (!c.colored[v]) continue;
+    const Color3f& col = c.color[v];
+    s.samples.push_back(
+        RegionSample{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {col[0], col[1], col[2]}});
+  }
+  auto t1 = std::chrono::steady_clock::now();
+  job.t_region = std::chrono::duration<double>(t1 - t0).count();
+  if (s.samples.empty()) return;
+  job.has_samples = true;
+  prepare_groups(c.ex, s.samples, lp, opt.averaging, s.groups, s.group);
+  job.groups = s.groups.size();
+  job.m = c.index.match(s.groups, lp);
+  auto t2 = std::chrono::steady_clock::now();
+  job.t_match = std::chrono::duration<double>(t2 - t1).count();
+  if (!opt.graph_cut) {
+    job.writes.push_back({p, texel(c.ex, lp, job.m.qx, job.m.qy)});
+  } else {
+    s.nodes.resize(reg.vertices.size());
+    for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
+      const std::size_t v = reg.vertices[i];
+      RegionSample smp{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {}};
+      const auto o = sample_offset(c.ex, smp, lp);
+      const int lv = c.ex.pyramid ? lp : c.level[v];
+      TransferNode& n = s.nodes[i];
+      n.colored = c.colored[v] != 0;
+      const Color3f& col = c.color[v];
+      n.surface = {col[0], col[1], col[2]};
+      n.texture = texel(c.ex, lv, job.m.qx + o[0], job.m.qy + o[1]);
+      n.distance = std::sqrt(smp.du * smp.du + smp.dv * smp.dv);
+      n.hops = reg.hops[i];
+    }
+    const double r = c.ex.scale(lp) * opt.region_texels;
+    GraphCutTransferOptions go;
+    go.sigma = opt.sigma;
+    const auto cut = graph_cut_transfer(s.nodes, reg.edges, 0, job.k, r, go);
+    for (std::size_t i = 0; i < reg.vertices.size(); ++i)
+      if (cut.take_texture[i]) job.writes.push_back({reg.vertices[i], s.nodes[i].texture});
+  }
+  job.t_transfer = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
 }
 
 }  // namespace
@@ -43,101 +136,127 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const std::vector<std::size_t>& order,
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng) {
+  const ExemplarIndex index(ex);
+  return synthesis_pass(mesh, ex, index, order, colored, r_scale, hierarchy_level, opt, rng);
+}
+
+SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
+                                  const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
+                                  int hierarchy_level, const SubdivisionSynthesisOptions& opt,
+                                  std::mt19937_64& rng) {
   const std::size_t nv = mesh.number_of_vertices();
   if (colored.size() != nv) throw InvalidInputError("synthesis_pass: colored has the wrong size");
+  for (std::size_t p : order)
+    if (p >= nv) throw InvalidInputError("synthesis_pass: order names vertex " + std::to_string(p));
+  auto t_setup = std::chrono::steady_clock::now();
   const SurfaceFrames fr = compute_surface_frames(mesh);
+  const RegionGraph graph = make_region_graph(mesh, fr);
   auto col = get_or_add(mesh, kVertexColor, Color3f{0.5f, 0.5f, 0.5f});
+  std::vector<Color3f> color(nv);
+  for (VertexIndex v : mesh.vertices()) color[v.idx()] = col[v];
   const int nlev = static_cast<int>(ex.levels.size());
   const int fixed_level = std::clamp(hierarchy_level, 0, nlev - 1);
   std::vector<int> level(nv);
   for (std::size_t i = 0; i < nv; ++i)
     level[i] = opt.antialias ? antialias_level(ex, r_scale, fr.mean_edge[i]) : fixed_level;
   std::vector<char> patched(nv, 0);
+  std::vector<std::uint32_t> written(nv, 0);  // chunk stamp of the last write
   bool any_colored = std::any_of(colored.begin(), colored.end(), [](char c) { return c != 0; });
   SynthesisPassStats st;
-  KRegion reg;
-  std::vector<RegionSample> samples;
-  std::vector<TransferNode> nodes;
-  MatchOptions mo;
-  mo.averaging = opt.averaging;
+  st.seconds_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
+  const PassContext ctx{graph, fr, ex, index, level, colored, color, r_scale, opt};
   double sum_k = 0, sum_region = 0, sum_groups = 0;
-  for (std::size_t p : order) {
-    if (p >= nv) throw InvalidInputError("synthesis_pass: order names vertex " + std::to_string(p));
-    if (opt.skip_patched && patched[p]) continue;
-    const VertexIndex vp(static_cast<Mesh::size_type>(p));
-    if (mesh.is_isolated(vp)) continue;
-    const int lp = level[p];
-    const double e = fr.mean_edge[p] > 0 ? fr.mean_edge[p] : fr.mean_edge_length;
-    if (!any_colored) {  // the very first vertex: a random texel
-      std::uniform_int_distribution<int> ux(0, ex.width(lp) - 1), uy(0, ex.height(lp) - 1);
-      const int x = ux(rng), y = uy(rng);
-      const auto t = texel(ex, lp, x, y);
-      col[vp] = {t[0], t[1], t[2]};
-      colored[p] = 1;
-      any_colored = true;
-      ++st.seeded;
-      continue;
-    }
-    auto t0 = std::chrono::steady_clock::now();
-    const int k = region_k(opt.region_texels, lp, ex.pyramid, r_scale, e, opt.max_k);
-    k_region(mesh, fr, p, k, opt.coordinates, reg);
-    samples.clear();
-    for (std::size_t i = 1; i < reg.vertices.size(); ++i) {
-      const std::size_t v = reg.vertices[i];
-      if (!colored[v]) continue;
-      const Color3f& c = col[VertexIndex(static_cast<Mesh::size_type>(v))];
-      samples.push_back(RegionSample{r_scale * reg.uv[i][0], r_scale * reg.uv[i][1], level[v], {c[0], c[1], c[2]}});
-    }
-    st.seconds_region += seconds_since(t0);
-    if (samples.empty()) {
-      ++st.skipped;
-      continue;
-    }
-    t0 = std::chrono::steady_clock::now();
-    const MatchResult m = match_region(ex, samples, lp, mo);
-    st.seconds_match += seconds_since(t0);
-    ++st.matched;
-    sum_k += k;
-    sum_region += reg.vertices.size();
-    sum_groups += m.comparisons;
-    t0 = std::chrono::steady_clock::now();
-    if (!opt.graph_cut) {
-      const auto t = texel(ex, lp, m.qx, m.qy);
-      col[vp] = {t[0], t[1], t[2]};
-      colored[p] = 1;
-    } else {
-      nodes.resize(reg.vertices.size());
-      for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
-        const std::size_t v = reg.vertices[i];
-        RegionSample s{r_scale * reg.uv[i][0], r_scale * reg.uv[i][1], level[v], {}};
-        const auto o = sample_offset(ex, s, lp);
-        const int lv = ex.pyramid ? lp : level[v];
-        TransferNode& n = nodes[i];
-        n.colored = colored[v] != 0;
-        const Color3f& c = col[VertexIndex(static_cast<Mesh::size_type>(v))];
-        n.surface = {c[0], c[1], c[2]};
-        n.texture = texel(ex, lv, m.qx + o[0], m.qy + o[1]);
-        n.distance = std::sqrt(s.du * s.du + s.dv * s.dv);
-        n.hops = reg.hops[i];
+
+  // Speculative parallel matching, sequential commit (exactly the sequential
+  // pass of sections 3.1.2 and 3.3.1): the order is cut into chunks of
+  // consecutive vertices; every vertex of a chunk is matched (and its cut
+  // solved) in parallel against the colours at the start of the chunk; the
+  // results are then committed one by one in the pass order. A vertex whose
+  // region received a colour from an earlier commit of the same chunk read
+  // stale colours: its job is recomputed at commit time against the current
+  // colours. Every committed result is thus the one the sequential pass would
+  // compute, whatever the thread count. The chunk size adapts to the conflict
+  // rate, deterministically (it depends only on the data).
+  std::vector<VertexJob> jobs;
+  tbb::enumerable_thread_specific<JobScratch> scratch;
+  JobScratch serial;
+  std::size_t chunk = 16;
+  std::uint32_t stamp = 0;
+  for (std::size_t begin = 0; begin < order.size();) {
+    const std::size_t end = std::min(order.size(), begin + chunk);
+    ++stamp;
+    if (jobs.size() < end - begin) jobs.resize(end - begin);
+    auto needs_job = [&](std::size_t p) {
+      return !(opt.skip_patched && patched[p]) && graph.offset[p] != graph.offset[p + 1] && any_colored;
+    };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      JobScratch& s = scratch.local();
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const std::size_t p = order[i];
+        jobs[i - begin].p = static_cast<std::size_t>(-1);
+        if (needs_job(p)) run_job(ctx, p, jobs[i - begin], s);
       }
-      const double r = ex.scale(lp) * opt.region_texels;
-      GraphCutTransferOptions go;
-      go.sigma = opt.sigma;
-      const auto cut = graph_cut_transfer(nodes, reg.edges, 0, k, r, go);
-      for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
-        if (!cut.take_texture[i]) continue;
-        const std::size_t v = reg.vertices[i];
-        col[VertexIndex(static_cast<Mesh::size_type>(v))] = {nodes[i].texture[0], nodes[i].texture[1],
-                                                              nodes[i].texture[2]};
-        colored[v] = 1;
-        if (i > 0) {
-          patched[v] = 1;
+    });
+    std::size_t conflicts = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t p = order[i];
+      if (opt.skip_patched && patched[p]) continue;
+      if (graph.offset[p] == graph.offset[p + 1]) continue;  // isolated
+      if (!any_colored) {  // the very first vertex: a random texel
+        const int lp = level[p];
+        std::uniform_int_distribution<int> ux(0, ex.width(lp) - 1), uy(0, ex.height(lp) - 1);
+        const int x = ux(rng), y = uy(rng);
+        const auto t = texel(ex, lp, x, y);
+        color[p] = {t[0], t[1], t[2]};
+        colored[p] = 1;
+        written[p] = stamp;
+        any_colored = true;
+        ++st.seeded;
+        continue;
+      }
+      VertexJob& job = jobs[i - begin];
+      bool stale = job.p != p;
+      if (!stale)
+        for (std::size_t v : job.reg.vertices)
+          if (written[v] == stamp) {
+            stale = true;
+            break;
+          }
+      if (stale) {
+        ++conflicts;
+        run_job(ctx, p, job, serial);
+      }
+      st.seconds_region += job.t_region;
+      st.seconds_match += job.t_match;
+      st.seconds_transfer += job.t_transfer;
+      if (!job.has_samples) {
+        ++st.skipped;
+        continue;
+      }
+      ++st.matched;
+      sum_k += job.k;
+      sum_region += job.reg.vertices.size();
+      sum_groups += job.groups;
+      st.candidates += job.m.candidates;
+      for (const auto& w : job.writes) {
+        color[w.first] = {w.second[0], w.second[1], w.second[2]};
+        colored[w.first] = 1;
+        written[w.first] = stamp;
+        if (w.first != p) {
+          patched[w.first] = 1;
           ++st.patched;
         }
       }
     }
-    st.seconds_transfer += seconds_since(t0);
+    st.recomputed += conflicts;
+    const std::size_t n = end - begin;
+    if (4 * conflicts > n)
+      chunk = std::max<std::size_t>(1, chunk / 2);
+    else if (16 * conflicts < n)
+      chunk = std::min<std::size_t>(1024, chunk * 2);
+    begin = end;
   }
+  for (VertexIndex v : mesh.vertices()) col[v] = color[v.idx()];
   if (st.matched) {
     st.mean_k = sum_k / st.matched;
     st.mean_region = sum_region / st.matched;
@@ -184,6 +303,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
   }
 
   const ExemplarLevels ex = make_exemplar_levels(exemplar, opt.pyramid);
+  const ExemplarIndex index(ex);
   res.stack_levels = static_cast<int>(ex.levels.size());
   std::vector<OrientationKey> keys = opt.keys;
   if (keys.empty()) keys.push_back(OrientationKey{0, {1, 0, 0}});
@@ -225,7 +345,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
     for (int pass = 0; pass < opt.passes; ++pass) {
       report_progress(opt.progress, "synthesis level " + std::to_string(level),
                       double(level * opt.passes + pass) / double((opt.levels + 1) * opt.passes));
-      ls.pass_stats.push_back(synthesis_pass(mesh, ex, order, colored, r_mesh, hierarchy_level, opt, rng));
+      ls.pass_stats.push_back(synthesis_pass(mesh, ex, index, order, colored, r_mesh, hierarchy_level, opt, rng));
       ++ls.passes;
       if (pass == 0) {
         // Fill passes: vertices left without coloured neighbours (section 4).
@@ -234,7 +354,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
           for (std::size_t v : order)
             if (!colored[v] && !mesh.is_isolated(VertexIndex(static_cast<Mesh::size_type>(v)))) missing.push_back(v);
           if (missing.empty()) break;
-          const SynthesisPassStats fs = synthesis_pass(mesh, ex, missing, colored, r_mesh, hierarchy_level, opt, rng);
+          const SynthesisPassStats fs = synthesis_pass(mesh, ex, index, missing, colored, r_mesh, hierarchy_level, opt, rng);
           ls.pass_stats.push_back(fs);
           ++ls.passes;
           ++ls.fill_passes;

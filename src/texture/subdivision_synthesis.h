@@ -76,7 +76,11 @@ struct SynthesisPassStats {
   double mean_k = 0;
   double mean_region = 0;    ///< vertices per region
   double mean_groups = 0;    ///< compared groups per match (after averaging)
+  std::size_t candidates = 0;  ///< exemplar texels scored over all matches (branch and bound)
+  std::size_t recomputed = 0;  ///< speculative jobs redone at commit (their region changed)
+  /// Thread time summed over vertices (so it can exceed the wall time).
   double seconds_match = 0, seconds_transfer = 0, seconds_region = 0;
+  double seconds_setup = 0;    ///< frames, region graph (wall)
 };
 
 struct SynthesisLevelStats {
@@ -104,8 +108,20 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
 /// vertices have a colour in kVertexColor (updated). `hierarchy_level` is the
 /// stack level used without anti-aliasing. `r_scale` here is texels per MESH
 /// unit. Returns the pass statistics.
+///
+/// The pass is the sequential one (each vertex matched against the colours
+/// left by the vertices before it in `order`), computed speculatively in
+/// parallel: chunks of consecutive vertices are matched with TBB against the
+/// colours at the chunk's start and committed in order; a vertex whose region
+/// was written by an earlier commit of its chunk is recomputed. Results do
+/// not depend on the thread count.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const std::vector<std::size_t>& order,
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
+/// The same with a prebuilt index of `ex` (reused across passes).
+SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
+                                  const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
+                                  int hierarchy_level, const SubdivisionSynthesisOptions& opt,
+                                  std::mt19937_64& rng);
 
 }  // namespace surftex

@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
 
 #include <cmath>
 #include <random>
@@ -9,6 +12,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "geometry/turk_orientation_field.h"
+#include "texture/displace_by_vertex_color.h"
 #include "texture/graph_cut_transfer.h"
 #include "texture/k_region_matching.h"
 #include "texture/procedural_texture.h"
@@ -202,4 +206,155 @@ TEST(SubdivisionSynthesis, BadInputErrors) {
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   Mesh empty;
   EXPECT_THROW(synthesize_on_subdivision(empty, ex, {}), InvalidInputError);
+}
+
+// The stencil matcher used by the passes returns exactly (bit for bit) what
+// the exhaustive reference scan returns, ties included, on random inputs with
+// and without averaging, stacks and pyramids.
+TEST(KRegionMatching, IndexedMatcherEqualsExhaustiveScan) {
+  for (std::uint64_t seed = 1; seed <= 80; ++seed) {
+    std::mt19937_64 rng(seed * 31);
+    const bool pyramid = seed % 4 == 0;
+    Image img = random_image(29, 23, rng);
+    if (seed % 5 == 0)  // quantised colours: many exact ties
+      for (float& v : img.data) v = std::round(v * 2) / 2;
+    const ExemplarLevels ex = make_exemplar_levels(img, pyramid, 3);
+    const ExemplarIndex index(ex);
+    std::uniform_real_distribution<double> off(-6.0, 6.0);
+    std::uniform_real_distribution<float> c(0.f, 1.f);
+    std::uniform_int_distribution<int> lv(0, 2), n(1, 60);
+    std::vector<RegionSample> s(n(rng));
+    for (auto& x : s) x = RegionSample{off(rng), off(rng), lv(rng), {c(rng), c(rng), c(rng)}};
+    if (seed % 5 == 0)
+      for (auto& x : s) x.color = {0.5f, 0.5f, 0.5f};
+    const int cl = pyramid ? lv(rng) : lv(rng) % 2;
+    for (bool averaging : {true, false}) {
+      MatchOptions mo;
+      mo.averaging = averaging;
+      const MatchResult ref = match_region(ex, s, cl, mo);
+      std::vector<SampleGroup> groups;
+      GroupScratch gs;
+      prepare_groups(ex, s, cl, averaging, groups, gs);
+      const MatchResult fast = index.match(groups, cl);
+      EXPECT_EQ(fast.qx, ref.qx) << "seed " << seed;
+      EXPECT_EQ(fast.qy, ref.qy) << "seed " << seed;
+      EXPECT_EQ(fast.distance, ref.distance) << "seed " << seed;
+      EXPECT_EQ(fast.comparisons, ref.comparisons);
+    }
+    // group_into keeps first-occurrence order and the group_samples result.
+    std::vector<SampleGroup> g1;
+    GroupScratch gs;
+    group_into(ex, s, cl, g1, gs);
+    const auto g2 = group_samples(ex, s, cl);
+    ASSERT_EQ(g1.size(), g2.size());
+    for (std::size_t i = 0; i < g1.size(); ++i) {
+      EXPECT_EQ(g1[i].dx, g2[i].dx);
+      EXPECT_EQ(g1[i].dy, g2[i].dy);
+      EXPECT_EQ(g1[i].weight, g2[i].weight);
+      EXPECT_EQ(g1[i].color, g2[i].color);
+    }
+  }
+}
+
+// The k-region by hop count on a regular quad grid: ring sizes 1, 4, 8, 12
+// ((k+1)^2 + k^2 vertices up to k, section 3.3.2), and the unfolding of a
+// flat grid reproduces the planar coordinates exactly (every shortest path
+// gives the same sum of edge steps).
+TEST(KRegionMatching, RegionOnAQuadGridCountsAndUnfoldsExactly) {
+  Mesh m;
+  std::vector<VertexIndex> v;
+  const int n = 11;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) v.push_back(m.add_vertex(Point3(0.1 * i, 0.1 * j, 0)));
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i)
+      m.add_face(v[j * n + i], v[j * n + i + 1], v[(j + 1) * n + i + 1], v[(j + 1) * n + i]);
+  get_or_add(m, kVertexDirection, Vector3(1, 0, 0));
+  const SurfaceFrames fr = compute_surface_frames(m);
+  const RegionGraph g = make_region_graph(m, fr);
+  RegionScratch scr;
+  KRegion r;
+  const std::size_t c = 5 * n + 5;
+  for (int k = 0; k <= 4; ++k) {
+    k_region(g, c, k, LocalCoordinates::kUnfolding, r, scr);
+    EXPECT_EQ(r.vertices.size(), std::size_t((k + 1) * (k + 1) + k * k)) << "k " << k;
+    for (std::size_t i = 0; i < r.vertices.size(); ++i) {
+      const Point3 p = m.point(VertexIndex(static_cast<Mesh::size_type>(r.vertices[i])));
+      EXPECT_NEAR(r.uv[i][0], p.x() - 0.5, 1e-12);
+      EXPECT_NEAR(r.uv[i][1], p.y() - 0.5, 1e-12);
+      EXPECT_EQ(r.hops[i], int(std::lround(std::abs(p.x() - 0.5) / 0.1 + std::abs(p.y() - 0.5) / 0.1)));
+    }
+  }
+  // The mesh overload gives the same region; the scratch index is reset.
+  KRegion r2;
+  k_region(m, fr, c, 3, LocalCoordinates::kUnfolding, r2);
+  k_region(g, c, 3, LocalCoordinates::kUnfolding, r, scr);
+  EXPECT_EQ(r.vertices, r2.vertices);
+  EXPECT_EQ(r.edges, r2.edges);
+  for (int x : scr.index) ASSERT_EQ(x, -1);
+}
+
+// The speculative parallel pass gives the same colours with 1 and 2 threads
+// (and so equals the sequential pass), with and without the graph cut.
+TEST(SubdivisionSynthesis, PassIsIndependentOfTheThreadCount) {
+  const Image img = make_cells(32, 3, 5);
+  const ExemplarLevels ex = make_exemplar_levels(img, false);
+  for (bool cut : {false, true}) {
+    auto run = [&](int threads) {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+      Mesh m;
+      make_icosphere(m, 3);
+      turk_orientation_field(m, {{0, {1, 0, 0}}});
+      std::mt19937_64 rng(5);
+      std::vector<char> colored(m.number_of_vertices(), 0);
+      std::vector<std::size_t> order(m.number_of_vertices());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::shuffle(order.begin(), order.end(), rng);
+      SubdivisionSynthesisOptions o;
+      o.graph_cut = cut;
+      for (int pass = 0; pass < 3; ++pass) synthesis_pass(m, ex, order, colored, 30.0, 0, o, rng);
+      std::vector<float> c;
+      auto col = find(m, kVertexColor).first;
+      for (VertexIndex v : m.vertices())
+        for (int k = 0; k < 3; ++k) c.push_back(col[v][k]);
+      return c;
+    };
+    const auto a = run(1), b = run(2);
+    EXPECT_EQ(a, b) << "graph cut " << cut;
+  }
+}
+
+// --displace: a flat grid (normals +z) with grey colours g moves to z = H g.
+TEST(DisplaceByVertexColor, FlatGridMovesAlongTheNormalByHeightTimesGrey) {
+  Mesh m;
+  std::vector<VertexIndex> v;
+  const int n = 9;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) v.push_back(m.add_vertex(Point3(i, j, 0)));
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i)
+      m.add_face(v[j * n + i], v[j * n + i + 1], v[(j + 1) * n + i + 1], v[(j + 1) * n + i]);
+  EXPECT_THROW(displace_by_vertex_color(m, 1.0), InvalidInputError);
+  auto col = get_or_add(m, kVertexColor, Color3f{0.f, 0.f, 0.f});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::vector<double> grey(m.number_of_vertices());
+  for (VertexIndex x : m.vertices()) {
+    const float g = u(rng);
+    col[x] = {g, g, g};
+    grey[x.idx()] = g;
+  }
+  const double H = 0.37;
+  const auto r = displace_by_vertex_color(m, H);
+  double lo = 1e300, hi = -1e300;
+  for (VertexIndex x : m.vertices()) {
+    const Point3 p = m.point(x);
+    EXPECT_NEAR(p.z(), H * grey[x.idx()], 1e-9);
+    EXPECT_EQ(p.x(), double(x.idx() % n));
+    EXPECT_EQ(p.y(), double(x.idx() / n));
+    lo = std::min(lo, H * grey[x.idx()]), hi = std::max(hi, H * grey[x.idx()]);
+  }
+  EXPECT_NEAR(r.min_offset, lo, 1e-9);
+  EXPECT_NEAR(r.max_offset, hi, 1e-9);
+  EXPECT_THROW(displace_by_vertex_color(m, std::nan("")), InvalidInputError);
 }
