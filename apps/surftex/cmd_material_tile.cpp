@@ -102,7 +102,7 @@ SubcommandRegistrar reg{
        app.add_option("--layers", a->layers, "M: layer intervals per pair of keys (1..256, default 8)")
            ->check(CLI::Range(1, 256));
        app.add_option("--size", a->size,
-                      "Layer side in texels (16..2048, default 256; divisible by 2^(levels-1))")
+                      "Layer side in texels (16..2048, default 256; each pyramid level halves it, rounding up)")
            ->check(CLI::Range(16, 2048));
        app.add_option("--levels", a->levels,
                       "Pyramid levels of the synthesis (0 = automatic down to about 32x32, default 0; 0..8)")

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Section 1.2 of Ray et al. 2009. Choices where the paper is vague:
-//  - the pyramid: a private toroidal binomial (1 4 6 4 1)/16 blur + decimation
-//    (no shared pyramid header existed when this was written); mask pyramids
-//    are blurred too, so coarse masks are fractional coverages;
+//  - the pyramid: texture/gaussian_pyramid.h, toroidal (binomial (1 4 6 4 1)/16
+//    blur, even pixels kept, odd sides round up); mask pyramids are blurred
+//    too, so coarse masks are fractional coverages;
 //  - the neighbourhood: the paper compares 3x3 neighbourhoods, the brief asks
 //    for a 5x5 colour neighbourhood reduced by PCA plus the 3x3 mask; the PCA
 //    is fitted per level on (a regular subsample of) the exemplar's own 5x5
@@ -35,6 +35,7 @@
 #include <string>
 
 #include "geometry/errors.h"
+#include "texture/gaussian_pyramid.h"
 
 namespace surftex {
 
@@ -45,31 +46,13 @@ inline int wrap(int v, int n) {
   return v < 0 ? v + n : v;
 }
 
-Image downsample_wrap(const Image& in) {
-  static const float k[5] = {1.f / 16, 4.f / 16, 6.f / 16, 4.f / 16, 1.f / 16};
-  const int w = in.width, h = in.height, c = in.channels;
-  Image tmp(w / 2, h, c), out(w / 2, h / 2, c);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w / 2; ++x)
-      for (int ch = 0; ch < c; ++ch) {
-        float s = 0;
-        for (int i = -2; i <= 2; ++i) s += k[i + 2] * in.at(wrap(2 * x + i, w), y, ch);
-        tmp.at(x, y, ch) = s;
-      }
-  for (int y = 0; y < h / 2; ++y)
-    for (int x = 0; x < w / 2; ++x)
-      for (int ch = 0; ch < c; ++ch) {
-        float s = 0;
-        for (int i = -2; i <= 2; ++i) s += k[i + 2] * tmp.at(x, wrap(2 * y + i, h), ch);
-        out.at(x, y, ch) = s;
-      }
-  return out;
-}
-
-// Pyramid, index 0 = coarsest.
+// Pyramid, index 0 = coarsest: texture/gaussian_pyramid.h, toroidal (the
+// exemplar and the masks are tiles). Odd sides round up (ceil(w/2)).
 std::vector<Image> pyramid(const Image& finest, int levels) {
-  std::vector<Image> p{finest};
-  for (int r = 1; r < levels; ++r) p.push_back(downsample_wrap(p.back()));
+  PyramidOptions po;
+  po.levels = levels;
+  po.toroidal = true;
+  std::vector<Image> p = gaussian_pyramid(finest, po);
   std::reverse(p.begin(), p.end());
   return p;
 }
@@ -328,8 +311,10 @@ IndirectionMap identity_map(int w, int h) {
   return m;
 }
 
+// The coarse map upsampled to the fine level's ew x eh texels (ew is 2 c.width
+// or 2 c.width - 1 for an odd side): I(2i+b) = 2 I(i) + b, wrapped.
 IndirectionMap upsample_map(const IndirectionMap& c, int ew, int eh) {
-  IndirectionMap m{2 * c.width, 2 * c.height, std::vector<std::int32_t>(std::size_t(4) * c.width * c.height * 2)};
+  IndirectionMap m{ew, eh, std::vector<std::int32_t>(std::size_t(ew) * eh * 2)};
   for (int j = 0; j < m.height; ++j)
     for (int i = 0; i < m.width; ++i) {
       std::size_t t = std::size_t(j) * m.width + i;
@@ -366,17 +351,18 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
                             ", passes " + std::to_string(opt.coarse_passes) + "/" +
                             std::to_string(opt.fine_passes) + ", pca_dims " + std::to_string(opt.pca_dims) +
                             ", candidates " + std::to_string(opt.candidates) + " (1..16))");
+  // Level sizes halve rounding up (gaussian_pyramid): side >> r rounded up.
+  auto side = [](int n, int r) { return (n + (1 << r) - 1) >> r; };
   int levels = opt.levels;
   if (levels == 0) {
     levels = 1;
-    while (std::max(W, H) >> (levels - 1) > 32 && ((W >> (levels - 1)) % 2 == 0) &&
-           ((H >> (levels - 1)) % 2 == 0) && std::min(W, H) >> levels >= 8)
+    while (std::max(side(W, levels - 1), side(H, levels - 1)) > 32 && std::min(side(W, levels), side(H, levels)) >= 8)
       ++levels;
   }
-  if (W % (1 << (levels - 1)) || H % (1 << (levels - 1)) || std::min(W, H) >> (levels - 1) < 4)
+  if (levels > 30 || std::min(side(W, levels - 1), side(H, levels - 1)) < 4)
     throw InvalidInputError(fn + "size " + std::to_string(W) + "x" + std::to_string(H) +
                             " does not allow " + std::to_string(levels) +
-                            " levels (needs divisibility by 2^(levels-1), coarsest side >= 4)");
+                            " levels (the coarsest side, ceil(side / 2^(levels-1)), must be >= 4)");
   const int K = static_cast<int>(target_masks.size());
 
   // Pyramids (section 1.2: input colour, input mask, interpolated masks).

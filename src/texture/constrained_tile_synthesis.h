@@ -39,8 +39,10 @@ struct IndirectionMap {
 };
 
 struct ConstrainedSynthesisOptions {
-  /// Pyramid levels (>= 1). 0 (default) = halve until the coarsest side is
-  /// <= 32 texels (or odd): 256 -> 4 levels (256, 128, 64, 32).
+  /// Pyramid levels (>= 1). Each level halves the sides, rounding up
+  /// (texture/gaussian_pyramid.h): 63x45 -> 32x23 -> 16x12. 0 (default) =
+  /// halve while the longer side exceeds 32 texels and the next level's
+  /// shorter side stays >= 8: 256 -> 4 levels (256, 128, 64, 32).
   int levels = 0;
   int coarse_passes = 20;  ///< passes at the coarsest level (>= 0)
   int fine_passes = 3;     ///< passes at every finer level (>= 0)
@@ -87,7 +89,7 @@ struct ConstrainedSynthesisResult {
 /// its feature mask (W x H, channel 0 > 0.5 = feature); `target_masks`: F_0 ..
 /// F_K (each W x H). Returns K+1 layers of W x H. Deterministic for a seed,
 /// whatever the thread count. Throws InvalidInputError for empty or mismatched
-/// sizes, a size not divisible by 2^(levels-1), or options out of range;
+/// sizes, a coarsest level side (ceil(side / 2^(levels-1))) below 4, or options out of range;
 /// SolverError if the PCA eigen-decomposition fails.
 ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar,
                                                         const Image& exemplar_mask,

@@ -186,22 +186,51 @@ int GraphcutCanvas::place_graphcut(const PatchPlacement& placement,
         }
       }
     }
-  GraphCut gc(n + static_cast<int>(seams.size()));
+  // Pixels that must take the new patch (uncovered or forced) are not graph
+  // nodes: their links become terminal costs of their free neighbours, so
+  // the graph only spans the overlap.
+  std::vector<int> node(static_cast<std::size_t>(n) + seams.size(), -1);
+  int nodes = 0;
   for (int q = 0; q < n; ++q)
-    if (tsrc[static_cast<std::size_t>(q)] > 0.0 || tsink[static_cast<std::size_t>(q)] > 0.0)
-      gc.add_terminal(q, tsrc[static_cast<std::size_t>(q)], tsink[static_cast<std::size_t>(q)]);
-  for (const Term& e : edges) gc.add_edge(e.u, e.v, e.cuv, e.cvu);
+    if (tsink[static_cast<std::size_t>(q)] < GraphCut::kInfinity) node[static_cast<std::size_t>(q)] = nodes++;
+  for (std::size_t k = 0; k < seams.size(); ++k) node[static_cast<std::size_t>(n) + k] = nodes++;
+  GraphCut gc(nodes);
+  std::vector<double> extra_sink(static_cast<std::size_t>(nodes), 0.0);
+  // Link u-v: c_uv is paid when u keeps the old label and v takes the new one.
+  auto link = [&](int u, int v, double c_uv, double c_vu) {
+    const int nu = node[static_cast<std::size_t>(u)], nv = node[static_cast<std::size_t>(v)];
+    if (nu >= 0 && nv >= 0) {
+      if (c_uv > 0.0 || c_vu > 0.0) gc.add_edge(nu, nv, c_uv, c_vu);
+    } else if (nu >= 0) {
+      extra_sink[static_cast<std::size_t>(nu)] += c_uv;  // v is new: paid if u stays old
+    } else if (nv >= 0) {
+      extra_sink[static_cast<std::size_t>(nv)] += c_vu;
+    }
+  };
+  for (const Term& e : edges) link(e.u, e.v, e.cuv, e.cvu);
   for (std::size_t k = 0; k < seams.size(); ++k) {
-    const int s = n + static_cast<int>(k);
-    gc.add_edge(seams[k].q, s, seams[k].cq, seams[k].cq);
-    gc.add_edge(s, seams[k].r, seams[k].cr, seams[k].cr);
-    gc.add_terminal(s, 0.0, seams[k].old);
+    const int sn = n + static_cast<int>(k);
+    link(seams[k].q, sn, seams[k].cq, seams[k].cq);
+    link(sn, seams[k].r, seams[k].cr, seams[k].cr);
+    gc.add_terminal(node[static_cast<std::size_t>(sn)], 0.0, seams[k].old);
   }
-  gc.solve();
+  for (int q = 0; q < n; ++q) {
+    const int nq = node[static_cast<std::size_t>(q)];
+    if (nq < 0) continue;
+    const double src = tsrc[static_cast<std::size_t>(q)];
+    const double snk = tsink[static_cast<std::size_t>(q)] + extra_sink[static_cast<std::size_t>(nq)];
+    if (src > 0.0 || snk > 0.0) gc.add_terminal(nq, src, snk);
+  }
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    const int nq = node[static_cast<std::size_t>(n) + k];
+    if (extra_sink[static_cast<std::size_t>(nq)] > 0.0) gc.add_terminal(nq, 0.0, extra_sink[static_cast<std::size_t>(nq)]);
+  }
+  if (nodes > 0) gc.solve();
   int changed = 0;
   for (int j = 0; j < p.height; ++j)
     for (int i = 0; i < p.width; ++i) {
-      if (gc.is_source_side(j * p.width + i)) continue;
+      const int nq = node[static_cast<std::size_t>(j) * p.width + i];
+      if (nq >= 0 && gc.is_source_side(nq)) continue;
       const std::size_t o = idx(fp.ox(i), fp.oy(j));
       const int bx = p.ex_x + i, by = p.ex_y + j;
       if (sx_[o] != bx || sy_[o] != by) ++changed;

@@ -16,9 +16,11 @@
 //    different earlier patches gets a seam node joined to both pixels (costs
 //    M(s,t,A_s,B), M(s,t,B,A_t)) and to the new patch (cost M(s,t,A_s,A_t)),
 //    so a later patch can remove or replace an earlier seam.
-//  - pixels not yet covered are tied to the new patch with infinite links;
-//    pairs between the footprint and untouched pixels around it become
-//    terminal costs (old seam kept vs new seam made).
+//  - pixels not yet covered (and forced pixels) must take the new patch:
+//    they are left out of the graph and their links to free pixels become
+//    terminal costs, so the graph spans only the overlap; pairs between the
+//    footprint and untouched pixels around it become terminal costs too (old
+//    seam kept vs new seam made).
 // Every cut goes through surftex::GraphCut (Boost.Graph Boykov-Kolmogorov).
 //
 // Placement (section 4): the output is first filled in scan order with

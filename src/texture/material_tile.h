@@ -37,7 +37,7 @@ struct MaterialKey {
 };
 
 struct MaterialTileOptions {
-  int size = 256;    ///< layer side in texels (>= 16, divisible by 2^(levels-1))
+  int size = 256;    ///< layer side in texels (>= 16; levels halve it rounding up)
   int layers = 8;    ///< M: intervals per key pair (>= 1); a pair gives M+1 layers
   /// Key tiles: the input is first reduced to its largest centred square and
   /// resampled (bilinear) to size x size. If `keys_are_tileable` is false

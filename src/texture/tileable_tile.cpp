@@ -16,7 +16,7 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
   g.placement = o.placement;
   g.patch_size = o.patch_size > 0
                      ? o.patch_size
-                     : std::max(4, std::min({64, exemplar.width, exemplar.height, size / 2}));
+                     : std::max(4, std::min(size * 7 / 8, std::min(exemplar.width, exemplar.height) * 3 / 4));
   if (o.patch_size != 0 && o.patch_size < 4)
     throw InvalidInputError("make_tileable: patch_size must be 0 (auto) or >= 4, got " +
                             std::to_string(o.patch_size));

@@ -115,6 +115,47 @@ TEST(MaterialTile, ConstrainedSynthesisKeepsTheHistogramAndUsesMostPixels) {
   EXPECT_LE(r.unused_fraction[1], r0.unused_fraction[1]);  // the penalty spreads the usage
 }
 
+// Regression: the synthesis had its own pyramid (floor(w/2) per level) and
+// refused sides not divisible by 2^(levels-1); it now uses gaussian_pyramid,
+// whose levels round odd sides up, so a 63x45 tile runs at 3 levels.
+TEST(MaterialTile, ConstrainedSynthesisOnAnOddSizedExemplarUsesCeilLevels) {
+  Image cells = make_cells(64, 4, 11);
+  Image ex(63, 45, cells.channels);
+  for (int y = 0; y < ex.height; ++y)
+    for (int x = 0; x < ex.width; ++x)
+      for (int c = 0; c < ex.channels; ++c) ex.at(x, y, c) = cells.at(x, y, c);
+  Image mask = compute_feature_mask(ex).mask;
+  Image other(63, 45, 1, 0.f);
+  for (int y = 0; y < 45; ++y)
+    for (int x = 0; x < 63; ++x) other.at(x, y) = mask.at(62 - x, 44 - y);  // mirrored mask
+  ConstrainedSynthesisOptions o;
+  o.levels = 3;
+  ConstrainedSynthesisResult r = synthesize_constrained_tiles(ex, mask, {mask, other}, o);
+  ASSERT_EQ(r.levels, 3);
+  const int want[3][2] = {{16, 12}, {32, 23}, {63, 45}};  // coarsest first
+  for (int k = 0; k < 2; ++k)
+    for (int l = 0; l < 3; ++l) {
+      const IndirectionMap& m = r.maps[k][l];
+      EXPECT_EQ(m.width, want[l][0]) << k << " " << l;
+      EXPECT_EQ(m.height, want[l][1]) << k << " " << l;
+      ASSERT_EQ(m.coords.size(), 2u * m.width * m.height);
+      for (int j = 0; j < m.height; ++j)
+        for (int i = 0; i < m.width; ++i) {
+          ASSERT_TRUE(m.x(i, j) >= 0 && m.x(i, j) < want[l][0]) << k << " " << l;
+          ASSERT_TRUE(m.y(i, j) >= 0 && m.y(i, j) < want[l][1]) << k << " " << l;
+        }
+    }
+  EXPECT_EQ(r.layers[0].data, ex.data);  // identity layer
+  ASSERT_EQ(r.layers[1].width, 63);
+  EXPECT_GE(r.mask_agreement[1], 0.85);
+  // Automatic levels on an odd size: 63x45 already has its longer side above
+  // 32, and halving once more (32x23) keeps the shorter side >= 8: 2 levels.
+  o.levels = 0;
+  EXPECT_EQ(synthesize_constrained_tiles(ex, mask, {mask}, o).levels, 2);
+  o.levels = 5;  // 63x45 -> ... -> 4x3: coarsest side below 4
+  EXPECT_THROW(synthesize_constrained_tiles(ex, mask, {mask}, o), InvalidInputError);
+}
+
 TEST(MaterialTile, ChainsThreeKeys) {
   MaterialTileOptions o = small_options();
   o.layers = 2;
