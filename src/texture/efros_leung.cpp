@@ -166,8 +166,8 @@ void weighted_ssd_any(int C, SURFTEX_WEIGHTED_ARGS) {
 }
 #undef SURFTEX_WEIGHTED_ARGS
 
-// Appends (e[i], ids[i]) for every i < N with e[i] <= T to out; returns the
-// new end. Tests 8 errors at a time and only looks at single lanes when one
+// Appends (e[i], ids[i]) for every i < N with e[i] <= T to out (room for N
+// entries); returns the new end. Tests 8 errors at a time and only looks at single lanes when one
 // of the 8 passes (a few percent of the groups).
 SURFTEX_SIMD_CLONES std::pair<float, int>* collect_at_most(const float* e, const int* ids,
                                                            std::size_t N, float T,
@@ -183,8 +183,10 @@ SURFTEX_SIMD_CLONES std::pair<float, int>* collect_at_most(const float* e, const
     m |= __builtin_shuffle(m, I8{2, 3, 0, 1, 6, 7, 4, 5});
     m |= __builtin_shuffle(m, I8{1, 0, 3, 2, 5, 4, 7, 6});
     if (!m[0]) continue;
-    for (int l = 0; l < kLanes; ++l)
-      if (e[i + l] <= T) *out++ = {e[i + l], ids[i + l]};
+    for (int l = 0; l < kLanes; ++l) {  // branch-free: write, keep if <= T
+      *out = {e[i + l], ids[i + l]};
+      out += e[i + l] <= T;
+    }
   }
   for (; i < N; ++i)
     if (e[i] <= T) *out++ = {e[i], ids[i]};

@@ -2,8 +2,15 @@
 // Patch-based oriented surface synthesis (Gorla et al. 2003, 3-5).
 #include "texture/patch_synthesis.h"
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 
@@ -280,16 +287,22 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   const int R = opt.flatten.resolution;
   const std::size_t N = static_cast<std::size_t>(R) * R;
   res.images.assign(P, Image(R, R, C, 0.f));
-  std::vector<char> done(P, 0);
+  // Exemplar rotations prepared once for every patch (not once per patch).
+  const std::shared_ptr<const ElPreparedExemplars> prepared = el_prepare_exemplars(exemplars, opt.el);
+  // Per patch: texels filled, of which seeded, Known boundary pixels.
+  std::vector<std::size_t> texels(P, 0), seeded(P, 0), known(P, 0);
+  std::mutex progress_mutex;
   const Vector3 light = normalized_or(vec(opt.light), Vector3(0, 0, 1));
   const int E = static_cast<int>(exemplars.size());
   std::size_t step = 0;
   const std::size_t steps = P + opt.resynthesize.size();
 
-  auto synth_one = [&](int p, int pass) {
+  // synth_one(p, pass, available): available(q) says whether patch q's
+  // image is a boundary condition for p (synthesised before p in the order).
+  auto synth_one = [&](int p, int pass, const auto& available, bool pixel_parallel) {
     const FlatPatch& fp = patches[p];
     ElInput in;
-    in.exemplars = exemplars;
+    in.prepared = prepared;
     in.target = Image(R, R, C, 0.f);
     in.state.assign(N, PixelState::Outside);
     const Vector3 e1 = vec(fp.e1), e2 = vec(fp.e2);
@@ -303,7 +316,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
       const auto& b = fp.pixel_bary[i];
       if (kind == PatchPixel::Boundary) {
         const int q = face_patch[f.idx()];
-        if (!done[q]) continue;
+        if (!available(q)) continue;
         const FlatPatch& fq = patches[q];
         const FlatTriangle& tq = fq.triangles[face_slot[f.idx()]];
         const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
@@ -311,7 +324,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         const auto pq = fq.to_pixel(u, v);
         if (sample_inside(fq, res.images[q], pq[0], pq[1], &in.target.data[i * C])) {
           in.state[i] = PixelState::Known;
-          ++res.known_boundary;
+          ++known[p];
         }
         continue;
       }
@@ -347,6 +360,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
     ElOptions eo = opt.el;
     eo.seed = mix_seed(opt.seed, static_cast<std::uint64_t>(p), static_cast<std::uint64_t>(pass));
     eo.progress = nullptr;
+    eo.parallel_pixel_search = eo.parallel_pixel_search && pixel_parallel;
     if (eo.order == FillOrder::Direction) {
       double a = std::atan2(mean_s, mean_c);
       if (line_field) a *= 0.5;
@@ -355,19 +369,65 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
       eo.direction_y = -std::sin(a);  // pixel y points down
     }
     ElResult r = efros_leung_synthesize(in, eo);
-    res.texels += r.synthesized + r.seeded;
-    res.seeded += r.seeded;
+    texels[p] += r.synthesized + r.seeded;
+    seeded[p] += r.seeded;
     // Keep only Inside pixels in the stored image (boundary filled at the end).
     Image& img = res.images[p];
     for (std::size_t i = 0; i < N; ++i)
       if (fp.pixel[i] == PatchPixel::Inside)
         for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[i * C + c];
-    done[p] = 1;
-    report_progress(opt.progress, "synthesis", static_cast<double>(++step) / steps);
+    if (opt.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      report_progress(opt.progress, "synthesis", static_cast<double>(++step) / steps);
+    }
   };
-  for (int p : res.order) synth_one(p, 0);
+
+  // Main pass: patch p reads the images of its neighbours that come before
+  // it in res.order, exactly as a sequential run in that order would; so p
+  // may run as soon as those neighbours are done, and patches with no such
+  // dependency between them run in parallel (TBB tasks). The result is the
+  // same bytes for any thread count and schedule.
+  {
+    std::vector<int> rank(P);
+    for (int i = 0; i < P; ++i) rank[res.order[i]] = i;
+    std::vector<std::vector<int>> successors(P);
+    std::unique_ptr<std::atomic<int>[]> pending(new std::atomic<int>[P]);
+    for (int p = 0; p < P; ++p) {
+      std::vector<int> deps;
+      for (const FlatTriangle& tr : patches[p].boundary) {
+        const int q = face_patch[tr.face];
+        if (q != p && rank[q] < rank[p]) deps.push_back(q);
+      }
+      std::sort(deps.begin(), deps.end());
+      deps.erase(std::unique(deps.begin(), deps.end()), deps.end());
+      pending[p].store(static_cast<int>(deps.size()), std::memory_order_relaxed);
+      for (int q : deps) successors[q].push_back(p);
+    }
+    // Splitting each pixel's search over threads only pays when few patches
+    // can run side by side.
+    const bool pixel_parallel = P < 4 * tbb::this_task_arena::max_concurrency();
+    tbb::task_group tg;
+    std::function<void(int)> run = [&](int p) {
+      synth_one(p, 0, [&](int q) { return rank[q] < rank[p]; }, pixel_parallel);
+      for (int q : successors[p])
+        if (pending[q].fetch_sub(1, std::memory_order_acq_rel) == 1) tg.run([&run, q] { run(q); });
+    };
+    for (int p : res.order)
+      if (pending[p].load(std::memory_order_relaxed) == 0) tg.run([&run, p] { run(p); });
+    tg.wait();
+  }
+  // Re-synthesis (4.1) in the given order, each seeing every other patch.
+  std::vector<char> done(P, 1);
   for (int p : opt.resynthesize) done[p] = 0;
-  for (int p : opt.resynthesize) synth_one(p, 1);
+  for (int p : opt.resynthesize) {
+    synth_one(p, 1, [&](int q) { return done[q] != 0; }, true);
+    done[p] = 1;
+  }
+  for (int p = 0; p < P; ++p) {
+    res.texels += texels[p];
+    res.seeded += seeded[p];
+    res.known_boundary += known[p];
+  }
   res.seconds_synthesis = t.seconds();
 
   // 7. Boundary pixels of every image from the neighbour's texture.

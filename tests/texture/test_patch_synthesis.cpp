@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Patch-based oriented surface synthesis (Gorla et al. 2003, 3-5): seams
 // measured on the surface, stripes following the requested field, multi-
-// texturing by height, re-synthesis keeps the other patches, determinism,
-// bad input.
+// texturing by height, re-synthesis keeps the other patches, determinism
+// (also across thread counts), bad input.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -197,6 +198,35 @@ TEST(PatchSynthesis, DeterministicAndResynthesisKeepsOthers) {
       EXPECT_TRUE(same) << "patch " << p;
     }
   }
+}
+
+TEST(PatchSynthesis, SameBytesForOneThreadAndAllThreads) {
+  // Patches run as parallel tasks once the neighbours they read are done;
+  // the result must not depend on the schedule or the thread count.
+  const Image ex = make_noise(40, 4, 3);
+  auto run = [&] {
+    Mesh m;
+    make_icosphere(m, 2);
+    PatchSynthesisOptions o = small_options(24);
+    o.partition.max_faces = 12;  // many patches, so several are ready at once
+    o.field = PatchField::Constant;
+    o.seed = 9;
+    return synthesize_patches(m, {ex}, o);
+  };
+  const PatchSynthesisResult all = run();
+  PatchSynthesisResult one;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = run();
+  }
+  ASSERT_GT(all.images.size(), 8u);
+  ASSERT_EQ(all.images.size(), one.images.size());
+  EXPECT_EQ(all.order, one.order);
+  EXPECT_EQ(all.texels, one.texels);
+  EXPECT_EQ(all.known_boundary, one.known_boundary);
+  EXPECT_GT(all.known_boundary, 0u);
+  for (std::size_t p = 0; p < all.images.size(); ++p)
+    EXPECT_EQ(all.images[p].data, one.images[p].data) << "patch " << p;
 }
 
 TEST(PatchSynthesis, BadInputThrows) {
