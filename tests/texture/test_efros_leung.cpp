@@ -285,11 +285,12 @@ TEST(EfrosLeung, PreselectHoldsTheExactNBestOfPassOne) {
   // search, which this test repeats in double precision by brute force:
   // pass 1 ranks every candidate by unweighted SSD over the 3x3 window, keeps
   // the n best; pass 2 picks the Gaussian-weighted best among them (pick_min
-  // 1, no tolerance: deterministic). With 42x42 = 1764 candidates and n = 8
-  // the fast selection path (sampled threshold) is the one exercised.
-  const int ew = 48, W = 15, win = 7, n = 8;
+  // 1, no tolerance: deterministic). With 42x42 = 1764 candidates and n = 1
+  // or 8 the fast selection path (sampled threshold) is the one exercised.
+  const int ew = 48, W = 15, win = 7;
   const int lo = -(win / 2), hi = win - 1 - win / 2;
-  for (std::uint64_t trial = 0; trial < (sanitized() ? 2u : 6u); ++trial) {
+  for (std::uint64_t trial = 0; trial < (sanitized() ? 4u : 24u); ++trial) {
+    const int n = trial % 2 ? 8 : 1;  // 1: the pick is pass 1's own best
     std::mt19937_64 rng(trial);
     const int C = 1 + static_cast<int>(trial % 3);
     const Image ex = binomial_blur(noise(ew, ew, C, 300 + trial));
@@ -326,6 +327,7 @@ TEST(EfrosLeung, PreselectHoldsTheExactNBestOfPassOne) {
       }
     std::sort(p1.begin(), p1.end());
     ASSERT_GT(p1.size(), 16u * n);
+    ASSERT_LT(p1[n - 1].first, p1[n].first);  // no tie at the cut
     double best = 1e300;
     int best_id = -1;
     for (int i = 0; i < n; ++i) {
