@@ -609,11 +609,20 @@ void Synthesizer::select_smallest(const SearchImage& s, std::size_t n) {
   scored_.clear();
   const float* e = err_.data();
   if (N > 16 * n) {
-    sample_.clear();
-    for (std::size_t i = 0; i < N; i += 8) sample_.push_back(e[i]);
-    const std::size_t r = std::min(sample_.size() - 1, (2 * n + 7) / 8);
-    std::nth_element(sample_.begin(), sample_.begin() + r, sample_.end());
-    const float T = sample_[r];
+    // The r+1 smallest of the sample, kept sorted; after the first r+1 an
+    // element enters only if it beats the largest kept (rarely, and a
+    // predictable branch, unlike a partition-based nth_element).
+    const std::size_t r = (2 * n + 7) / 8;  // < N / 8: the sample is larger
+    sample_.assign(r + 1, std::numeric_limits<float>::infinity());
+    float* top = sample_.data();
+    for (std::size_t i = 0; i < N; i += 8) {
+      const float v = e[i];
+      if (!(v < top[r])) continue;
+      std::size_t j = r;
+      for (; j > 0 && top[j - 1] > v; --j) top[j] = top[j - 1];
+      top[j] = v;
+    }
+    const float T = top[r];
     if (collect_.size() < N) collect_.resize(N);
     Scored* const begin = collect_.data();
     Scored* const end = collect_at_most(e, s.ids.data(), N, T, begin);

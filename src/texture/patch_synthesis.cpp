@@ -301,15 +301,31 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   // image is a boundary condition for p (synthesised before p in the order).
   auto synth_one = [&](int p, int pass, const auto& available, bool pixel_parallel) {
     const FlatPatch& fp = patches[p];
+    // Synthesis runs on the bounding box of the patch's Inside and Boundary
+    // pixels (most of the raster is Outside); row-major order, relative
+    // positions and hence the result are those of the full raster.
+    int x0 = R, y0 = R, x1 = -1, y1 = -1;
+    for (int y = 0; y < R; ++y)
+      for (int x = 0; x < R; ++x)
+        if (fp.pixel[static_cast<std::size_t>(y) * R + x] != PatchPixel::Outside) {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = std::max(y1, y);
+        }
+    if (x1 < 0) x0 = y0 = x1 = y1 = 0;  // nothing to do: one Outside pixel
+    const int BW = x1 - x0 + 1, BH = y1 - y0 + 1;
+    const std::size_t BN = static_cast<std::size_t>(BW) * BH;
     ElInput in;
     in.prepared = prepared;
-    in.target = Image(R, R, C, 0.f);
-    in.state.assign(N, PixelState::Outside);
+    in.target = Image(BW, BH, C, 0.f);
+    in.state.assign(BN, PixelState::Outside);
     const Vector3 e1 = vec(fp.e1), e2 = vec(fp.e2);
-    if (oriented) in.angle = Image(R, R, 1, 0.f);
-    if (opt.multi != MultiTexture::None) in.exemplar_index.assign(N, 0);
+    if (oriented) in.angle = Image(BW, BH, 1, 0.f);
+    if (opt.multi != MultiTexture::None) in.exemplar_index.assign(BN, 0);
     double mean_c = 0, mean_s = 0;
-    for (std::size_t i = 0; i < N; ++i) {
+    for (std::size_t j = 0; j < BN; ++j) {
+      const std::size_t i = static_cast<std::size_t>(y0 + j / BW) * R + x0 + j % BW;
       const PatchPixel kind = fp.pixel[i];
       if (kind == PatchPixel::Outside) continue;
       const FaceIndex f(static_cast<Mesh::size_type>(fp.pixel_face[i]));
@@ -322,13 +338,13 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
         const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
         const auto pq = fq.to_pixel(u, v);
-        if (sample_inside(fq, res.images[q], pq[0], pq[1], &in.target.data[i * C])) {
-          in.state[i] = PixelState::Known;
+        if (sample_inside(fq, res.images[q], pq[0], pq[1], &in.target.data[j * C])) {
+          in.state[j] = PixelState::Known;
           ++known[p];
         }
         continue;
       }
-      in.state[i] = PixelState::Fill;
+      in.state[j] = PixelState::Fill;
       const auto vv = face_vertices(mesh, f);
       if (oriented) {
         const Vector3 fd = fdir[f.idx()];
@@ -341,7 +357,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         double du = d * e1, dv = d * e2;
         if (du * du + dv * dv < 1e-12) { du = fd * e1; dv = fd * e2; }
         const double a = std::atan2(dv, du);  // exemplar +x along (du, dv) in the plane
-        in.angle.data[i] = static_cast<float>(a);
+        in.angle.data[j] = static_cast<float>(a);
         mean_c += std::cos(line_field ? 2 * a : a);
         mean_s += std::sin(line_field ? 2 * a : a);
       }
@@ -354,7 +370,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         } else {
           tt = b[0] * vt[vv[0].idx()] + b[1] * vt[vv[1].idx()] + b[2] * vt[vv[2].idx()];
         }
-        in.exemplar_index[i] = std::clamp(static_cast<int>(std::floor(tt * E)), 0, E - 1);
+        in.exemplar_index[j] = std::clamp(static_cast<int>(std::floor(tt * E)), 0, E - 1);
       }
     }
     ElOptions eo = opt.el;
@@ -373,9 +389,11 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
     seeded[p] += r.seeded;
     // Keep only Inside pixels in the stored image (boundary filled at the end).
     Image& img = res.images[p];
-    for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = 0; j < BN; ++j) {
+      const std::size_t i = static_cast<std::size_t>(y0 + j / BW) * R + x0 + j % BW;
       if (fp.pixel[i] == PatchPixel::Inside)
-        for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[i * C + c];
+        for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[j * C + c];
+    }
     if (opt.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
       report_progress(opt.progress, "synthesis", static_cast<double>(++step) / steps);
