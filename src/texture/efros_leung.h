@@ -47,12 +47,15 @@
 // are merged under the total order (error, candidate position), so the result
 // is the same bytes for any thread count.
 //
-// Speed (exact, no approximation): pass 1 runs over channel planes, 8
-// consecutive candidates per vector register, abandoning a group of 8 as soon
-// as all its partial sums exceed the current n-th best (a bounded heap keyed
-// by (error, position)). Exemplar preparation (rotations, channel planes,
-// candidate lists) can be done once for many runs (el_prepare_exemplars), as
-// the patch pipeline does for its hundreds of patches.
+// Speed (exact, no approximation): pass 1 computes every candidate's error
+// over channel planes, 8 consecutive candidates per vector register; the n
+// best are then found without sorting thousands of candidates: a threshold
+// guessed from every 8th error keeps about 2n of them (checked: if fewer
+// than n pass, all are ranked), ranked by (error, position). Pass 2 ranks
+// only the best max(pick_min, ...) it picks from. Exemplar preparation
+// (rotations, channel planes, candidate lists) can be done once for many
+// runs (el_prepare_exemplars), as the patch pipeline does for its hundreds
+// of patches.
 //
 // Throws InvalidInputError naming the option or input on any invalid value.
 
