@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 #include "geometry/errors.h"
 #include "geometry/mesh_util.h"
@@ -207,7 +208,7 @@ TEST(PatchSynthesis, SameBytesForOneThreadAndAllThreads) {
   auto run = [&] {
     Mesh m;
     make_icosphere(m, 2);
-    PatchSynthesisOptions o = small_options(24);
+    PatchSynthesisOptions o = small_options(sanitized() ? 16 : 24);
     o.partition.max_faces = 12;  // many patches, so several are ready at once
     o.field = PatchField::Constant;
     o.seed = 9;
@@ -249,6 +250,18 @@ TEST(PatchSynthesis, BadInputThrows) {
   PatchSynthesisOptions cv = o;
   cv.constant_vector = {0, 0, 0};
   EXPECT_THROW(synthesize_patches(m, {ex}, cv), InvalidInputError);
+  // A 9x9 window fits a 10x10 exemplar unrotated, but no rotation by 45
+  // degrees of it: thrown inside a patch task, it must reach the caller.
+  const Image tiny = make_noise(10, 2, 1);
+  PatchSynthesisOptions rot = o;
+  rot.field = PatchField::Constant;
+  rot.el.rotations = 8;
+  try {
+    synthesize_patches(m, {tiny}, rot);
+    ADD_FAILURE() << "no exception";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rotated"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
