@@ -5,6 +5,13 @@
 // larger case (128x128 -> 256x256, window 11, default first pass and
 // preselect). Prints one JSON line per case: best of 3 runs.
 //
+// Measured (2 cores shared with other builds, load average 15-17; the old
+// and new binaries back to back, same output bytes):
+//   Fig 5 before: 2.63 s CPU, 6.60 s wall (9.9K texels/s under that load)
+//   Fig 5 now:    1.37 s CPU, 3.64 s wall (18.0K texels/s under that load);
+//                 single thread 1.30-1.34 s CPU (was 2.42-2.50 s)
+//   w11 128 -> 256 now: 4.16 s CPU, 12.0 s wall under that load.
+//
 // Usage: bench_synthesis [texture.png] [out_prefix] [threads] [only_fig5]
 // (default: leather_64.png from the shared data, no PNG output, all cores;
 // out_prefix writes the results as PNG; "" keeps a default).

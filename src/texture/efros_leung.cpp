@@ -2,13 +2,17 @@
 // Two-pass Efros-Leung synthesis (Gorla et al. 2003, 3.3, 3.3.2, 5).
 #include "texture/efros_leung.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <queue>
 #include <random>
 #include <string>
@@ -27,41 +31,65 @@ constexpr std::size_t kPad = 4 * kLanes;
 
 // Pass-1 kernel: unweighted SSD of `len` consecutive candidate positions
 // starting at buffer index `row`, over `nk` known neighbours (buffer offsets
-// delta[k], values tv[k * C + c]). Candidates are processed 8 at a time in one
-// vector register (GCC vector extension), so the accumulator never leaves the
-// register; every lane performs the same operations in the same order, so
-// the result does not depend on the instruction set picked at run time.
-// Early abandon: every 4 neighbours, if all 8 partial sums exceed `limit`
-// (the current n-th best) the group stops; its outputs are then partial
-// sums, already > limit, which the caller discards as it would the full ones.
+// delta[k], values tv[k * C + c]), written to out[0..len). Candidates are
+// processed 8 at a time in one vector register (GCC vector extension), so
+// the accumulators never leave the registers; every lane performs the same
+// operations in the same order, so the result does not depend on the
+// instruction set picked at run time (no FMA contraction: the project builds
+// with -std=c++17, i.e. -ffp-contract=off). Even and odd neighbours go to two
+// accumulators, and the channels of one neighbour are summed as a tree, so
+// that the loop is bound by throughput, not by the latency of one chain of
+// additions.
 typedef float V8 __attribute__((vector_size(kLanes * sizeof(float))));
 typedef int I8 __attribute__((vector_size(kLanes * sizeof(int))));
+
+// acc += sum over channels of (planes[c][base] - t[c])^2, 8 lanes.
+template <int C>
+__attribute__((always_inline)) inline void add_neighbour_sq(V8& acc, const float* base,
+                                                            std::size_t plane_size, const float* t) {
+  V8 v0;
+  std::memcpy(&v0, base, sizeof(V8));
+  const V8 d0 = v0 - t[0];
+  if constexpr (C == 1) {
+    acc += d0 * d0;
+  } else {
+    V8 v1;
+    std::memcpy(&v1, base + plane_size, sizeof(V8));
+    const V8 d1 = v1 - t[1];
+    V8 s = d0 * d0 + d1 * d1;
+    if constexpr (C >= 3) {
+      V8 v2;
+      std::memcpy(&v2, base + 2 * plane_size, sizeof(V8));
+      const V8 d2 = v2 - t[2];
+      V8 s2 = d2 * d2;
+      if constexpr (C == 4) {
+        V8 v3;
+        std::memcpy(&v3, base + 3 * plane_size, sizeof(V8));
+        const V8 d3 = v3 - t[3];
+        s2 += d3 * d3;
+      }
+      s += s2;
+    }
+    acc += s;
+  }
+}
 
 template <int C>
 __attribute__((always_inline)) inline void span_ssd_impl(const float* planes, std::size_t plane_size,
                                                          const int* delta, const float* tv, int nk,
-                                                         int len, std::size_t row, float limit,
-                                                         float* out) {
+                                                         int len, std::size_t row, float* out) {
   for (int i = 0; i < len; i += kLanes) {
-    V8 acc = {};
-    V8 lim;
-    for (int l = 0; l < kLanes; ++l) lim[l] = limit;
-    for (int k = 0; k < nk; ++k) {
-      const float* base = planes + row + i + delta[k];
-      for (int c = 0; c < C; ++c) {
-        V8 v;
-        std::memcpy(&v, base + c * plane_size, sizeof(V8));
-        const V8 d = v - tv[k * C + c];
-        acc += d * d;
-      }
-      if ((k & 3) == 3) {
-        const I8 over = acc > lim;
-        int all = -1;
-        for (int l = 0; l < kLanes; ++l) all &= over[l];
-        if (all) break;
-      }
+    const float* p = planes + row + i;
+    V8 acc0 = {}, acc1 = {};
+    int k = 0;
+    for (; k + 2 <= nk; k += 2) {
+      add_neighbour_sq<C>(acc0, p + delta[k], plane_size, tv + k * C);
+      add_neighbour_sq<C>(acc1, p + delta[k + 1], plane_size, tv + (k + 1) * C);
     }
-    std::memcpy(out + i, &acc, sizeof(V8));  // out has room for a full group
+    if (k < nk) add_neighbour_sq<C>(acc0, p + delta[k], plane_size, tv + k * C);
+    const V8 acc = acc0 + acc1;
+    // Never past out[len): spans of different threads are adjacent in out.
+    std::memcpy(out + i, &acc, sizeof(float) * std::min(kLanes, len - i));
   }
 }
 
@@ -72,63 +100,97 @@ __attribute__((always_inline)) inline void span_ssd_impl(const float* planes, st
 #endif
 
 SURFTEX_SIMD_CLONES void span_ssd_c1(const float* p, std::size_t ps, const int* d, const float* t,
-                                     int nk, int len, std::size_t row, float lim, float* out) {
-  span_ssd_impl<1>(p, ps, d, t, nk, len, row, lim, out);
+                                     int nk, int len, std::size_t row, float* out) {
+  span_ssd_impl<1>(p, ps, d, t, nk, len, row, out);
 }
 SURFTEX_SIMD_CLONES void span_ssd_c3(const float* p, std::size_t ps, const int* d, const float* t,
-                                     int nk, int len, std::size_t row, float lim, float* out) {
-  span_ssd_impl<3>(p, ps, d, t, nk, len, row, lim, out);
+                                     int nk, int len, std::size_t row, float* out) {
+  span_ssd_impl<3>(p, ps, d, t, nk, len, row, out);
 }
 SURFTEX_SIMD_CLONES void span_ssd_c4(const float* p, std::size_t ps, const int* d, const float* t,
-                                     int nk, int len, std::size_t row, float lim, float* out) {
-  span_ssd_impl<4>(p, ps, d, t, nk, len, row, lim, out);
+                                     int nk, int len, std::size_t row, float* out) {
+  span_ssd_impl<4>(p, ps, d, t, nk, len, row, out);
 }
-// Pass-2 kernel: Gaussian-weighted SSD of one candidate `id`. The window is
-// stored per active row as nv groups of 8 offsets starting at buffer offset
-// roff[r]; weights are 0 at unknown offsets (and past the window), so they
-// contribute exactly 0. Lanes are summed in a fixed order at the end.
+// Pass-2 kernel: Gaussian-weighted SSD of the candidates ids[0..count),
+// into out. The window is stored per active row as nv groups of 8 offsets
+// starting at buffer offset roff[r]; weights are 0 at unknown offsets (and
+// past the window), so they contribute exactly 0. Even and odd rows go to
+// two accumulators; lanes are summed in a fixed order at the end.
 template <int C>
-__attribute__((always_inline)) inline float weighted_ssd_impl(const float* planes,
-                                                              std::size_t plane_size, int Cr,
-                                                              const int* roff, const float* w,
-                                                              const float* t, int nrows, int nv,
-                                                              int id) {
+__attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes,
+                                                             std::size_t plane_size, int Cr,
+                                                             const int* roff, const float* w,
+                                                             const float* t, int nrows, int nv,
+                                                             const int* ids, std::size_t count,
+                                                             float* out) {
   const int ch = C > 0 ? C : Cr;
-  V8 acc = {};
-  for (int r = 0; r < nrows; ++r)
-    for (int g = 0; g < nv; ++g) {
-      const std::size_t o = static_cast<std::size_t>(r) * nv + g;
-      V8 wv;
-      std::memcpy(&wv, w + o * kLanes, sizeof(V8));
-      V8 sq = {};
-      for (int c = 0; c < ch; ++c) {
-        V8 v, tv;
-        std::memcpy(&v, planes + c * plane_size + id + roff[r] + g * kLanes, sizeof(V8));
-        std::memcpy(&tv, t + ((static_cast<std::size_t>(r) * ch + c) * nv + g) * kLanes, sizeof(V8));
-        const V8 d = v - tv;
-        sq += d * d;
+  for (std::size_t j = 0; j < count; ++j) {
+    const int id = ids[j];
+    V8 acc[2] = {{}, {}};
+    for (int r = 0; r < nrows; ++r)
+      for (int g = 0; g < nv; ++g) {
+        const std::size_t o = static_cast<std::size_t>(r) * nv + g;
+        V8 wv;
+        std::memcpy(&wv, w + o * kLanes, sizeof(V8));
+        V8 sq = {};
+        for (int c = 0; c < ch; ++c) {
+          V8 v, tv;
+          std::memcpy(&v, planes + c * plane_size + id + roff[r] + g * kLanes, sizeof(V8));
+          std::memcpy(&tv, t + ((static_cast<std::size_t>(r) * ch + c) * nv + g) * kLanes,
+                      sizeof(V8));
+          const V8 d = v - tv;
+          sq += d * d;
+        }
+        acc[r & 1] += wv * sq;
       }
-      acc += wv * sq;
+    const V8 a = acc[0] + acc[1];
+    float e = 0.f;
+    for (int l = 0; l < kLanes; ++l) e += a[l];
+    out[j] = e;
+  }
+}
+#define SURFTEX_WEIGHTED_ARGS                                                                 \
+  const float *p, std::size_t ps, const int *ro, const float *w, const float *t, int nr, int nv, \
+      const int *ids, std::size_t count, float *out
+SURFTEX_SIMD_CLONES void weighted_ssd_c1(SURFTEX_WEIGHTED_ARGS) {
+  weighted_ssd_impl<1>(p, ps, 1, ro, w, t, nr, nv, ids, count, out);
+}
+SURFTEX_SIMD_CLONES void weighted_ssd_c3(SURFTEX_WEIGHTED_ARGS) {
+  weighted_ssd_impl<3>(p, ps, 3, ro, w, t, nr, nv, ids, count, out);
+}
+SURFTEX_SIMD_CLONES void weighted_ssd_c4(SURFTEX_WEIGHTED_ARGS) {
+  weighted_ssd_impl<4>(p, ps, 4, ro, w, t, nr, nv, ids, count, out);
+}
+void weighted_ssd_any(int C, SURFTEX_WEIGHTED_ARGS) {
+  weighted_ssd_impl<0>(p, ps, C, ro, w, t, nr, nv, ids, count, out);
+}
+#undef SURFTEX_WEIGHTED_ARGS
+
+// Appends (e[i], ids[i]) for every i < N with e[i] <= T to out (room for N
+// entries); returns the new end. Tests 8 errors at a time and only looks at single lanes when one
+// of the 8 passes (a few percent of the groups).
+SURFTEX_SIMD_CLONES std::pair<float, int>* collect_at_most(const float* e, const int* ids,
+                                                           std::size_t N, float T,
+                                                           std::pair<float, int>* out) {
+  V8 t;
+  for (int l = 0; l < kLanes; ++l) t[l] = T;
+  std::size_t i = 0;
+  for (; i + kLanes <= N; i += kLanes) {
+    V8 v;
+    std::memcpy(&v, e + i, sizeof(V8));
+    I8 m = v <= t;  // -1 in lanes <= T
+    m |= __builtin_shuffle(m, I8{4, 5, 6, 7, 0, 1, 2, 3});
+    m |= __builtin_shuffle(m, I8{2, 3, 0, 1, 6, 7, 4, 5});
+    m |= __builtin_shuffle(m, I8{1, 0, 3, 2, 5, 4, 7, 6});
+    if (!m[0]) continue;
+    for (int l = 0; l < kLanes; ++l) {  // branch-free: write, keep if <= T
+      *out = {e[i + l], ids[i + l]};
+      out += e[i + l] <= T;
     }
-  float e = 0.f;
-  for (int l = 0; l < kLanes; ++l) e += acc[l];
-  return e;
-}
-SURFTEX_SIMD_CLONES float weighted_ssd_c1(const float* p, std::size_t ps, const int* ro,
-                                          const float* w, const float* t, int nr, int nv, int id) {
-  return weighted_ssd_impl<1>(p, ps, 1, ro, w, t, nr, nv, id);
-}
-SURFTEX_SIMD_CLONES float weighted_ssd_c3(const float* p, std::size_t ps, const int* ro,
-                                          const float* w, const float* t, int nr, int nv, int id) {
-  return weighted_ssd_impl<3>(p, ps, 3, ro, w, t, nr, nv, id);
-}
-SURFTEX_SIMD_CLONES float weighted_ssd_c4(const float* p, std::size_t ps, const int* ro,
-                                          const float* w, const float* t, int nr, int nv, int id) {
-  return weighted_ssd_impl<4>(p, ps, 4, ro, w, t, nr, nv, id);
-}
-float weighted_ssd_any(const float* p, std::size_t ps, int C, const int* ro, const float* w,
-                       const float* t, int nr, int nv, int id) {
-  return weighted_ssd_impl<0>(p, ps, C, ro, w, t, nr, nv, id);
+  }
+  for (; i < N; ++i)
+    if (e[i] <= T) *out++ = {e[i], ids[i]};
+  return out;
 }
 
 // Any channel count: accumulate channel by channel (C = 2 or > 4).
@@ -158,6 +220,7 @@ struct SearchImage {
     int y, x0, x1;  // centres (x0..x1-1, y)
   };
   std::vector<Span> spans;
+  std::vector<int> span_first;  // per span: index in ids of its first candidate
   std::vector<int> ids;  // every candidate position y*pw+x, increasing
   // Span blocks of roughly equal size for the parallel pass 1.
   std::vector<std::pair<int, int>> blocks;
@@ -208,6 +271,7 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
     }
   }
   for (const auto& sp : s.spans) {
+    s.span_first.push_back(static_cast<int>(s.ids.size()));
     s.max_span = std::max(s.max_span, sp.x1 - sp.x0);
     for (int x = sp.x0; x < sp.x1; ++x) s.ids.push_back(sp.y * s.pw + x);
   }
@@ -227,12 +291,80 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
   return s;
 }
 
-// A known neighbour of the pixel being synthesised.
-struct KnownOffset {
-  int dx, dy;
-  float weight;
-  bool in_first;
+void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& opt) {
+  auto bad = [](const std::string& m) { throw InvalidInputError("efros_leung: " + m); };
+  if (opt.window < 3 || opt.window > 51)
+    bad("window " + std::to_string(opt.window) + " outside 3..51");
+  if (opt.rotations < 1 || opt.rotations > 128)
+    bad("rotations " + std::to_string(opt.rotations) + " outside 1..128");
+  if (exemplars.empty()) bad("exemplars: none given");
+  for (std::size_t e = 0; e < exemplars.size(); ++e) {
+    const Image& ex = exemplars[e];
+    if (ex.empty() || ex.data.size() != static_cast<std::size_t>(ex.width) * ex.height * ex.channels)
+      bad("exemplar " + std::to_string(e) + " is empty");
+    if (ex.channels != exemplars[0].channels)
+      bad("exemplar " + std::to_string(e) + " has " + std::to_string(ex.channels) +
+          " channels, exemplar 0 has " + std::to_string(exemplars[0].channels));
+    if (!opt.periodic_exemplar && (ex.width < opt.window || ex.height < opt.window))
+      bad("exemplar " + std::to_string(e) + " (" + std::to_string(ex.width) + "x" +
+          std::to_string(ex.height) + ") is smaller than the window " +
+          std::to_string(opt.window));
+    for (float v : ex.data)
+      if (!std::isfinite(v)) bad("exemplar " + std::to_string(e) + " holds a non-finite value");
+  }
+}
+
+}  // namespace
+
+// Search images built on first use: slot e * rotations + k holds exemplar e
+// rotated by 2 pi k / rotations. A slot, once built, never changes, so
+// readers only need the acquire load of its pointer.
+struct ElPreparedExemplars {
+  std::vector<Image> exemplars;
+  int window = 0, rotations = 1;
+  bool periodic = false;
+  mutable std::mutex build_mutex;
+  mutable std::vector<std::unique_ptr<SearchImage>> storage;
+  mutable std::unique_ptr<std::atomic<const SearchImage*>[]> slots;
+
+  const SearchImage& get(int e, int k) const {
+    const std::size_t i = static_cast<std::size_t>(e) * rotations + k;
+    if (const SearchImage* s = slots[i].load(std::memory_order_acquire)) return *s;
+    std::lock_guard<std::mutex> lock(build_mutex);
+    if (const SearchImage* s = slots[i].load(std::memory_order_relaxed)) return *s;
+    const Image& ex = exemplars[e];
+    const int margin = std::max(-lo_of(window), hi_of(window));
+    RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
+    auto s = std::make_unique<SearchImage>(
+        make_search_image(r, window, periodic, margin, ex.width, ex.height));
+    if (s->ids.empty())
+      throw InvalidInputError("efros_leung: exemplar " + std::to_string(e) + " rotated by " +
+                              std::to_string(360.0 * k / rotations) +
+                              " degrees has no position where the whole window " +
+                              std::to_string(window) +
+                              " fits; use a larger exemplar, a smaller window or "
+                              "periodic_exemplar");
+    storage.push_back(std::move(s));
+    slots[i].store(storage.back().get(), std::memory_order_release);
+    return *storage.back();
+  }
 };
+
+namespace {
+
+std::shared_ptr<ElPreparedExemplars> prepare(const std::vector<Image>& exemplars,
+                                             const ElOptions& opt) {
+  validate_exemplars(exemplars, opt);
+  auto p = std::make_shared<ElPreparedExemplars>();
+  p->exemplars = exemplars;
+  p->window = opt.window;
+  p->rotations = opt.rotations;
+  p->periodic = opt.periodic_exemplar;
+  const std::size_t n = exemplars.size() * static_cast<std::size_t>(opt.rotations);
+  p->slots = std::make_unique<std::atomic<const SearchImage*>[]>(n);
+  for (std::size_t i = 0; i < n; ++i) p->slots[i].store(nullptr, std::memory_order_relaxed);
+  return p;
+}
 
 class Synthesizer {
  public:
@@ -245,6 +377,7 @@ class Synthesizer {
   int search_key(int p) const { return key_[p]; }
   void gather_known(int p, const SearchImage& s);
   int pass1(const SearchImage& s, std::size_t n);
+  void select_smallest(const SearchImage& s, std::size_t n);
   void score_full(const SearchImage& s, const std::vector<int>& ids, std::vector<Scored>& out);
   void synthesize_pixel(int p);
   void seed_patch(int p);
@@ -252,13 +385,14 @@ class Synthesizer {
 
   const ElInput& in_;
   const ElOptions& opt_;
+  std::shared_ptr<const ElPreparedExemplars> prep_;
   int W = 0, H = 0, C = 0, window_ = 0, first_ = 0;
   double sigma_ = 0;
   std::vector<PixelState> state_;
   std::vector<std::uint8_t> known_;
   Image out_;
   std::vector<int> key_;                 // per pixel: index into search_ (or -1)
-  std::vector<SearchImage> search_;
+  std::vector<const SearchImage*> search_;
   std::vector<float> gauss_;             // per full-window offset
   std::mt19937_64 rng_;
   // Onion-peel bookkeeping.
@@ -269,16 +403,14 @@ class Synthesizer {
   std::vector<int> delta_;               // buffer offset per known neighbour
   std::vector<float> value_;             // known values, [k * C + c]
   std::vector<float> weight_;            // Gaussian weight per known neighbour
-  std::vector<int> first_idx_;           // known neighbours inside the first-pass window
   std::vector<int> p2_roff_;
   std::vector<float> p2_w_, p2_t_;
   int p2_row_dy_ = 0;
   std::vector<int> p1_delta_;
   std::vector<float> p1_value_;
-  std::vector<std::vector<Scored>> block_heaps_;
-  std::vector<std::vector<float>> block_acc_;
+  std::vector<float> err_, sample_, p2_err_;
   std::vector<int> pre_;
-  std::vector<Scored> scored_;
+  std::vector<Scored> scored_, collect_;
   std::size_t synthesized_ = 0, seeded_ = 0;
 };
 
@@ -298,35 +430,35 @@ void Synthesizer::validate() {
   if (opt_.pick_min < 1) bad("pick_min " + std::to_string(opt_.pick_min) + " < 1");
   if (!std::isfinite(opt_.error_tolerance))
     bad("error_tolerance " + std::to_string(opt_.error_tolerance) + " is not finite");
-  if (opt_.rotations < 1 || opt_.rotations > 128)
-    bad("rotations " + std::to_string(opt_.rotations) + " outside 1..128");
   if (opt_.order == FillOrder::Direction &&
       (!std::isfinite(opt_.direction_x) || !std::isfinite(opt_.direction_y) ||
        (opt_.direction_x == 0.0 && opt_.direction_y == 0.0)))
     bad("direction (" + std::to_string(opt_.direction_x) + ", " +
         std::to_string(opt_.direction_y) + ") must be finite and non-zero");
-  if (in_.exemplars.empty()) bad("exemplars: none given");
-  for (std::size_t e = 0; e < in_.exemplars.size(); ++e) {
-    const Image& ex = in_.exemplars[e];
-    if (ex.empty() || ex.data.size() != static_cast<std::size_t>(ex.width) * ex.height * ex.channels)
-      bad("exemplar " + std::to_string(e) + " is empty");
-    if (ex.channels != in_.exemplars[0].channels)
-      bad("exemplar " + std::to_string(e) + " has " + std::to_string(ex.channels) +
-          " channels, exemplar 0 has " + std::to_string(in_.exemplars[0].channels));
-    if (!opt_.periodic_exemplar && (ex.width < opt_.window || ex.height < opt_.window))
-      bad("exemplar " + std::to_string(e) + " (" + std::to_string(ex.width) + "x" +
-          std::to_string(ex.height) + ") is smaller than the window " +
-          std::to_string(opt_.window));
-    for (float v : ex.data)
-      if (!std::isfinite(v)) bad("exemplar " + std::to_string(e) + " holds a non-finite value");
+  if (in_.prepared) {
+    if (!in_.exemplars.empty()) bad("exemplars and prepared are both given; give one");
+    const ElPreparedExemplars& p = *in_.prepared;
+    if (p.window != opt_.window)
+      bad("window " + std::to_string(opt_.window) + " differs from the prepared exemplars' " +
+          std::to_string(p.window));
+    if (p.rotations != opt_.rotations)
+      bad("rotations " + std::to_string(opt_.rotations) +
+          " differs from the prepared exemplars' " + std::to_string(p.rotations));
+    if (p.periodic != opt_.periodic_exemplar)
+      bad(std::string("periodic_exemplar ") + (opt_.periodic_exemplar ? "true" : "false") +
+          " differs from the prepared exemplars'");
+    prep_ = in_.prepared;
+  } else {
+    prep_ = prepare(in_.exemplars, opt_);
   }
+  const std::vector<Image>& exemplars = prep_->exemplars;
   const Image& t = in_.target;
   if (t.width <= 0 || t.height <= 0)
     bad("target size " + std::to_string(t.width) + "x" + std::to_string(t.height) +
         " must be positive");
-  if (t.channels != in_.exemplars[0].channels)
+  if (t.channels != exemplars[0].channels)
     bad("target has " + std::to_string(t.channels) + " channels, the exemplars " +
-        std::to_string(in_.exemplars[0].channels));
+        std::to_string(exemplars[0].channels));
   const std::size_t n = static_cast<std::size_t>(t.width) * t.height;
   if (t.data.size() != n * t.channels) bad("target data size does not match its dimensions");
   if (!in_.state.empty() && in_.state.size() != n)
@@ -348,8 +480,8 @@ void Synthesizer::validate() {
 void Synthesizer::prepare_search_images() {
   const std::size_t n = static_cast<std::size_t>(W) * H;
   const bool oriented = !in_.angle.empty() || static_cast<bool>(in_.angle_fn);
-  const int K = oriented ? opt_.rotations : 1;
-  const int E = static_cast<int>(in_.exemplars.size());
+  const int K = opt_.rotations;
+  const int E = static_cast<int>(prep_->exemplars.size());
   std::vector<int> pair_of(n, -1);
   std::vector<std::uint8_t> needed(static_cast<std::size_t>(E) * K, 0);
   for (std::size_t p = 0; p < n; ++p) {
@@ -375,22 +507,11 @@ void Synthesizer::prepare_search_images() {
     needed[pair_of[p]] = 1;
   }
   std::vector<int> slot(needed.size(), -1);
-  const int margin = std::max(-lo_of(window_), hi_of(window_));
   for (int e = 0; e < E; ++e)
     for (int k = 0; k < K; ++k) {
       if (!needed[e * K + k]) continue;
-      const Image& ex = in_.exemplars[e];
-      RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / K, opt_.periodic_exemplar, margin);
-      SearchImage s = make_search_image(r, window_, opt_.periodic_exemplar, margin, ex.width, ex.height);
-      if (s.ids.empty())
-        throw InvalidInputError("efros_leung: exemplar " + std::to_string(e) + " rotated by " +
-                                std::to_string(360.0 * k / K) +
-                                " degrees has no position where the whole window " +
-                                std::to_string(window_) +
-                                " fits; use a larger exemplar, a smaller window or "
-                                "periodic_exemplar");
       slot[e * K + k] = static_cast<int>(search_.size());
-      search_.push_back(std::move(s));
+      search_.push_back(&prep_->get(e, k));
     }
   key_.assign(n, -1);
   for (std::size_t p = 0; p < n; ++p)
@@ -401,7 +522,8 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   delta_.clear();
   value_.clear();
   weight_.clear();
-  first_idx_.clear();
+  p1_delta_.clear();
+  p1_value_.clear();
   const int px = p % W, py = p / W;
   const int lo = lo_of(window_), hi = hi_of(window_);
   const int flo = lo_of(first_), fhi = hi_of(first_);
@@ -416,11 +538,13 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
       if (x < 0 || y < 0 || x >= W || y >= H) continue;
       const int q = y * W + x;
       if (!known_[q]) continue;
-      if (dx >= flo && dx <= fhi && dy >= flo && dy <= fhi)
-        first_idx_.push_back(static_cast<int>(delta_.size()));
+      const float* v = out_.pixel(x, y);
+      if (dx >= flo && dx <= fhi && dy >= flo && dy <= fhi) {
+        p1_delta_.push_back(dy * s.pw + dx);
+        p1_value_.insert(p1_value_.end(), v, v + C);
+      }
       delta_.push_back(dy * s.pw + dx);
       weight_.push_back(gauss_[g]);
-      const float* v = out_.pixel(x, y);
       value_.insert(value_.end(), v, v + C);
       // Row-grouped copy for the pass-2 kernel.
       if (p2_roff_.empty() || p2_row_dy_ != dy) {
@@ -436,79 +560,85 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
 }
 
 // Pass 1: the n best candidates by unweighted SSD over the known neighbours
-// listed in first_idx_ (or all known neighbours if none is in the small
-// window). Writes pre_ (ids, increasing error). Returns the count.
+// inside the first-pass window (p1_delta_/p1_value_; all known neighbours if
+// none is). Writes pre_ (ids, in no particular order). Returns the count.
 int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
-  std::vector<int> use = first_idx_;
-  if (use.empty())
-    for (int k = 0; k < static_cast<int>(delta_.size()); ++k) use.push_back(k);
+  if (p1_delta_.empty()) {
+    p1_delta_ = delta_;
+    p1_value_ = value_;
+  }
   const int nb = static_cast<int>(s.blocks.size());
-  if (static_cast<int>(block_heaps_.size()) < nb) {
-    block_heaps_.resize(nb);
-    block_acc_.resize(nb);
-  }
-  // Offsets and values of the neighbours pass 1 compares, contiguous.
-  p1_delta_.clear();
-  p1_value_.clear();
-  for (int k : use) {
-    p1_delta_.push_back(delta_[k]);
-    p1_value_.insert(p1_value_.end(), value_.begin() + static_cast<std::ptrdiff_t>(k) * C,
-                     value_.begin() + static_cast<std::ptrdiff_t>(k + 1) * C);
-  }
   const int nk = static_cast<int>(p1_delta_.size());
   const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
-  // Each block keeps a buffer of candidates that may still be among the n
-  // best: those with error <= limit, the n-th smallest error seen so far
-  // (re-established by nth_element whenever the buffer reaches 8n). Exact:
-  // anything above the limit has n better candidates in the same block.
+  const std::size_t N = s.ids.size();
+  // Every candidate's error, in candidate order (spans of a block are
+  // consecutive in ids, so blocks write disjoint ranges).
+  err_.resize(N);
   auto run_block = [&](int b) {
-    std::vector<Scored>& buf = block_heaps_[b];
-    std::vector<float>& acc = block_acc_[b];
-    buf.clear();
-    acc.resize(s.max_span + kLanes);
-    float* a = acc.data();
-    float limit = std::numeric_limits<float>::infinity();
-    const std::size_t cap = std::max<std::size_t>(8 * n, 64);
     for (int si = s.blocks[b].first; si < s.blocks[b].second; ++si) {
       const auto& sp = s.spans[si];
       const int len = sp.x1 - sp.x0;
       const std::size_t row = static_cast<std::size_t>(sp.y) * s.pw + sp.x0;
+      float* a = err_.data() + s.span_first[si];
       switch (C) {
-        case 1: span_ssd_c1(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
-        case 3: span_ssd_c3(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
-        case 4: span_ssd_c4(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, limit, a); break;
+        case 1: span_ssd_c1(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, a); break;
+        case 3: span_ssd_c3(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, a); break;
+        case 4: span_ssd_c4(s.planes.data(), ps, p1_delta_.data(), p1_value_.data(), nk, len, row, a); break;
         default: span_ssd_any(s.planes.data(), ps, C, p1_delta_.data(), p1_value_.data(), nk, len, row, a);
-      }
-      const int id0 = sp.y * s.pw + sp.x0;
-      for (int i = 0; i < len; ++i)
-        if (a[i] <= limit) buf.push_back({a[i], id0 + i});
-      if (buf.size() >= cap) {
-        std::nth_element(buf.begin(), buf.begin() + (n - 1), buf.end());
-        buf.resize(n);
-        limit = buf[n - 1].first;  // the n-th smallest error
       }
     }
   };
-  const std::size_t work = s.ids.size() * use.size() * static_cast<std::size_t>(C);
-  if (nb > 1 && work > 40000)
+  const std::size_t work = N * static_cast<std::size_t>(nk) * C;
+  if (nb > 1 && opt_.parallel_pixel_search && work > 40000)
     tbb::parallel_for(0, nb, run_block);
   else
     for (int b = 0; b < nb; ++b) run_block(b);
-  scored_.clear();
-  for (int b = 0; b < nb; ++b)
-    scored_.insert(scored_.end(), block_heaps_[b].begin(), block_heaps_[b].end());
-  if (scored_.size() > n) {
-    std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
-    scored_.resize(n);
-  }
-  std::sort(scored_.begin(), scored_.end());
+  select_smallest(s, n);
   pre_.clear();
   for (const auto& v : scored_) pre_.push_back(v.second);
   return static_cast<int>(pre_.size());
 }
 
+// The n smallest (err_[i], ids[i]) into scored_ (in no particular order:
+// pass 2 ranks them again). A threshold T is guessed from every 8th error
+// (the value of rank about 2n among all); if at least n errors are <= T,
+// every member of the n smallest is among them (exact), else all candidates
+// are ranked.
+void Synthesizer::select_smallest(const SearchImage& s, std::size_t n) {
+  const std::size_t N = err_.size();
+  scored_.clear();
+  const float* e = err_.data();
+  if (N > 16 * n) {
+    // The r+1 smallest of the sample, kept sorted; after the first r+1 an
+    // element enters only if it beats the largest kept (rarely, and a
+    // predictable branch, unlike a partition-based nth_element).
+    const std::size_t r = (2 * n + 7) / 8;  // < N / 8: the sample is larger
+    sample_.assign(r + 1, std::numeric_limits<float>::infinity());
+    float* top = sample_.data();
+    for (std::size_t i = 0; i < N; i += 8) {
+      const float v = e[i];
+      if (!(v < top[r])) continue;
+      std::size_t j = r;
+      for (; j > 0 && top[j - 1] > v; --j) top[j] = top[j - 1];
+      top[j] = v;
+    }
+    const float T = top[r];
+    if (collect_.size() < N) collect_.resize(N);
+    Scored* const begin = collect_.data();
+    Scored* const end = collect_at_most(e, s.ids.data(), N, T, begin);
+    if (static_cast<std::size_t>(end - begin) >= n)
+      scored_.assign(begin, end);
+  }
+  if (scored_.empty())
+    for (std::size_t i = 0; i < N; ++i) scored_.push_back({e[i], s.ids[i]});
+  if (scored_.size() > n) {
+    std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
+    scored_.resize(n);
+  }
+}
+
 // Pass 2: Gaussian-weighted SSD over every known neighbour, renormalised by
-// the sum of the known weights; sorted by (error, id).
+// the sum of the known weights; unsorted (the caller ranks what it needs).
 void Synthesizer::score_full(const SearchImage& s, const std::vector<int>& ids,
                              std::vector<Scored>& out) {
   double wsum = 0;
@@ -520,23 +650,25 @@ void Synthesizer::score_full(const SearchImage& s, const std::vector<int>& ids,
   const int nr = static_cast<int>(p2_roff_.size());
   const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
   const float* P = s.planes.data();
-  auto score = [&](std::size_t i) {
-    const int id = ids[i];
-    float e;
+  p2_err_.resize(ids.size());
+  auto score = [&](std::size_t i0, std::size_t i1) {
+    const int* I = ids.data() + i0;
+    float* o = p2_err_.data() + i0;
+    const std::size_t m = i1 - i0;
     switch (C) {
-      case 1: e = weighted_ssd_c1(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
-      case 3: e = weighted_ssd_c3(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
-      case 4: e = weighted_ssd_c4(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id); break;
-      default: e = weighted_ssd_any(P, ps, C, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, id);
+      case 1: weighted_ssd_c1(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      case 3: weighted_ssd_c3(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      case 4: weighted_ssd_c4(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      default: weighted_ssd_any(C, P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o);
     }
-    out[i] = {e * inv, id};
   };
   const std::size_t work = ids.size() * nk * static_cast<std::size_t>(C);
-  if (work > 200000)
-    tbb::parallel_for(std::size_t(0), ids.size(), score);
+  if (opt_.parallel_pixel_search && work > 200000)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) { score(r.begin(), r.end()); });
   else
-    for (std::size_t i = 0; i < ids.size(); ++i) score(i);
-  std::sort(out.begin(), out.end());
+    score(0, ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) out[i] = {p2_err_[i] * inv, ids[i]};
 }
 
 void Synthesizer::mark_filled(int p) {
@@ -555,7 +687,7 @@ void Synthesizer::mark_filled(int p) {
 }
 
 void Synthesizer::seed_patch(int p) {
-  const SearchImage& s = search_[search_key(p)];
+  const SearchImage& s = *search_[search_key(p)];
   const int id = s.ids[rng_() % s.ids.size()];
   const int px = p % W, py = p / W;
   for (int dy = -1; dy <= 1; ++dy)
@@ -573,7 +705,7 @@ void Synthesizer::seed_patch(int p) {
 }
 
 void Synthesizer::synthesize_pixel(int p) {
-  const SearchImage& s = search_[search_key(p)];
+  const SearchImage& s = *search_[search_key(p)];
   gather_known(p, s);
   if (delta_.empty()) {
     seed_patch(p);
@@ -583,10 +715,11 @@ void Synthesizer::synthesize_pixel(int p) {
   if (opt_.single_pass) {
     score_full(s, s.ids, scored_);
   } else {
+    const std::vector<Image>& ex = prep_->exemplars;
     std::size_t n = opt_.preselect > 0 ? static_cast<std::size_t>(opt_.preselect)
-                                       : static_cast<std::size_t>(in_.exemplars[0].width);
+                                       : static_cast<std::size_t>(ex[0].width);
     if (!in_.exemplar_index.empty())
-      n = opt_.preselect > 0 ? n : static_cast<std::size_t>(in_.exemplars[in_.exemplar_index[p]].width);
+      n = opt_.preselect > 0 ? n : static_cast<std::size_t>(ex[in_.exemplar_index[p]].width);
     n = std::min(n, total);
     pass1(s, n);
     score_full(s, pre_, scored_);
@@ -595,6 +728,8 @@ void Synthesizer::synthesize_pixel(int p) {
   std::size_t k = std::max<std::size_t>(static_cast<std::size_t>(opt_.pick_min),
                                         static_cast<std::size_t>(std::ceil(opt_.pick_fraction * m)));
   k = std::min(k, m);
+  // Only the k best, in the total order (error, id), are needed.
+  std::partial_sort(scored_.begin(), scored_.begin() + k, scored_.end());
   if (opt_.error_tolerance >= 0) {
     const double limit = scored_[0].first * (1.0 + opt_.error_tolerance);
     std::size_t within = 1;
@@ -731,6 +866,11 @@ ElResult Synthesizer::run() {
 }
 
 }  // namespace
+
+std::shared_ptr<const ElPreparedExemplars> el_prepare_exemplars(const std::vector<Image>& exemplars,
+                                                                const ElOptions& opt) {
+  return prepare(exemplars, opt);
+}
 
 int el_first_pass_window(const ElOptions& opt) {
   if (opt.first_pass_window > 0) return opt.first_pass_window;

@@ -47,10 +47,21 @@
 // are merged under the total order (error, candidate position), so the result
 // is the same bytes for any thread count.
 //
+// Speed (exact, no approximation): pass 1 computes every candidate's error
+// over channel planes, 8 consecutive candidates per vector register; the n
+// best are then found without sorting thousands of candidates: a threshold
+// guessed from every 8th error keeps about 2n of them (checked: if fewer
+// than n pass, all are ranked), ranked by (error, position). Pass 2 ranks
+// only the best max(pick_min, ...) it picks from. Exemplar preparation
+// (rotations, channel planes, candidate lists) can be done once for many
+// runs (el_prepare_exemplars), as the patch pipeline does for its hundreds
+// of patches.
+//
 // Throws InvalidInputError naming the option or input on any invalid value.
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "geometry/image.h"
@@ -108,17 +119,33 @@ struct ElOptions {
   /// full Gaussian-weighted window (no preselection). Slow; for tests and
   /// comparisons.
   bool single_pass = false;
+  /// Split each pixel's candidate search over TBB threads when the search is
+  /// large enough (the result does not depend on it). Turn off when several
+  /// syntheses run in parallel already (one task per patch), where the
+  /// per-pixel fork/join would cost more than it gains. Default on.
+  bool parallel_pixel_search = true;
   /// Seed of every random choice.
   std::uint64_t seed = 1;
   /// Called with stage "synthesis" and the filled fraction.
   ProgressCallback progress;
 };
 
+/// Exemplars prepared for the search: per (exemplar, orientation) the
+/// rotated exemplar as channel planes and its candidate positions, built
+/// lazily (on first use, thread-safe) and shared by every run given it.
+/// Opaque; made by el_prepare_exemplars.
+struct ElPreparedExemplars;
+
 /// Everything a synthesis run reads besides the options.
 struct ElInput {
   /// One or more exemplars (multi-texturing, Gorla 5), same channel count,
-  /// each at least `window` pixels on each side unless periodic.
+  /// each at least `window` pixels on each side unless periodic. Must be
+  /// empty when `prepared` is given (the prepared exemplars are used).
   std::vector<Image> exemplars;
+  /// Alternative to `exemplars`: exemplars prepared once for many runs
+  /// (el_prepare_exemplars with the same window, rotations and
+  /// periodic_exemplar as the run's options, else InvalidInputError).
+  std::shared_ptr<const ElPreparedExemplars> prepared;
   /// Output canvas: size and channels of the result (channels must match the
   /// exemplars); values at Known pixels are the boundary conditions.
   Image target;
@@ -152,6 +179,13 @@ ElResult efros_leung_synthesize(const ElInput& input, const ElOptions& opt = {})
 /// Convenience: a width x height image grown from one exemplar from scratch.
 Image efros_leung_synthesize(const Image& exemplar, int width, int height,
                              const ElOptions& opt = {});
+
+/// Validates `exemplars` (as efros_leung_synthesize does) and prepares them
+/// for runs with opt.window, opt.rotations and opt.periodic_exemplar (other
+/// options are not read). Rotations are built on first use. Throws
+/// InvalidInputError.
+std::shared_ptr<const ElPreparedExemplars> el_prepare_exemplars(const std::vector<Image>& exemplars,
+                                                                const ElOptions& opt);
 
 /// The effective first-pass window for `opt` (resolves the 0 default).
 int el_first_pass_window(const ElOptions& opt);

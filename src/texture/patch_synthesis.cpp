@@ -2,8 +2,15 @@
 // Patch-based oriented surface synthesis (Gorla et al. 2003, 3-5).
 #include "texture/patch_synthesis.h"
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 
@@ -280,42 +287,64 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   const int R = opt.flatten.resolution;
   const std::size_t N = static_cast<std::size_t>(R) * R;
   res.images.assign(P, Image(R, R, C, 0.f));
-  std::vector<char> done(P, 0);
+  // Exemplar rotations prepared once for every patch (not once per patch).
+  const std::shared_ptr<const ElPreparedExemplars> prepared = el_prepare_exemplars(exemplars, opt.el);
+  // Per patch: texels filled, of which seeded, Known boundary pixels.
+  std::vector<std::size_t> texels(P, 0), seeded(P, 0), known(P, 0);
+  std::mutex progress_mutex;
   const Vector3 light = normalized_or(vec(opt.light), Vector3(0, 0, 1));
   const int E = static_cast<int>(exemplars.size());
   std::size_t step = 0;
   const std::size_t steps = P + opt.resynthesize.size();
 
-  auto synth_one = [&](int p, int pass) {
+  // synth_one(p, pass, available): available(q) says whether patch q's
+  // image is a boundary condition for p (synthesised before p in the order).
+  auto synth_one = [&](int p, int pass, const auto& available, bool pixel_parallel) {
     const FlatPatch& fp = patches[p];
+    // Synthesis runs on the bounding box of the patch's Inside and Boundary
+    // pixels (most of the raster is Outside); row-major order, relative
+    // positions and hence the result are those of the full raster.
+    int x0 = R, y0 = R, x1 = -1, y1 = -1;
+    for (int y = 0; y < R; ++y)
+      for (int x = 0; x < R; ++x)
+        if (fp.pixel[static_cast<std::size_t>(y) * R + x] != PatchPixel::Outside) {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = std::max(y1, y);
+        }
+    if (x1 < 0) x0 = y0 = x1 = y1 = 0;  // nothing to do: one Outside pixel
+    const int BW = x1 - x0 + 1, BH = y1 - y0 + 1;
+    const std::size_t BN = static_cast<std::size_t>(BW) * BH;
     ElInput in;
-    in.exemplars = exemplars;
-    in.target = Image(R, R, C, 0.f);
-    in.state.assign(N, PixelState::Outside);
+    in.prepared = prepared;
+    in.target = Image(BW, BH, C, 0.f);
+    in.state.assign(BN, PixelState::Outside);
     const Vector3 e1 = vec(fp.e1), e2 = vec(fp.e2);
-    if (oriented) in.angle = Image(R, R, 1, 0.f);
-    if (opt.multi != MultiTexture::None) in.exemplar_index.assign(N, 0);
+    if (oriented) in.angle = Image(BW, BH, 1, 0.f);
+    if (opt.multi != MultiTexture::None) in.exemplar_index.assign(BN, 0);
     double mean_c = 0, mean_s = 0;
-    for (std::size_t i = 0; i < N; ++i) {
+    for (std::size_t j = 0; j < BN; ++j) {
+      const std::size_t i = static_cast<std::size_t>(y0 + j / BW) * R + x0 + j % BW;
       const PatchPixel kind = fp.pixel[i];
       if (kind == PatchPixel::Outside) continue;
       const FaceIndex f(static_cast<Mesh::size_type>(fp.pixel_face[i]));
       const auto& b = fp.pixel_bary[i];
       if (kind == PatchPixel::Boundary) {
         const int q = face_patch[f.idx()];
-        if (!done[q]) continue;
+        if (!available(q)) continue;
         const FlatPatch& fq = patches[q];
         const FlatTriangle& tq = fq.triangles[face_slot[f.idx()]];
         const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
         const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
         const auto pq = fq.to_pixel(u, v);
-        if (sample_inside(fq, res.images[q], pq[0], pq[1], &in.target.data[i * C])) {
-          in.state[i] = PixelState::Known;
-          ++res.known_boundary;
+        if (sample_inside(fq, res.images[q], pq[0], pq[1], &in.target.data[j * C])) {
+          in.state[j] = PixelState::Known;
+          ++known[p];
         }
         continue;
       }
-      in.state[i] = PixelState::Fill;
+      in.state[j] = PixelState::Fill;
       const auto vv = face_vertices(mesh, f);
       if (oriented) {
         const Vector3 fd = fdir[f.idx()];
@@ -328,7 +357,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         double du = d * e1, dv = d * e2;
         if (du * du + dv * dv < 1e-12) { du = fd * e1; dv = fd * e2; }
         const double a = std::atan2(dv, du);  // exemplar +x along (du, dv) in the plane
-        in.angle.data[i] = static_cast<float>(a);
+        in.angle.data[j] = static_cast<float>(a);
         mean_c += std::cos(line_field ? 2 * a : a);
         mean_s += std::sin(line_field ? 2 * a : a);
       }
@@ -341,12 +370,13 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
         } else {
           tt = b[0] * vt[vv[0].idx()] + b[1] * vt[vv[1].idx()] + b[2] * vt[vv[2].idx()];
         }
-        in.exemplar_index[i] = std::clamp(static_cast<int>(std::floor(tt * E)), 0, E - 1);
+        in.exemplar_index[j] = std::clamp(static_cast<int>(std::floor(tt * E)), 0, E - 1);
       }
     }
     ElOptions eo = opt.el;
     eo.seed = mix_seed(opt.seed, static_cast<std::uint64_t>(p), static_cast<std::uint64_t>(pass));
     eo.progress = nullptr;
+    eo.parallel_pixel_search = eo.parallel_pixel_search && pixel_parallel;
     if (eo.order == FillOrder::Direction) {
       double a = std::atan2(mean_s, mean_c);
       if (line_field) a *= 0.5;
@@ -355,19 +385,67 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
       eo.direction_y = -std::sin(a);  // pixel y points down
     }
     ElResult r = efros_leung_synthesize(in, eo);
-    res.texels += r.synthesized + r.seeded;
-    res.seeded += r.seeded;
+    texels[p] += r.synthesized + r.seeded;
+    seeded[p] += r.seeded;
     // Keep only Inside pixels in the stored image (boundary filled at the end).
     Image& img = res.images[p];
-    for (std::size_t i = 0; i < N; ++i)
+    for (std::size_t j = 0; j < BN; ++j) {
+      const std::size_t i = static_cast<std::size_t>(y0 + j / BW) * R + x0 + j % BW;
       if (fp.pixel[i] == PatchPixel::Inside)
-        for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[i * C + c];
-    done[p] = 1;
-    report_progress(opt.progress, "synthesis", static_cast<double>(++step) / steps);
+        for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[j * C + c];
+    }
+    if (opt.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      report_progress(opt.progress, "synthesis", static_cast<double>(++step) / steps);
+    }
   };
-  for (int p : res.order) synth_one(p, 0);
+
+  // Main pass: patch p reads the images of its neighbours that come before
+  // it in res.order, exactly as a sequential run in that order would; so p
+  // may run as soon as those neighbours are done, and patches with no such
+  // dependency between them run in parallel (TBB tasks). The result is the
+  // same bytes for any thread count and schedule.
+  {
+    std::vector<int> rank(P);
+    for (int i = 0; i < P; ++i) rank[res.order[i]] = i;
+    std::vector<std::vector<int>> successors(P);
+    std::unique_ptr<std::atomic<int>[]> pending(new std::atomic<int>[P]);
+    for (int p = 0; p < P; ++p) {
+      std::vector<int> deps;
+      for (const FlatTriangle& tr : patches[p].boundary) {
+        const int q = face_patch[tr.face];
+        if (q != p && rank[q] < rank[p]) deps.push_back(q);
+      }
+      std::sort(deps.begin(), deps.end());
+      deps.erase(std::unique(deps.begin(), deps.end()), deps.end());
+      pending[p].store(static_cast<int>(deps.size()), std::memory_order_relaxed);
+      for (int q : deps) successors[q].push_back(p);
+    }
+    // Splitting each pixel's search over threads only pays when few patches
+    // can run side by side.
+    const bool pixel_parallel = P < 4 * tbb::this_task_arena::max_concurrency();
+    tbb::task_group tg;
+    std::function<void(int)> run = [&](int p) {
+      synth_one(p, 0, [&](int q) { return rank[q] < rank[p]; }, pixel_parallel);
+      for (int q : successors[p])
+        if (pending[q].fetch_sub(1, std::memory_order_acq_rel) == 1) tg.run([&run, q] { run(q); });
+    };
+    for (int p : res.order)
+      if (pending[p].load(std::memory_order_relaxed) == 0) tg.run([&run, p] { run(p); });
+    tg.wait();
+  }
+  // Re-synthesis (4.1) in the given order, each seeing every other patch.
+  std::vector<char> done(P, 1);
   for (int p : opt.resynthesize) done[p] = 0;
-  for (int p : opt.resynthesize) synth_one(p, 1);
+  for (int p : opt.resynthesize) {
+    synth_one(p, 1, [&](int q) { return done[q] != 0; }, true);
+    done[p] = 1;
+  }
+  for (int p = 0; p < P; ++p) {
+    res.texels += texels[p];
+    res.seeded += seeded[p];
+    res.known_boundary += known[p];
+  }
   res.seconds_synthesis = t.seconds();
 
   // 7. Boundary pixels of every image from the neighbour's texture.

@@ -56,6 +56,10 @@
 //
 // Deterministic: the patch order and every Efros-Leung run are seeded from
 // `seed` (per patch and pass), so the same input gives the same bytes.
+// Parallel: a patch reads only the neighbours that precede it in the order,
+// so it starts as soon as those are done; independent patches run as TBB
+// tasks side by side, with the same result for any thread count. The
+// exemplar rotations are prepared once per run (el_prepare_exemplars).
 //
 // Writes kFacePatch, kFaceDirection (unless field None), kVertexKmax/Kmin/
 // Dmax/Dmin when curvature is needed, kVertexNormal. Throws InvalidInputError

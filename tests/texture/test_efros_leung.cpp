@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Two-pass Efros-Leung synthesis (Gorla 2003, 3.3): boundary conditions,
 // periodic reproduction, histogram, orientation, multi-texturing,
-// determinism, two-pass == one-pass with a full preselect, option checks.
+// determinism, two-pass == one-pass with a full preselect, pass 1 keeps the
+// exact n best (brute-force reference), prepared exemplars, option checks.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -276,6 +278,125 @@ TEST(EfrosLeung, TwoPassWithFullPreselectPicksAsSinglePassExhaustive) {
     const ElResult one = efros_leung_synthesize(in, opt);
     EXPECT_EQ(two.image.data, one.image.data) << "trial " << trial;
   }
+}
+
+TEST(EfrosLeung, PreselectHoldsTheExactNBestOfPassOne) {
+  // One Fill pixel amid Known ones: the run performs exactly one two-pass
+  // search, which this test repeats in double precision by brute force:
+  // pass 1 ranks every candidate by unweighted SSD over the 3x3 window, keeps
+  // the n best; pass 2 picks the Gaussian-weighted best among them (pick_min
+  // 1, no tolerance: deterministic). With 42x42 = 1764 candidates and n = 1
+  // or 8 the fast selection path (sampled threshold) is the one exercised.
+  const int ew = 48, W = 15, win = 7;
+  const int lo = -(win / 2), hi = win - 1 - win / 2;
+  for (std::uint64_t trial = 0; trial < (sanitized() ? 4u : 24u); ++trial) {
+    const int n = trial % 2 ? 8 : 1;  // 1: the pick is pass 1's own best
+    std::mt19937_64 rng(trial);
+    const int C = 1 + static_cast<int>(trial % 3);
+    const Image ex = binomial_blur(noise(ew, ew, C, 300 + trial));
+    ElInput in;
+    in.exemplars = {ex};
+    in.target = noise(W, W, C, 400 + trial);
+    in.state.assign(W * W, PixelState::Known);
+    const int px = 5 + static_cast<int>(rng() % 5), py = 5 + static_cast<int>(rng() % 5);
+    in.state[py * W + px] = PixelState::Fill;
+    ElOptions opt;
+    opt.window = win;
+    opt.first_pass_window = 3;
+    opt.preselect = n;
+    opt.pick_min = 1;
+    opt.pick_fraction = 0;
+    opt.error_tolerance = -1;
+    const ElResult r = efros_leung_synthesize(in, opt);
+    ASSERT_EQ(r.synthesized, 1u);
+    // Brute force.
+    const double sigma = win / 6.4;
+    std::vector<std::pair<double, int>> p1;
+    for (int y = -lo; y < ew - hi; ++y)
+      for (int x = -lo; x < ew - hi; ++x) {
+        double e = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            for (int c = 0; c < C; ++c) {
+              const double d = ex.at(x + dx, y + dy, c) - in.target.at(px + dx, py + dy, c);
+              e += d * d;
+            }
+          }
+        p1.push_back({e, y * ew + x});
+      }
+    std::sort(p1.begin(), p1.end());
+    ASSERT_GT(p1.size(), 16u * n);
+    ASSERT_LT(p1[n - 1].first, p1[n].first);  // no tie at the cut
+    double best = 1e300;
+    int best_id = -1;
+    for (int i = 0; i < n; ++i) {
+      const int x = p1[i].second % ew, y = p1[i].second / ew;
+      double e = 0;
+      for (int dy = lo; dy <= hi; ++dy)
+        for (int dx = lo; dx <= hi; ++dx) {
+          if (dx == 0 && dy == 0) continue;
+          const double w = std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma));
+          for (int c = 0; c < C; ++c) {
+            const double d = ex.at(x + dx, y + dy, c) - in.target.at(px + dx, py + dy, c);
+            e += w * d * d;
+          }
+        }
+      if (e < best) {
+        best = e;
+        best_id = p1[i].second;
+      }
+    }
+    for (int c = 0; c < C; ++c)
+      EXPECT_EQ(r.image.at(px, py, c), ex.at(best_id % ew, best_id / ew, c))
+          << "trial " << trial << " channel " << c;
+  }
+}
+
+TEST(EfrosLeung, PreparedExemplarsGiveTheSameBytesAndMustMatchTheOptions) {
+  const Image ex = noise(24, 24, 3, 5);
+  ElOptions opt;
+  opt.window = 7;
+  opt.rotations = 16;
+  opt.seed = 3;
+  ElInput in;
+  in.exemplars = {ex};
+  in.target = Image(30, 30, 3);
+  in.angle_fn = [](int x, int y) { return 0.05 * (x + y); };
+  const ElResult plain = efros_leung_synthesize(in, opt);
+  ElInput prep = in;
+  prep.exemplars.clear();
+  prep.prepared = el_prepare_exemplars({ex}, opt);
+  const ElResult a = efros_leung_synthesize(prep, opt);
+  const ElResult b = efros_leung_synthesize(prep, opt);  // rotations now cached
+  EXPECT_GT(plain.rotations_used, 1);
+  EXPECT_EQ(plain.image.data, a.image.data);
+  EXPECT_EQ(plain.image.data, b.image.data);
+  // Pixel search split or not: same bytes.
+  ElOptions serial = opt;
+  serial.parallel_pixel_search = false;
+  EXPECT_EQ(plain.image.data, efros_leung_synthesize(prep, serial).image.data);
+  auto message = [&](const ElInput& i, const ElOptions& o) -> std::string {
+    try {
+      efros_leung_synthesize(i, o);
+    } catch (const InvalidInputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  ElOptions other = opt;
+  other.window = 9;
+  EXPECT_NE(message(prep, other).find("window"), std::string::npos);
+  other = opt;
+  other.rotations = 8;
+  EXPECT_NE(message(prep, other).find("rotations"), std::string::npos);
+  other = opt;
+  other.periodic_exemplar = true;
+  EXPECT_NE(message(prep, other).find("periodic_exemplar"), std::string::npos);
+  ElInput both = prep;
+  both.exemplars = {ex};
+  EXPECT_NE(message(both, opt).find("prepared"), std::string::npos);
+  EXPECT_THROW(el_prepare_exemplars({Image(5, 5, 3)}, opt), InvalidInputError);  // < window
 }
 
 TEST(EfrosLeung, InvalidOptionsThrowNamingTheOption) {

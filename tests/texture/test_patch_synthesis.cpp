@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Patch-based oriented surface synthesis (Gorla et al. 2003, 3-5): seams
 // measured on the surface, stripes following the requested field, multi-
-// texturing by height, re-synthesis keeps the other patches, determinism,
-// bad input.
+// texturing by height, re-synthesis keeps the other patches, determinism
+// (also across thread counts), bad input.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 #include "geometry/errors.h"
 #include "geometry/mesh_util.h"
@@ -199,6 +201,35 @@ TEST(PatchSynthesis, DeterministicAndResynthesisKeepsOthers) {
   }
 }
 
+TEST(PatchSynthesis, SameBytesForOneThreadAndAllThreads) {
+  // Patches run as parallel tasks once the neighbours they read are done;
+  // the result must not depend on the schedule or the thread count.
+  const Image ex = make_noise(40, 4, 3);
+  auto run = [&] {
+    Mesh m;
+    make_icosphere(m, 2);
+    PatchSynthesisOptions o = small_options(sanitized() ? 16 : 24);
+    o.partition.max_faces = 12;  // many patches, so several are ready at once
+    o.field = PatchField::Constant;
+    o.seed = 9;
+    return synthesize_patches(m, {ex}, o);
+  };
+  const PatchSynthesisResult all = run();
+  PatchSynthesisResult one;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = run();
+  }
+  ASSERT_GT(all.images.size(), 8u);
+  ASSERT_EQ(all.images.size(), one.images.size());
+  EXPECT_EQ(all.order, one.order);
+  EXPECT_EQ(all.texels, one.texels);
+  EXPECT_EQ(all.known_boundary, one.known_boundary);
+  EXPECT_GT(all.known_boundary, 0u);
+  for (std::size_t p = 0; p < all.images.size(); ++p)
+    EXPECT_EQ(all.images[p].data, one.images[p].data) << "patch " << p;
+}
+
 TEST(PatchSynthesis, BadInputThrows) {
   Mesh m;
   make_icosphere(m, 1);
@@ -219,6 +250,18 @@ TEST(PatchSynthesis, BadInputThrows) {
   PatchSynthesisOptions cv = o;
   cv.constant_vector = {0, 0, 0};
   EXPECT_THROW(synthesize_patches(m, {ex}, cv), InvalidInputError);
+  // A 9x9 window fits a 10x10 exemplar unrotated, but no rotation by 45
+  // degrees of it: thrown inside a patch task, it must reach the caller.
+  const Image tiny = make_noise(10, 2, 1);
+  PatchSynthesisOptions rot = o;
+  rot.field = PatchField::Constant;
+  rot.el.rotations = 8;
+  try {
+    synthesize_patches(m, {tiny}, rot);
+    ADD_FAILURE() << "no exception";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rotated"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
