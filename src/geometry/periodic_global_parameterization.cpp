@@ -44,15 +44,27 @@ void check_options(const PgpOptions& o) {
                             std::to_string(o.stiffness));
 }
 
-std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
-                                     std::vector<FaceFrame>* frames_out) {
+std::vector<FaceFrame> all_frames(const Mesh& mesh) {
+  std::vector<FaceFrame> frames(mesh.num_faces());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_faces(), 2048),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+      const FaceIndex f(static_cast<Mesh::size_type>(fi));
+      if (!mesh.is_removed(f)) frames[fi] = face_frame(mesh, f);
+    }
+  });
+  return frames;
+}
+
+/// g = d / S^T per face (only where `mask` is set when given), written into `g`.
+void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceFrame>& frames,
+                         const std::vector<char>* mask, std::vector<FaceGrad>& g) {
   auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
   if (!dir.second)
     throw InvalidInputError("periodic_global_parameterization: face map '" + o.direction_map +
                             "' absent (interpolate a direction field first)");
   auto scale = mesh.property_map<VertexIndex, double>(o.scale_map);
-  std::vector<FaceGrad> g(mesh.num_faces());
-  std::vector<FaceFrame> frames(mesh.num_faces());
+  g.resize(mesh.num_faces());
   // Check the scale first (serially: the first bad vertex is reported).
   if (scale.second)
     for (VertexIndex v : mesh.vertices()) {
@@ -66,9 +78,8 @@ std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
                     [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
       const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f)) continue;
-      const FaceFrame fr = face_frame(mesh, f);
-      frames[fi] = fr;
+      if (mesh.is_removed(f) || (mask && !(*mask)[fi])) continue;
+      const FaceFrame& fr = frames[fi];
       double s = 0;
       for (VertexIndex v : face_vertices(mesh, f)) s += scale.second ? scale.first[v] : 1.0;
       s /= 3;
@@ -78,20 +89,29 @@ std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
       g[fi] = {ds / s, dt / s};
     }
   });
+}
+
+std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
+                                     std::vector<FaceFrame>* frames_out) {
+  std::vector<FaceFrame> frames = all_frames(mesh);
+  std::vector<FaceGrad> g;
+  face_gradients_into(mesh, o, frames, nullptr, g);
   if (frames_out) *frames_out = std::move(frames);
   return g;
 }
 
-std::vector<std::array<double, 2>> halfedge_alphas(const Mesh& mesh, const PgpOptions& o,
-                                                   const std::vector<FaceGrad>& g,
-                                                   const std::vector<FaceFrame>& frames) {
+/// Alphas of equation (3) per halfedge (only edges where `edge_mask` is set
+/// when given), written into `alpha`.
+void halfedge_alphas_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceGrad>& g,
+                          const std::vector<FaceFrame>& frames, const std::vector<char>* edge_mask,
+                          std::vector<std::array<double, 2>>& alpha) {
   const double step = 2 * M_PI / o.symmetry;
-  std::vector<std::array<double, 2>> alpha(mesh.num_halfedges(), {0.0, 0.0});
+  alpha.resize(mesh.num_halfedges(), {0.0, 0.0});
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_edges(), 2048),
                     [&](const tbb::blocked_range<std::size_t>& range) {
   for (std::size_t ei = range.begin(); ei != range.end(); ++ei) {
     const EdgeIndex e(static_cast<Mesh::size_type>(ei));
-    if (mesh.is_removed(e)) continue;
+    if (mesh.is_removed(e) || (edge_mask && !(*edge_mask)[ei])) continue;
     HalfedgeIndex h = mesh.halfedge(e, 0);
     if (mesh.is_border(h)) h = mesh.opposite(h);
     if (mesh.is_border(h)) continue;  // isolated edge
@@ -116,6 +136,13 @@ std::vector<std::array<double, 2>> halfedge_alphas(const Mesh& mesh, const PgpOp
     alpha[o.idx()] = {-a[0], -a[1]};
   }
   });
+}
+
+std::vector<std::array<double, 2>> halfedge_alphas(const Mesh& mesh, const PgpOptions& o,
+                                                   const std::vector<FaceGrad>& g,
+                                                   const std::vector<FaceFrame>& frames) {
+  std::vector<std::array<double, 2>> alpha;
+  halfedge_alphas_into(mesh, o, g, frames, nullptr, alpha);
   return alpha;
 }
 
@@ -151,6 +178,7 @@ struct PgpTopology {
   std::vector<int> component;              // per vertex: connected component, -1 = none
   int components = 0;
   std::vector<std::uint32_t> faces;        // live face indices
+  std::vector<FaceFrame> frames;           // per face index
 
   bool matches(const Mesh& m) const {
     return nv == m.num_vertices() && nf == m.num_faces() && ne == m.num_edges() && nh == m.num_halfedges();
@@ -168,6 +196,7 @@ PgpTopology make_topology(const Mesh& mesh) {
     t.faces.push_back(static_cast<std::uint32_t>(f.idx()));
     area[f.idx()] = face_area(mesh, f);
   }
+  t.frames = all_frames(mesh);
   t.mass.assign(t.nv, 0.0);
   for (FaceIndex f : mesh.faces())
     for (VertexIndex v : face_vertices(mesh, f)) t.mass[v.idx()] += area[f.idx()] / 3;
@@ -255,6 +284,13 @@ struct PeriodicGlobalParameterization::Impl {
   std::unique_ptr<PgpPattern> pattern;
   Ldlt solver[2];
   bool analyzed = false;
+  // Field-dependent values of the last solve; a local update recomputes them
+  // only next to the free faces (the only faces whose direction or scale
+  // may have changed).
+  std::vector<FaceGrad> grad;
+  std::vector<std::array<double, 2>> alpha;         // per halfedge
+  std::vector<std::array<double, 2>> edge_energy;  // per live edge
+  bool cache_valid = false;
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {}
 
@@ -263,6 +299,7 @@ struct PeriodicGlobalParameterization::Impl {
       topo = std::make_unique<PgpTopology>(make_topology(mesh));
       pattern.reset();
       analyzed = false;
+      cache_valid = false;
     }
     return *topo;
   }
@@ -320,9 +357,25 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   check_options(opt);
   require_triangle_mesh(mesh, "periodic_global_parameterization");
   const PgpTopology& t = topology();
-  std::vector<FaceFrame> frames;
-  const auto g = face_gradients(mesh, opt, &frames);
-  const auto alpha = halfedge_alphas(mesh, opt, g, frames);
+  // Faces whose gradient may have changed (free faces) and edges whose alpha
+  // may have (edges of free faces): everything when no valid cache.
+  std::vector<char> face_mask, edge_mask;
+  const bool partial = free_face && cache_valid;
+  if (partial) {
+    face_mask.assign(t.nf, 0);
+    edge_mask.assign(t.ne, 0);
+    for (std::uint32_t f : t.faces) {
+      if (!(*free_face)[f]) continue;
+      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
+        edge_mask[mesh.edge(h).idx()] = 1;
+        face_mask[f] = 1;
+        // the opposite face's gradient enters the edge's alpha: unchanged
+        // unless free, so it is read from the cache
+      }
+    }
+  }
+  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+  halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha);
   const auto ealpha = edge_alphas(alpha);
 
   std::vector<int> var(t.nv, -1);
@@ -491,13 +544,24 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     zt[opt.locked_vertex] = Cplx(1, 0);
   }
 
-  // Energies at the (normalised) solution (serial sum: deterministic).
-  for (std::size_t k = 0; k < t.ends.size(); ++k) {
-    const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
-    const double w = t.weight[k];
-    res.energy_s += w * std::norm(zs[j] - std::polar(1.0, 2 * M_PI * ealpha[k][0]) * zs[i]);
-    res.energy_t += w * std::norm(zt[j] - std::polar(1.0, 2 * M_PI * ealpha[k][1]) * zt[i]);
+  // Energies at the (normalised) solution: per edge (only edges of free
+  // faces change in an update), then a serial sum (deterministic).
+  edge_energy.resize(t.ends.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      if (partial && !edge_mask[t.edges[k]]) continue;
+      const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
+      const double w = t.weight[k];
+      edge_energy[k] = {w * std::norm(zs[j] - std::polar(1.0, 2 * M_PI * ealpha[k][0]) * zs[i]),
+                        w * std::norm(zt[j] - std::polar(1.0, 2 * M_PI * ealpha[k][1]) * zt[i])};
+    }
+  });
+  for (const auto& en : edge_energy) {
+    res.energy_s += en[0];
+    res.energy_t += en[1];
   }
+  cache_valid = true;
 
   write_corners(alpha, free_face);
   res.seconds = timer.seconds();
@@ -555,6 +619,7 @@ void PeriodicGlobalParameterization::set_state(std::vector<std::complex<double>>
   impl_->zt = std::move(zt);
   impl_->initialized = true;
   impl_->analyzed = false;
+  impl_->cache_valid = false;
 }
 
 void PeriodicGlobalParameterization::write_corners() {
@@ -562,9 +627,13 @@ void PeriodicGlobalParameterization::write_corners() {
     throw InvalidInputError("PeriodicGlobalParameterization::write_corners called before initialize()/set_state()");
   check_options(impl_->opt);
   require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
-  std::vector<FaceFrame> frames;
-  const auto g = face_gradients(impl_->mesh, impl_->opt, &frames);
-  impl_->write_corners(halfedge_alphas(impl_->mesh, impl_->opt, g, frames), nullptr);
+  Impl& im = *impl_;
+  const PgpTopology& t = im.topology();
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad);
+  halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha);
+  im.edge_energy.clear();
+  im.cache_valid = false;  // energies not computed
+  im.write_corners(im.alpha, nullptr);
 }
 
 double pgp_default_scale(const Mesh& mesh, double edges_per_period) {

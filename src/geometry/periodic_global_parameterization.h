@@ -60,7 +60,7 @@ struct PgpOptions {
   std::uint32_t locked_vertex = 0;  ///< has s = t = 0 after initialisation
   /// Relaxation steps of the initialisation (>= 1), each one solve with the
   /// factorisation reused.
-  int init_iterations = 8;
+  int init_iterations = 16;
   /// Relaxation steps of a local update (>= 1).
   int update_iterations = 4;
   /// Weight mu of the unit-modulus pull, relative to the mean diagonal of
