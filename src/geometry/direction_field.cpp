@@ -8,6 +8,8 @@
 #include <cmath>
 #include <complex>
 #include <deque>
+#include <functional>
+#include <queue>
 #include <string>
 
 #include "geometry/effect_area.h"
@@ -180,23 +182,63 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
   }
 
   // Combing: every face in the area may take any of its N representatives
-  // (constraints fix orientations modulo 2 pi / N only). Walk the area breadth
-  // first from the faces outside it (fixed), or from the lowest constrained
-  // face, and give each face the representative closest to its parent's
-  // direction transported across the shared edge.
+  // (constraints fix orientations modulo 2 pi / N only). Grow from the faces
+  // outside the area (fixed), or from the lowest constrained face, and give
+  // each face the representative closest to its parent's direction
+  // transported across the shared edge.
   std::vector<double> final_theta(nf, 0.0);
   for (FaceIndex g : order) final_theta[g.idx()] = solved[g.idx()];
   for (FaceIndex f : mesh.faces())
     if (locked[f.idx()]) final_theta[f.idx()] = theta[f.idx()];
   {
-    std::vector<char> done(nf, 0);
-    std::deque<FaceIndex> q;
-    for (FaceIndex f : mesh.faces())
-      if (!is_free(f)) {
-        done[f.idx()] = 1;
-        if (relevant[f.idx()]) q.push_back(f);  // the others have no free neighbour
+    // Smoothest edges first (Prim's algorithm on the dual graph, the cost of
+    // crossing an edge = the angle left between the transported direction and
+    // the closest representative): the representatives then disagree (a
+    // quarter-turn "cut", where s and t swap for the parameterization) only
+    // where the field turns fastest, near its singularities, instead of
+    // wherever two breadth-first fronts happen to meet.
+    struct Candidate {
+      double cost;
+      std::uint32_t g, f, h;
+      bool operator>(const Candidate& o) const {
+        if (cost != o.cost) return cost > o.cost;
+        if (g != o.g) return g > o.g;
+        return h > o.h;
       }
-    // Start components at a constrained face (it keeps its given representative).
+    };
+    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap;
+    std::vector<char> done(nf, 0);
+    auto push_neighbours = [&](FaceIndex f) {
+      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+        const HalfedgeIndex o = mesh.opposite(h);
+        if (mesh.is_border(o)) continue;
+        const FaceIndex g = mesh.face(o);
+        if (done[g.idx()] || !(locked[g.idx()] || reach[g.idx()])) continue;
+        const double transported = final_theta[f.idx()] - edge_angle(h, f.idx()) + edge_angle(h, g.idx());
+        const double rep = closest_representative(final_theta[g.idx()], transported, N);
+        heap.push({std::abs(rep - transported), static_cast<std::uint32_t>(g.idx()),
+                   static_cast<std::uint32_t>(f.idx()), static_cast<std::uint32_t>(h.idx())});
+      }
+    };
+    auto grow = [&] {
+      while (!heap.empty()) {
+        const Candidate c = heap.top();
+        heap.pop();
+        if (done[c.g]) continue;
+        done[c.g] = 1;
+        const HalfedgeIndex h(c.h);
+        const double transported = final_theta[c.f] - edge_angle(h, c.f) + edge_angle(h, c.g);
+        final_theta[c.g] = closest_representative(final_theta[c.g], transported, N);
+        push_neighbours(FaceIndex(c.g));
+      }
+    };
+    for (FaceIndex f : mesh.faces())
+      if (!is_free(f)) done[f.idx()] = 1;
+    for (FaceIndex f : mesh.faces())
+      if (!is_free(f) && relevant[f.idx()]) push_neighbours(f);  // the fixed outside
+    grow();
+    // Components not touching the outside start at a constrained face (it
+    // keeps its given representative), else at their lowest face.
     std::vector<FaceIndex> starts;
     for (FaceIndex f : mesh.faces())
       if (locked[f.idx()]) starts.push_back(f);
@@ -204,25 +246,9 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
       if (!locked[f.idx()]) starts.push_back(f);
     for (FaceIndex f0 : starts) {
       if (done[f0.idx()] || !(locked[f0.idx()] || reach[f0.idx()])) continue;
-      if (q.empty()) {  // a component not touching the outside: start here
-        done[f0.idx()] = 1;
-        q.push_back(f0);
-      }
-      while (!q.empty()) {
-        const FaceIndex f = q.front();
-        q.pop_front();
-        for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
-          const HalfedgeIndex o = mesh.opposite(h);
-          if (mesh.is_border(o)) continue;
-          const FaceIndex g = mesh.face(o);
-          if (done[g.idx()] || !(locked[g.idx()] || reach[g.idx()])) continue;
-          done[g.idx()] = 1;
-          const double transported =
-              final_theta[f.idx()] - edge_angle(h, f.idx()) + edge_angle(h, g.idx());
-          final_theta[g.idx()] = closest_representative(final_theta[g.idx()], transported, N);
-          q.push_back(g);
-        }
-      }
+      done[f0.idx()] = 1;
+      push_neighbours(f0);
+      grow();
     }
   }
   for (FaceIndex f : mesh.faces()) {
