@@ -6,27 +6,28 @@
 // run); one JSON line per mesh and step.
 // Usage: bench_pgp [mesh ...]   (default: shared data fandisk, dragon_25k, armadillo_52k)
 //
-// Measured 2026-11-22 on the shared 2-core machine under load 12-15 (so wall
-// is ~2.5-3x CPU; quiet-machine figures are for the lead to re-measure),
-// wall / CPU seconds:
+// Measured 2026-11-22 on the shared 2-core machine under load 10-13 (wall is
+// ~2.5x CPU; quiet-machine figures are for the lead to re-measure),
+// wall / CPU seconds (CPU = all threads of the best run):
 //   faces                          12.9K           25.0K           52.0K
-//   interpolate orientation        0.093 / 0.040   0.128 / 0.056   0.393 / 0.152
-//   PGP initialisation             0.207 / 0.084   0.452 / 0.157   1.124 / 0.370
-//   local update, total            0.026 / 0.014   0.107 / 0.043   0.255 / 0.084
-//     of which orientation         0.009 / 0.005   0.039 / 0.015   0.097 / 0.033
-//     of which PGP                 0.015 / 0.007   0.047 / 0.019   0.120 / 0.037
-// (before this version: PGP init 0.29 s CPU at 52K with one factorisation
-// but whole-mesh passes; local update 0.14 s CPU.) Goals: init <= 0.5 s,
-// local update <= 0.1 s: met in CPU time, to be confirmed in wall time on a
-// quiet machine. Paper (2009 hardware): 1.2/4.1/8.9 s, 1.3/3.7/7.4 s, 0.5-4 s.
-// Singular fraction (default period 8 mean edges, curvature field):
-// fandisk 23%, dragon_25k 64%, armadillo_52k 41% (were 27/67/46%). What
-// remains is dominated by the 4-field itself, not the PGP: 80% of the
-// distorted faces on fandisk lie in the 1-ring of a field cut edge (where the
-// combed representatives differ by a quarter turn and s, t swap), and
-// dragon_25k has ~750-800 field-singular vertices (angle defects > 45
-// degrees at its scales and spikes force them). On analytic surfaces the PGP
-// alone gives: torus with principal field 0%, sphere 12-13%.
+//   interpolate orientation        0.085 / 0.037   0.144 / 0.061   0.381 / 0.153
+//   PGP initialisation             0.196 / 0.083   0.233 / 0.101   0.765 / 0.303
+//   local update, total            0.023 / 0.015   0.058 / 0.031   0.220 / 0.087
+//     of which orientation         0.009 / 0.005   0.025 / 0.013   0.084 / 0.036
+//     of which PGP                 0.011 / 0.007   0.025 / 0.012   0.106 / 0.037
+// (previous version, same load: local update 0.35 s wall / ~0.14 s CPU at
+// 52K.) Goals: init <= 0.5 s, local update <= 0.1 s: met in CPU time, to be
+// confirmed in wall time on a quiet machine. Paper (2009 hardware):
+// 1.2/4.1/8.9 s, 1.3/3.7/7.4 s, 0.5-4 s.
+// Singular fraction at the default period (8 mean edges), curvature field /
+// strokes field: fandisk 23% / 20%, dragon_25k 58% / 52%, armadillo_52k
+// 33% / 32% (previous version: 27/25, 67/66, 46/44%). What remains is mostly
+// the 4-field itself, not the PGP: on fandisk 80% of the distorted faces lie
+// in the 1-ring of a field cut edge (combed representatives differ by a
+// quarter turn there, s and t swap), and dragon_25k has ~750-800
+// field-singular vertices (angle defects over 45 degrees at its spikes and
+// scales force them). On analytic surfaces the PGP alone gives: torus with a
+// principal field 0%, sphere with a projected constant field 12-13%.
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
