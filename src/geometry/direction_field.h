@@ -23,9 +23,11 @@
 //     face) solved once with Eigen's SimplicialLDLT (info() checked); with an
 //     effect area only the free faces and their neighbours are visited;
 //   - d_s = frame direction of arg(u_f)/N; the N representatives are then
-//     "combed" by a breadth-first walk from the locked faces so that adjacent
-//     faces carry the closest representative (mismatches remain only around
-//     singular vertices).
+//     "combed" by growing a dual spanning tree from the locked faces,
+//     smoothest edges first (Prim), each face taking the representative
+//     closest to its parent's transported direction: quarter-turn mismatches
+//     remain only on cut paths joining singular vertices, where the field
+//     turns fastest.
 // A connected component with no constrained face gets d_s = e1 of each face
 // (and is counted in `unconstrained_faces`).
 //
