@@ -6,7 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <deque>
+#include <functional>
+#include <queue>
 #include <string>
 
 #include "geometry/effect_area.h"
@@ -45,9 +48,21 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
                             std::to_string(nf));
   auto dir = mesh.add_property_map<FaceIndex, Vector3>(opt.direction_map, Vector3(0, 0, 0)).first;
 
-  std::vector<FaceFrame> frames(nf);
-  for (FaceIndex f : mesh.faces()) frames[f.idx()] = face_frame(mesh, f);
   auto is_free = [&](FaceIndex f) { return !opt.area || opt.area->face_free[f.idx()]; };
+  // Faces that take part: the free ones and their edge neighbours (locked
+  // boundary). Outside that band nothing is read, so a local edit costs in
+  // proportion to its area (frames, breadth-first walks).
+  std::vector<char> relevant(nf, opt.area ? 0 : 1);
+  if (opt.area)
+    for (FaceIndex f : mesh.faces()) {
+      if (!is_free(f)) continue;
+      relevant[f.idx()] = 1;
+      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
+        if (!mesh.is_border(mesh.opposite(h))) relevant[mesh.face(mesh.opposite(h)).idx()] = 1;
+    }
+  std::vector<FaceFrame> frames(nf);
+  for (FaceIndex f : mesh.faces())
+    if (relevant[f.idx()]) frames[f.idx()] = face_frame(mesh, f);
 
   // State per face: 0 = free unknown, 1 = locked (constraint or outside area).
   std::vector<char> locked(nf, 0);
@@ -73,6 +88,7 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
   for (FaceIndex f : mesh.faces()) {
     if (is_free(f)) continue;
     locked[f.idx()] = 1;
+    if (!relevant[f.idx()]) continue;  // never read
     const Vector3 d = dir[f];
     theta[f.idx()] = norm(d) > 0 ? frames[f.idx()].angle_of(d) : 0.0;
   }
@@ -85,7 +101,7 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
   for (FaceIndex f : mesh.faces())
     if (locked[f.idx()]) {
       reach[f.idx()] = 1;
-      queue.push_back(f);
+      if (relevant[f.idx()]) queue.push_back(f);  // the others have no free neighbour
     }
   std::vector<FaceIndex> order;  // BFS order of the free faces from the locked ones
   while (!queue.empty()) {
@@ -117,9 +133,14 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
 
   std::vector<double> solved(nf, 0.0);
   if (n_var > 0) {
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(static_cast<std::size_t>(n_var) * 16);
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * n_var);
+    // Complex Hermitian form (u_f as one complex number; half the unknowns
+    // and a quarter of the entries of the equivalent real 2x2-block system):
+    // for the residual u_g - r u_f, r = exp(i N (a_g - a_f)): A(f,f) += w,
+    // A(g,g) += w, A(g,f) = -w r, A(f,g) = -w conj(r); lower triangle stored.
+    using Cplx = std::complex<double>;
+    std::vector<Eigen::Triplet<Cplx>> trip;
+    trip.reserve(static_cast<std::size_t>(n_var) * 4);
+    Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(n_var);
     for (EdgeIndex e : mesh.edges()) {
       if (mesh.is_border(e)) continue;
       const HalfedgeIndex h = mesh.halfedge(e, 0);
@@ -130,69 +151,94 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
       const double area = face_area(mesh, FaceIndex(f)) + face_area(mesh, FaceIndex(g));
       const double len2 = (mesh.point(mesh.target(h)) - mesh.point(mesh.source(h))).squared_length();
       const double w = area > 0 ? std::min(3 * len2 / area, 1e3) : 1e3;
-      const double ang = N * (edge_angle(h, g) - edge_angle(h, f));
-      const double c = std::cos(ang), s = std::sin(ang);
-      // residual u_g - R u_f, R = [[c,-s],[s,c]].
-      auto add_diag = [&](int v) {
-        trip.emplace_back(2 * v, 2 * v, w);
-        trip.emplace_back(2 * v + 1, 2 * v + 1, w);
-      };
-      if (vf >= 0) add_diag(vf);
-      if (vg >= 0) add_diag(vg);
+      const Cplx r = std::polar(1.0, N * (edge_angle(h, g) - edge_angle(h, f)));
+      if (vf >= 0) trip.emplace_back(vf, vf, Cplx(w, 0));
+      if (vg >= 0) trip.emplace_back(vg, vg, Cplx(w, 0));
       if (vf >= 0 && vg >= 0) {
-        // block (g,f) = -w R, block (f,g) = -w R^T
-        trip.emplace_back(2 * vg, 2 * vf, -w * c);
-        trip.emplace_back(2 * vg, 2 * vf + 1, w * s);
-        trip.emplace_back(2 * vg + 1, 2 * vf, -w * s);
-        trip.emplace_back(2 * vg + 1, 2 * vf + 1, -w * c);
-        trip.emplace_back(2 * vf, 2 * vg, -w * c);
-        trip.emplace_back(2 * vf, 2 * vg + 1, -w * s);
-        trip.emplace_back(2 * vf + 1, 2 * vg, w * s);
-        trip.emplace_back(2 * vf + 1, 2 * vg + 1, -w * c);
-      } else if (vg >= 0) {  // f locked: rhs_g += w R u_f
-        const double ur = std::cos(N * theta[f]), ui = std::sin(N * theta[f]);
-        rhs[2 * vg] += w * (c * ur - s * ui);
-        rhs[2 * vg + 1] += w * (s * ur + c * ui);
-      } else {  // g locked: rhs_f += w R^T u_g
-        const double ur = std::cos(N * theta[g]), ui = std::sin(N * theta[g]);
-        rhs[2 * vf] += w * (c * ur + s * ui);
-        rhs[2 * vf + 1] += w * (-s * ur + c * ui);
+        if (vg > vf)
+          trip.emplace_back(vg, vf, -w * r);
+        else
+          trip.emplace_back(vf, vg, -w * std::conj(r));
+      } else if (vg >= 0) {  // f locked: rhs_g += w r u_f
+        rhs[vg] += w * r * std::polar(1.0, N * theta[f]);
+      } else {  // g locked: rhs_f += w conj(r) u_g
+        rhs[vf] += w * std::conj(r) * std::polar(1.0, N * theta[g]);
       }
     }
-    Eigen::SparseMatrix<double> A(2 * n_var, 2 * n_var);
+    Eigen::SparseMatrix<Cplx> A(n_var, n_var);
     A.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<Cplx>> solver(A);
     if (solver.info() != Eigen::Success)
       throw SolverError("interpolate_direction_field: factorisation failed (" +
                         std::to_string(n_var) + " free faces)");
-    const Eigen::VectorXd x = solver.solve(rhs);
+    const Eigen::VectorXcd x = solver.solve(rhs);
     if (solver.info() != Eigen::Success)
       throw SolverError("interpolate_direction_field: solve failed");
     for (FaceIndex g : order) {
       const int v = var[g.idx()];
-      const double a = std::atan2(x[2 * v + 1], x[2 * v]);  // atan2(0,0) = 0: never NaN
+      const double a = std::atan2(x[v].imag(), x[v].real());  // atan2(0,0) = 0: never NaN
       solved[g.idx()] = (std::isfinite(a) ? a : 0.0) / N;
     }
   }
 
   // Combing: every face in the area may take any of its N representatives
-  // (constraints fix orientations modulo 2 pi / N only). Walk the area breadth
-  // first from the faces outside it (fixed), or from the lowest constrained
-  // face, and give each face the representative closest to its parent's
-  // direction transported across the shared edge.
+  // (constraints fix orientations modulo 2 pi / N only). Grow from the faces
+  // outside the area (fixed), or from the lowest constrained face, and give
+  // each face the representative closest to its parent's direction
+  // transported across the shared edge.
   std::vector<double> final_theta(nf, 0.0);
   for (FaceIndex g : order) final_theta[g.idx()] = solved[g.idx()];
   for (FaceIndex f : mesh.faces())
     if (locked[f.idx()]) final_theta[f.idx()] = theta[f.idx()];
   {
-    std::vector<char> done(nf, 0);
-    std::deque<FaceIndex> q;
-    for (FaceIndex f : mesh.faces())
-      if (!is_free(f)) {
-        done[f.idx()] = 1;
-        q.push_back(f);
+    // Smoothest edges first (Prim's algorithm on the dual graph, the cost of
+    // crossing an edge = the angle left between the transported direction and
+    // the closest representative): the representatives then disagree (a
+    // quarter-turn "cut", where s and t swap for the parameterization) only
+    // where the field turns fastest, near its singularities, instead of
+    // wherever two breadth-first fronts happen to meet.
+    struct Candidate {
+      double cost;
+      std::uint32_t g, f, h;
+      bool operator>(const Candidate& o) const {
+        if (cost != o.cost) return cost > o.cost;
+        if (g != o.g) return g > o.g;
+        return h > o.h;
       }
-    // Start components at a constrained face (it keeps its given representative).
+    };
+    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> heap;
+    std::vector<char> done(nf, 0);
+    auto push_neighbours = [&](FaceIndex f) {
+      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+        const HalfedgeIndex o = mesh.opposite(h);
+        if (mesh.is_border(o)) continue;
+        const FaceIndex g = mesh.face(o);
+        if (done[g.idx()] || !(locked[g.idx()] || reach[g.idx()])) continue;
+        const double transported = final_theta[f.idx()] - edge_angle(h, f.idx()) + edge_angle(h, g.idx());
+        const double rep = closest_representative(final_theta[g.idx()], transported, N);
+        heap.push({std::abs(rep - transported), static_cast<std::uint32_t>(g.idx()),
+                   static_cast<std::uint32_t>(f.idx()), static_cast<std::uint32_t>(h.idx())});
+      }
+    };
+    auto grow = [&] {
+      while (!heap.empty()) {
+        const Candidate c = heap.top();
+        heap.pop();
+        if (done[c.g]) continue;
+        done[c.g] = 1;
+        const HalfedgeIndex h(c.h);
+        const double transported = final_theta[c.f] - edge_angle(h, c.f) + edge_angle(h, c.g);
+        final_theta[c.g] = closest_representative(final_theta[c.g], transported, N);
+        push_neighbours(FaceIndex(c.g));
+      }
+    };
+    for (FaceIndex f : mesh.faces())
+      if (!is_free(f)) done[f.idx()] = 1;
+    for (FaceIndex f : mesh.faces())
+      if (!is_free(f) && relevant[f.idx()]) push_neighbours(f);  // the fixed outside
+    grow();
+    // Components not touching the outside start at a constrained face (it
+    // keeps its given representative), else at their lowest face.
     std::vector<FaceIndex> starts;
     for (FaceIndex f : mesh.faces())
       if (locked[f.idx()]) starts.push_back(f);
@@ -200,25 +246,9 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
       if (!locked[f.idx()]) starts.push_back(f);
     for (FaceIndex f0 : starts) {
       if (done[f0.idx()] || !(locked[f0.idx()] || reach[f0.idx()])) continue;
-      if (q.empty()) {  // a component not touching the outside: start here
-        done[f0.idx()] = 1;
-        q.push_back(f0);
-      }
-      while (!q.empty()) {
-        const FaceIndex f = q.front();
-        q.pop_front();
-        for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
-          const HalfedgeIndex o = mesh.opposite(h);
-          if (mesh.is_border(o)) continue;
-          const FaceIndex g = mesh.face(o);
-          if (done[g.idx()] || !(locked[g.idx()] || reach[g.idx()])) continue;
-          done[g.idx()] = 1;
-          const double transported =
-              final_theta[f.idx()] - edge_angle(h, f.idx()) + edge_angle(h, g.idx());
-          final_theta[g.idx()] = closest_representative(final_theta[g.idx()], transported, N);
-          q.push_back(g);
-        }
-      }
+      done[f0.idx()] = 1;
+      push_neighbours(f0);
+      grow();
     }
   }
   for (FaceIndex f : mesh.faces()) {

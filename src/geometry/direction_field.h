@@ -19,12 +19,15 @@
 //   - minimise sum_e w_e |u_g - r_fg u_f|^2, w_e = 3 |e|^2 / (A_f + A_g)
 //     (the ratio dual-edge / primal-edge, capped at 1e3 so slivers stay sane),
 //     with constrained faces (and faces outside the effect area) locked: a
-//     sparse symmetric positive definite system in 2x2 real blocks solved once
-//     with Eigen's SimplicialLDLT (info() checked);
+//     sparse Hermitian positive definite complex system (one unknown per free
+//     face) solved once with Eigen's SimplicialLDLT (info() checked); with an
+//     effect area only the free faces and their neighbours are visited;
 //   - d_s = frame direction of arg(u_f)/N; the N representatives are then
-//     "combed" by a breadth-first walk from the locked faces so that adjacent
-//     faces carry the closest representative (mismatches remain only around
-//     singular vertices).
+//     "combed" by growing a dual spanning tree from the locked faces,
+//     smoothest edges first (Prim), each face taking the representative
+//     closest to its parent's transported direction: quarter-turn mismatches
+//     remain only on cut paths joining singular vertices, where the field
+//     turns fastest.
 // A connected component with no constrained face gets d_s = e1 of each face
 // (and is counted in `unconstrained_faces`).
 //
