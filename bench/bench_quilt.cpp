@@ -4,12 +4,17 @@
 // 1.08). CGAL's bunny00.off (extracted from Debian's libcgal-demo tarball into
 // a temporary folder) is decimated to about 5K faces (CGAL
 // Surface_mesh_simplification, edge collapse with a face-count stop
-// predicate), then quilted with the generated weave swatch (about 15K faces),
+// predicate and a placement that refuses collapses turning faces over), then quilted with the generated weave swatch (about 15K faces),
 // the quilt embedded through the stretch-minimised shell map. Prints one JSON
 // object per stage (times, output faces, stretch before/after,
 // self-intersections).
 // Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
+//                    [edges kept by the decimation (7500)]
+#include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_cost.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_placement.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <unistd.h>
 
@@ -45,6 +50,7 @@ int main(int argc, char** argv) {
   const std::string tarball = argc > 1 && argv[1][0] ? argv[1] : SURFTEX_CGAL_DATA_TARBALL;
   const std::string outdir = argc > 2 ? argv[2] : "";
   const double rel = argc > 3 ? std::atof(argv[3]) : 0.12;
+  const long edges = argc > 4 ? std::atol(argv[4]) : 7500;
   const fs::path dir = fs::temp_directory_path() / ("surftex-bench-quilt-" + std::to_string(::getpid()));
   try {
     fs::create_directories(dir);
@@ -55,11 +61,16 @@ int main(int argc, char** argv) {
     read_mesh((dir / "data" / "meshes" / "bunny00.off").string(), base);
     const std::size_t faces_in = base.number_of_faces();
     // CGAL 5.5's Count_stop_predicate counts edges: E = 1.5 F on a closed mesh.
-    SMS::Count_stop_predicate<Mesh> stop(7500);
-    const int removed = SMS::edge_collapse(base, stop);
+    SMS::Count_stop_predicate<Mesh> stop(static_cast<std::size_t>(edges));
+    // Lindstrom-Turk placement wrapped so that no collapse turns a face over
+    // (a folded sliver has no offset direction: the shell cannot be built over it).
+    const SMS::Bounded_normal_change_placement<SMS::LindstromTurk_placement<Mesh>> placement;
+    const int removed = SMS::edge_collapse(
+        base, stop, CGAL::parameters::get_cost(SMS::LindstromTurk_cost<Mesh>()).get_placement(placement));
     base.collect_garbage();
     line({{"stage", "decimate"}, {"faces_in", faces_in}, {"faces", base.number_of_faces()}, {"edges_removed", removed},
           {"seconds", t.seconds()}});
+    if (!outdir.empty()) write_mesh(outdir + "/bunny_base.off", base);
     t.reset();
     Mesh sm;
     make_weave_swatch(sm);
@@ -72,7 +83,10 @@ int main(int argc, char** argv) {
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
           {"patches_shrunk", r.patches_shrunk}, {"max_patch_distortion", r.max_patch_distortion},
-          {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused}, {"dropped_new", r.dropped_new},
+          {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
+          {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
+          {"refused_border", r.stats.refused_border}, {"out_replaced", r.stats.out_replaced},
+          {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}});

@@ -33,6 +33,9 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   pruned_projection += o.pruned_projection;
   stitched += o.stitched;
   stitch_refused += o.stitch_refused;
+  refused_infeasible += o.refused_infeasible;
+  refused_loops += o.refused_loops;
+  refused_border += o.refused_border;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
   in_added += o.in_added;
@@ -272,6 +275,12 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
           add_in[e] = 0;
       } else {
         ++stats.stitch_refused;
+        if (r.reason.find("infeasible") != std::string::npos)
+          ++stats.refused_infeasible;
+        else if (r.reason.find("loops") != std::string::npos)
+          ++stats.refused_loops;
+        else
+          ++stats.refused_border;
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
           add_in[e] = 0;
