@@ -29,6 +29,7 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "geometry/self_intersections.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
@@ -75,7 +76,8 @@ int main(int argc, char** argv) {
     Mesh sm;
     make_weave_swatch(sm);
     const Swatch s = make_swatch(sm);
-    line({{"stage", "swatch"}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()}, {"seconds", t.seconds()}});
+    line({{"stage", "swatch"}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()},
+          {"self_intersections", count_self_intersections(sm)}, {"seconds", t.seconds()}});
     SurfaceQuiltOptions qo;
     qo.relative_size = rel;
     qo.up = {0, 1, 0};  // the bunny's up axis
@@ -87,6 +89,7 @@ int main(int argc, char** argv) {
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
           {"refused_border", r.stats.refused_border}, {"out_replaced", r.stats.out_replaced},
           {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
+          {"elements_not_expressible", r.elements_not_expressible},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}});
@@ -94,10 +97,12 @@ int main(int argc, char** argv) {
     eo.stretch.iterations = 40;
     Mesh out;
     const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-    line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"clamped_vertices", er.clamped_vertices},
+    line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"shell_height", er.shell_height}, {"clamped_vertices", er.clamped_vertices},
           {"stretch_before", er.stretch.stretch_before}, {"stretch_after", er.stretch.stretch_after},
           {"faces", out.number_of_faces()}, {"outside_vertices", er.embed.outside},
-          {"self_intersections", er.embed.self_intersecting_pairs}, {"seconds_atlas", er.seconds_atlas},
+          {"self_intersections", er.embed.self_intersecting_pairs},
+          {"self_intersections_within", er.self_intersections_within},
+          {"self_intersections_between", er.self_intersections_between}, {"seconds_atlas", er.seconds_atlas},
           {"seconds_shell", er.seconds_shell}, {"seconds_stretch", er.seconds_stretch},
           {"seconds_map", er.seconds_map}, {"seconds_embed", er.seconds_embed}});
     line({{"stage", "total"}, {"seconds", total.seconds()}, {"paper_minutes", 86}, {"paper_faces", 700000},

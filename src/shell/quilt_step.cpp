@@ -50,6 +50,38 @@ int find_root(std::vector<int>& p, int x) {
   while (p[x] != x) x = p[x] = p[p[x]];
   return x;
 }
+// Keeps the relations (C_out, C_in) that are each other's strongest: the most
+// vertex-face pairs among the relations of C_out and among those of C_in (ties:
+// smaller summed eq. 1 cost, then lower index). The paper's relation ("there
+// exists a pair") also links elements that merely cross (a weave's threads
+// over and under each other, neighbouring chain-mail rings), and joins every
+// element of the overlap into one group whose merges fail; one strongest
+// partner per element is what the merge of section 2.7 can stitch.
+std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& corr) {
+  std::map<std::pair<int, int>, std::pair<std::size_t, double>> strength;  // (out, in) -> (pairs, -cost)
+  for (const VertexFacePair& p : corr.pairs) {
+    auto& s = strength[{p.out_element, p.in_element}];
+    ++s.first;
+    s.second -= p.cost;
+  }
+  std::map<int, std::pair<std::pair<std::size_t, double>, int>> best_out, best_in;
+  for (const auto& [r, st] : strength) {
+    auto upd = [&](std::map<int, std::pair<std::pair<std::size_t, double>, int>>& m, int key, int other) {
+      auto it = m.find(key);
+      if (it == m.end() || st > it->second.first) m[key] = {st, other};
+    };
+    upd(best_out, r.first, r.second);
+    upd(best_in, r.second, r.first);
+  }
+  std::vector<std::pair<int, int>> keep;
+  for (const auto& [r, st] : strength)
+    if (best_out[r.first].second == r.second && best_in[r.second].second == r.first) keep.push_back(r);
+  std::vector<VertexFacePair> pairs;
+  for (const VertexFacePair& p : corr.pairs)
+    if (std::binary_search(keep.begin(), keep.end(), std::make_pair(p.out_element, p.in_element))) pairs.push_back(p);
+  corr.pairs.swap(pairs);
+  return keep;
+}
 }  // namespace
 
 std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
@@ -177,7 +209,7 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
     co.lambda = opt.lambda;
     co.prune_factor = opt.prune_factor;
     corr = find_element_correspondences(elements, near, placed, in_overlap, co);
-    related = corr.related;
+    related = opt.one_to_one ? strongest_relations(corr) : corr.related;
   }
   stats.pairs += corr.pairs.size();
   stats.related += related.size();

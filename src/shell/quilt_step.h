@@ -42,6 +42,11 @@ struct QuiltStepOptions {
   /// on top of it: overlapping duplicates are worse than a small gap. The
   /// paper has no refusals (its merge always succeeds).
   bool drop_refused_inputs = true;
+  /// Keep only mutually strongest relations (most vertex-face pairs) between
+  /// output and input elements, so that each element is merged with at most
+  /// one partner (see strongest_relations in the .cpp); false = the paper's
+  /// "any surviving pair relates two elements".
+  bool one_to_one = true;
 };
 
 struct QuiltStepStats {
