@@ -9,7 +9,7 @@
 // object per stage (times, output faces, stretch before/after,
 // self-intersections).
 // Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
-//                    [edges kept by the decimation (7500)]
+//                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   const std::string outdir = argc > 2 ? argv[2] : "";
   const double rel = argc > 3 ? std::atof(argv[3]) : 0.12;
   const long edges = argc > 4 ? std::atol(argv[4]) : 7500;
+  const std::string kind = argc > 5 ? argv[5] : "weave";
   const fs::path dir = fs::temp_directory_path() / ("surftex-bench-quilt-" + std::to_string(::getpid()));
   try {
     fs::create_directories(dir);
@@ -74,9 +75,12 @@ int main(int argc, char** argv) {
     if (!outdir.empty()) write_mesh(outdir + "/bunny_base.off", base);
     t.reset();
     Mesh sm;
-    make_weave_swatch(sm);
+    if (kind == "chainmail")
+      make_chainmail_swatch(sm);
+    else
+      make_weave_swatch(sm);
     const Swatch s = make_swatch(sm);
-    line({{"stage", "swatch"}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()},
+    line({{"stage", "swatch"}, {"kind", kind}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()},
           {"self_intersections", count_self_intersections(sm)}, {"seconds", t.seconds()}});
     SurfaceQuiltOptions qo;
     qo.relative_size = rel;
@@ -109,11 +113,11 @@ int main(int argc, char** argv) {
           {"paper_stretch", {1.14, 1.08}}});
     if (!outdir.empty()) {
       color_by_element(out, 1);
-      write_mesh(outdir + "/bunny_weave.ply", out);
+      write_mesh(outdir + "/bunny_" + kind + ".ply", out);
       Mesh scene = base;
       get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
       scene.join(out);
-      write_image(outdir + "/bunny_weave.png", render_preview(scene, 30.f, 20.f, 1000));
+      write_image(outdir + "/bunny_" + kind + ".png", render_preview(scene, 30.f, 20.f, 1000));
     }
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
