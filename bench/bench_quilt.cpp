@@ -4,12 +4,17 @@
 // 1.08). CGAL's bunny00.off (extracted from Debian's libcgal-demo tarball into
 // a temporary folder) is decimated to about 5K faces (CGAL
 // Surface_mesh_simplification, edge collapse with a face-count stop
-// predicate), then quilted with the generated weave swatch (about 15K faces),
+// predicate and a placement that refuses collapses turning faces over), then quilted with the generated weave swatch (about 15K faces),
 // the quilt embedded through the stretch-minimised shell map. Prints one JSON
 // object per stage (times, output faces, stretch before/after,
 // self-intersections).
 // Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
+//                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
+#include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_cost.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_placement.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <unistd.h>
 
@@ -24,6 +29,7 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "geometry/self_intersections.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
@@ -45,6 +51,8 @@ int main(int argc, char** argv) {
   const std::string tarball = argc > 1 && argv[1][0] ? argv[1] : SURFTEX_CGAL_DATA_TARBALL;
   const std::string outdir = argc > 2 ? argv[2] : "";
   const double rel = argc > 3 ? std::atof(argv[3]) : 0.12;
+  const long edges = argc > 4 ? std::atol(argv[4]) : 7500;
+  const std::string kind = argc > 5 ? argv[5] : "weave";
   const fs::path dir = fs::temp_directory_path() / ("surftex-bench-quilt-" + std::to_string(::getpid()));
   try {
     fs::create_directories(dir);
@@ -55,16 +63,25 @@ int main(int argc, char** argv) {
     read_mesh((dir / "data" / "meshes" / "bunny00.off").string(), base);
     const std::size_t faces_in = base.number_of_faces();
     // CGAL 5.5's Count_stop_predicate counts edges: E = 1.5 F on a closed mesh.
-    SMS::Count_stop_predicate<Mesh> stop(7500);
-    const int removed = SMS::edge_collapse(base, stop);
+    SMS::Count_stop_predicate<Mesh> stop(static_cast<std::size_t>(edges));
+    // Lindstrom-Turk placement wrapped so that no collapse turns a face over
+    // (a folded sliver has no offset direction: the shell cannot be built over it).
+    const SMS::Bounded_normal_change_placement<SMS::LindstromTurk_placement<Mesh>> placement;
+    const int removed = SMS::edge_collapse(
+        base, stop, CGAL::parameters::get_cost(SMS::LindstromTurk_cost<Mesh>()).get_placement(placement));
     base.collect_garbage();
     line({{"stage", "decimate"}, {"faces_in", faces_in}, {"faces", base.number_of_faces()}, {"edges_removed", removed},
           {"seconds", t.seconds()}});
+    if (!outdir.empty()) write_mesh(outdir + "/bunny_base.off", base);
     t.reset();
     Mesh sm;
-    make_weave_swatch(sm);
+    if (kind == "chainmail")
+      make_chainmail_swatch(sm);
+    else
+      make_weave_swatch(sm);
     const Swatch s = make_swatch(sm);
-    line({{"stage", "swatch"}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()}, {"seconds", t.seconds()}});
+    line({{"stage", "swatch"}, {"kind", kind}, {"faces", s.mesh.tris.size()}, {"elements", s.elements.size()},
+          {"self_intersections", count_self_intersections(sm)}, {"seconds", t.seconds()}});
     SurfaceQuiltOptions qo;
     qo.relative_size = rel;
     qo.up = {0, 1, 0};  // the bunny's up axis
@@ -72,7 +89,11 @@ int main(int argc, char** argv) {
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
           {"patches_shrunk", r.patches_shrunk}, {"max_patch_distortion", r.max_patch_distortion},
-          {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused}, {"dropped_new", r.dropped_new},
+          {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
+          {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
+          {"refused_border", r.stats.refused_border}, {"out_replaced", r.stats.out_replaced},
+          {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
+          {"elements_not_expressible", r.elements_not_expressible},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}});
@@ -80,21 +101,23 @@ int main(int argc, char** argv) {
     eo.stretch.iterations = 40;
     Mesh out;
     const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-    line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"clamped_vertices", er.clamped_vertices},
+    line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"shell_height", er.shell_height}, {"clamped_vertices", er.clamped_vertices},
           {"stretch_before", er.stretch.stretch_before}, {"stretch_after", er.stretch.stretch_after},
           {"faces", out.number_of_faces()}, {"outside_vertices", er.embed.outside},
-          {"self_intersections", er.embed.self_intersecting_pairs}, {"seconds_atlas", er.seconds_atlas},
+          {"self_intersections", er.embed.self_intersecting_pairs},
+          {"self_intersections_within", er.self_intersections_within},
+          {"self_intersections_between", er.self_intersections_between}, {"seconds_atlas", er.seconds_atlas},
           {"seconds_shell", er.seconds_shell}, {"seconds_stretch", er.seconds_stretch},
           {"seconds_map", er.seconds_map}, {"seconds_embed", er.seconds_embed}});
     line({{"stage", "total"}, {"seconds", total.seconds()}, {"paper_minutes", 86}, {"paper_faces", 700000},
           {"paper_stretch", {1.14, 1.08}}});
     if (!outdir.empty()) {
       color_by_element(out, 1);
-      write_mesh(outdir + "/bunny_weave.ply", out);
+      write_mesh(outdir + "/bunny_" + kind + ".ply", out);
       Mesh scene = base;
       get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
       scene.join(out);
-      write_image(outdir + "/bunny_weave.png", render_preview(scene, 30.f, 20.f, 1000));
+      write_image(outdir + "/bunny_" + kind + ".png", render_preview(scene, 30.f, 20.f, 1000));
     }
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -3,10 +3,12 @@
 // 3.2) on the bunny: atlas, shell build, stretch before/after minimisation,
 // shell map, embedding of a layer of small boxes with the exact
 // self-intersection check. Prints one JSON object per stage.
-// Usage: bench_shell_map [mesh] [output folder for OBJ/PNG previews]
+// Usage: bench_shell_map [mesh] [output folder for OBJ/PNG previews] [atlas normal cone (deg)]
+//                        [shell height in mean edge lengths]
 //   default mesh: $SURFTEX_SHARED_DATA_DIR/meshes/bunny_6k.obj (6598 faces).
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <iostream>
 #include <string>
 
@@ -65,13 +67,17 @@ int main(int argc, char** argv) {
           {"vertices", base.number_of_vertices()}, {"seconds", t.seconds()}});
 
     t.reset();
-    const BaseMeshAtlasResult atlas = compute_base_mesh_atlas(base);
+    BaseMeshAtlasOptions ao;
+    if (argc > 3) ao.max_normal_angle_deg = std::atof(argv[3]);
+    const BaseMeshAtlasResult atlas = compute_base_mesh_atlas(base, ao);
     line({{"stage", "atlas"}, {"charts", atlas.num_charts}, {"flipped_faces", atlas.flipped_faces},
           {"area_distortion", atlas.mean_area_distortion}, {"packing", atlas.packing_efficiency},
           {"seconds", t.seconds()}});
 
     t.reset();
-    ShellSpace shell = build_shell_space(base);
+    ShellSpaceOptions so;
+    if (argc > 4) so.height = std::atof(argv[4]);
+    ShellSpace shell = build_shell_space(base, so);
     const ShellOrientationCheck o0 = check_shell_orientation(shell);
     line({{"stage", "shell"}, {"tets", shell.tets.size()}, {"shell_vertices", shell.shell_points.size()},
           {"height", shell.height}, {"clamped_vertices", shell.clamped_vertices},

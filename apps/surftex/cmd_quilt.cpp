@@ -205,10 +205,17 @@ int run_quilt(QuiltArgs& a) {
     rep["stretch_before"] = er.stretch.stretch_before;
     rep["stretch_after"] = er.stretch.stretch_after;
     rep["outside_vertices"] = er.embed.outside;
-    if (er.embed.checked)
+    rep["elements_not_expressible"] = r.elements_not_expressible;
+    rep["stitch_refused_loops"] = r.stats.refused_loops;
+    rep["stitch_refused_border"] = r.stats.refused_border;
+    rep["stitch_refused_infeasible"] = r.stats.refused_infeasible;
+    if (er.embed.checked) {
       rep["self_intersections"] = er.embed.self_intersecting_pairs;
-    else
+      rep["self_intersections_within_elements"] = er.self_intersections_within;
+      rep["self_intersections_between_elements"] = er.self_intersections_between;
+    } else {
       rep["self_intersections"] = nullptr;
+    }
     rep["seconds"] = {{"swatch", swatch_seconds},
                       {"read", read_seconds},
                       {"quilt", r.seconds},

@@ -71,12 +71,15 @@ bool owns(Side side, Region r) {
 }
 }  // namespace
 
-ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
-                       const MergeOptions& opt, const std::vector<char>* b_keep) {
+namespace {
+// cut_element with the closest-point trees of A and B built by the caller
+// (merge_elements cuts A against B and B against A with the same two trees).
+ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side side_a, const ElementMesh& b,
+                          const TriangleDistance& tb, Side side_b, const RegionFn& region, const MergeOptions& opt,
+                          const std::vector<char>* b_keep) {
   auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
   ElementCut res;
   const double match = auto_match(a, b, opt);
-  TriangleDistance tb(b), ta(a);
   const int nt = static_cast<int>(a.tris.size());
   std::vector<TriangleDistance::Hit> hit(a.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
@@ -145,6 +148,13 @@ ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, 
       res.cost += (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
   return res;
 }
+}  // namespace
+
+ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                       const MergeOptions& opt, const std::vector<char>* b_keep) {
+  const TriangleDistance ta(a), tb(b);
+  return cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, b_keep);
+}
 
 namespace {
 /// Kept part of `m` and the loops opened by the cut (loops made of edges that
@@ -194,13 +204,14 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
                            const MergeOptions& opt) {
   MergeResult r;
   auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
-  ElementCut ca = cut_element(a, side_a, b, side_b, region, opt);
+  const TriangleDistance ta(a), tb(b);
+  ElementCut ca = cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, nullptr);
   r.cost_a = ca.cost;
   if (!ca.feasible) {
     r.reason = "cut of A infeasible";
     return r;
   }
-  ElementCut cb = cut_element(b, side_b, a, side_a, region, opt, &ca.keep);
+  ElementCut cb = cut_with_trees(b, tb, side_b, a, ta, side_a, region, opt, &ca.keep);
   r.cost_b = cb.cost;
   if (!cb.feasible) {
     r.reason = "cut of B infeasible";

@@ -1,12 +1,20 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/embed_surface_quilt.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/self_intersections.h"
 #include "geometry/timer.h"
+#include "shell/element_mesh.h"
 #include "shell/shell_map.h"
 #include "shell/shell_space.h"
 
@@ -41,12 +49,98 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   t.reset();
   report_progress(opt.progress, "embed", 0.0);
   const ShellMap map(shell);
-  surface_quilt_to_texture(atlas_mesh, quilt, out);
   res.seconds_map = t.seconds();
   t.reset();
-  EmbedInShellOptions eo;
-  eo.check_self_intersections = opt.check_self_intersections;
-  res.embed = embed_in_shell(out, map, eo);
+  // Texture coordinates (u, v, w) of every quilt vertex (as surface_quilt_to_texture).
+  auto [uv, has_uv] = atlas_mesh.property_map<HalfedgeIndex, UV>(kCornerUV.name);
+  if (!has_uv) throw InvalidInputError("embed_surface_quilt: the atlas wrote no kCornerUV");
+  const std::size_t nf = atlas_mesh.number_of_faces(), nv = quilt.vertices.size();
+  const double dz = quilt.z_max - quilt.z_min;
+  std::vector<std::array<UV, 3>> face_uv(nf);
+  for (FaceIndex f : atlas_mesh.faces()) {
+    int k = 0;
+    for (HalfedgeIndex hh : atlas_mesh.halfedges_around_face(atlas_mesh.halfedge(f)))
+      if (k < 3) face_uv[f.idx()][static_cast<std::size_t>(k++)] = uv[hh];
+  }
+  for (const SurfaceQuiltVertex& v : quilt.vertices)
+    if (v.face < 0 || static_cast<std::size_t>(v.face) >= nf)
+      throw InvalidInputError("embed_surface_quilt: quilt vertex on face " + std::to_string(v.face) + " (base has " +
+                              std::to_string(nf) + " faces)");
+  // Tets 3f .. 3f+2 are the prism of base face f (build_shell_space order).
+  if (shell.tets.size() != 3 * nf) throw InvalidInputError("embed_surface_quilt: unexpected shell layout");
+  std::vector<Vec3> pos(nv);
+  std::vector<char> outside(nv, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
+      const SurfaceQuiltVertex& v = quilt.vertices[i];
+      const auto& c = face_uv[static_cast<std::size_t>(v.face)];
+      const double b0 = 1 - v.b1 - v.b2;
+      const Vec3 uvw{b0 * c[0][0] + v.b1 * c[1][0] + v.b2 * c[2][0], b0 * c[0][1] + v.b1 * c[1][1] + v.b2 * c[2][1],
+                     (v.z - quilt.z_min) / dz};
+      const ShellMap::Location loc = map.locate_texture(uvw, false);
+      if (loc.inside) {
+        pos[i] = map.shell_point(loc);
+        continue;
+      }
+      // Outside the texture space (w beyond [0,1] after deformation, or
+      // (u, v) pushed out of the prism by the moved offset vertices): the
+      // affine map of the vertex's own prism tet with the largest smallest
+      // barycentric coordinate, extrapolated. Local by construction: a global
+      // nearest-tet search can pick a tet of another chart (long spikes).
+      outside[i] = 1;
+      const Vec3 x{uvw[0], uvw[1], uvw[2] * shell.w_scale};
+      double best = -1e300;
+      std::array<double, 4> bb{1, 0, 0, 0};
+      int bt = 3 * v.face;
+      for (int k = 0; k < 3; ++k) {
+        const Tet& tt = shell.tets[static_cast<std::size_t>(3 * v.face + k)];
+        const Vec3 p0 = shell.texture_metric(tt[0]), p1 = shell.texture_metric(tt[1]), p2 = shell.texture_metric(tt[2]),
+                   p3 = shell.texture_metric(tt[3]);
+        const double vol = tet_signed_volume(p0, p1, p2, p3);
+        if (!(vol > 0)) continue;
+        const std::array<double, 4> w{tet_signed_volume(x, p1, p2, p3) / vol, tet_signed_volume(p0, x, p2, p3) / vol,
+                                      tet_signed_volume(p0, p1, x, p3) / vol, tet_signed_volume(p0, p1, p2, x) / vol};
+        const double m = std::min({w[0], w[1], w[2], w[3]});
+        if (m > best) best = m, bb = w, bt = 3 * v.face + k;
+      }
+      const Tet& tt = shell.tets[static_cast<std::size_t>(bt)];
+      Vec3 q{0, 0, 0};
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d) q[static_cast<std::size_t>(d)] += bb[static_cast<std::size_t>(k)] * shell.shell_points[static_cast<std::size_t>(tt[static_cast<std::size_t>(k)])][static_cast<std::size_t>(d)];
+      pos[i] = q;
+    }
+  });
+  // Elements as meshes (kFaceElement = element id).
+  std::vector<ElementMesh> els(static_cast<std::size_t>(quilt.elements));
+  std::vector<int> local(nv, -1);
+  for (std::size_t f = 0; f < quilt.tris.size(); ++f) {
+    ElementMesh& m = els[static_cast<std::size_t>(quilt.tri_element[f])];
+    Tri tri;
+    for (int k = 0; k < 3; ++k) {
+      const int v = quilt.tris[f][static_cast<std::size_t>(k)];
+      if (local[static_cast<std::size_t>(v)] < 0) {
+        local[static_cast<std::size_t>(v)] = static_cast<int>(m.points.size());
+        m.points.push_back(pos[static_cast<std::size_t>(v)]);
+      }
+      tri[static_cast<std::size_t>(k)] = local[static_cast<std::size_t>(v)];
+    }
+    m.tris.push_back(tri);
+  }
+  mesh_from_elements(els, out);
+  res.embed.vertices = nv;
+  for (char o : outside) res.embed.outside += static_cast<std::size_t>(o);
+  if (opt.check_self_intersections) {
+    const std::vector<FacePair> pairs = self_intersecting_faces(out);
+    auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+    for (const FacePair& fp : pairs) {
+      if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])
+        ++res.self_intersections_within;
+      else
+        ++res.self_intersections_between;
+    }
+    res.embed.self_intersecting_pairs = pairs.size();
+    res.embed.checked = true;
+  }
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);
   return res;

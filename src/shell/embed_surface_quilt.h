@@ -6,8 +6,11 @@
 // texture space (surface_quilt_to_texture), builds the shell
 // (shell_space.h) of thickness shell_height * (swatch height * quilt scale),
 // minimises its stretch (shell_map_minimize_stretch, eq. 8-9) and maps every
-// vertex through the shell map into 3D (embed_in_shell.h), with the exact
-// self-intersection count of the result.
+// vertex through the shell map into 3D (as embed_in_shell.h, except that a
+// vertex outside the texture space is extrapolated by a tet of its own base
+// face's prism, not by the nearest tet anywhere), with the exact
+// self-intersection count of the result split into pairs within one element
+// and pairs between two elements.
 // Reads: the base mesh's points (a copy gets the atlas; `base` is unchanged).
 // Writes: `out` (cleared first): the embedded quilt, kFaceElement.
 // Throws: InvalidInputError (bad options), and what the stages throw
@@ -26,7 +29,15 @@ namespace surftex {
 struct EmbedSurfaceQuiltOptions {
   /// Shell thickness in units of the scaled swatch height (z_max - z_min) * scale; > 0.
   double shell_height = 1.0;
-  BaseMeshAtlasOptions atlas;
+  /// The base mesh atlas; its normal cone defaults to 30 degrees here (not
+  /// the atlas' 50): the bottom of the shell keeps the atlas' distortion, which
+  /// the stretch minimisation cannot remove (on the 5K-face bunny the mean area
+  /// distortion drops from 1.12 to 1.01, about 100 -> 280 charts).
+  BaseMeshAtlasOptions atlas = [] {
+    BaseMeshAtlasOptions a;
+    a.max_normal_angle_deg = 30.0;
+    return a;
+  }();
   MinimizeStretchOptions stretch;
   /// Run the exact self-intersection count on the embedded mesh.
   bool check_self_intersections = true;
@@ -38,7 +49,11 @@ struct EmbedSurfaceQuiltResult {
   MinimizeStretchResult stretch;  ///< stretch_before / stretch_after (normalised eq. 9)
   std::size_t tets = 0, clamped_vertices = 0;
   double shell_height = 0;        ///< nominal absolute shell height (mesh units)
-  EmbedInShellResult embed;       ///< outside vertices, self-intersecting pairs
+  EmbedInShellResult embed;       ///< outside vertices, self-intersecting pairs (all)
+  /// The self-intersecting pairs split by element: both faces in one element
+  /// (what the swatch's elements may already have, and deformation adds) and
+  /// faces of two different elements (overlapping elements: a quilting defect).
+  std::size_t self_intersections_within = 0, self_intersections_between = 0;
   double seconds_atlas = 0, seconds_shell = 0, seconds_stretch = 0, seconds_map = 0, seconds_embed = 0;
 };
 

@@ -33,6 +33,9 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   pruned_projection += o.pruned_projection;
   stitched += o.stitched;
   stitch_refused += o.stitch_refused;
+  refused_infeasible += o.refused_infeasible;
+  refused_loops += o.refused_loops;
+  refused_border += o.refused_border;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
   in_added += o.in_added;
@@ -46,6 +49,38 @@ namespace {
 int find_root(std::vector<int>& p, int x) {
   while (p[x] != x) x = p[x] = p[p[x]];
   return x;
+}
+// Keeps the relations (C_out, C_in) that are each other's strongest: the most
+// vertex-face pairs among the relations of C_out and among those of C_in (ties:
+// smaller summed eq. 1 cost, then lower index). The paper's relation ("there
+// exists a pair") also links elements that merely cross (a weave's threads
+// over and under each other, neighbouring chain-mail rings), and joins every
+// element of the overlap into one group whose merges fail; one strongest
+// partner per element is what the merge of section 2.7 can stitch.
+std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& corr) {
+  std::map<std::pair<int, int>, std::pair<std::size_t, double>> strength;  // (out, in) -> (pairs, -cost)
+  for (const VertexFacePair& p : corr.pairs) {
+    auto& s = strength[{p.out_element, p.in_element}];
+    ++s.first;
+    s.second -= p.cost;
+  }
+  std::map<int, std::pair<std::pair<std::size_t, double>, int>> best_out, best_in;
+  for (const auto& [r, st] : strength) {
+    auto upd = [&](std::map<int, std::pair<std::pair<std::size_t, double>, int>>& m, int key, int other) {
+      auto it = m.find(key);
+      if (it == m.end() || st > it->second.first) m[key] = {st, other};
+    };
+    upd(best_out, r.first, r.second);
+    upd(best_in, r.second, r.first);
+  }
+  std::vector<std::pair<int, int>> keep;
+  for (const auto& [r, st] : strength)
+    if (best_out[r.first].second == r.second && best_in[r.second].second == r.first) keep.push_back(r);
+  std::vector<VertexFacePair> pairs;
+  for (const VertexFacePair& p : corr.pairs)
+    if (std::binary_search(keep.begin(), keep.end(), std::make_pair(p.out_element, p.in_element))) pairs.push_back(p);
+  corr.pairs.swap(pairs);
+  return keep;
 }
 }  // namespace
 
@@ -174,7 +209,7 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
     co.lambda = opt.lambda;
     co.prune_factor = opt.prune_factor;
     corr = find_element_correspondences(elements, near, placed, in_overlap, co);
-    related = corr.related;
+    related = opt.one_to_one ? strongest_relations(corr) : corr.related;
   }
   stats.pairs += corr.pairs.size();
   stats.related += related.size();
@@ -272,6 +307,12 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
           add_in[e] = 0;
       } else {
         ++stats.stitch_refused;
+        if (r.reason.find("infeasible") != std::string::npos)
+          ++stats.refused_infeasible;
+        else if (r.reason.find("loops") != std::string::npos)
+          ++stats.refused_loops;
+        else
+          ++stats.refused_border;
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
           add_in[e] = 0;

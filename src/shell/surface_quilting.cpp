@@ -1,10 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/surface_quilting.h"
 
-#ifndef CGAL_EIGEN3_ENABLED
-#define CGAL_EIGEN3_ENABLED  // LSCM's default solver is the Eigen one
-#endif
-
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Surface_mesh_parameterization/Error_code.h>
 #include <CGAL/Surface_mesh_parameterization/LSCM_parameterizer_3.h>
@@ -32,6 +28,9 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 namespace SMP = CGAL::Surface_mesh_parameterization;
 using V2 = std::array<double, 2>;
 constexpr double kPi = 3.14159265358979323846;
+// Cosine of the largest angle between an off-patch vertex's face and its
+// nearest patch face for the element to be expressed in the patch frame.
+constexpr double kFrameCos = 0.5;
 
 P3 sub3(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 double dot3(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -501,7 +500,23 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
 
     // 6. Output elements touching the patch, in the frame.
     Timer ts;
-    auto frame_of_loc = [&](const SurfaceQuiltVertex& v, std::unordered_map<int, int>& near_cache) -> P3 {
+    std::unordered_map<int, int> near_cache;
+    // Index in flat.faces of the patch face whose centroid is nearest to base face f's.
+    auto nearest_patch_face = [&](int f) {
+      auto it = near_cache.find(f);
+      if (it == near_cache.end()) {
+        double bd = 1e300;
+        int bk = 0;
+        for (std::size_t q = 0; q < flat.faces.size(); ++q) {
+          const P3 dd = sub3(b.centroid[flat.faces[q]], b.centroid[f]);
+          const double d2 = dot3(dd, dd);
+          if (d2 < bd) bd = d2, bk = static_cast<int>(q);
+        }
+        it = near_cache.emplace(f, bk).first;
+      }
+      return it->second;
+    };
+    auto frame_of_loc = [&](const SurfaceQuiltVertex& v) -> P3 {
       int k = patch_slot[v.face];
       if (k >= 0) {
         const auto& t = ftris[k];
@@ -509,18 +524,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         return {b0 * t[0][0] + v.b1 * t[1][0] + v.b2 * t[2][0], b0 * t[0][1] + v.b1 * t[1][1] + v.b2 * t[2][1], v.z};
       }
       // Off the patch: project onto the plane of the patch face with the nearest centroid.
-      auto it = near_cache.find(v.face);
-      if (it == near_cache.end()) {
-        double bd = 1e300;
-        int bk = 0;
-        for (std::size_t q = 0; q < flat.faces.size(); ++q) {
-          const P3 dd = sub3(b.centroid[flat.faces[q]], b.centroid[v.face]);
-          const double d2 = dot3(dd, dd);
-          if (d2 < bd) bd = d2, bk = static_cast<int>(q);
-        }
-        it = near_cache.emplace(v.face, bk).first;
-      }
-      k = it->second;
+      k = nearest_patch_face(v.face);
       const int g = flat.faces[k];
       const P3 p = base_point(b, v);
       const auto& tg = b.faces[g];
@@ -539,7 +543,6 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     std::vector<int> ids;  // global element ids in the frame
     std::vector<ElementMesh> frame;
     std::map<P3, SurfaceQuiltVertex> keep_loc;  // frame point -> local coordinates it came from
-    std::unordered_map<int, int> near_cache;
     for (std::size_t e = 0; e < elements.size(); ++e) {
       Element& el = elements[e];
       if (!el.alive) continue;
@@ -550,11 +553,32 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
           break;
         }
       if (!touches) continue;
+      // An element reaching far beyond the patch (a long stitched thread, an
+      // element across an ear) cannot be expressed in this frame: its off-patch
+      // vertices would be projected onto the plane of a distant patch face,
+      // land at arbitrary frame points, possibly in the overlap, be moved
+      // there and come back as long spikes. Such elements are left as they are
+      // (not merged in this step).
+      bool expressible = true;
+      for (const auto& v : el.loc) {
+        if (patch_slot[v.face] >= 0) continue;
+        const int k = nearest_patch_face(v.face);
+        const int g = flat.faces[static_cast<std::size_t>(k)];
+        const P3 d = sub3(base_point(b, v), b.centroid[g]);
+        if (dot3(b.normal[g], b.normal[v.face]) < kFrameCos || dot3(d, d) > 4 * R * R) {
+          expressible = false;
+          break;
+        }
+      }
+      if (!expressible) {
+        ++res.elements_not_expressible;
+        continue;
+      }
       ElementMesh m;
       m.tris = el.mesh.tris;
       m.points.resize(el.loc.size());
       for (std::size_t v = 0; v < el.loc.size(); ++v) {
-        m.points[v] = frame_of_loc(el.loc[v], near_cache);
+        m.points[v] = frame_of_loc(el.loc[v]);
         keep_loc.emplace(m.points[v], el.loc[v]);
       }
       ids.push_back(static_cast<int>(e));

@@ -30,7 +30,9 @@
 // 6. Output elements with a vertex on a patch triangle are expressed in the
 //    frame (vertices on other triangles: projected onto the plane of the
 //    patch triangle with the nearest centroid, barycentric coordinates
-//    extrapolated), quilt_step (quilt_step.h) runs, and new or changed
+//    extrapolated; an element with a vertex farther than 2R from that triangle
+//    or on a face at more than 60 degrees to it is left out of the step, see
+//    SurfaceQuiltResult::elements_not_expressible), quilt_step (quilt_step.h) runs, and new or changed
 //    vertices are expressed again in local coordinates: base triangle +
 //    barycentric coordinates of the orthogonal projection (the flattening's
 //    triangle containing the frame point; outside the patch the triangle whose
@@ -116,6 +118,10 @@ struct SurfaceQuiltResult {
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
+  /// Times an output element touching a patch was left out of its step because
+  /// a vertex lies off the patch, farther than the patch radius from (or at
+  /// more than 60 degrees to) the nearest patch face.
+  std::size_t elements_not_expressible = 0;
   QuiltStepStats stats;
   double seconds = 0, seconds_patch = 0, seconds_step = 0;
 };

@@ -3,6 +3,8 @@
 // quilting, correspondences, Laplacian deformation, graph-cut merging.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <cmath>
 #include <cstdlib>
 
@@ -314,5 +316,36 @@ TEST(PlanarQuiltingScale, RejectsBadSizes) {
   EXPECT_THROW(quilt_plane(s, 5, 5, out, o), InvalidInputError);
 }
 
+}  // namespace
+}  // namespace surftex
+
+namespace surftex {
+namespace {
+// Weave threads cross each other in every overlap: with the paper's relation
+// ("any surviving vertex-face pair") crossing threads are related too; with
+// mutually strongest relations each element keeps at most one partner, so
+// there are no more relations than with any-pair relations. The refusal
+// reasons add up to the refusals. (On this planar weave every stitch is still
+// refused for different loop counts either way: see the lead's report.)
+TEST(QuiltStep, OneToOneRelationsAreNoMoreThanAnyPairRelationsAndRefusalsAddUp) {
+  const Swatch sw = small_weave();
+  PlanarQuiltOptions o;
+  o.seed = 3;
+  Mesh a, b;
+  const QuiltResult one = quilt_plane(sw, 2.2 * sw.length(), 2.2 * sw.width(), a, o);
+  o.step.one_to_one = false;
+  const QuiltResult any = quilt_plane(sw, 2.2 * sw.length(), 2.2 * sw.width(), b, o);
+  std::cout << "[ weave ] one-to-one: related " << one.stats.related << ", stitched " << one.stats.stitched
+            << ", refused " << one.stats.stitch_refused << " (loops " << one.stats.refused_loops << ", border "
+            << one.stats.refused_border << ", infeasible " << one.stats.refused_infeasible << "); any pair: related "
+            << any.stats.related << ", stitched " << any.stats.stitched << ", refused " << any.stats.stitch_refused
+            << "\n";
+  EXPECT_EQ(one.stats.stitch_refused,
+            one.stats.refused_loops + one.stats.refused_border + one.stats.refused_infeasible);
+  EXPECT_EQ(any.stats.stitch_refused,
+            any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible);
+  EXPECT_GT(one.stats.related, 0u);
+  EXPECT_LT(one.stats.related, any.stats.related);
+}
 }  // namespace
 }  // namespace surftex

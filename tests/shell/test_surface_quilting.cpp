@@ -173,6 +173,63 @@ TEST(SurfaceQuilting, ConcaveValleyShellEmbeddingHasNoSelfIntersectionsNaiveHas)
   EXPECT_LT(er.embed.self_intersecting_pairs * 4, naive_hits);
 }
 
+// The embedded quilt's self-intersections are split into pairs inside one
+// element and pairs between two elements; the split is checked against a
+// per-element count, and no embedded vertex leaves the shell (elements that
+// reach far beyond a patch used to be projected onto a distant patch plane,
+// moved there and come back as spikes). Torus: curvature of both signs.
+TEST(SurfaceQuilting, TorusChainmailIntersectionsSplitByElementAndNoVertexLeavesTheShell) {
+  Mesh base;
+  const double R = 1.0, r = 0.45;
+  make_torus(base, R, r, test::sanitized() ? 24 : 40, test::sanitized() ? 12 : 20);
+  const Swatch sw = tiny_chainmail(2);
+  std::size_t swatch_within = 0;  // the swatch's own intersections inside its elements
+  {
+    std::vector<std::vector<int>> tris(sw.elements.size());
+    for (std::size_t f = 0; f < sw.face_element.size(); ++f) tris[sw.face_element[f]].push_back(static_cast<int>(f));
+    for (auto& t : tris) {
+      Mesh one;
+      mesh_from_elements({extract_triangles(sw.mesh, t)}, one);
+      swatch_within += count_self_intersections(one);
+    }
+  }
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.3;
+  SurfaceQuilt q;
+  const SurfaceQuiltResult qr = quilt_surface(base, sw, q, o);
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 5;
+  Mesh out;
+  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+  ASSERT_TRUE(er.embed.checked);
+  EXPECT_EQ(er.self_intersections_within + er.self_intersections_between, er.embed.self_intersecting_pairs);
+  // Recount inside every element on its own.
+  const ElementMesh all = element_mesh_from(out);
+  auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+  std::vector<std::vector<int>> by_el(static_cast<std::size_t>(q.elements));
+  for (FaceIndex f : out.faces()) by_el[static_cast<std::size_t>(el[f])].push_back(static_cast<int>(f.idx()));
+  std::size_t within = 0;
+  for (const auto& t : by_el) {
+    Mesh one;
+    mesh_from_elements({extract_triangles(all, t)}, one);
+    within += count_self_intersections(one);
+  }
+  EXPECT_EQ(within, er.self_intersections_within);
+  std::cout << "[ torus ] elements " << q.elements << ", not expressible " << qr.elements_not_expressible
+            << ", stitched " << qr.stats.stitched << ", refused " << qr.stats.stitch_refused << ", stretch "
+            << er.stretch.stretch_before << " -> " << er.stretch.stretch_after << ", pairs within "
+            << er.self_intersections_within << " (swatch " << swatch_within << "), between "
+            << er.self_intersections_between << "\n";
+  // Every vertex lies in the shell: distance to the torus' core circle in [r - eps, r + shell height + eps].
+  for (VertexIndex v : out.vertices()) {
+    const Point3 p = out.point(v);
+    const double rho = std::hypot(p.x(), p.y());
+    const double d = std::hypot(rho - R, p.z());
+    EXPECT_GT(d, r - 0.05);
+    EXPECT_LT(d, r + 1.3 * er.shell_height + 0.05);
+  }
+}
+
 TEST(SurfaceQuilting, RejectsBadInput) {
   Mesh base;
   make_icosphere(base, 1);
