@@ -27,7 +27,9 @@
 //    region (graph_cut_transfer, r = a^m n texels) or P alone. With
 //    skip_patched, vertices that received colour from a cut earlier in the
 //    same pass are not matched again in that pass (the speed-up of section 4).
-// Colours are read from the stack level of each vertex (3.3.4).
+// Colours are read from the stack level of each vertex (3.3.4); each colour
+// remembers that level and is compared against it when it serves as a sample
+// (old vertices carry coarse, blurred colours into the next mesh level).
 //
 // Writes kVertexColor (linear RGB), kVertexDirection, kVertexSweep on the
 // final (finest) mesh, which replaces `mesh`. Throws InvalidInputError (bad
@@ -119,9 +121,15 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
 /// The same with a prebuilt index of `ex` (reused across passes).
+/// `color_level` (optional, one entry per vertex, updated): the stack level
+/// each vertex's current colour was read from. A sample is compared against
+/// that level, not the vertex's current anti-aliasing level: colours carried
+/// from a coarser mesh level are blurred, and comparing them against sharper
+/// texels makes SSD prefer the exemplar's extreme (dark) texels, which then
+/// grow into blobs. Null = every colour belongs to its vertex's current level.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,
-                                  std::mt19937_64& rng);
+                                  std::mt19937_64& rng, std::vector<int>* color_level = nullptr);
 
 }  // namespace surftex
