@@ -466,3 +466,45 @@ TEST(SubdivisionSynthesis, StripesFollowTheFieldOnAFlatGridWholePipeline) {
   EXPECT_LT(s.along_x, 0.25 * s.along_y) << "stripes not along the field";
   EXPECT_GT(s.falling, 3 * s.rising) << "stripe profile mirrored";
 }
+
+// Regression (dark blobs on a flat plane): a colour carried from a coarser
+// mesh level was read from a blurred stack level but compared against the
+// vertex's current, sharper level; SSD then preferred the exemplar's most
+// uniform (dark) areas. With color_level each sample is compared at the level
+// its colour came from: a neighbourhood planted from stack level 3 is found
+// exactly although the pass matches at level 0.
+TEST(SubdivisionSynthesis, CarriedColoursAreComparedAtTheirOwnStackLevel) {
+  std::mt19937_64 rng(11);
+  const ExemplarLevels ex = make_exemplar_levels(random_image(32, 32, rng), false);
+  const int n = 8, ic = 4, jc = 4, X = 13, Y = 20, L = 3;
+  Mesh m;
+  make_quad_plane(m, n, 1.0);
+  turk_orientation_field(m, {{0, {1, 0, 0}}});
+  auto col = get_or_add(m, kVertexColor, Color3f{0.5f, 0.5f, 0.5f});
+  std::vector<char> colored(m.number_of_vertices(), 1);
+  std::vector<int> level(m.number_of_vertices(), L);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const auto t = texel(ex, L, X + (i - ic), Y - (j - jc));  // u = +x, v = -y in the image
+      col[VertexIndex(static_cast<Mesh::size_type>(j * (n + 1) + i))] = {t[0], t[1], t[2]};
+    }
+  const std::size_t centre = jc * (n + 1) + ic;
+  colored[centre] = 0;
+  SubdivisionSynthesisOptions o;
+  o.antialias = false;  // the pass matches at level 0
+  o.graph_cut = false;
+  o.region_texels = 3;
+  const ExemplarIndex index(ex);
+  const SynthesisPassStats st = synthesis_pass(m, ex, index, {centre}, colored, 1.0, 0, o, rng, &level);
+  EXPECT_EQ(st.matched, 1u);
+  const auto want = texel(ex, 0, X, Y);  // the centre's colour comes from its own level (0)
+  const Color3f got = find(m, kVertexColor).first[VertexIndex(static_cast<Mesh::size_type>(centre))];
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(got[c], want[c]);
+  EXPECT_EQ(level[centre], 0);
+  // Compared at level 0 instead (no record), the planted neighbourhood is not found.
+  col[VertexIndex(static_cast<Mesh::size_type>(centre))] = {0.5f, 0.5f, 0.5f};
+  colored[centre] = 0;
+  synthesis_pass(m, ex, index, {centre}, colored, 1.0, 0, o, rng, nullptr);
+  const Color3f naive = find(m, kVertexColor).first[VertexIndex(static_cast<Mesh::size_type>(centre))];
+  EXPECT_FALSE(naive[0] == want[0] && naive[1] == want[1] && naive[2] == want[2]);
+}
