@@ -97,6 +97,7 @@ int main(int argc, char** argv) {
       SubdivisionSynthesisOptions o;
       o.graph_cut = cut;
       o.skip_patched = false;
+      o.region_texels = 3;  // Table 1: "the equivalent of 3x3 texture neighbourhood"
       Timer tp;
       const SynthesisPassStats st = synthesis_pass(mesh, ex, index, order, colored, rs / unit_paper, 0, o, rng);
       const double secs = tp.seconds();

@@ -52,7 +52,12 @@ struct VertexJob {
   KRegion reg;
   MatchResult m;
   std::size_t groups = 0;
-  std::vector<std::pair<std::size_t, std::array<float, 3>>> writes;  ///< (vertex, colour), centre first
+  struct Write {
+    std::size_t vertex;
+    std::array<float, 3> color;
+    int level;  ///< stack level the colour was read from
+  };
+  std::vector<Write> writes;  ///< centre first
   double t_region = 0, t_match = 0, t_transfer = 0;
 };
 
@@ -72,6 +77,7 @@ struct PassContext {
   const std::vector<int>& level;
   const std::vector<char>& colored;
   const std::vector<Color3f>& color;
+  const std::vector<int>& color_level;  ///< stack level each vertex's colour was read from
   double r_scale;
   const SubdivisionSynthesisOptions& opt;
 };
@@ -92,8 +98,11 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
     const std::size_t v = reg.vertices[i];
     if (!c.colored[v]) continue;
     const Color3f& col = c.color[v];
+    // Compared at the level its colour represents (a colour carried from a
+    // coarser mesh level is a blurred one: matching it against sharper texels
+    // turns blurred dark seams into solid dark blobs).
     s.samples.push_back(
-        RegionSample{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {col[0], col[1], col[2]}});
+        RegionSample{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.color_level[v], {col[0], col[1], col[2]}});
   }
   auto t1 = std::chrono::steady_clock::now();
   job.t_region = std::chrono::duration<double>(t1 - t0).count();
@@ -105,7 +114,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
   auto t2 = std::chrono::steady_clock::now();
   job.t_match = std::chrono::duration<double>(t2 - t1).count();
   if (!opt.graph_cut) {
-    job.writes.push_back({p, texel(c.ex, lp, job.m.qx, job.m.qy)});
+    job.writes.push_back({p, texel(c.ex, lp, job.m.qx, job.m.qy), lp});
   } else {
     s.nodes.resize(reg.vertices.size());
     for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
@@ -126,7 +135,8 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
     go.sigma = opt.sigma;
     const auto cut = graph_cut_transfer(s.nodes, reg.edges, 0, job.k, r, go);
     for (std::size_t i = 0; i < reg.vertices.size(); ++i)
-      if (cut.take_texture[i]) job.writes.push_back({reg.vertices[i], s.nodes[i].texture});
+      if (cut.take_texture[i])
+        job.writes.push_back({reg.vertices[i], s.nodes[i].texture, c.ex.pyramid ? lp : c.level[reg.vertices[i]]});
   }
   job.t_transfer = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
 }
@@ -137,15 +147,18 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng) {
   const ExemplarIndex index(ex);
-  return synthesis_pass(mesh, ex, index, order, colored, r_scale, hierarchy_level, opt, rng);
+  return synthesis_pass(mesh, ex, index, order, colored, r_scale, hierarchy_level, opt, rng, nullptr);
 }
 
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,
-                                  std::mt19937_64& rng) {
+                                  std::mt19937_64& rng, std::vector<int>* color_level_io) {
   const std::size_t nv = mesh.number_of_vertices();
   if (colored.size() != nv) throw InvalidInputError("synthesis_pass: colored has the wrong size");
+  if (color_level_io && color_level_io->size() != nv)
+    throw InvalidInputError("synthesis_pass: color_level has " + std::to_string(color_level_io->size()) +
+                            " entries for " + std::to_string(nv) + " vertices");
   for (std::size_t p : order)
     if (p >= nv) throw InvalidInputError("synthesis_pass: order names vertex " + std::to_string(p));
   auto t_setup = std::chrono::steady_clock::now();
@@ -159,12 +172,17 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
   std::vector<int> level(nv);
   for (std::size_t i = 0; i < nv; ++i)
     level[i] = opt.antialias ? antialias_level(ex, r_scale, fr.mean_edge[i]) : fixed_level;
+  // Without a caller's record, every colour is taken to represent its vertex's level.
+  std::vector<int> own_level;
+  if (!color_level_io) own_level = level;
+  std::vector<int>& color_level = color_level_io ? *color_level_io : own_level;
+  for (int& l : color_level) l = std::clamp(l, 0, nlev - 1);
   std::vector<char> patched(nv, 0);
   std::vector<std::uint32_t> written(nv, 0);  // chunk stamp of the last write
   bool any_colored = std::any_of(colored.begin(), colored.end(), [](char c) { return c != 0; });
   SynthesisPassStats st;
   st.seconds_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
-  const PassContext ctx{graph, fr, ex, index, level, colored, color, r_scale, opt};
+  const PassContext ctx{graph, fr, ex, index, level, colored, color, color_level, r_scale, opt};
   double sum_k = 0, sum_region = 0, sum_groups = 0;
 
   // Speculative parallel matching, sequential commit (exactly the sequential
@@ -208,6 +226,7 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
         const int x = ux(rng), y = uy(rng);
         const auto t = texel(ex, lp, x, y);
         color[p] = {t[0], t[1], t[2]};
+        color_level[p] = lp;
         colored[p] = 1;
         written[p] = stamp;
         any_colored = true;
@@ -239,11 +258,12 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
       sum_groups += job.groups;
       st.candidates += job.m.candidates;
       for (const auto& w : job.writes) {
-        color[w.first] = {w.second[0], w.second[1], w.second[2]};
-        colored[w.first] = 1;
-        written[w.first] = stamp;
-        if (w.first != p) {
-          patched[w.first] = 1;
+        color[w.vertex] = {w.color[0], w.color[1], w.color[2]};
+        color_level[w.vertex] = w.level;
+        colored[w.vertex] = 1;
+        written[w.vertex] = stamp;
+        if (w.vertex != p) {
+          patched[w.vertex] = 1;
           ++st.patched;
         }
       }
@@ -308,13 +328,29 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
   std::vector<OrientationKey> keys = opt.keys;
   if (keys.empty()) keys.push_back(OrientationKey{0, {1, 0, 0}});
   std::vector<char> colored;
+  std::vector<int> color_level;  // stack level each vertex's colour was read from
   for (int level = 0; level <= opt.levels; ++level) {
     SynthesisLevelStats ls;
     ls.level = level;
     Timer t;
     if (level > 0) {
+      const std::size_t old_nv = mesh.number_of_vertices();
       sqrt2_subdivide(mesh);
       ls.seconds_subdivide = t.seconds();
+      // Old vertices keep their index and colour, so the level that colour was
+      // read from; a face point's averaged colour is at least as coarse as its
+      // face's corners (its neighbours).
+      color_level.resize(mesh.number_of_vertices(), 0);
+      for (std::size_t v = old_nv; v < color_level.size(); ++v) {
+        const VertexIndex fv(static_cast<Mesh::size_type>(v));
+        int l = 0;
+        if (!mesh.is_isolated(fv))
+          for (VertexIndex w : mesh.vertices_around_target(mesh.halfedge(fv)))
+            if (w.idx() < old_nv) l = std::max(l, color_level[w.idx()]);
+        color_level[v] = l;
+      }
+    } else {
+      color_level.assign(mesh.number_of_vertices(), 0);
     }
     t.reset();
     TurkFieldOptions to;
@@ -345,7 +381,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
     for (int pass = 0; pass < opt.passes; ++pass) {
       report_progress(opt.progress, "synthesis level " + std::to_string(level),
                       double(level * opt.passes + pass) / double((opt.levels + 1) * opt.passes));
-      ls.pass_stats.push_back(synthesis_pass(mesh, ex, index, order, colored, r_mesh, hierarchy_level, opt, rng));
+      ls.pass_stats.push_back(synthesis_pass(mesh, ex, index, order, colored, r_mesh, hierarchy_level, opt, rng, &color_level));
       ++ls.passes;
       if (pass == 0) {
         // Fill passes: vertices left without coloured neighbours (section 4).
@@ -354,7 +390,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
           for (std::size_t v : order)
             if (!colored[v] && !mesh.is_isolated(VertexIndex(static_cast<Mesh::size_type>(v)))) missing.push_back(v);
           if (missing.empty()) break;
-          const SynthesisPassStats fs = synthesis_pass(mesh, ex, index, missing, colored, r_mesh, hierarchy_level, opt, rng);
+          const SynthesisPassStats fs = synthesis_pass(mesh, ex, index, missing, colored, r_mesh, hierarchy_level, opt, rng, &color_level);
           ls.pass_stats.push_back(fs);
           ++ls.passes;
           ++ls.fill_passes;
@@ -365,6 +401,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
             get_or_add(mesh, kVertexColor)[VertexIndex(static_cast<Mesh::size_type>(missing.front()))] = {
                 tx[0], tx[1], tx[2]};
             colored[missing.front()] = 1;
+            color_level[missing.front()] = 0;
           }
         }
       }

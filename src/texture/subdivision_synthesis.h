@@ -27,7 +27,9 @@
 //    region (graph_cut_transfer, r = a^m n texels) or P alone. With
 //    skip_patched, vertices that received colour from a cut earlier in the
 //    same pass are not matched again in that pass (the speed-up of section 4).
-// Colours are read from the stack level of each vertex (3.3.4).
+// Colours are read from the stack level of each vertex (3.3.4); each colour
+// remembers that level and is compared against it when it serves as a sample
+// (old vertices carry coarse, blurred colours into the next mesh level).
 //
 // Writes kVertexColor (linear RGB), kVertexDirection, kVertexSweep on the
 // final (finest) mesh, which replaces `mesh`. Throws InvalidInputError (bad
@@ -53,7 +55,11 @@ struct SubdivisionSynthesisOptions {
   double adaptive_factor = 0;   ///< f of 3.2.2; 0 = no adaptive subdivision
   int adaptive_steps = 4;       ///< adaptive steps when adaptive_factor > 0, 0..32
   int passes = 2;               ///< passes per level, 1..16
-  double region_texels = 3;     ///< n: neighbourhood edge length in texels (3 = the paper's 3x3), > 0
+  /// n: neighbourhood edge length in texels, > 0. 3 is the paper's Table-1 (timing)
+  /// setting; it is too small for structured exemplars at the fine stack levels,
+  /// where SSD favours the most uniform exemplar areas (dark seams of a brick
+  /// wall grow into blobs). 9 keeps brick structure on brick_small_96.
+  double region_texels = 9;
   bool pyramid = false;         ///< Gaussian pyramid (a = 2) instead of the stack (a = 1)
   bool antialias = true;        ///< per-vertex stack level (3.3.4)
   bool averaging = true;        ///< oversampling groups (3.3.3)
@@ -119,9 +125,15 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
 /// The same with a prebuilt index of `ex` (reused across passes).
+/// `color_level` (optional, one entry per vertex, updated): the stack level
+/// each vertex's current colour was read from. A sample is compared against
+/// that level, not the vertex's current anti-aliasing level: colours carried
+/// from a coarser mesh level are blurred, and comparing them against sharper
+/// texels makes SSD prefer the exemplar's extreme (dark) texels, which then
+/// grow into blobs. Null = every colour belongs to its vertex's current level.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,
-                                  std::mt19937_64& rng);
+                                  std::mt19937_64& rng, std::vector<int>* color_level = nullptr);
 
 }  // namespace surftex

@@ -3,6 +3,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <map>
 
 #include <cmath>
 #include <random>
@@ -357,4 +358,153 @@ TEST(DisplaceByVertexColor, FlatGridMovesAlongTheNormalByHeightTimesGrey) {
   EXPECT_NEAR(r.min_offset, lo, 1e-9);
   EXPECT_NEAR(r.max_offset, hi, 1e-9);
   EXPECT_THROW(displace_by_vertex_color(m, std::nan("")), InvalidInputError);
+}
+
+namespace {
+
+// An n x n quad grid in the plane z = 0 (spacing h), faces counter-clockwise
+// seen from +z (normals +z).
+void make_quad_plane(Mesh& m, int n, double h) {
+  std::vector<VertexIndex> v;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) v.push_back(m.add_vertex(Point3(h * i, h * j, 0)));
+  const int w = n + 1;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) m.add_face(v[j * w + i], v[j * w + i + 1], v[(j + 1) * w + i + 1], v[(j + 1) * w + i]);
+}
+
+// Horizontal stripes with an asymmetric profile: grey rises from 0.1 to 0.9
+// over 8 image rows (y down), then drops. Constant along image x.
+Image sawtooth_stripes(int size) {
+  Image im(size, size, 3);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.1f + 0.8f * float(y % 8) / 7.f;
+  return im;
+}
+
+struct StripeStats {
+  double along_x = 0, along_y = 0;  ///< mean |grey difference| between x- and y-neighbours
+  int falling = 0, rising = 0;      ///< y-neighbour pairs (j -> j+1) getting darker / lighter
+  std::size_t cells = 0;
+};
+
+// Grey of every vertex on the lattice of spacing h (vertices off the lattice
+// are ignored), then neighbour statistics.
+StripeStats stripe_stats(const Mesh& m, double h) {
+  std::map<std::pair<long, long>, float> grey;
+  auto col = find(m, kVertexColor).first;
+  for (VertexIndex v : m.vertices()) {
+    const Point3& p = m.point(v);
+    const double gx = p.x() / h, gy = p.y() / h;
+    if (std::abs(gx - std::round(gx)) > 1e-6 || std::abs(gy - std::round(gy)) > 1e-6) continue;
+    grey[{std::lround(gx), std::lround(gy)}] = (col[v][0] + col[v][1] + col[v][2]) / 3.f;
+  }
+  StripeStats s;
+  std::size_t nx = 0, ny = 0;
+  for (const auto& [ij, g] : grey) {
+    auto right = grey.find({ij.first + 1, ij.second});
+    if (right != grey.end()) s.along_x += std::abs(right->second - g), ++nx;
+    auto up = grey.find({ij.first, ij.second + 1});
+    if (up != grey.end()) {
+      s.along_y += std::abs(up->second - g), ++ny;
+      if (up->second < g - 0.02f) ++s.falling;
+      if (up->second > g + 0.02f) ++s.rising;
+    }
+  }
+  s.along_x /= std::max<std::size_t>(nx, 1);
+  s.along_y /= std::max<std::size_t>(ny, 1);
+  s.cells = grey.size();
+  return s;
+}
+
+}  // namespace
+
+// Orientation of the copied texture: u (the field, world x here) is image x,
+// v = n x u (world y) is image -y (image rows grow downwards, so the exemplar
+// appears upright seen from +z). Horizontal sawtooth stripes synthesised on a
+// flat quad grid with a constant field must come out as stripes along world x
+// that get darker going up (+y). An axis swap gives stripes along y; a sign
+// flip of v gives stripes that get lighter going up.
+TEST(SubdivisionSynthesis, StripesFollowTheFieldOnAFlatGridOnePassLevel) {
+  const ExemplarLevels ex = make_exemplar_levels(sawtooth_stripes(32), false);
+  for (bool cut : {false, true}) {
+    Mesh m;
+    const int n = 24;
+    make_quad_plane(m, n, 1.0);
+    turk_orientation_field(m, {{0, {1, 0, 0}}});
+    std::mt19937_64 rng(7);
+    std::vector<char> colored(m.number_of_vertices(), 0);
+    std::vector<std::size_t> order(m.number_of_vertices());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;  // row by row, like a sweep along x
+    SubdivisionSynthesisOptions o;
+    o.graph_cut = cut;
+    o.antialias = false;
+    for (int pass = 0; pass < 3; ++pass) synthesis_pass(m, ex, order, colored, 1.0, 0, o, rng);
+    const StripeStats s = stripe_stats(m, 1.0);
+    EXPECT_EQ(s.cells, std::size_t((n + 1) * (n + 1)));
+    EXPECT_LT(s.along_x, 0.25 * s.along_y) << "cut " << cut << ": stripes not along the field";
+    EXPECT_GT(s.falling, 3 * s.rising) << "cut " << cut << ": stripe profile mirrored";
+  }
+}
+
+// The same through the whole hierarchy (base level, sqrt(2) steps, stack
+// levels chosen per vertex): the final grid must still show the stripes.
+TEST(SubdivisionSynthesis, StripesFollowTheFieldOnAFlatGridWholePipeline) {
+  const Image img = sawtooth_stripes(32);
+  Mesh m;
+  const int n = 12;
+  make_quad_plane(m, n, 1.0 / n);
+  SubdivisionSynthesisOptions o;
+  o.levels = 2;           // two sqrt(2) steps: a grid again, spacing 1 / (2n)
+  o.r_scale = 2.0 * n;    // one texel per final edge
+  o.keys = {{0, {1, 0, 0}}};
+  o.seed = 3;
+  synthesize_on_subdivision(m, img, o);
+  const StripeStats s = stripe_stats(m, 1.0 / (2 * n));
+  EXPECT_GT(s.cells, std::size_t((2 * n + 1) * (2 * n + 1)) / 2);
+  EXPECT_LT(s.along_x, 0.25 * s.along_y) << "stripes not along the field";
+  EXPECT_GT(s.falling, 3 * s.rising) << "stripe profile mirrored";
+}
+
+// Regression (dark blobs on a flat plane): a colour carried from a coarser
+// mesh level was read from a blurred stack level but compared against the
+// vertex's current, sharper level; SSD then preferred the exemplar's most
+// uniform (dark) areas. With color_level each sample is compared at the level
+// its colour came from: a neighbourhood planted from stack level 3 is found
+// exactly although the pass matches at level 0.
+TEST(SubdivisionSynthesis, CarriedColoursAreComparedAtTheirOwnStackLevel) {
+  std::mt19937_64 rng(11);
+  const ExemplarLevels ex = make_exemplar_levels(random_image(32, 32, rng), false);
+  const int n = 8, ic = 4, jc = 4, X = 13, Y = 20, L = 3;
+  Mesh m;
+  make_quad_plane(m, n, 1.0);
+  turk_orientation_field(m, {{0, {1, 0, 0}}});
+  auto col = get_or_add(m, kVertexColor, Color3f{0.5f, 0.5f, 0.5f});
+  std::vector<char> colored(m.number_of_vertices(), 1);
+  std::vector<int> level(m.number_of_vertices(), L);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const auto t = texel(ex, L, X + (i - ic), Y - (j - jc));  // u = +x, v = -y in the image
+      col[VertexIndex(static_cast<Mesh::size_type>(j * (n + 1) + i))] = {t[0], t[1], t[2]};
+    }
+  const std::size_t centre = jc * (n + 1) + ic;
+  colored[centre] = 0;
+  SubdivisionSynthesisOptions o;
+  o.antialias = false;  // the pass matches at level 0
+  o.graph_cut = false;
+  o.region_texels = 3;
+  const ExemplarIndex index(ex);
+  const SynthesisPassStats st = synthesis_pass(m, ex, index, {centre}, colored, 1.0, 0, o, rng, &level);
+  EXPECT_EQ(st.matched, 1u);
+  const auto want = texel(ex, 0, X, Y);  // the centre's colour comes from its own level (0)
+  const Color3f got = find(m, kVertexColor).first[VertexIndex(static_cast<Mesh::size_type>(centre))];
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(got[c], want[c]);
+  EXPECT_EQ(level[centre], 0);
+  // Compared at level 0 instead (no record), the planted neighbourhood is not found.
+  col[VertexIndex(static_cast<Mesh::size_type>(centre))] = {0.5f, 0.5f, 0.5f};
+  colored[centre] = 0;
+  synthesis_pass(m, ex, index, {centre}, colored, 1.0, 0, o, rng, nullptr);
+  const Color3f naive = find(m, kVertexColor).first[VertexIndex(static_cast<Mesh::size_type>(centre))];
+  EXPECT_FALSE(naive[0] == want[0] && naive[1] == want[1] && naive[2] == want[2]);
 }
