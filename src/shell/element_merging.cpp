@@ -83,12 +83,20 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   const int nt = static_cast<int>(a.tris.size());
   std::vector<TriangleDistance::Hit> hit(a.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
-  // Faces of B "with a corresponding vertex in A": within `match` of A.
+  // Faces of B "with a corresponding vertex in A" (see the header): the point
+  // q of A closest to the face's centroid c must be within `match` and must
+  // itself have its closest point of B at c (within half an edge of B), i.e.
+  // A reaches this face, not merely passes near it. Past the end of A (e.g.
+  // beyond the end cap of a thread, whose closest points of A all lie on the
+  // cap rim) the round trip lands back at the cap, so B's faces there are
+  // uncovered and the A vertices next to them are deleted.
+  const double round_trip = 0.5 * mean_edge(b);
   std::vector<char> covered(b.tris.size());
   std::vector<char> b_in(b.tris.size());
   for (std::size_t g = 0; g < b.tris.size(); ++g) {
     const P3 c = centroid(b, b.tris[g]);
-    covered[g] = ta.closest(c).distance <= match;
+    const auto q = ta.closest(c);
+    covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
     b_in[g] = !owns(side_b, region(c));  // not in B's own outside
   }
   // Edge-neighbours of B's faces.

@@ -20,10 +20,15 @@
 // rounded overlap region into the other side; such triangles are not forced
 // either way. Where both infinite rules hit one triangle, keeping wins (the
 // paper's rules would otherwise make every such cut infinite).
-// The paper's correspondence is per vertex; with meshes of similar resolution
-// most faces are nobody's closest face, so we read "has a corresponding
-// vertex" as "lies within match_distance of A" (face centroid to A), which is
-// what the rule is after: B continues where A does not.
+// The paper's correspondence is per vertex (a vertex of A and its closest
+// face of B); with meshes of similar resolution most faces are nobody's
+// closest face, so we read "face g has a corresponding vertex in A" in the
+// continuous sense: the point q of A closest to g's centroid c is within
+// match_distance, and c is (within half a mean edge of B) the point of B
+// closest to q, i.e. some point of A has g as its closest face. This is what
+// the rule is after: B continues where A does not. (A plain "c within
+// match_distance of A" also covers B's faces past A's end, e.g. beyond a
+// thread's end cap, so A's end was never deleted and tubes opened no loop.)
 // The cut of B is "found using the exact same approach"; to make the two cut
 // paths meet (the paper only asks that they be close) the cut of B also gets
 // finite guide links: a triangle of B within match_distance of A is pulled to

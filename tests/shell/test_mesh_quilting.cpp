@@ -5,6 +5,7 @@
 
 #include <iostream>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -345,7 +346,47 @@ TEST(QuiltStep, OneToOneRelationsAreNoMoreThanAnyPairRelationsAndRefusalsAddUp) 
   EXPECT_EQ(any.stats.stitch_refused,
             any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible);
   EXPECT_GT(one.stats.related, 0u);
-  EXPECT_LT(one.stats.related, any.stats.related);
+  // Once weave threads stitch (issue #8) each output thread relates to one
+  // input thread, so the weave ties; interlocked chain mail rings do not.
+  EXPECT_LE(one.stats.related, any.stats.related);
+  const Swatch cm = small_chainmail();
+  o.step.one_to_one = true;
+  const QuiltResult cm_one = quilt_plane(cm, 2.2 * cm.length(), 2.2 * cm.width(), a, o);
+  o.step.one_to_one = false;
+  const QuiltResult cm_any = quilt_plane(cm, 2.2 * cm.length(), 2.2 * cm.width(), b, o);
+  std::cout << "[ chainmail ] one-to-one: related " << cm_one.stats.related << ", stitched " << cm_one.stats.stitched
+            << ", refused " << cm_one.stats.stitch_refused << "; any pair: related " << cm_any.stats.related << "\n";
+  EXPECT_LT(cm_one.stats.related, cm_any.stats.related);
+}
+/// Longest xy extent of any element of `s`.
+double longest_element(const Swatch& s) {
+  double l = 0;
+  for (const SwatchElement& e : s.elements)
+    l = std::max({l, e.bbox_max[0] - e.bbox_min[0], e.bbox_max[1] - e.bbox_min[1]});
+  return l;
+}
+
+// Regression for issue #8: every weave merge was refused ("cuts opened 0 and
+// 1 loops") because any face of B within match_distance of A counted as
+// corresponding, also past A's end cap, so A's end was never forced out and
+// its cut kept the whole thread. Now most related pairs stitch into threads
+// longer than any thread of the swatch, closed as the swatch's are.
+TEST(QuiltStep, PlanarWeaveStitchesMostMergesIntoLongerClosedThreads) {
+  const Swatch sw = small_weave();
+  PlanarQuiltOptions o;
+  o.seed = 3;
+  Mesh out;
+  const QuiltResult r = quilt_plane(sw, 2.2 * sw.length(), 2.2 * sw.width(), out, o);
+  const std::size_t tried = r.stats.stitched + r.stats.stitch_refused;
+  std::cout << "[ weave ] stitched " << r.stats.stitched << ", refused " << r.stats.stitch_refused << " (loops "
+            << r.stats.refused_loops << ", border " << r.stats.refused_border << ", infeasible "
+            << r.stats.refused_infeasible << ")\n";
+  ASSERT_GT(tried, 0u);
+  EXPECT_GT(2 * r.stats.stitched, tried);
+  EXPECT_EQ(border_edges(out), 0u);  // the swatch's threads are closed tubes
+  const Swatch q = make_swatch(out);
+  for (const SwatchElement& e : q.elements) EXPECT_TRUE(e.closed);
+  EXPECT_GT(longest_element(q), 1.3 * longest_element(sw));
 }
 }  // namespace
 }  // namespace surftex
