@@ -19,15 +19,23 @@
 // 52K.) Goals: init <= 0.5 s, local update <= 0.1 s: met in CPU time, to be
 // confirmed in wall time on a quiet machine. Paper (2009 hardware):
 // 1.2/4.1/8.9 s, 1.3/3.7/7.4 s, 0.5-4 s.
+// s and t coupled across the field's cuts (vertex frames, real 4x4-block
+// system), 2026-11-22, load 4-10, wall / CPU seconds:
+//   PGP initialisation   fandisk 1.28 / 0.39 (was 0.083 CPU), dragon_25k
+//                        0.82 / 0.45 and armadillo_52k 4.9 / 1.69 with dense
+//                        4x4 blocks (before the parity pattern, which halved
+//                        fandisk's); armadillo with the parity pattern
+//                        15.4 / 1.77 (load ~5, a build alongside): goal of
+//                        0.5 s CPU missed, 6x the uncoupled complex solves
+//   local update PGP     fandisk 0.028 / 0.016, dragon 0.055 / 0.047 (dense
+//                        blocks), armadillo 0.97 / 0.14 (parity pattern)
 // Singular fraction at the default period (8 mean edges), curvature field /
-// strokes field: fandisk 23% / 20%, dragon_25k 58% / 52%, armadillo_52k
-// 33% / 32% (previous version: 27/25, 67/66, 46/44%). What remains is mostly
-// the 4-field itself, not the PGP: on fandisk 80% of the distorted faces lie
-// in the 1-ring of a field cut edge (combed representatives differ by a
-// quarter turn there, s and t swap), and dragon_25k has ~750-800
-// field-singular vertices (angle defects over 45 degrees at its spikes and
-// scales force them). On analytic surfaces the PGP alone gives: torus with a
-// principal field 0%, sphere with a projected constant field 12-13%.
+// strokes field: fandisk 9.6% / 11.6% (before the coupling 23% / 20%),
+// dragon_25k 58% (unchanged: ~800 field-singular vertices), armadillo_52k
+// 30% (was 33%). Printed with each figure: field_singular_vertices, cut_edges
+// (combed representatives differing by k != 0 quarter turns) and
+// distorted_at_cut (distorted faces with a vertex on a cut edge; fandisk
+// 157 of 391 after the coupling, 80% before).
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -40,6 +48,8 @@
 #include <vector>
 
 #include "geometry/direction_field.h"
+#include "geometry/direction_field_singularities.h"
+#include "geometry/mesh_util.h"
 #include "geometry/effect_area.h"
 #include "geometry/mesh.h"
 #include "geometry/periodic_global_parameterization.h"
@@ -82,15 +92,42 @@ void emit(const std::string& mesh, std::size_t faces, const std::string& step, d
   std::cout << extra.dump() << std::endl;
 }
 
-nlohmann::json singularity_figures(const PgpSingularities& s) {
+nlohmann::json singularity_figures(const Mesh& mesh, const PgpSingularities& s) {
   std::size_t distorted = 0, mismatched = 0, sv = 0;
   for (char x : s.distorted_face) distorted += x;
   for (char x : s.mismatched_edge) mismatched += x;
   for (char x : s.singular_vertex) sv += x;
+  // The 4-field itself: singular vertices (nonzero index) and cut edges
+  // (combed representatives differing by k != 0 quarter turns), and the
+  // distorted faces with a vertex on a cut edge.
+  std::size_t field_singular = 0, cuts = 0, distorted_at_cut = 0;
+  for (int i : direction_field_indices(mesh)) field_singular += i != 0;
+  auto dir = mesh.property_map<FaceIndex, Vector3>("f:dir").first;
+  std::vector<char> on_cut(mesh.num_vertices(), 0);
+  for (EdgeIndex e : mesh.edges()) {
+    if (mesh.is_border(e)) continue;
+    const HalfedgeIndex h = mesh.halfedge(e, 0), o = mesh.opposite(h);
+    const FaceFrame fT = face_frame(mesh, mesh.face(h)), fU = face_frame(mesh, mesh.face(o));
+    const Vector3 ev = mesh.point(mesh.target(h)) - mesh.point(mesh.source(h));
+    const double tr = fT.angle_of(dir[mesh.face(h)]) - fT.angle_of(ev) + fU.angle_of(ev);
+    const long k = ((long(std::lround((tr - fU.angle_of(dir[mesh.face(o)])) / (M_PI / 2))) % 4) + 4) % 4;
+    if (k == 0) continue;
+    ++cuts;
+    on_cut[mesh.source(h).idx()] = on_cut[mesh.target(h).idx()] = 1;
+  }
+  for (FaceIndex f : mesh.faces()) {
+    if (!s.distorted_face[f.idx()]) continue;
+    bool at = false;
+    for (VertexIndex v : face_vertices(mesh, f)) at = at || on_cut[v.idx()];
+    distorted_at_cut += at;
+  }
   return {{"singular_fraction", s.singular_fraction},
           {"distorted_faces", distorted},
+          {"distorted_at_cut", distorted_at_cut},
           {"mismatched_edges", mismatched},
           {"singular_vertices", sv},
+          {"field_singular_vertices", field_singular},
+          {"cut_edges", cuts},
           {"faces", s.singular_face.size()}};
 }
 
@@ -132,7 +169,7 @@ int main(int argc, char** argv) {
     emit(name, nf, "pgp_initialize", best_of_3([&] { pgp.initialize(); }));
     PgpSingularities sing;
     const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
-    emit(name, nf, "detect_singularities", t_sing, singularity_figures(sing));
+    emit(name, nf, "detect_singularities", t_sing, singularity_figures(mesh, sing));
 
     // Local update: effect area of 25% of the faces around a vertex.
     EffectAreaOptions eo;
@@ -170,7 +207,7 @@ int main(int argc, char** argv) {
       interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
       PeriodicGlobalParameterization p2(mesh);
       p2.initialize();
-      nlohmann::json fig = singularity_figures(detect_pgp_singularities(mesh));
+      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
       fig["edges_per_period"] = k;
       fig["field"] = field ? "curvature" : "strokes";
       emit(name, nf, "singular_fraction_vs_period", 0.0, fig);

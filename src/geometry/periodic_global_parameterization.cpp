@@ -22,8 +22,45 @@ namespace surftex {
 namespace {
 
 using Cplx = std::complex<double>;
-using SpMat = Eigen::SparseMatrix<Cplx>;
+using SpMat = Eigen::SparseMatrix<double>;
 using Ldlt = Eigen::SimplicialLDLT<SpMat>;
+using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
+using Mat4 = std::array<Vec4, 4>;    // [row][col]
+using St = std::array<double, 2>;
+
+/// (s,t) seen from a frame whose representative is turned by q quarter turns
+/// (d_s' = d_t, d_t' = -d_s per turn): (s,t) -> (t,-s) per turn.
+St turn_st(St a, int q) {
+  q = ((q % 4) + 4) % 4;
+  for (int r = 0; r < q; ++r) a = {a[1], -a[0]};
+  return a;
+}
+/// The same on the unit complex numbers: z_s' = z_t, z_t' = conj(z_s) per turn.
+Vec4 turn_z(Vec4 x, int q) {
+  q = ((q % 4) + 4) % 4;
+  for (int r = 0; r < q; ++r) x = {x[2], x[3], x[0], -x[1]};
+  return x;
+}
+/// x -> (exp(2 pi i a_s) z_s, exp(2 pi i a_t) z_t), given (cos, sin) of both angles.
+Vec4 rotate_z(const Vec4& x, const Vec4& cs) {
+  return {cs[0] * x[0] - cs[1] * x[1], cs[1] * x[0] + cs[0] * x[1], cs[2] * x[2] - cs[3] * x[3],
+          cs[3] * x[2] + cs[2] * x[3]};
+}
+/// Edge map of the coupled system: x_j = M x_i in the vertices' own frames,
+/// M = P_mj Rot(alpha) P_-mi (alpha in the edge's face frame, m_v the turns
+/// from that face's frame to vertex v's frame). Orthogonal.
+Mat4 edge_map(int mi, int mj, const St& a) {
+  Mat4 M{};
+  const Vec4 cs{std::cos(2 * M_PI * a[0]), std::sin(2 * M_PI * a[0]), std::cos(2 * M_PI * a[1]),
+                std::sin(2 * M_PI * a[1])};
+  for (int c = 0; c < 4; ++c) {
+    Vec4 e{0, 0, 0, 0};
+    e[c] = 1;
+    const Vec4 y = turn_z(rotate_z(turn_z(e, -mi), cs), mj);
+    for (int r = 0; r < 4; ++r) M[r][c] = y[r];
+  }
+  return M;
+}
 
 struct FaceGrad {
   Vector3 gs, gt;
@@ -104,9 +141,12 @@ std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
 /// when given), written into `alpha`.
 void halfedge_alphas_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceGrad>& g,
                           const std::vector<FaceFrame>& frames, const std::vector<char>* edge_mask,
-                          std::vector<std::array<double, 2>>& alpha) {
+                          std::vector<std::array<double, 2>>& alpha,
+                          std::vector<std::uint8_t>* quarter = nullptr) {
   const double step = 2 * M_PI / o.symmetry;
   alpha.resize(mesh.num_halfedges(), {0.0, 0.0});
+  if (quarter) quarter->resize(mesh.num_halfedges(), 0);
+  const long per = 4 / o.symmetry;  // quarter turns per symmetry step
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_edges(), 2048),
                     [&](const tbb::blocked_range<std::size_t>& range) {
   for (std::size_t ei = range.begin(); ei != range.end(); ++ei) {
@@ -125,6 +165,13 @@ void halfedge_alphas_into(const Mesh& mesh, const PgpOptions& o, const std::vect
       const double tT = fT.angle_of(g[T].gs), tU = fU.angle_of(g[U].gs);
       const double transported = tT - fT.angle_of(ev) + fU.angle_of(ev);
       const double k = std::round((transported - tU) / step);
+      if (quarter) {
+        // Matching: T's representative = U's turned by q quarter turns
+        // (frame(face(h)) = frame(face(opposite)) rotated by quarter[h]).
+        const long q = ((static_cast<long>(k) * per) % 4 + 4) % 4;
+        (*quarter)[h.idx()] = static_cast<std::uint8_t>(q);
+        (*quarter)[o.idx()] = static_cast<std::uint8_t>((4 - q) % 4);
+      }
       const double inv_s = norm(g[U].gs);
       const Vector3 ds = fU.direction(tU + k * step);
       const Vector3 dt = CGAL::cross_product(fU.n, ds);
@@ -237,24 +284,38 @@ PgpTopology make_topology(const Mesh& mesh) {
 // for new alphas costs one pass (no triplet sort).
 struct PgpPattern {
   std::vector<int> var;              // per vertex: unknown index or -1
-  int n = 0;
+  int n = 0;                         // free vertices (4 real unknowns each)
   SpMat A;                           // pattern (values overwritten per fill)
-  std::vector<std::ptrdiff_t> diag;  // per unknown: position of (v,v)
-  std::vector<std::ptrdiff_t> off;   // per live edge: position of its entry or -1
+  std::vector<std::ptrdiff_t> diag;  // per real unknown: position of (r,r)
+  /// per live edge: parity of the turns between its two vertex frames (0: s
+  /// couples to s and t to t; 1: s to t), which decides the block's nonzeros
+  std::vector<std::uint8_t> parity;
+  /// per live edge: positions of the 4x4 block (row-major) below the diagonal,
+  /// -1 for the entries that are structurally zero (or no block)
+  std::vector<std::array<std::ptrdiff_t, 16>> off;
 };
 
-PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n) {
+/// Entry (r, c) of an edge block is structurally nonzero iff the pairs of r
+/// and c (s = 0, t = 1) match up to the parity of the frames' turns.
+bool block_entry(int r, int c, int parity) { return ((r / 2) ^ (c / 2)) == parity; }
+
+PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::vector<std::uint8_t> parity) {
   PgpPattern p;
   p.var = std::move(var);
   p.n = n;
-  std::vector<Eigen::Triplet<Cplx>> trip;
-  trip.reserve(static_cast<std::size_t>(n) * 4);
-  for (int v = 0; v < n; ++v) trip.emplace_back(v, v, Cplx(0, 0));
-  for (const auto& ij : t.ends) {
-    const int a = p.var[ij[0]], b = p.var[ij[1]];
-    if (a >= 0 && b >= 0 && a != b) trip.emplace_back(std::max(a, b), std::min(a, b), Cplx(0, 0));
+  p.parity = std::move(parity);
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(static_cast<std::size_t>(n) * 4 + t.ends.size() * 8);
+  for (int v = 0; v < 4 * n; ++v) trip.emplace_back(v, v, 0.0);
+  for (std::size_t k = 0; k < t.ends.size(); ++k) {
+    const int a = p.var[t.ends[k][0]], b = p.var[t.ends[k][1]];
+    if (a >= 0 && b >= 0 && a != b)
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+          if (block_entry(r, c, p.parity[k]))
+            trip.emplace_back(4 * std::max(a, b) + r, 4 * std::min(a, b) + c, 0.0);
   }
-  p.A.resize(n, n);
+  p.A.resize(4 * n, 4 * n);
   p.A.setFromTriplets(trip.begin(), trip.end());
   p.A.makeCompressed();
   auto position = [&](int row, int col) -> std::ptrdiff_t {
@@ -263,14 +324,64 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n) {
     const int* it = std::lower_bound(begin, end, row);
     return it - p.A.innerIndexPtr();
   };
-  p.diag.resize(static_cast<std::size_t>(n));
-  for (int v = 0; v < n; ++v) p.diag[static_cast<std::size_t>(v)] = position(v, v);
-  p.off.assign(t.ends.size(), -1);
+  p.diag.resize(static_cast<std::size_t>(4 * n));
+  for (int v = 0; v < 4 * n; ++v) p.diag[static_cast<std::size_t>(v)] = position(v, v);
+  std::array<std::ptrdiff_t, 16> none;
+  none.fill(-1);
+  p.off.assign(t.ends.size(), none);
   for (std::size_t k = 0; k < t.ends.size(); ++k) {
     const int a = p.var[t.ends[k][0]], b = p.var[t.ends[k][1]];
-    if (a >= 0 && b >= 0 && a != b) p.off[k] = position(std::max(a, b), std::min(a, b));
+    if (a >= 0 && b >= 0 && a != b)
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+          if (block_entry(r, c, p.parity[k]))
+            p.off[k][4 * r + c] = position(4 * std::max(a, b) + r, 4 * std::min(a, b) + c);
   }
   return p;
+}
+
+/// Per halfedge h (not border): turns q such that the frame of target(h) (the
+/// representative of its reference face, the first non-border face met from
+/// halfedge(v)) is face(h)'s representative turned by q. Walks each vertex's
+/// fan both ways from the reference face, accumulating the edge matchings
+/// (around a field singularity the walk stops where it started: one spoke
+/// then carries the holonomy).
+std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
+  std::vector<std::uint8_t> cm(mesh.num_halfedges(), 0);
+  std::vector<HalfedgeIndex> fan;
+  std::vector<int> m;
+  for (VertexIndex v : mesh.vertices()) {
+    if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+    fan.clear();
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) fan.push_back(h);
+    const std::size_t d = fan.size();
+    std::size_t s0 = d;
+    for (std::size_t i = 0; i < d; ++i)
+      if (!mesh.is_border(fan[i])) {
+        s0 = i;
+        break;
+      }
+    if (s0 == d) continue;
+    m.assign(d, -1);
+    m[s0] = 0;
+    // Forward: fan[i+1] = opposite(next(fan[i])), across next(fan[i]).
+    for (std::size_t r = 0; r + 1 < d; ++r) {
+      const std::size_t i = (s0 + r) % d, j = (i + 1) % d;
+      if (mesh.is_border(fan[j]) || m[j] >= 0) break;
+      m[j] = (m[i] + quarter[mesh.next(fan[i]).idx()]) % 4;
+    }
+    // Backward: across opposite(next(fan[j])) = edge of fan[i] in face(fan[j])... i.e.
+    // from face(fan[i]) to face(fan[j]), j = i - 1, through halfedge opposite(fan[i]) of face(fan[j])'s next.
+    for (std::size_t r = 0; r + 1 < d; ++r) {
+      const std::size_t i = (s0 + d - r) % d, j = (i + d - 1) % d;
+      if (mesh.is_border(fan[j]) || m[j] >= 0) break;
+      // next(fan[j]) is the shared edge's halfedge in face(fan[j]); its opposite lies in face(fan[i]).
+      m[j] = (m[i] + quarter[mesh.opposite(mesh.next(fan[j])).idx()]) % 4;
+    }
+    for (std::size_t i = 0; i < d; ++i)
+      if (m[i] >= 0) cm[fan[i].idx()] = static_cast<std::uint8_t>(m[i]);
+  }
+  return cm;
 }
 
 }  // namespace
@@ -282,13 +393,15 @@ struct PeriodicGlobalParameterization::Impl {
   bool initialized = false;
   std::unique_ptr<PgpTopology> topo;
   std::unique_ptr<PgpPattern> pattern;
-  Ldlt solver[2];
+  Ldlt solver;
   bool analyzed = false;
   // Field-dependent values of the last solve; a local update recomputes them
   // only next to the free faces (the only faces whose direction or scale
   // may have changed).
   std::vector<FaceGrad> grad;
   std::vector<std::array<double, 2>> alpha;         // per halfedge
+  std::vector<std::uint8_t> quarter;                // per halfedge: edge matching (turns)
+  std::vector<std::uint8_t> corner;                 // per halfedge: face -> vertex frame turns
   std::vector<std::array<double, 2>> edge_energy;  // per live edge
   bool cache_valid = false;
 
@@ -308,6 +421,20 @@ struct PeriodicGlobalParameterization::Impl {
     std::vector<std::array<double, 2>> a(topo->edges.size());
     for (std::size_t k = 0; k < a.size(); ++k) a[k] = alpha[2 * std::size_t(topo->edges[k])];
     return a;
+  }
+  /// alpha along h in face(h)'s frame (alpha[] is in the frame of the edge's
+  /// reference face, face(halfedge(e, 0)) unless that is the border).
+  St face_alpha(HalfedgeIndex h) const {
+    const HalfedgeIndex h0 = mesh.halfedge(mesh.edge(h), 0);
+    const bool reference = h == h0 ? true : mesh.is_border(h0);
+    return reference ? St{alpha[h.idx()][0], alpha[h.idx()][1]}
+                     : turn_st({alpha[h.idx()][0], alpha[h.idx()][1]}, quarter[h.idx()]);
+  }
+  /// Turns from the reference face of live edge k to its (source, target) frames.
+  std::array<int, 2> edge_turns(std::size_t k) const {
+    const HalfedgeIndex h = mesh.halfedge(EdgeIndex(topo->edges[k]), 0), o = mesh.opposite(h);
+    if (!mesh.is_border(h)) return {corner[mesh.prev(h).idx()], corner[h.idx()]};
+    return {corner[o.idx()], corner[mesh.prev(o).idx()]};
   }
   PgpResult solve(const std::vector<char>& free_vertex, const std::vector<char>* free_face, bool global);
   void write_corners(const std::vector<std::array<double, 2>>& alpha, const std::vector<char>* free_face);
@@ -329,12 +456,19 @@ void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::
       if (free_face && !(*free_face)[f.idx()]) continue;
       const HalfedgeIndex h0 = mesh.halfedge(f);
       const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
-      const VertexIndex vi = mesh.target(h0);
-      const double si = std::arg(zs[vi.idx()]) / (2 * M_PI);
-      const double ti = std::arg(zt[vi.idx()]) / (2 * M_PI);
+      // Each vertex's (s,t) is in its own frame: seen from f's frame
+      // through the corner's matching.
+      auto local = [&](HalfedgeIndex h) {
+        const VertexIndex v = mesh.target(h);
+        return turn_st({std::arg(zs[v.idx()]) / (2 * M_PI), std::arg(zt[v.idx()]) / (2 * M_PI)},
+                       -int(corner[h.idx()]));
+      };
+      const St sti = local(h0);
+      const double si = sti[0], ti = sti[1];
       // alpha along i -> corner c: c = 1 via hs[1] (i -> j); c = 2 against hs[0] (k -> i).
-      const std::array<double, 2> a1 = alpha[hs[1].idx()];
-      const std::array<double, 2> a2{-alpha[hs[0].idx()][0], -alpha[hs[0].idx()][1]};
+      const St a1 = face_alpha(hs[1]);
+      const St a0 = face_alpha(hs[0]);
+      const St a2{-a0[0], -a0[1]};
       for (int c = 0; c < 3; ++c) {
         const VertexIndex v = mesh.target(hs[c]);
         const double m = mat.second ? mat.first[v] : 0.0;
@@ -342,9 +476,9 @@ void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::
           stm[hs[c]] = {si, ti, m};
           continue;
         }
-        const std::array<double, 2>& a = c == 1 ? a1 : a2;
-        const double sj = std::arg(zs[v.idx()]) / (2 * M_PI);
-        const double tj = std::arg(zt[v.idx()]) / (2 * M_PI);
+        const St& a = c == 1 ? a1 : a2;
+        const St stj = local(hs[c]);
+        const double sj = stj[0], tj = stj[1];
         stm[hs[c]] = {sj + std::round(si + a[0] - sj), tj + std::round(ti + a[1] - tj), m};
       }
     }
@@ -375,8 +509,11 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     }
   }
   face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
-  halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha);
+  halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
+  corner = corner_matchings(mesh, quarter);
   const auto ealpha = edge_alphas(alpha);
+  std::vector<std::array<int, 2>> turns(t.ends.size());
+  for (std::size_t k = 0; k < t.ends.size(); ++k) turns[k] = edge_turns(k);
 
   std::vector<int> var(t.nv, -1);
   int count = 0;
@@ -384,23 +521,38 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     if (free_vertex[v.idx()]) var[v.idx()] = count++;
   PgpResult res;
   res.free_vertices = static_cast<std::size_t>(count);
-  const bool same_pattern = analyzed && pattern && pattern->var == var;
+  std::vector<std::uint8_t> parity(t.ends.size());
+  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
+  const bool same_pattern = analyzed && pattern && pattern->var == var && pattern->parity == parity;
   res.reused_analysis = same_pattern;
-  if (!pattern || pattern->var != var) pattern = std::make_unique<PgpPattern>(make_pattern(t, std::move(var), count));
+  if (!pattern || pattern->var != var || pattern->parity != parity)
+    pattern = std::make_unique<PgpPattern>(make_pattern(t, std::move(var), count, std::move(parity)));
   analyzed = analyzed && same_pattern;
   const PgpPattern& P = *pattern;
   const int n = P.n;
 
-  // Complex Hermitian form of F_PGP: for the residual z_j - r z_i (r = exp(2 pi
-  // i alpha_ij)), A(i,i) += w, A(j,j) += w, A(j,i) = -w r, A(i,j) = -w conj(r);
-  // only the lower triangle is stored. `b` collects the locked neighbours' terms.
-  auto fill = [&](int c, double shift, SpMat& A, Eigen::VectorXcd& b, Eigen::VectorXd& mass) {
+  // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
+  // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
+  // the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
+  // (edge_map): A(i,i) += w I, A(j,j) += w I, A(j,i) = -w M, A(i,j) = -w M^T;
+  // lower triangle stored. `b` collects the locked neighbours' terms.
+  auto state = [&](std::size_t v) -> Vec4 { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; };
+  // Edge maps where they are read: edges touching a free vertex, and the
+  // edges whose energy is recomputed.
+  std::vector<Mat4> maps(t.ends.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k)
+      if (!partial || edge_mask[t.edges[k]] || P.var[t.ends[k][0]] >= 0 || P.var[t.ends[k][1]] >= 0)
+        maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
+  });
+  const int n4 = 4 * n;
+  auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
     A = P.A;
-    Cplx* val = A.valuePtr();
-    std::fill(val, val + A.nonZeros(), Cplx(0, 0));
-    b = Eigen::VectorXcd::Zero(n);
+    double* val = A.valuePtr();
+    std::fill(val, val + A.nonZeros(), 0.0);
+    b = Eigen::VectorXd::Zero(n4);
     mass.resize(n);
-    const std::vector<Cplx>& z = c ? zt : zs;
     for (std::size_t v = 0; v < t.nv; ++v)
       if (P.var[v] >= 0) mass[P.var[v]] = t.mass[v];
     for (std::size_t k = 0; k < t.ends.size(); ++k) {
@@ -408,18 +560,31 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       const int vi = P.var[i], vj = P.var[j];
       if (vi < 0 && vj < 0) continue;
       const double w = t.weight[k];
-      const Cplx r = std::polar(1.0, 2 * M_PI * ealpha[k][c]);
-      if (vi >= 0) val[P.diag[vi]] += w;
-      if (vj >= 0) val[P.diag[vj]] += w;
+      const Mat4& M = maps[k];
+      for (int r = 0; r < 4; ++r) {
+        if (vi >= 0) val[P.diag[4 * vi + r]] += w;
+        if (vj >= 0) val[P.diag[4 * vj + r]] += w;
+      }
       if (vi >= 0 && vj >= 0) {
-        if (P.off[k] >= 0) val[P.off[k]] += vj > vi ? -w * r : -w * std::conj(r);
+        // Only the parity's entries: the others of M are exact zeros (signed
+        // permutations around block-diagonal rotations).
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) {
+            const std::ptrdiff_t pos = P.off[k][4 * r + c];
+            if (pos >= 0) val[pos] += vj > vi ? -w * M[r][c] : -w * M[c][r];
+          }
       } else if (vj >= 0) {
-        b[vj] += w * r * z[i];
+        const Vec4 xi = state(i);
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) b[4 * vj + r] += w * M[r][c] * xi[c];
       } else {
-        b[vi] += w * std::conj(r) * z[j];
+        const Vec4 xj = state(j);
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c) b[4 * vi + r] += w * M[c][r] * xj[c];
       }
     }
-    for (int v = 0; v < n; ++v) val[P.diag[v]] += shift * mass[v];
+    for (int v = 0; v < n; ++v)
+      for (int r = 0; r < 4; ++r) val[P.diag[4 * v + r]] += shift * mass[v];
   };
 
   // Reference scale of the shift: mean diagonal of F_PGP over mean mass.
@@ -428,124 +593,105 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   for (double m : t.mass) trace_m += m;
   const double unit = trace_m > 0 ? trace_w / trace_m : 1.0;
 
-  std::vector<Cplx>* zc[2] = {&zs, &zt};
-  std::string failure[2];
-  auto run = [&](int c) {
-    if (n == 0) return;
-    SpMat A;
-    Eigen::VectorXcd b;
-    Eigen::VectorXd mass;
-    std::vector<Cplx>& z = *zc[c];
-    Eigen::VectorXcd x(n);
-    for (std::size_t v = 0; v < t.nv; ++v)
-      if (P.var[v] >= 0) x[P.var[v]] = z[v];
-    // Ginzburg-Landau relaxation with one factorisation of F_PGP + mu M:
-    // min F + mu sum_i M_i |z_i - u_i|^2, u = z/|z| of the previous iterate
-    // (from the tree-integrated start at initialisation, from the previous
-    // solution in a local update, locked vertices entering through b). The
-    // unit-modulus pull matters: F alone with one locked vertex has a
-    // solution decaying away from it (median |z| ~ 3e-3 on fandisk), and
-    // F's smallest eigenvector localises where the field's curl is low,
-    // its tail not following the field (80% distorted faces on a torus).
-    const double shift = opt.stiffness * unit;
-    fill(c, shift, A, b, mass);
-    if (!same_pattern || !analyzed) solver[c].analyzePattern(A);
-    solver[c].factorize(A);
-    if (solver[c].info() != Eigen::Success) {
-      failure[c] = "factorisation failed";
-      return;
-    }
-    const int iterations = global ? opt.init_iterations : opt.update_iterations;
-    Eigen::VectorXcd rhs(n);
-    for (int it = 0; it < iterations; ++it) {
-      for (int v = 0; v < n; ++v) {
-        const double a = std::abs(x[v]);
-        rhs[v] = b[v] + shift * mass[v] * ((a > 1e-300 && std::isfinite(a)) ? x[v] / a : Cplx(1, 0));
-      }
-      x = solver[c].solve(rhs);
-      if (solver[c].info() != Eigen::Success) {
-        failure[c] = "solve failed";
-        return;
-      }
-    }
-    // Normalise to unit complex numbers.
-    for (std::size_t v = 0; v < t.nv; ++v) {
-      if (P.var[v] < 0) continue;
-      const Cplx val = x[P.var[v]];
-      const double a = std::abs(val);
-      z[v] = (a > 1e-300 && std::isfinite(a)) ? val / a : Cplx(1, 0);
-    }
-  };
   if (global) {
-    {
-      // Integrate the alphas along a breadth-first spanning tree from each
-      // component's lowest vertex: exact on the tree edges, the holonomy of
-      // the field (what forces singularities) piles up where the tree's
-      // branches meet; the relaxation below spreads it into vortices.
-      std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
-      for (std::size_t k = 0; k < t.ends.size(); ++k) {
-        adj[t.ends[k][0]].push_back({t.ends[k][1], k});
-        adj[t.ends[k][1]].push_back({t.ends[k][0], k});
-      }
-      std::vector<char> seen(t.nv, 0);
-      std::vector<double> ss(t.nv, 0.0), tt(t.nv, 0.0);
-      std::vector<std::uint32_t> q;
-      for (VertexIndex v0 : mesh.vertices()) {
-        if (seen[v0.idx()]) continue;
-        seen[v0.idx()] = 1;
-        q.assign(1, v0.idx());
-        for (std::size_t qi = 0; qi < q.size(); ++qi) {
-          const std::uint32_t i = q[qi];
-          for (auto [j, k] : adj[i]) {
-            if (seen[j]) continue;
-            seen[j] = 1;
-            const double sg = t.ends[k][0] == i ? 1.0 : -1.0;
-            ss[j] = ss[i] + sg * ealpha[k][0];
-            tt[j] = tt[i] + sg * ealpha[k][1];
-            q.push_back(j);
+    // Integrate the alphas along a breadth-first spanning tree from each
+    // component's reference vertex (locked_vertex, else the lowest), through
+    // the frames: exact on the tree edges, the holonomy of the field (what
+    // forces singularities) piles up where the tree's branches meet; the
+    // relaxation below spreads it into vortices.
+    std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
+    for (std::size_t k = 0; k < t.ends.size(); ++k) {
+      adj[t.ends[k][0]].push_back({t.ends[k][1], k});
+      adj[t.ends[k][1]].push_back({t.ends[k][0], k});
+    }
+    std::vector<char> seen(t.nv, 0);
+    std::vector<St> st(t.nv, St{0, 0});
+    std::vector<std::uint32_t> q;
+    std::vector<std::uint32_t> roots{opt.locked_vertex};
+    for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
+    for (std::uint32_t v0 : roots) {
+      if (seen[v0]) continue;
+      seen[v0] = 1;
+      q.assign(1, v0);
+      for (std::size_t qi = 0; qi < q.size(); ++qi) {
+        const std::uint32_t i = q[qi];
+        for (auto [j, k] : adj[i]) {
+          if (seen[j]) continue;
+          seen[j] = 1;
+          const int ma = turns[k][0], mb = turns[k][1];
+          if (t.ends[k][0] == i) {
+            const St c = turn_st(st[i], -ma);
+            st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
+          } else {
+            const St c = turn_st(st[i], -mb);
+            st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
           }
+          q.push_back(j);
         }
       }
-      for (std::size_t v = 0; v < t.nv; ++v) {
-        zs[v] = std::polar(1.0, 2 * M_PI * ss[v]);
-        zt[v] = std::polar(1.0, 2 * M_PI * tt[v]);
-      }
     }
-  }
-  tbb::parallel_invoke([&] { run(0); }, [&] { run(1); });
-  for (int c = 0; c < 2; ++c)
-    if (!failure[c].empty())
-      throw SolverError(std::string("periodic_global_parameterization: ") + (c ? "t" : "s") +
-                        " system " + failure[c] + " (" + std::to_string(n) + " free vertices)");
-  analyzed = n > 0;
-
-  if (global) {
-    // The eigenvector is defined up to a global phase per component: rotate
-    // each so that its reference vertex (locked_vertex for its component, the
-    // lowest index otherwise) has s = t = 0.
-    std::vector<Cplx> ref_s(static_cast<std::size_t>(t.components), Cplx(0, 0)), ref_t = ref_s;
-    std::vector<char> has(static_cast<std::size_t>(t.components), 0);
-    auto take = [&](std::size_t v) {
-      const int c = t.component[v];
-      if (c < 0 || has[c]) return;
-      has[c] = 1;
-      ref_s[c] = std::conj(zs[v]);
-      ref_t[c] = std::conj(zt[v]);
-    };
-    take(opt.locked_vertex);
-    for (VertexIndex v : mesh.vertices()) take(v.idx());
     for (std::size_t v = 0; v < t.nv; ++v) {
-      const int c = t.component[v];
-      if (c < 0) continue;
-      zs[v] *= ref_s[c];
-      zt[v] *= ref_t[c];
+      zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
+      zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
     }
-    zs[opt.locked_vertex] = Cplx(1, 0);
-    zt[opt.locked_vertex] = Cplx(1, 0);
   }
 
-  // Energies at the (normalised) solution: per edge (only edges of free
-  // faces change in an update), then a serial sum (deterministic).
+  std::string failure;
+  if (n > 0) {
+    SpMat A;
+    Eigen::VectorXd b, mass;
+    Eigen::VectorXd x(n4);
+    for (std::size_t v = 0; v < t.nv; ++v)
+      if (P.var[v] >= 0) {
+        const Vec4 xv = state(v);
+        for (int r = 0; r < 4; ++r) x[4 * P.var[v] + r] = xv[r];
+      }
+    // Ginzburg-Landau relaxation with one factorisation of F_PGP + mu M:
+    // min F + mu sum_i M_i |z_i - u_i|^2, u = z/|z| of the previous iterate
+    // (per complex pair), from the tree-integrated start at initialisation,
+    // from the previous solution in a local update, locked vertices entering
+    // through b. The unit-modulus pull matters: F alone with one locked
+    // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
+    // fandisk), and F's smallest eigenvector localises where the field's curl
+    // is low, its tail not following the field (80% distorted faces on a torus).
+    const double shift = opt.stiffness * unit;
+    fill(shift, A, b, mass);
+    if (!same_pattern || !analyzed) solver.analyzePattern(A);
+    solver.factorize(A);
+    if (solver.info() != Eigen::Success) failure = "factorisation failed";
+    const int iterations = global ? opt.init_iterations : opt.update_iterations;
+    Eigen::VectorXd rhs(n4);
+    for (int it = 0; it < iterations && failure.empty(); ++it) {
+      for (int v = 0; v < n; ++v)
+        for (int p = 0; p < 2; ++p) {
+          const double re = x[4 * v + 2 * p], im = x[4 * v + 2 * p + 1];
+          const double a = std::hypot(re, im);
+          const bool ok = a > 1e-300 && std::isfinite(a);
+          rhs[4 * v + 2 * p] = b[4 * v + 2 * p] + shift * mass[v] * (ok ? re / a : 1.0);
+          rhs[4 * v + 2 * p + 1] = b[4 * v + 2 * p + 1] + shift * mass[v] * (ok ? im / a : 0.0);
+        }
+      x = solver.solve(rhs);
+      if (solver.info() != Eigen::Success) failure = "solve failed";
+    }
+    if (failure.empty())
+      for (std::size_t v = 0; v < t.nv; ++v) {
+        if (P.var[v] < 0) continue;
+        const int o = 4 * P.var[v];
+        const Cplx a(x[o], x[o + 1]), c(x[o + 2], x[o + 3]);
+        const double la = std::abs(a), lc = std::abs(c);
+        zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
+        zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
+      }
+  }
+  if (!failure.empty())
+    throw SolverError("periodic_global_parameterization: coupled (s,t) system " + failure + " (" +
+                      std::to_string(n) + " free vertices)");
+  analyzed = n > 0;
+  // The reference vertices were locked at (1, 1) at initialisation: s = t = 0 there.
+
+  // Energies at the (normalised) solution, in the edge's reference frame:
+  // per edge (only edges of free faces change in an update), then a serial
+  // sum (deterministic).
   edge_energy.resize(t.ends.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -553,8 +699,14 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       if (partial && !edge_mask[t.edges[k]]) continue;
       const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
       const double w = t.weight[k];
-      edge_energy[k] = {w * std::norm(zs[j] - std::polar(1.0, 2 * M_PI * ealpha[k][0]) * zs[i]),
-                        w * std::norm(zt[j] - std::polar(1.0, 2 * M_PI * ealpha[k][1]) * zt[i])};
+      const Vec4 xi = state(i), xj = state(j);
+      Vec4 d{};
+      for (int a = 0; a < 4; ++a) {
+        d[a] = xj[a];
+        for (int c = 0; c < 4; ++c) d[a] -= maps[k][a][c] * xi[c];
+      }
+      d = turn_z(d, -turns[k][1]);  // s and t of the edge's reference frame
+      edge_energy[k] = {w * (d[0] * d[0] + d[1] * d[1]), w * (d[2] * d[2] + d[3] * d[3])};
     }
   });
   for (const auto& en : edge_energy) {
@@ -588,6 +740,21 @@ PgpResult PeriodicGlobalParameterization::initialize() {
   const PgpTopology& t = impl_->topology();
   std::vector<char> free_vertex(nv, 0);
   for (const auto& ij : t.ends) free_vertex[ij[0]] = free_vertex[ij[1]] = 1;
+  // One locked vertex per component (the paper's): locked_vertex for its
+  // component, the lowest index otherwise. With s and t coupled through the
+  // frames a constant shift of (s,t) is no symmetry any more, so the phase is
+  // fixed in the solve instead of afterwards.
+  {
+    std::vector<char> has(static_cast<std::size_t>(t.components), 0);
+    auto lock = [&](std::size_t v) {
+      const int c = t.component[v];
+      if (c < 0 || has[c]) return;
+      has[c] = 1;
+      free_vertex[v] = 0;
+    };
+    lock(impl_->opt.locked_vertex);
+    for (VertexIndex v : mesh.vertices()) lock(v.idx());
+  }
   PgpResult r = impl_->solve(free_vertex, nullptr, true);
   impl_->initialized = true;
   return r;
@@ -622,6 +789,35 @@ void PeriodicGlobalParameterization::set_state(std::vector<std::complex<double>>
   impl_->cache_valid = false;
 }
 
+std::array<double, 2> PeriodicGlobalParameterization::energies() {
+  if (!impl_->initialized)
+    throw InvalidInputError("PeriodicGlobalParameterization::energies called before initialize()/set_state()");
+  check_options(impl_->opt);
+  require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
+  Impl& im = *impl_;
+  const PgpTopology& t = im.topology();
+  std::vector<FaceGrad> g;
+  std::vector<std::array<double, 2>> alpha;
+  std::vector<std::uint8_t> quarter;
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g);
+  halfedge_alphas_into(im.mesh, im.opt, g, t.frames, nullptr, alpha, &quarter);
+  const std::vector<std::uint8_t> corner = corner_matchings(im.mesh, quarter);
+  std::array<double, 2> out{0, 0};
+  for (std::size_t k = 0; k < t.ends.size(); ++k) {
+    const HalfedgeIndex h = im.mesh.halfedge(EdgeIndex(t.edges[k]), 0), o = im.mesh.opposite(h);
+    const int mi = im.mesh.is_border(h) ? corner[o.idx()] : corner[im.mesh.prev(h).idx()];
+    const int mj = im.mesh.is_border(h) ? corner[im.mesh.prev(o).idx()] : corner[h.idx()];
+    const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
+    // Residual in the edge's reference frame: P_-mj x_j - R P_-mi x_i.
+    const Vec4 xi = turn_z({im.zs[i].real(), im.zs[i].imag(), im.zt[i].real(), im.zt[i].imag()}, -mi);
+    const Vec4 xj = turn_z({im.zs[j].real(), im.zs[j].imag(), im.zt[j].real(), im.zt[j].imag()}, -mj);
+    const Cplx rs = std::polar(1.0, 2 * M_PI * alpha[h.idx()][0]), rt = std::polar(1.0, 2 * M_PI * alpha[h.idx()][1]);
+    out[0] += t.weight[k] * std::norm(Cplx(xj[0], xj[1]) - rs * Cplx(xi[0], xi[1]));
+    out[1] += t.weight[k] * std::norm(Cplx(xj[2], xj[3]) - rt * Cplx(xi[2], xi[3]));
+  }
+  return out;
+}
+
 void PeriodicGlobalParameterization::write_corners() {
   if (!impl_->initialized)
     throw InvalidInputError("PeriodicGlobalParameterization::write_corners called before initialize()/set_state()");
@@ -630,7 +826,8 @@ void PeriodicGlobalParameterization::write_corners() {
   Impl& im = *impl_;
   const PgpTopology& t = im.topology();
   face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad);
-  halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha);
+  halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha, &im.quarter);
+  im.corner = corner_matchings(im.mesh, im.quarter);
   im.edge_energy.clear();
   im.cache_valid = false;  // energies not computed
   im.write_corners(im.alpha, nullptr);

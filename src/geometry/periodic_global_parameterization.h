@@ -6,19 +6,30 @@
 // S^T = mean vertex scale), defined up to integers, so a periodic tile maps
 // seamlessly wherever the field allows it.
 //
-// Per coordinate (s; t is identical) and per vertex i one unit complex number
-// z_i = exp(2 pi i s_i). For each edge (i,j) with faces T, T':
+// Per vertex i two unit complex numbers z_s = exp(2 pi i s_i), z_t =
+// exp(2 pi i t_i), expressed in the vertex's own frame: the representative of
+// its reference face (the first non-border face around halfedge(v)). Each
+// face corner knows the quarter turns m between its face's representative and
+// its vertex's (the edge matchings accumulated around the vertex), and one
+// turn maps (s,t) -> (t,-s), i.e. z_s -> z_t, z_t -> conj(z_s): across a cut
+// of the combed 4-field s on one side is t on the other, which independent
+// s and t unknowns cannot represent (Ray et al. 2006 couple them the same
+// way). The system is therefore real-linear, 4 reals per vertex. For each
+// edge (i,j) with faces T, T':
 //   alpha_ij = e_ij . (g^T + g^T') / 2            (in periods; the paper's
 //              2 pi e.g is the same in radians),
 // where g^T' is taken from the representative of T''s N-symmetric cross that
 // best matches T's after transport across the edge (the paper says "there is no
 // swapping of texture coordinates"; with a 4-field some swapping is
 // unavoidable near singularities, and matching per edge keeps the local
-// gradients consistent everywhere else). Equation (3) z_j = exp(2 pi i alpha_ij) z_i
-// is solved in the least squares sense, F_PGP = sum (A_T + A_T') |z_j - R z_i|^2,
-// a sparse Hermitian positive definite complex form (lower triangle assembled
-// in a precomputed order; Eigen SimplicialLDLT, symbolic analysis reused
-// while the free set is unchanged). The paper writes R with the opposite
+// gradients consistent everywhere else). Equation (3) z_j = exp(2 pi i alpha_ij) z_i,
+// written in T's frame (alpha_ij is), becomes x_j = P_mj R P_-mi x_i in the
+// vertices' frames (x = (Re z_s, Im z_s, Re z_t, Im z_t), P_m the m turns, R
+// the two rotations by alpha), solved in the least squares sense,
+// F_PGP = sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2: a sparse symmetric
+// positive definite real form with 4x4 blocks (lower triangle assembled in a
+// precomputed order; Eigen SimplicialLDLT, symbolic analysis reused while
+// the free set is unchanged). The paper writes R with the opposite
 // rotation sign and a 2 pi missing in the rounding of (4); we use the
 // self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -32,16 +43,19 @@
 //       z <- argmin F(z) + mu sum_i M_i |z_i - u_i|^2,  u = z/|z| (previous),
 //     mu = `stiffness` x (mean diagonal of F / mean vertex area), one
 //     factorisation of F + mu M for all steps; the holonomy becomes a few
-//     small vortices (the PGP singularities). Then each component's phase is
-//     rotated so that its reference vertex (`locked_vertex` for its
-//     component, the lowest index otherwise) has s = t = 0;
+//     small vortices (the PGP singularities). One reference vertex per
+//     component (`locked_vertex` for its component, the lowest index
+//     otherwise) is locked at s = t = 0, as the paper does (with s and t
+//     coupled a constant shift is no longer a symmetry to fix afterwards);
 //   - local update: vertices outside the effect area's free set keep their z
 //     (they enter the right-hand side); `update_iterations` relaxation steps
 //     from the previous solution. Gradients, alphas and energies are
 //     recomputed only next to the free faces (the mesh must not change
 //     between calls, nor the maps outside the area).
-// Corner coordinates (equation 4): in face T = (i,j,k) (i = target of
-// halfedge(T)), s_i = Arg(z_i)/2pi, s_j = Arg(z_j)/2pi + p_j with the integer
+// Corner coordinates (equation 4), in the face's own frame (each vertex's
+// (s,t) turned by its corner's matching, the alphas of edges whose reference
+// face is the neighbour turned by the edge's matching): in face T = (i,j,k)
+// (i = target of halfedge(T)), s_i = Arg(z_i)/2pi, s_j = Arg(z_j)/2pi + p_j with the integer
 // p_j = round(s_i + alpha_ij - Arg(z_j)/2pi), alpha_ij the edge's shared
 // expected increase (as the paper writes it; an earlier version used T's own
 // gradient, which let the two faces of an edge round differently and doubled
@@ -98,7 +112,8 @@ struct PgpResult {
 
 /// Expected increase of (s,t) along each halfedge h (source -> target), in
 /// periods: alpha_h = e_h . (g^T + g^T')/2 of equation (3) (one-sided on the
-/// border). Indexed by halfedge `.idx()`; alpha[opposite] = -alpha.
+/// border), in the frame of the edge's reference face, face(halfedge(e, 0))
+/// unless that is the border. Indexed by halfedge `.idx()`; alpha[opposite] = -alpha.
 std::vector<std::array<double, 2>> pgp_halfedge_alphas(const Mesh& mesh, const PgpOptions& options);
 
 /// Per face and corner c (0..2 = target of halfedge(f), next, next-next), the
@@ -124,7 +139,8 @@ class PeriodicGlobalParameterization {
   /// not match the mesh.
   PgpResult update(const EffectArea& area);
 
-  /// Per vertex (by `.idx()`) complex coordinates z_s, z_t (unit after solve).
+  /// Per vertex (by `.idx()`) complex coordinates z_s, z_t (unit after solve),
+  /// in the vertex's frame (see above; it depends on the direction field).
   const std::vector<std::complex<double>>& z_s() const;
   const std::vector<std::complex<double>>& z_t() const;
   /// Restores a previous state (e.g. loaded from disk for `--update`).
@@ -133,6 +149,10 @@ class PeriodicGlobalParameterization {
   /// current direction/scale/material maps (e.g. after set_state on a freshly
   /// loaded mesh). Throws InvalidInputError before initialize()/set_state().
   void write_corners();
+  /// F_PGP (s part, t part) of the current state recomputed from scratch
+  /// over every edge (in each edge's reference frame). Throws
+  /// InvalidInputError before initialize()/set_state().
+  std::array<double, 2> energies();
 
  private:
   struct Impl;

@@ -79,11 +79,23 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
     if (mesh.is_border(e)) continue;
     const HalfedgeIndex h = mesh.halfedge(e, 0), o = mesh.opposite(h);
     // Corner of face(h) at target(h) and at source(h) = target(prev(h)).
-    for (int k = 0; k < 2; ++k) {
-      const double d1 = stm[h][k] - stm[mesh.prev(h)][k];
-      const double d2 = stm[mesh.prev(o)][k] - stm[o][k];
-      if (!(std::abs(d1 - d2) <= opt.mismatch_tolerance)) out.mismatched_edge[e.idx()] = 1;
+    // The two faces' (s,t) may be expressed in representatives of the cross
+    // that differ by quarter turns (a cut of the combed field, where the
+    // coupled PGP turns (s,t) -> (t,-s)): the edge matches if the increase
+    // along it agrees up to such a turn.
+    const double d1[2] = {stm[h][0] - stm[mesh.prev(h)][0], stm[h][1] - stm[mesh.prev(h)][1]};
+    double d2[2] = {stm[mesh.prev(o)][0] - stm[o][0], stm[mesh.prev(o)][1] - stm[o][1]};
+    bool match = false;
+    const int turns = 4 / opt.pgp.symmetry;
+    for (int r = 0; r < 4; ++r) {
+      if (r % turns == 0 && std::abs(d1[0] - d2[0]) <= opt.mismatch_tolerance &&
+          std::abs(d1[1] - d2[1]) <= opt.mismatch_tolerance)
+        match = true;
+      const double s = d2[0];
+      d2[0] = d2[1];
+      d2[1] = -s;
     }
+    if (!match) out.mismatched_edge[e.idx()] = 1;
   }
   for (VertexIndex v : mesh.vertices()) {
     if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
