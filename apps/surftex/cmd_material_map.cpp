@@ -58,7 +58,9 @@ struct Args {
 
 // ---- solver state (S.json) -------------------------------------------------
 
-const char* const kStateFormat = "surftex material-map state";
+// Version 2: z_s, z_t are stored in per-vertex frames (s/t coupled across
+// field cuts); version-1 states (independent s and t) are refused.
+const char* const kStateFormat = "surftex material-map state v2";
 
 void save_state(const std::string& path, const Mesh& mesh, const PeriodicGlobalParameterization& pgp,
                 double default_scale, bool overwrite) {
@@ -119,7 +121,9 @@ double load_state(const std::string& path, Mesh& mesh, PeriodicGlobalParameteriz
     throw InvalidInputError("state '" + path + "': malformed JSON at byte " + std::to_string(e.byte));
   }
   if (!j.is_object() || j.value("format", "") != kStateFormat)
-    throw InvalidInputError("state '" + path + "': not a material-map state (field 'format')");
+    throw InvalidInputError("state '" + path + "': not a material-map state of this version (field 'format' is '" +
+                            j.value("format", std::string()) + "', expected '" + kStateFormat +
+                            "'; re-run material-map without --update to make one)");
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
   const auto zs = state_array(j, "z_s", 2 * nv, path), zt = state_array(j, "z_t", 2 * nv, path);
   const auto d = state_array(j, "direction", 3 * nf, path);
