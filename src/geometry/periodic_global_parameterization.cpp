@@ -304,17 +304,21 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
   p.var = std::move(var);
   p.n = n;
   p.parity = std::move(parity);
+  // Visits every stored off-diagonal entry of every edge block:
+  // f(edge k, index 4r+c in the 4x4 block, row, column) in the lower triangle.
+  auto for_each_block_entry = [&](auto&& f) {
+    for (std::size_t k = 0; k < t.ends.size(); ++k) {
+      const int a = p.var[t.ends[k][0]], b = p.var[t.ends[k][1]];
+      if (a < 0 || b < 0 || a == b) continue;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+          if (block_entry(r, c, p.parity[k])) f(k, 4 * r + c, 4 * std::max(a, b) + r, 4 * std::min(a, b) + c);
+    }
+  };
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(static_cast<std::size_t>(n) * 4 + t.ends.size() * 8);
   for (int v = 0; v < 4 * n; ++v) trip.emplace_back(v, v, 0.0);
-  for (std::size_t k = 0; k < t.ends.size(); ++k) {
-    const int a = p.var[t.ends[k][0]], b = p.var[t.ends[k][1]];
-    if (a >= 0 && b >= 0 && a != b)
-      for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c)
-          if (block_entry(r, c, p.parity[k]))
-            trip.emplace_back(4 * std::max(a, b) + r, 4 * std::min(a, b) + c, 0.0);
-  }
+  for_each_block_entry([&](std::size_t, int, int row, int col) { trip.emplace_back(row, col, 0.0); });
   p.A.resize(4 * n, 4 * n);
   p.A.setFromTriplets(trip.begin(), trip.end());
   p.A.makeCompressed();
@@ -329,14 +333,7 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
   std::array<std::ptrdiff_t, 16> none;
   none.fill(-1);
   p.off.assign(t.ends.size(), none);
-  for (std::size_t k = 0; k < t.ends.size(); ++k) {
-    const int a = p.var[t.ends[k][0]], b = p.var[t.ends[k][1]];
-    if (a >= 0 && b >= 0 && a != b)
-      for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c)
-          if (block_entry(r, c, p.parity[k]))
-            p.off[k][4 * r + c] = position(4 * std::max(a, b) + r, 4 * std::min(a, b) + c);
-  }
+  for_each_block_entry([&](std::size_t k, int rc, int row, int col) { p.off[k][rc] = position(row, col); });
   return p;
 }
 
