@@ -222,7 +222,7 @@ int run(const Args& a) {
   sec["read_tile"] = t.seconds();
   t = Timer();
   Mesh mesh;
-  read_mesh(a.mesh, mesh);
+  rep["input_mesh"] = to_json(load_method_mesh(a.mesh, mesh, a.common));
   require_triangle_mesh(mesh, "material-map");
   sec["read_mesh"] = t.seconds();
   rep["vertices"] = mesh.number_of_vertices();

@@ -181,7 +181,7 @@ int run(const PatchArgs& a) {
     check_output((fs::path(a.outdir) / name).string(), inputs, a.common.force);
   auto limit = apply_thread_limit(a.common.threads);
   Mesh mesh;
-  read_mesh(a.mesh, mesh);
+  const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common);
   std::vector<Image> ex{as_rgb(read_image(a.exemplar), a.exemplar_size)};
   if (!a.exemplar2.empty()) ex.push_back(as_rgb(read_image(a.exemplar2), a.exemplar_size));
   po.partition.max_angle_deg = a.max_angle;
@@ -197,6 +197,7 @@ int run(const PatchArgs& a) {
   po.progress = terminal_progress(a.common.quiet);
   nlohmann::json rep = run_pipeline(mesh, ex, po, a.outdir, a.common.seed);
   rep["mesh"] = a.mesh;
+  rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["field"] = a.field;
   rep["order"] = a.order;

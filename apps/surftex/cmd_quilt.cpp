@@ -162,7 +162,7 @@ int run_quilt(QuiltArgs& a) {
   } else {
     t.reset();
     Mesh base;
-    read_mesh(a.base, base);
+    rep["input_mesh"] = to_json(load_method_mesh(a.base, base, a.common));
     base.collect_garbage();
     const double read_seconds = t.seconds();
     const Swatch s = make_swatch(sm);

@@ -28,23 +28,6 @@ struct RepairArgs {
   CommonOptions common;
 };
 
-nlohmann::json soup_json(const SoupRepairCounts& c) {
-  return {{"input_points", c.input_points},
-          {"input_polygons", c.input_polygons},
-          {"duplicate_points_merged", c.duplicate_points_merged},
-          {"degenerate_polygons_removed", c.degenerate_polygons_removed},
-          {"duplicate_polygons_removed", c.duplicate_polygons_removed},
-          {"isolated_points_removed", c.isolated_points_removed},
-          {"pinched_polygons_split", c.pinched_polygons_split},
-          {"points_duplicated_to_orient", c.points_duplicated_to_orient},
-          {"oriented", c.oriented},
-          {"faces_triangulated", c.faces_triangulated},
-          {"faces_fan_triangulated", c.faces_fan_triangulated},
-          {"short_polygons_dropped", c.short_polygons_dropped},
-          {"output_vertices", c.output_vertices},
-          {"output_faces", c.output_faces}};
-}
-
 int run_repair(const RepairArgs& a) {
   require_input_file(a.input, "input mesh");
   check_output(a.output, {a.input}, a.common.force);
@@ -74,7 +57,7 @@ int run_repair(const RepairArgs& a) {
   nlohmann::json report = to_json(r);
   report["input"] = a.input;
   report["output"] = a.output;
-  report["load"] = soup_json(counts);
+  report["load"] = to_json(counts);
   report["seconds"]["load"] = load_s;
   report["seconds"]["repair"] = repair_s;
   report["options"] = {{"fill_holes", a.fill_holes},

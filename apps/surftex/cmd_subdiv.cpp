@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <unordered_set>
+#include <vector>
 
 #include "geometry/bake_vertex_colors.h"
 #include "geometry/base_mesh_atlas.h"
@@ -34,23 +36,57 @@ namespace {
 
 // Fan triangulation keeping vertex indices and colours (quads split along the
 // shorter diagonal), for the atlas (compute_base_mesh_atlas wants triangles).
+// A fan diagonal that already exists as an edge (of the mesh, or of another
+// face's fan) would make the result non-manifold; that happens on messy
+// input, e.g. around valence-2 vertices. The other fan starts are tried, and
+// if every start has such a diagonal, the face's fan is built on copies of
+// its vertices (same positions and colours): a separate small component that
+// the atlas charts on its own.
 Mesh triangulated_copy(const Mesh& m) {
+  auto key = [](VertexIndex a, VertexIndex b) {
+    const std::uint64_t x = std::min(a.idx(), b.idx()), y = std::max(a.idx(), b.idx());
+    return (x << 32) | y;
+  };
+  std::unordered_set<std::uint64_t> edges;
+  for (EdgeIndex e : m.edges()) edges.insert(key(m.vertex(e, 0), m.vertex(e, 1)));
   Mesh t;
-  for (VertexIndex v : m.vertices()) t.add_vertex(m.point(v));
+  std::vector<VertexIndex> from;  // source vertex of every vertex of t
+  std::vector<VertexIndex> to(m.num_vertices(), Mesh::null_vertex());
+  for (VertexIndex v : m.vertices()) {
+    to[v.idx()] = t.add_vertex(m.point(v));
+    from.push_back(v);
+  }
   for (FaceIndex f : m.faces()) {
     std::vector<VertexIndex> vs;
-    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) vs.push_back(VertexIndex(v.idx()));
-    if (vs.size() == 4 && (t.point(vs[0]) - t.point(vs[2])).squared_length() >
-                              (t.point(vs[1]) - t.point(vs[3])).squared_length())
+    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) vs.push_back(v);
+    if (vs.size() == 4 && (m.point(vs[0]) - m.point(vs[2])).squared_length() >
+                              (m.point(vs[1]) - m.point(vs[3])).squared_length())
       std::rotate(vs.begin(), vs.begin() + 1, vs.end());
-    for (std::size_t i = 1; i + 1 < vs.size(); ++i)
-      if (t.add_face(vs[0], vs[i], vs[i + 1]) == Mesh::null_face())
-        throw TopologyError("subdiv: could not triangulate face " + std::to_string(f.idx()) + " for the atlas");
+    bool fits = false;
+    for (std::size_t start = 0; start < vs.size() && !fits; ++start) {
+      fits = true;
+      for (std::size_t i = 2; i + 1 < vs.size() && fits; ++i) fits = !edges.count(key(vs[0], vs[i]));
+      if (!fits) std::rotate(vs.begin(), vs.begin() + 1, vs.end());
+    }
+    std::vector<VertexIndex> tv;
+    if (fits) {
+      for (std::size_t i = 2; i + 1 < vs.size(); ++i) edges.insert(key(vs[0], vs[i]));
+      for (VertexIndex v : vs) tv.push_back(to[v.idx()]);
+    } else {
+      for (VertexIndex v : vs) {
+        tv.push_back(t.add_vertex(m.point(v)));
+        from.push_back(v);
+      }
+    }
+    for (std::size_t i = 1; i + 1 < tv.size(); ++i)
+      if (t.add_face(tv[0], tv[i], tv[i + 1]) == Mesh::null_face())
+        throw TopologyError("subdiv: could not triangulate face " + std::to_string(f.idx()) +
+                            " for the atlas");
   }
   auto src = find(m, kVertexColor);
   if (src.second) {
     auto dst = get_or_add(t, kVertexColor);
-    for (VertexIndex v : t.vertices()) dst[v] = src.first[VertexIndex(v.idx())];
+    for (VertexIndex v : t.vertices()) dst[v] = src.first[from[v.idx()]];
   }
   return t;
 }
@@ -144,9 +180,8 @@ int run_subdiv(const SubdivArgs& a) {
   auto limit = apply_thread_limit(a.common.threads);
   Timer total, t;
   Mesh mesh;
-  SoupToMeshOptions so;
-  so.triangulate = false;  // sqrt(2)-subdivision takes any polygons
-  read_mesh(a.mesh, mesh, so);
+  // sqrt(2)-subdivision takes any polygons: they are kept when they need no repair.
+  const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common, true);
   const Image ex = read_image(a.exemplar);
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
@@ -171,6 +206,7 @@ int run_subdiv(const SubdivArgs& a) {
   nlohmann::json rep = synthesis_report(r, o);
   if (a.displace != 0) rep["displace_offset_range"] = {disp.min_offset, disp.max_offset};
   rep["mesh"] = a.mesh;
+  rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
   rep["seconds_read"] = seconds_read;

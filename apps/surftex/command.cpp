@@ -72,6 +72,17 @@ void require_input_file(const std::string& input, const std::string& what) {
     throw IOError(what + " '" + input + "' is not a regular file");
 }
 
+LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const CommonOptions& opt,
+                                 bool keep_polygons) {
+  LoadInputOptions lo;
+  lo.keep_polygons = keep_polygons;
+  lo.progress = terminal_progress(opt.quiet);
+  LoadInputReport r = load_input_mesh(path, mesh, lo);
+  if (!opt.quiet && !r.summary.empty())
+    std::fprintf(stderr, "note: repaired '%s' before use: %s\n", path.c_str(), r.summary.c_str());
+  return r;
+}
+
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force) {
   for (const auto& in : inputs)
     if (!in.empty() && same_file(output, in))

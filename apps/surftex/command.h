@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "geometry/load_input_mesh.h"
+#include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
 
 namespace surftex::cli {
@@ -48,6 +50,13 @@ void require_input_file(const std::string& input, const std::string& what);
 /// Throws if `output` names the same file as any of `inputs` (never overwrite
 /// what the user gave), or exists while !force.
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force);
+
+/// Reads and repairs a method's input mesh (geometry/load_input_mesh.h): a
+/// mesh that cannot be repaired is refused (TopologyError); what was repaired
+/// is said in one "note:" line on stderr unless opt.quiet. Put the returned
+/// report in the command's JSON report under "input_mesh" (to_json).
+LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const CommonOptions& opt,
+                                 bool keep_polygons = false);
 
 struct Subcommand {
   std::string name;

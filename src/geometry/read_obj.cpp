@@ -24,7 +24,7 @@ std::size_t resolve(const std::string& path, const std::string& where, std::stri
   if (r < 0 || static_cast<std::uint64_t>(r) >= count)
     fail_input(path, where,
                std::string(what) + " index " + std::to_string(i) + " out of range (" +
-                   std::to_string(count) + " " + what + "s defined so far)");
+                   std::to_string(count) + " defined so far)");
   return static_cast<std::size_t>(r);
 }
 

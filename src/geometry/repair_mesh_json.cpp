@@ -53,4 +53,21 @@ nlohmann::json to_json(const RepairReport& r) {
   return j;
 }
 
+nlohmann::json to_json(const SoupRepairCounts& c) {
+  return nlohmann::json{{"input_points", c.input_points},
+                        {"input_polygons", c.input_polygons},
+                        {"duplicate_points_merged", c.duplicate_points_merged},
+                        {"degenerate_polygons_removed", c.degenerate_polygons_removed},
+                        {"duplicate_polygons_removed", c.duplicate_polygons_removed},
+                        {"isolated_points_removed", c.isolated_points_removed},
+                        {"pinched_polygons_split", c.pinched_polygons_split},
+                        {"points_duplicated_to_orient", c.points_duplicated_to_orient},
+                        {"oriented", c.oriented},
+                        {"faces_triangulated", c.faces_triangulated},
+                        {"faces_fan_triangulated", c.faces_fan_triangulated},
+                        {"short_polygons_dropped", c.short_polygons_dropped},
+                        {"output_vertices", c.output_vertices},
+                        {"output_faces", c.output_faces}};
+}
+
 }  // namespace surftex

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "geometry/read_mesh.h"
 #include "geometry/repair_mesh.h"
 
 namespace surftex {
@@ -13,5 +14,9 @@ namespace surftex {
 /// {"found": {...}, "done": {...}, "result": {...}, "valid": b, "refusal": s,
 ///  "seconds": {step: s, ...}}; every count of the structs under its own name.
 nlohmann::json to_json(const RepairReport& report);
+
+/// Every count of what reading a file repaired in its polygon soup, under its
+/// own name.
+nlohmann::json to_json(const SoupRepairCounts& counts);
 
 }  // namespace surftex

@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "geometry/load_input_mesh.h"
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/repair_mesh_json.h"
+
+namespace surftex {
+namespace {
+
+/// True when some three corners of face f are not collinear (exact
+/// predicate): the face spans a non-zero area.
+bool face_has_area(const Mesh& m, FaceIndex f) {
+  std::vector<Point3> p;
+  for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) p.push_back(m.point(v));
+  for (std::size_t i = 1; i + 1 < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j)
+      if (!CGAL::collinear(p[0], p[i], p[j])) return true;
+  return false;
+}
+
+bool all_triangles(const Mesh& m) {
+  for (FaceIndex f : m.faces())
+    if (m.degree(f) != 3) return false;
+  return true;
+}
+
+/// A polygon mesh needs no repair when every face spans an area and no
+/// vertex is isolated (Surface_mesh built from an oriented soup is already
+/// manifold and consistently oriented).
+bool polygons_usable(const Mesh& m) {
+  for (VertexIndex v : m.vertices())
+    if (m.is_isolated(v)) return false;
+  for (FaceIndex f : m.faces())
+    if (!face_has_area(m, f)) return false;
+  return true;
+}
+
+void add(std::string& s, std::size_t n, const char* what) {
+  if (n == 0) return;
+  if (!s.empty()) s += ", ";
+  s += std::to_string(n) + " " + what;
+}
+
+}  // namespace
+
+LoadInputReport load_input_mesh(const std::string& path, Mesh& mesh, const LoadInputOptions& opt) {
+  LoadInputReport r;
+  SoupToMeshOptions so;
+  // repair_mesh triangulates (and counts what it cannot); with keep_polygons
+  // the polygons survive when they need no repair.
+  so.triangulate = false;
+  read_mesh(path, mesh, so, &r.soup);
+  if (opt.keep_polygons && !all_triangles(mesh) && polygons_usable(mesh)) return r;
+
+  RepairOptions ro;
+  ro.detect_self_intersections = false;  // costly, and reported by the methods that care
+  ro.progress = opt.progress;
+  r.repair = repair_mesh(mesh, ro);
+  r.repair_ran = true;
+  if (!r.repair.valid)
+    throw TopologyError("cannot use mesh '" + path + "': " + r.repair.refusal);
+  const RepairDone& d = r.repair.done;
+  std::string s;
+  add(s, d.untriangulable_faces_removed, "untriangulable faces removed");
+  add(s, d.stitched_edges, "border edges stitched");
+  add(s, d.degenerate_faces_removed + d.degenerate_faces_deleted, "zero-area faces removed");
+  add(s, d.needles_collapsed, "needle triangles collapsed");
+  add(s, d.caps_flipped, "cap triangles flipped");
+  add(s, d.non_manifold_vertices_split, "vertices added splitting non-manifold vertices");
+  add(s, d.isolated_vertices_removed, "isolated vertices removed");
+  add(s, d.components_reoriented, "inward components reoriented");
+  r.repair_changes = d.untriangulable_faces_removed + d.stitched_edges + d.degenerate_faces_removed +
+                     d.degenerate_faces_deleted + d.needles_collapsed + d.caps_flipped +
+                     d.non_manifold_vertices_split + d.isolated_vertices_removed +
+                     d.components_reoriented;
+  r.summary = s;
+  return r;
+}
+
+nlohmann::json to_json(const LoadInputReport& r) {
+  nlohmann::json j;
+  j["soup"] = to_json(r.soup);
+  j["repair"] = r.repair_ran ? to_json(r.repair) : nlohmann::json(nullptr);
+  j["summary"] = r.summary;
+  return j;
+}
+
+}  // namespace surftex
