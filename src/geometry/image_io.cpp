@@ -28,7 +28,15 @@ Image read_current(OIIO::ImageInput& in, const std::string& path) {
   Image img(spec.width, spec.height, spec.nchannels);
   if (!in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
                      img.data.data())) {
-    throw IOError("cannot decode image '" + path + "': " + in.geterror());
+    // Take every pending message now: OIIO prints the ones left unretrieved
+    // when the reader is destroyed, after our own error line.
+    std::string why = in.geterror();
+    in.close();
+    (void)in.geterror();
+    (void)OIIO::geterror();
+    const auto nl = why.find('\n');
+    if (nl != std::string::npos) why.resize(nl);  // the first (root) cause
+    throw IOError("cannot decode image '" + path + "' (truncated or corrupt): " + why);
   }
   for (float v : img.data)
     if (!std::isfinite(v)) throw InvalidInputError("image '" + path + "' holds NaN or infinite values");
@@ -39,6 +47,8 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw IOError("image '" + path + "' does not exist");
   if (std::filesystem::is_directory(path, ec)) throw IOError("image '" + path + "' is a folder");
+  if (std::filesystem::file_size(path, ec) == 0 && !ec)
+    throw IOError("image '" + path + "' is empty (0 bytes)");
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string why = OIIO::geterror();
