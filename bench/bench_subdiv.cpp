@@ -24,7 +24,9 @@
 // NOT reached on this loaded machine; a quiet re-measure is needed (CPU time
 // per pass is roughly a third of the wall figures above).
 //
-// Usage: bench_subdiv [MESH] [TEXTURE] [THREADS]. One JSON line per run.
+// Usage: bench_subdiv [MESH] [TEXTURE] [THREADS] [R_SCALES] [CUT]: R_SCALES a
+// comma-separated list (default 30,100,200), CUT one of both (default), cut,
+// nocut. One JSON line per run.
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -81,8 +83,21 @@ int main(int argc, char** argv) {
   const ExemplarLevels ex = make_exemplar_levels(read_image(tex_path), false);
   const ExemplarIndex index(ex);
   const std::size_t nv = mesh.number_of_vertices();
-  for (double rs : {30.0, 100.0, 200.0}) {
-    for (bool cut : {false, true}) {
+  std::vector<double> scales{30.0, 100.0, 200.0};
+  if (argc > 4) {
+    scales.clear();
+    for (std::string l = argv[4]; !l.empty();) {
+      const std::size_t c = l.find(',');
+      scales.push_back(std::atof(l.substr(0, c).c_str()));
+      l = c == std::string::npos ? std::string() : l.substr(c + 1);
+    }
+  }
+  const std::string cuts = argc > 5 ? argv[5] : "both";
+  std::vector<bool> cut_modes;
+  if (cuts != "cut") cut_modes.push_back(false);
+  if (cuts != "nocut") cut_modes.push_back(true);
+  for (double rs : scales) {
+    for (bool cut : cut_modes) {
       std::mt19937_64 rng(1);
       auto col = get_or_add(mesh, kVertexColor);
       std::uniform_int_distribution<int> ux(0, ex.width(0) - 1), uy(0, ex.height(0) - 1);
