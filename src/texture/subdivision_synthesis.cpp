@@ -273,9 +273,9 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
     }
     st.recomputed += conflicts;
     const std::size_t n = end - begin;
-    if (4 * conflicts > n)
+    if (16 * conflicts > n)
       chunk = std::max<std::size_t>(1, chunk / 2);
-    else if (16 * conflicts < n)
+    else if (64 * conflicts < n)
       chunk = std::min<std::size_t>(1024, chunk * 2);
     begin = end;
   }
