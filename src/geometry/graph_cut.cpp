@@ -93,10 +93,22 @@ double GraphCut::solve() {
   solved_ = true;
   const std::size_t n = static_cast<std::size_t>(n_);
   const std::size_t s = n, t = n + 1;
-  ArcList arcs;
-  arcs.from.reserve(2 * (edges_.size() + n));
-  arcs.to.reserve(2 * (edges_.size() + n));
-  arcs.cap.reserve(2 * (edges_.size() + n));
+  // Per-thread buffers: many small cuts (one per vertex in subdivision
+  // synthesis) reuse their storage instead of allocating it every time.
+  struct Scratch {
+    ArcList arcs;
+    std::vector<std::uint32_t> start, pos, next;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
+    std::vector<double> capacity, residual;
+    std::vector<CsrEdge> reverse, predecessor;
+    std::vector<boost::default_color_type> color;
+    std::vector<long> distance;
+  };
+  thread_local Scratch scr;
+  ArcList& arcs = scr.arcs;
+  arcs.from.clear();
+  arcs.to.clear();
+  arcs.cap.clear();
   // A node's two terminal links: only the part exceeding the smaller one
   // matters for the cut (min(cs, ct) is paid either way); keeping both would
   // be correct too, this just shortens augmenting paths.
@@ -121,25 +133,34 @@ double GraphCut::solve() {
   }
   // Stable counting sort of the arcs by source: CSR position of arc i.
   const std::size_t nn = n + 2, na = arcs.from.size();
-  std::vector<std::uint32_t> start(nn + 1, 0), pos(na);
+  std::vector<std::uint32_t>& start = scr.start;
+  std::vector<std::uint32_t>& pos = scr.pos;
+  start.assign(nn + 1, 0);
+  pos.resize(na);
   for (std::uint32_t f : arcs.from) ++start[f + 1];
   for (std::size_t u = 0; u < nn; ++u) start[u + 1] += start[u];
-  {
-    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < na; ++i) pos[i] = next[arcs.from[i]]++;
-  }
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted(na);
-  std::vector<double> capacity(na), residual(na, 0.0);
+  scr.next.assign(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < na; ++i) pos[i] = scr.next[arcs.from[i]]++;
+  auto& sorted = scr.sorted;
+  auto& capacity = scr.capacity;
+  auto& residual = scr.residual;
+  sorted.resize(na);
+  capacity.resize(na);
+  residual.assign(na, 0.0);
   for (std::size_t i = 0; i < na; ++i) {
     sorted[pos[i]] = {arcs.from[i], arcs.to[i]};
     capacity[pos[i]] = arcs.cap[i];
   }
   const Csr g(boost::edges_are_sorted, sorted.begin(), sorted.end(), static_cast<std::uint32_t>(nn));
-  std::vector<CsrEdge> reverse(na);
+  std::vector<CsrEdge>& reverse = scr.reverse;
+  reverse.resize(na);
   for (std::size_t i = 0; i < na; ++i) reverse[pos[i]] = CsrEdge(arcs.from[i ^ 1], pos[i ^ 1]);
-  std::vector<CsrEdge> predecessor(nn);
-  std::vector<boost::default_color_type> color(nn, boost::white_color);
-  std::vector<long> distance(nn, 0);
+  std::vector<CsrEdge>& predecessor = scr.predecessor;
+  std::vector<boost::default_color_type>& color = scr.color;
+  std::vector<long>& distance = scr.distance;
+  predecessor.assign(nn, CsrEdge());
+  color.assign(nn, boost::white_color);
+  distance.assign(nn, 0);
   const auto eidx = boost::get(boost::edge_index, g);
   const auto vidx = boost::get(boost::vertex_index, g);
   const double flow = boost::boykov_kolmogorov_max_flow(

@@ -68,6 +68,7 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
            std::exp(-(a.distance * a.distance + b.distance * b.distance) / denom);
   }
   GraphCut gc(n);
+  gc.reserve_edges(edges.size());
   std::vector<char> paste(n, 1);
   for (int i = 0; i < n; ++i) {
     const TransferNode& a = nodes[i];
