@@ -14,22 +14,24 @@
 // 1, so k and the groups per match are comparable); the bounding-box-based
 // 1/e is reported too (247 for this mesh).
 //
-// Measured (s2-subdiv, commit 57a16d6), 66,680 vertices, 2 threads,
-// machine shared (load 10-12 on 2 cores, so wall >> CPU), whole run (6
-// passes) 217 s wall, 70.6 s user CPU. Per pass wall (matching only / with
-// graph cut): r_scale 30: 40.2 / 94.1 s (k 9.5, 360 region vertices, 32
-// groups per match); r_scale 100: 24.2 / 30.1 s (k 2.8, 14 groups);
-// r_scale 200: 12.7 / 14.3 s (k 1.4, 6.6 groups). Before (same machine,
-// bounding-box units, lighter load): r_scale 30 took 123 s. The 5 s goal is
-// NOT reached on this loaded machine; a quiet re-measure is needed (CPU time
-// per pass is roughly a third of the wall figures above).
+// Measured (s3-subdiv), 66,680 vertices, 2 threads, machine shared (load
+// 7-8 on 2 cores, so wall >> CPU; the lead re-measures quietly). CPU seconds
+// per pass, all threads (matching only / with graph cut): r_scale 30: 7.2 /
+// 14.1 (k 9.5, 360 region vertices, 32 groups per match); r_scale 100: 3.9 /
+// 4.6 (k 2.8, 14 groups); r_scale 200: 2.4 / 2.7 (k 1.4, 6.6 groups). Before
+// (f533745, same load, process CPU of a one-pass run): r_scale 30 about 13.7 /
+// 32.6 CPU seconds. Quiet wall figures before: 6.9 / 15.3, 3.9 / 4.3,
+// 2.0 / 2.1 s.
 //
-// Usage: bench_subdiv [MESH] [TEXTURE] [THREADS]. One JSON line per run.
+// Usage: bench_subdiv [MESH] [TEXTURE] [THREADS] [R_SCALES] [CUT]: R_SCALES a
+// comma-separated list (default 30,100,200), CUT one of both (default), cut,
+// nocut. One JSON line per run.
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
 #include <algorithm>
 #include <cstdlib>
+#include <ctime>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -81,8 +83,21 @@ int main(int argc, char** argv) {
   const ExemplarLevels ex = make_exemplar_levels(read_image(tex_path), false);
   const ExemplarIndex index(ex);
   const std::size_t nv = mesh.number_of_vertices();
-  for (double rs : {30.0, 100.0, 200.0}) {
-    for (bool cut : {false, true}) {
+  std::vector<double> scales{30.0, 100.0, 200.0};
+  if (argc > 4) {
+    scales.clear();
+    for (std::string l = argv[4]; !l.empty();) {
+      const std::size_t c = l.find(',');
+      scales.push_back(std::atof(l.substr(0, c).c_str()));
+      l = c == std::string::npos ? std::string() : l.substr(c + 1);
+    }
+  }
+  const std::string cuts = argc > 5 ? argv[5] : "both";
+  std::vector<bool> cut_modes;
+  if (cuts != "cut") cut_modes.push_back(false);
+  if (cuts != "nocut") cut_modes.push_back(true);
+  for (double rs : scales) {
+    for (bool cut : cut_modes) {
       std::mt19937_64 rng(1);
       auto col = get_or_add(mesh, kVertexColor);
       std::uniform_int_distribution<int> ux(0, ex.width(0) - 1), uy(0, ex.height(0) - 1);
@@ -98,14 +113,20 @@ int main(int argc, char** argv) {
       o.graph_cut = cut;
       o.skip_patched = false;
       o.region_texels = 3;  // Table 1: "the equivalent of 3x3 texture neighbourhood"
+      // Table 1's region: n level-0 texels (a = 1 for the stack). The default
+      // (n texels of the vertex's stack level) gives bigger regions where
+      // r_scale e > 1.4 (r_scale 200 here: k 2.2 instead of 1.4).
+      o.level_relative_region = std::getenv("BENCH_LEVEL_RELATIVE") != nullptr;
       Timer tp;
+      const std::clock_t c0 = std::clock();
       const SynthesisPassStats st = synthesis_pass(mesh, ex, index, order, colored, rs / unit_paper, 0, o, rng);
       const double secs = tp.seconds();
+      const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
       nlohmann::json j{{"mesh", mesh_path}, {"texture", tex_path}, {"vertices", nv}, {"inv_mean_edge", 1.0 / ebar}, {"inv_mean_edge_bbox_units", 1.0 / ebar_box},
-                       {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs},
+                       {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs}, {"cpu_seconds_pass", cpu},
                        {"seconds_region", st.seconds_region}, {"seconds_match", st.seconds_match},
                        {"seconds_transfer", st.seconds_transfer}, {"matched", st.matched},
-                       {"mean_k", st.mean_k}, {"threads", threads},
+                       {"mean_k", st.mean_k}, {"threads", threads}, {"level_relative_region", o.level_relative_region},
                        {"candidates_per_match", double(st.candidates) / std::max<std::size_t>(1, st.matched)},
                        {"recomputed", st.recomputed}, {"seconds_setup", st.seconds_setup}, {"mean_region_vertices", st.mean_region},
                        {"mean_groups_compared", st.mean_groups},

@@ -7,10 +7,14 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+#include <boost/property_map/property_map.hpp>
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
 #include <limits>
 #include <string>
 
@@ -19,30 +23,30 @@
 namespace surftex {
 namespace {
 
-using Traits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
-using EdgeDesc = Traits::edge_descriptor;
+// A compact graph for boykov_kolmogorov_max_flow: compressed sparse rows
+// (two arrays, no per-edge or per-vertex allocation; the adjacency_list it
+// replaces allocated every edge's properties on the heap, which dominated
+// small cuts such as the per-vertex ones of subdivision synthesis). Edge
+// properties live in plain vectors indexed by the CSR edge index. Every
+// node's out-edges keep the order they were added in (a stable counting sort
+// by source), so the algorithm visits edges in the same order as before and
+// the cut is the same, bit for bit.
+using Csr = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, boost::no_property,
+                                               boost::no_property, std::uint32_t, std::uint32_t>;
+using CsrEdge = boost::graph_traits<Csr>::edge_descriptor;
 
-struct VertexProps {
-  boost::default_color_type color = boost::white_color;
-  long distance = 0;
-  EdgeDesc predecessor{};
+struct ArcList {
+  std::vector<std::uint32_t> from, to;  ///< arcs in insertion order (pairs: 2i, 2i+1 reverse each other)
+  std::vector<double> cap;
+  void add_pair(std::size_t u, std::size_t v, double cuv, double cvu) {
+    from.push_back(static_cast<std::uint32_t>(u));
+    to.push_back(static_cast<std::uint32_t>(v));
+    cap.push_back(cuv);
+    from.push_back(static_cast<std::uint32_t>(v));
+    to.push_back(static_cast<std::uint32_t>(u));
+    cap.push_back(cvu);
+  }
 };
-struct EdgeProps {
-  double capacity = 0.0;
-  double residual = 0.0;
-  EdgeDesc reverse{};
-};
-using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, VertexProps,
-                                    EdgeProps>;
-
-void add_pair(Graph& g, std::size_t u, std::size_t v, double cuv, double cvu) {
-  EdgeDesc e1 = boost::add_edge(u, v, g).first;
-  EdgeDesc e2 = boost::add_edge(v, u, g).first;
-  g[e1].capacity = cuv;
-  g[e2].capacity = cvu;
-  g[e1].reverse = e2;
-  g[e2].reverse = e1;
-}
 
 }  // namespace
 
@@ -89,7 +93,22 @@ double GraphCut::solve() {
   solved_ = true;
   const std::size_t n = static_cast<std::size_t>(n_);
   const std::size_t s = n, t = n + 1;
-  Graph g(n + 2);
+  // Per-thread buffers: many small cuts (one per vertex in subdivision
+  // synthesis) reuse their storage instead of allocating it every time.
+  struct Scratch {
+    ArcList arcs;
+    std::vector<std::uint32_t> start, pos, next;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
+    std::vector<double> capacity, residual;
+    std::vector<CsrEdge> reverse, predecessor;
+    std::vector<boost::default_color_type> color;
+    std::vector<long> distance;
+  };
+  thread_local Scratch scr;
+  ArcList& arcs = scr.arcs;
+  arcs.from.clear();
+  arcs.to.clear();
+  arcs.cap.clear();
   // A node's two terminal links: only the part exceeding the smaller one
   // matters for the cut (min(cs, ct) is paid either way); keeping both would
   // be correct too, this just shortens augmenting paths.
@@ -105,21 +124,56 @@ double GraphCut::solve() {
     constant += m;
     cs -= m;
     ct -= m;
-    if (cs > 0.0) add_pair(g, s, u, cs, 0.0);
-    if (ct > 0.0) add_pair(g, u, t, ct, 0.0);
+    if (cs > 0.0) arcs.add_pair(s, u, cs, 0.0);
+    if (ct > 0.0) arcs.add_pair(u, t, ct, 0.0);
   }
   for (const Edge& e : edges_) {
     if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
-    add_pair(g, static_cast<std::size_t>(e.u), static_cast<std::size_t>(e.v), e.cap_uv, e.cap_vu);
+    arcs.add_pair(static_cast<std::size_t>(e.u), static_cast<std::size_t>(e.v), e.cap_uv, e.cap_vu);
   }
-  double flow = boost::boykov_kolmogorov_max_flow(
-      g, boost::get(&EdgeProps::capacity, g), boost::get(&EdgeProps::residual, g),
-      boost::get(&EdgeProps::reverse, g), boost::get(&VertexProps::predecessor, g),
-      boost::get(&VertexProps::color, g), boost::get(&VertexProps::distance, g),
-      boost::get(boost::vertex_index, g), s, t);
+  // Stable counting sort of the arcs by source: CSR position of arc i.
+  const std::size_t nn = n + 2, na = arcs.from.size();
+  std::vector<std::uint32_t>& start = scr.start;
+  std::vector<std::uint32_t>& pos = scr.pos;
+  start.assign(nn + 1, 0);
+  pos.resize(na);
+  for (std::uint32_t f : arcs.from) ++start[f + 1];
+  for (std::size_t u = 0; u < nn; ++u) start[u + 1] += start[u];
+  scr.next.assign(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < na; ++i) pos[i] = scr.next[arcs.from[i]]++;
+  auto& sorted = scr.sorted;
+  auto& capacity = scr.capacity;
+  auto& residual = scr.residual;
+  sorted.resize(na);
+  capacity.resize(na);
+  residual.assign(na, 0.0);
+  for (std::size_t i = 0; i < na; ++i) {
+    sorted[pos[i]] = {arcs.from[i], arcs.to[i]};
+    capacity[pos[i]] = arcs.cap[i];
+  }
+  const Csr g(boost::edges_are_sorted, sorted.begin(), sorted.end(), static_cast<std::uint32_t>(nn));
+  std::vector<CsrEdge>& reverse = scr.reverse;
+  reverse.resize(na);
+  for (std::size_t i = 0; i < na; ++i) reverse[pos[i]] = CsrEdge(arcs.from[i ^ 1], pos[i ^ 1]);
+  std::vector<CsrEdge>& predecessor = scr.predecessor;
+  std::vector<boost::default_color_type>& color = scr.color;
+  std::vector<long>& distance = scr.distance;
+  predecessor.assign(nn, CsrEdge());
+  color.assign(nn, boost::white_color);
+  distance.assign(nn, 0);
+  const auto eidx = boost::get(boost::edge_index, g);
+  const auto vidx = boost::get(boost::vertex_index, g);
+  const double flow = boost::boykov_kolmogorov_max_flow(
+      g, boost::make_iterator_property_map(capacity.begin(), eidx),
+      boost::make_iterator_property_map(residual.begin(), eidx),
+      boost::make_iterator_property_map(reverse.begin(), eidx),
+      boost::make_iterator_property_map(predecessor.begin(), vidx),
+      boost::make_iterator_property_map(color.begin(), vidx),
+      boost::make_iterator_property_map(distance.begin(), vidx), vidx, static_cast<std::uint32_t>(s),
+      static_cast<std::uint32_t>(t));
   source_side_.assign(n, 0);
   for (std::size_t u = 0; u < n; ++u)
-    source_side_[u] = g[u].color == boost::black_color ? 1 : 0;
+    source_side_[u] = color[u] == boost::black_color ? 1 : 0;
   double total = flow + constant;
   if (total >= kInfinity) return std::numeric_limits<double>::infinity();
   return total;

@@ -33,6 +33,9 @@ class GraphCut {
 
   int num_nodes() const { return n_; }
 
+  /// Reserves room for `edges` add_edge calls (optional; saves reallocations).
+  void reserve_edges(std::size_t edges) { edges_.reserve(edges); }
+
   /// Adds the edge pair u->v (capacity cap_uv) and v->u (capacity cap_vu).
   /// Parallel edges add up. Throws InvalidInputError for a node out of range,
   /// u == v, or a negative / NaN capacity.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/graph_cut.h"
@@ -53,7 +54,21 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
   const int n = static_cast<int>(nodes.size());
   if (center < 0 || center >= n)
     throw InvalidInputError("graph_cut_transfer: center " + std::to_string(center) + " out of range");
+  // Mismatches once per node, weights once per edge (each W is used by the
+  // graph and by both seam costs).
+  thread_local std::vector<double> mis, w;
+  mis.resize(n);
+  for (int i = 0; i < n; ++i) mis[i] = mismatch(nodes[i]);
+  w.resize(edges.size());
+  const double denom = opt.sigma * r * r;
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const TransferNode& a = nodes[edges[k][0]];
+    const TransferNode& b = nodes[edges[k][1]];
+    w[k] = (mis[edges[k][0]] + mis[edges[k][1]]) *
+           std::exp(-(a.distance * a.distance + b.distance * b.distance) / denom);
+  }
   GraphCut gc(n);
+  gc.reserve_edges(edges.size());
   std::vector<char> paste(n, 1);
   for (int i = 0; i < n; ++i) {
     const TransferNode& a = nodes[i];
@@ -64,10 +79,8 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
       paste[i] = 0;
     }
   }
-  for (const auto& e : edges) {
-    const double w = edge_weight(nodes[e[0]], nodes[e[1]], r, opt.sigma);
-    if (w > 0) gc.add_edge(e[0], e[1], w, w);
-  }
+  for (std::size_t k = 0; k < edges.size(); ++k)
+    if (w[k] > 0) gc.add_edge(edges[k][0], edges[k][1], w[k], w[k]);
   gc.solve();
   GraphCutTransferResult res;
   res.take_texture.resize(n);
@@ -75,8 +88,11 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
     res.take_texture[i] = gc.is_source_side(i) ? 1 : 0;
     res.taken += res.take_texture[i];
   }
-  res.cut_cost = transfer_seam_cost(nodes, edges, res.take_texture, r, opt.sigma);
-  res.paste_cost = transfer_seam_cost(nodes, edges, paste, r, opt.sigma);
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const int u = edges[k][0], v = edges[k][1];
+    if (res.take_texture[u] != res.take_texture[v]) res.cut_cost += w[k];
+    if (paste[u] != paste[v]) res.paste_cost += w[k];
+  }
   return res;
 }
 

@@ -447,18 +447,29 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
   gx.resize(G);
   gy.resize(G);
   for (std::size_t g = 0; g < G; ++g) gx[g] = wrap(groups[g].dx, W), gy[g] = wrap(groups[g].dy, H);
+  thread_local std::vector<int> alive;
+  thread_local std::vector<const float*> rowp;
+  alive.resize(W);
+  rowp.resize(3 * G);
   float bd = std::numeric_limits<float>::infinity();
   int bi = -1;
   std::size_t scored = 0;
-  // Row by row, the region as a sparse stencil: each group adds its term to
-  // all W candidates of the row from one contiguous (wrapped in two pieces)
-  // run of its level's planes. The row is dropped as soon as every partial
-  // sum exceeds the best distance so far (terms are >= 0).
+  // Row by row, the region as a sparse stencil. Phase 1 (vectorised): the
+  // heaviest groups add their terms to all W candidates of the row from one
+  // contiguous (wrapped in two pieces) run of their level's planes; the row is
+  // dropped as soon as every partial sum reaches the best distance so far
+  // (terms are >= 0, and a later candidate must be strictly better to win).
+  // Phase 2 (once few candidates of the row survive): each survivor alone
+  // adds the remaining terms and is abandoned as soon as its partial sum
+  // reaches the best distance. Both phases add the same terms in the same
+  // order with the same arithmetic, so every finished sum equals the full
+  // scan's, bit for bit, and so does the argmin (first of equal minima).
   for (int y = 0; y < H; ++y) {
     std::fill(d.begin(), d.end(), 0.0f);
     bool dropped = false;
-    std::size_t next_check = 1;
-    for (std::size_t g = 0; g < G; ++g) {
+    int na = W;
+    std::size_t g = 0, next_check = 1;
+    while (g < G) {
       const Level& L = levels_[groups[g].level];
       int yy = y + gy[g];
       if (yy >= H) yy -= H;
@@ -469,18 +480,55 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
       const int s = gx[g];  // candidate x reads texel x + s (mod W)
       accumulate(d.data(), r + s, gg + s, b + s, W - s, groups[g]);
       accumulate(d.data() + (W - s), r, gg, b, s, groups[g]);
-      if (g + 1 == next_check && g + 1 < G) {
+      ++g;
+      if (g == next_check && g < G) {
         next_check *= 2;
-        if (*std::min_element(d.begin(), d.end()) > bd) {
+        na = 0;
+        for (int x = 0; x < W; ++x) na += d[x] < bd ? 1 : 0;
+        if (na == 0) {
           dropped = true;
           break;
         }
+        if (8 * na <= W) break;  // few survivors: phase 2
       }
     }
     if (dropped) continue;
-    scored += static_cast<std::size_t>(W);
+    if (g >= G) {  // every term added over the whole row
+      for (int x = 0; x < W; ++x)
+        if (d[x] < bd) bd = d[x], bi = y * W + x;  // row-major: the first of equal minima is kept
+      scored += static_cast<std::size_t>(W);
+      continue;
+    }
+    // Phase 2: survivors one by one over the remaining groups.
+    na = 0;
     for (int x = 0; x < W; ++x)
-      if (d[x] < bd) bd = d[x], bi = y * W + x;  // row-major: the first of equal minima is kept
+      if (d[x] < bd) alive[na++] = x;
+    for (std::size_t h = g; h < G; ++h) {
+      const Level& L = levels_[groups[h].level];
+      int yy = y + gy[h];
+      if (yy >= H) yy -= H;
+      const std::size_t row = static_cast<std::size_t>(yy) * W;
+      rowp[3 * h] = L.plane[0].data() + row;
+      rowp[3 * h + 1] = L.plane[1].data() + row;
+      rowp[3 * h + 2] = L.plane[2].data() + row;
+    }
+    for (int a = 0; a < na; ++a) {
+      const int x = alive[a];
+      float dx = d[x];
+      std::size_t h = g;
+      for (; h < G; ++h) {
+        const SampleGroup& grp = groups[h];
+        int xx = x + gx[h];
+        if (xx >= W) xx -= W;
+        const float e0 = rowp[3 * h][xx] - grp.color[0], e1 = rowp[3 * h + 1][xx] - grp.color[1],
+                    e2 = rowp[3 * h + 2][xx] - grp.color[2];
+        dx += grp.weight * (e0 * e0 + e1 * e1 + e2 * e2);
+        if (dx >= bd) break;
+      }
+      if (h < G) continue;  // abandoned
+      ++scored;
+      if (dx < bd) bd = dx, bi = y * W + x;  // x increasing: the first of equal minima is kept
+    }
   }
   if (bi < 0) bi = 0, bd = 0;  // only NaN colours: degenerate, take texel 0
   res.found = true;

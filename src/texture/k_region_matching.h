@@ -110,6 +110,9 @@ void k_region(const Mesh& mesh, const SurfaceFrames& frames, std::size_t center,
               KRegion& out);
 
 /// k from (k+1)^2 + k^2 = (a^m n / (r_scale e))^2, rounded up, clamped to [1, max_k].
+/// `pyramid` selects a = 2 (n in texels of level m); subdivision synthesis
+/// also passes true for a stack by default (SubdivisionSynthesisOptions::
+/// level_relative_region).
 int region_k(double region_texels, int level, bool pyramid, double r_scale, double mean_edge, int max_k = 32);
 
 /// The exemplar as a Gaussian stack (default, toroidal) or pyramid, RGB.
@@ -173,7 +176,7 @@ struct MatchResult {
   int qx = 0, qy = 0;   ///< best texel at the centre's level
   double distance = 0;  ///< d(Q_best) (without the constant C when averaging)
   std::size_t comparisons = 0;  ///< samples or groups compared per candidate
-  std::size_t candidates = 0;   ///< candidates in rows not abandoned at once (ExemplarIndex::match)
+  std::size_t candidates = 0;   ///< candidates summed to the end, not abandoned (ExemplarIndex::match)
 };
 
 /// Exhaustive best match (Algorithm 1) of the samples at `center_level`:
@@ -202,8 +205,11 @@ void prepare_groups(const ExemplarLevels& ex, const std::vector<RegionSample>& s
 /// separate R, G, B planes; candidates are scanned row by row with the region
 /// as a sparse stencil: each group adds m_g |I(Q + o_g) - c_g|^2 to the whole
 /// row of candidates from one contiguous run of texels (vectorisable), the
-/// heaviest groups first; a row is abandoned once all its partial sums exceed
-/// the best distance so far (checked after 1, 2, 4, ... groups).
+/// heaviest groups first; a row is abandoned once none of its partial sums is
+/// below the best distance so far (checked after 1, 2, 4, ... groups); once
+/// at most W/8 candidates of the row remain, each finishes alone and is
+/// abandoned as soon as its partial sum reaches the best distance.
+/// MatchResult::candidates counts the candidates summed to the end.
 /// Immutable after construction: match() may run concurrently.
 class ExemplarIndex {
  public:

@@ -90,7 +90,10 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
   job.has_samples = false;
   const int lp = c.level[p];
   const double e = c.fr.mean_edge[p] > 0 ? c.fr.mean_edge[p] : c.fr.mean_edge_length;
-  job.k = region_k(opt.region_texels, lp, c.ex.pyramid, c.r_scale, e, opt.max_k);
+  // n counted in texels of the centre's level (a = 2), or in level-0 texels
+  // for a stack with level_relative_region off (a = 1, the paper's choice).
+  const bool per_level = c.ex.pyramid || opt.level_relative_region;
+  job.k = region_k(opt.region_texels, lp, per_level, c.r_scale, e, opt.max_k);
   k_region(c.graph, p, job.k, opt.coordinates, job.reg, s.region, opt.graph_cut);
   const KRegion& reg = job.reg;
   s.samples.clear();
@@ -130,7 +133,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
       n.distance = std::sqrt(smp.du * smp.du + smp.dv * smp.dv);
       n.hops = reg.hops[i];
     }
-    const double r = c.ex.scale(lp) * opt.region_texels;
+    const double r = (per_level ? std::ldexp(1.0, lp) : 1.0) * opt.region_texels;
     GraphCutTransferOptions go;
     go.sigma = opt.sigma;
     const auto cut = graph_cut_transfer(s.nodes, reg.edges, 0, job.k, r, go);
@@ -270,9 +273,9 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
     }
     st.recomputed += conflicts;
     const std::size_t n = end - begin;
-    if (4 * conflicts > n)
+    if (16 * conflicts > n)
       chunk = std::max<std::size_t>(1, chunk / 2);
-    else if (16 * conflicts < n)
+    else if (64 * conflicts < n)
       chunk = std::min<std::size_t>(1024, chunk * 2);
     begin = end;
   }

@@ -19,12 +19,15 @@
 //    no coloured vertex yet; the very first vertex gets a random texel; after
 //    the first pass, fill passes visit the skipped vertices until all are
 //    coloured (section 4's two-pass process); then passes 2..P refine.
-// 6. Per vertex P (3.3): k from region_k at P's mean edge length, its
+// 6. Per vertex P (3.3): k from region_k at P's mean edge length and P's
+//    stack level m (the region spans region_texels texels OF LEVEL m, i.e.
+//    n 2^m level-0 texels, about n x n vertices at every mesh level: see
+//    level_relative_region; the graph cut's r is that span), its
 //    k-region with local (u,v), samples = the coloured region vertices other
 //    than P, each at its anti-aliasing level (or, without anti-aliasing, the
 //    level max(0, levels - level index): coarse mesh <-> coarse stack image),
 //    exhaustive match (match_region), then transfer: graph cut over the whole
-//    region (graph_cut_transfer, r = a^m n texels) or P alone. With
+//    region (graph_cut_transfer, r = 2^m n texels) or P alone. With
 //    skip_patched, vertices that received colour from a cut earlier in the
 //    same pass are not matched again in that pass (the speed-up of section 4).
 // Colours are read from the stack level of each vertex (3.3.4); each colour
@@ -65,6 +68,18 @@ struct SubdivisionSynthesisOptions {
   bool averaging = true;        ///< oversampling groups (3.3.3)
   bool graph_cut = true;        ///< graph-cut transfer (3.4), else P alone
   bool skip_patched = true;     ///< do not re-match vertices patched in the same pass
+  /// Count region_texels in texels of the centre's stack level m, i.e. the
+  /// region spans n 2^m level-0 texels (a = 2 in section 3.3.2's formula, as
+  /// for a pyramid), so every level matches about n x n vertices. Default on.
+  /// Off = the paper's a = 1 for a stack: a region of n level-0 texels at
+  /// every level, which at coarse levels (edges longer than n texels) is only
+  /// the 1-ring; its samples are blurred together by the level's stack
+  /// filter, the match then merely continues the colour around it, and the
+  /// structure laid down is far coarser than the exemplar's (on a deep
+  /// hierarchy: cells several times too large, or one uniform colour) which
+  /// the fine levels, whose regions are smaller than those features, cannot
+  /// break. Stack levels still give every sample its own anti-aliased level.
+  bool level_relative_region = true;
   double sigma = 1.0;           ///< sigma of equation (1), > 0
   int max_k = 24;               ///< cap on k, 1..64
   LocalCoordinates coordinates = LocalCoordinates::kUnfolding;
