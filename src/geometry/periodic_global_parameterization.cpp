@@ -484,10 +484,17 @@ void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::
 
 PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& free_vertex,
                                                       const std::vector<char>* free_face, bool global) {
-  Timer timer;
+  Timer timer, lap;
+  PgpResult res;
+  PgpResult::Breakdown& bd = res.breakdown;
+  auto split = [&lap](double& into) {
+    into += lap.seconds();
+    lap.reset();
+  };
   check_options(opt);
   require_triangle_mesh(mesh, "periodic_global_parameterization");
   const PgpTopology& t = topology();
+  split(bd.topology);
   // Faces whose gradient may have changed (free faces) and edges whose alpha
   // may have (edges of free faces): everything when no valid cache.
   std::vector<char> face_mask, edge_mask;
@@ -511,12 +518,12 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   const auto ealpha = edge_alphas(alpha);
   std::vector<std::array<int, 2>> turns(t.ends.size());
   for (std::size_t k = 0; k < t.ends.size(); ++k) turns[k] = edge_turns(k);
+  split(bd.field);
 
   std::vector<int> var(t.nv, -1);
   int count = 0;
   for (VertexIndex v : mesh.vertices())
     if (free_vertex[v.idx()]) var[v.idx()] = count++;
-  PgpResult res;
   res.free_vertices = static_cast<std::size_t>(count);
   std::vector<std::uint8_t> parity(t.ends.size());
   for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
@@ -527,6 +534,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   analyzed = analyzed && same_pattern;
   const PgpPattern& P = *pattern;
   const int n = P.n;
+  split(bd.pattern);
 
   // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
   // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
@@ -543,6 +551,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       if (!partial || edge_mask[t.edges[k]] || P.var[t.ends[k][0]] >= 0 || P.var[t.ends[k][1]] >= 0)
         maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
   });
+  split(bd.field);
   const int n4 = 4 * n;
   auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
     A = P.A;
@@ -632,6 +641,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
     }
   }
+  split(bd.start);
 
   std::string failure;
   if (n > 0) {
@@ -653,9 +663,12 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     // is low, its tail not following the field (80% distorted faces on a torus).
     const double shift = opt.stiffness * unit;
     fill(shift, A, b, mass);
+    split(bd.assembly);
     if (!same_pattern || !analyzed) solver.analyzePattern(A);
+    split(bd.analysis);
     solver.factorize(A);
     if (solver.info() != Eigen::Success) failure = "factorisation failed";
+    split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
     Eigen::VectorXd rhs(n4);
     for (int it = 0; it < iterations && failure.empty(); ++it) {
@@ -669,6 +682,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         }
       x = solver.solve(rhs);
       if (solver.info() != Eigen::Success) failure = "solve failed";
+      ++bd.steps;
     }
     if (failure.empty())
       for (std::size_t v = 0; v < t.nv; ++v) {
@@ -679,6 +693,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
         zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
       }
+    split(bd.solves);
   }
   if (!failure.empty())
     throw SolverError("periodic_global_parameterization: coupled (s,t) system " + failure + " (" +
@@ -711,8 +726,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     res.energy_t += en[1];
   }
   cache_valid = true;
+  split(bd.energy);
 
   write_corners(alpha, free_face);
+  split(bd.corners);
   res.seconds = timer.seconds();
   return res;
 }

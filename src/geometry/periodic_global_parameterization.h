@@ -108,6 +108,20 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
+  /// Wall-time breakdown of `seconds` (each step's own wall time, seconds):
+  struct Breakdown {
+    double topology = 0;     ///< connectivity, areas, frames (first call only)
+    double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
+    double pattern = 0;      ///< sparsity pattern of the free set (when it changed)
+    double start = 0;        ///< spanning-tree integration (initialisation only)
+    double assembly = 0;     ///< matrix values and locked-vertex right-hand side
+    double analysis = 0;     ///< fill-reducing ordering + symbolic factorisation (0 when reused)
+    double factorization = 0;  ///< numeric factorisation
+    double solves = 0;       ///< all relaxation steps (right-hand side + solve)
+    int steps = 0;           ///< relaxation steps run
+    double energy = 0;       ///< energies at the solution
+    double corners = 0;      ///< corner write-back (equation 4)
+  } breakdown;
 };
 
 /// Expected increase of (s,t) along each halfedge h (source -> target), in
