@@ -150,6 +150,57 @@ nlohmann::json singularity_figures(const Mesh& mesh, const PgpSingularities& s) 
           {"faces", s.singular_face.size()}};
 }
 
+/// Where the singular faces are: per distance (in edges, breadth-first over
+/// the vertex graph) of a face's nearest vertex to a field-singular vertex,
+/// the faces and the singular faces at that distance; and how many singular
+/// faces are singular only through mismatched spokes (no distorted face in
+/// their vertices' rings).
+nlohmann::json singular_face_diagnosis(const Mesh& mesh, const PgpSingularities& s) {
+  const std::vector<int> index = direction_field_indices(mesh);
+  std::vector<int> dist(mesh.num_vertices(), -1);
+  std::vector<std::uint32_t> q;
+  for (VertexIndex v : mesh.vertices())
+    if (index[v.idx()] != 0) {
+      dist[v.idx()] = 0;
+      q.push_back(static_cast<std::uint32_t>(v.idx()));
+    }
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const VertexIndex v(q[i]);
+    for (VertexIndex w : CGAL::vertices_around_target(mesh.halfedge(v), mesh))
+      if (dist[w.idx()] < 0) {
+        dist[w.idx()] = dist[v.idx()] + 1;
+        q.push_back(static_cast<std::uint32_t>(w.idx()));
+      }
+  }
+  const int bounds[] = {1, 2, 4, 8, 16, 1 << 30};
+  std::vector<std::size_t> faces(6, 0), singular(6, 0), distorted(6, 0);
+  std::vector<char> ring_distorted(mesh.num_vertices(), 0);
+  for (FaceIndex f : mesh.faces())
+    if (s.distorted_face[f.idx()])
+      for (VertexIndex v : face_vertices(mesh, f)) ring_distorted[v.idx()] = 1;
+  std::size_t mismatch_only = 0;
+  for (FaceIndex f : mesh.faces()) {
+    int d = 1 << 30;
+    bool any_ring_distorted = false;
+    for (VertexIndex v : face_vertices(mesh, f)) {
+      if (dist[v.idx()] >= 0) d = std::min(d, dist[v.idx()]);
+      any_ring_distorted = any_ring_distorted || (s.singular_vertex[v.idx()] && ring_distorted[v.idx()]);
+    }
+    int b = 0;
+    while (d >= bounds[b]) ++b;
+    ++faces[b];
+    singular[b] += s.singular_face[f.idx()];
+    distorted[b] += s.distorted_face[f.idx()];
+    mismatch_only += s.singular_face[f.idx()] && !any_ring_distorted;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  const char* names[] = {"0", "1", "2-3", "4-7", "8-15", ">=16"};
+  for (int b = 0; b < 6; ++b)
+    rows.push_back({{"distance", names[b]}, {"faces", faces[b]}, {"singular", singular[b]},
+                    {"distorted", distorted[b]}});
+  return {{"by_distance_to_field_singularity", rows}, {"singular_by_mismatch_only", mismatch_only}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -196,7 +247,11 @@ int main(int argc, char** argv) {
     emit(name, nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
     PgpSingularities sing;
     const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
-    emit(name, nf, "detect_singularities", t_sing, singularity_figures(mesh, sing));
+    {
+      nlohmann::json fig = singularity_figures(mesh, sing);
+      fig["diagnosis"] = singular_face_diagnosis(mesh, sing);
+      emit(name, nf, "detect_singularities", t_sing, fig);
+    }
 
     // Local update: effect area of 25% of the faces around a vertex.
     EffectAreaOptions eo;

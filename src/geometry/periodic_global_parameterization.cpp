@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/periodic_global_parameterization.h"
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
+#include <dlfcn.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <mutex>
 #include <string>
 
 #include "geometry/effect_area.h"
@@ -23,7 +25,25 @@ namespace {
 
 using Cplx = std::complex<double>;
 using SpMat = Eigen::SparseMatrix<double>;
-using Ldlt = Eigen::SimplicialLDLT<SpMat>;
+// Supernodal Cholesky (CHOLMOD, fill-reducing ordering by AMD or METIS,
+// whichever CHOLMOD's default strategy picks; deterministic). The dense
+// supernode kernels go through the BLAS libcholmod is linked with.
+using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
+
+/// Same bytes whatever the thread count: Debian's default BLAS (netlib) is
+/// single-threaded; if an OpenBLAS provides libblas.so.3 instead
+/// (update-alternatives), its thread count (the machine's cores by default)
+/// could change the summation order of the supernodes' dense updates, so it
+/// is pinned to one thread (once per process; the supernodes are small, a
+/// single thread is what they would use anyway).
+void pin_blas_threads() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    using SetThreads = void (*)(int);
+    for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
+      if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
+  });
+}
 using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
 using Mat4 = std::array<Vec4, 4>;    // [row][col]
 using St = std::array<double, 2>;
@@ -390,7 +410,7 @@ struct PeriodicGlobalParameterization::Impl {
   bool initialized = false;
   std::unique_ptr<PgpTopology> topo;
   std::unique_ptr<PgpPattern> pattern;
-  Ldlt solver;
+  Cholesky solver;
   bool analyzed = false;
   // Field-dependent values of the last solve; a local update recomputes them
   // only next to the free faces (the only faces whose direction or scale
@@ -402,7 +422,10 @@ struct PeriodicGlobalParameterization::Impl {
   std::vector<std::array<double, 2>> edge_energy;  // per live edge
   bool cache_valid = false;
 
-  Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {}
+  Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
+    pin_blas_threads();
+    solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
+  }
 
   const PgpTopology& topology() {
     if (!topo || !topo->matches(mesh)) {
@@ -664,10 +687,15 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     const double shift = opt.stiffness * unit;
     fill(shift, A, b, mass);
     split(bd.assembly);
-    if (!same_pattern || !analyzed) solver.analyzePattern(A);
+    if (!same_pattern || !analyzed) {
+      solver.analyzePattern(A);
+      if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
+    }
     split(bd.analysis);
-    solver.factorize(A);
-    if (solver.info() != Eigen::Success) failure = "factorisation failed";
+    if (failure.empty()) {
+      solver.factorize(A);
+      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
+    }
     split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
     Eigen::VectorXd rhs(n4);

@@ -28,7 +28,7 @@
 // the two rotations by alpha), solved in the least squares sense,
 // F_PGP = sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2: a sparse symmetric
 // positive definite real form with 4x4 blocks (lower triangle assembled in a
-// precomputed order; Eigen SimplicialLDLT, symbolic analysis reused while
+// precomputed order; CHOLMOD supernodal Cholesky, symbolic analysis reused while
 // the free set is unchanged). The paper writes R with the opposite
 // rotation sign and a 2 pi missing in the rounding of (4); we use the
 // self-consistent signs.
