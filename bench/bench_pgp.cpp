@@ -98,7 +98,8 @@ void emit(const std::string& mesh, std::size_t faces, const std::string& step, d
 nlohmann::json breakdown(const PgpResult& r) {
   const PgpResult::Breakdown& b = r.breakdown;
   return {{"pgp_seconds", r.seconds},         {"topology", b.topology},
-          {"field", b.field},                 {"pattern", b.pattern},
+          {"field", b.field},                 {"ordering", b.ordering},
+          {"pattern", b.pattern},
           {"start", b.start},                 {"assembly", b.assembly},
           {"analysis", b.analysis},           {"factorization", b.factorization},
           {"solves", b.solves},               {"steps", b.steps},
@@ -205,10 +206,12 @@ nlohmann::json singular_face_diagnosis(const Mesh& mesh, const PgpSingularities&
 
 int main(int argc, char** argv) {
   std::vector<std::string> meshes;
-  bool sweep = true;
+  bool sweep = true, field_sweep = false;
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-sweep")
       sweep = false;
+    else if (std::string(argv[i]) == "--field-sweep")
+      field_sweep = true;
     else
       meshes.push_back(argv[i]);
   }
@@ -280,6 +283,25 @@ int main(int argc, char** argv) {
     cpu_total += g_last_cpu;
     g_last_cpu = cpu_total;
     emit(name, nf, "local_update_total", t_dir + t_scale + t_pgp, {{"area_faces", area.free_faces}});
+
+    // Singular fraction against the curvature field's smoothness: jet-fitting
+    // rings and the fraction of faces constrained (8 edges per period).
+    for (int rings : {2, 4})
+      for (double fraction : {0.01, 0.05, 0.1}) {
+        if (!field_sweep) break;
+        PrincipalCurvatureOptions co;
+        co.rings = rings;
+        co.max_rings = std::max(co.max_rings, rings);
+        compute_principal_curvatures(mesh, co);
+        interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), {});
+        interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, 8.0)}}, scale_field_options());
+        PeriodicGlobalParameterization p2(mesh);
+        p2.initialize();
+        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
+        fig["rings"] = rings;
+        fig["constrained_fraction"] = fraction;
+        emit(name, nf, "singular_fraction_vs_curvature_field", 0.0, fig);
+      }
 
     // Singular fraction against the period (in mean edge lengths), the field
     // interpolated from the 5% most anisotropic faces' principal directions.

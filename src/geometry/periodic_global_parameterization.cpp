@@ -4,6 +4,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Sparse>
 #include <dlfcn.h>
+#include <metis.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -25,10 +26,49 @@ namespace {
 
 using Cplx = std::complex<double>;
 using SpMat = Eigen::SparseMatrix<double>;
-// Supernodal Cholesky (CHOLMOD, fill-reducing ordering by AMD or METIS,
-// whichever CHOLMOD's default strategy picks; deterministic). The dense
+// Supernodal Cholesky (CHOLMOD, unknowns pre-ordered by METIS nested
+// dissection of the vertex graph; deterministic). The dense
 // supernode kernels go through the BLAS libcholmod is linked with.
 using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
+
+/// Fill-reducing order of the free vertices: METIS nested dissection of the
+/// vertex graph (free vertices, edges between two of them), each vertex's
+/// 4 unknowns kept together. Ordering this graph (n nodes) instead of the
+/// 4n-unknown scalar graph costs a quarter of the time and gives CHOLMOD
+/// supernodes of whole vertices; on armadillo_52k it cut the factor's
+/// flops from 2.3e9 (CHOLMOD's default AMD on the scalar graph) to about
+/// 1.4e9. Deterministic (METIS' default seed). Returns var renumbered; on a
+/// METIS failure (or tiny systems) the input order is kept.
+std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
+                                         const std::vector<std::array<std::uint32_t, 2>>& ends) {
+  if (n < 16) return var;
+  std::vector<idx_t> degree(static_cast<std::size_t>(n) + 1, 0);
+  for (const auto& ij : ends) {
+    const int a = var[ij[0]], b = var[ij[1]];
+    if (a < 0 || b < 0 || a == b) continue;
+    ++degree[static_cast<std::size_t>(a) + 1];
+    ++degree[static_cast<std::size_t>(b) + 1];
+  }
+  for (int v = 0; v < n; ++v) degree[v + 1] += degree[v];
+  std::vector<idx_t> xadj = degree, adjncy(static_cast<std::size_t>(xadj[n]));
+  for (const auto& ij : ends) {
+    const int a = var[ij[0]], b = var[ij[1]];
+    if (a < 0 || b < 0 || a == b) continue;
+    adjncy[degree[a]++] = b;
+    adjncy[degree[b]++] = a;
+  }
+  idx_t nv = n;
+  std::vector<idx_t> perm(static_cast<std::size_t>(n)), iperm(static_cast<std::size_t>(n));
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_NUMBERING] = 0;
+  if (METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) != METIS_OK)
+    return var;
+  std::vector<int> out(var.size(), -1);
+  for (std::size_t v = 0; v < var.size(); ++v)
+    if (var[v] >= 0) out[v] = static_cast<int>(iperm[static_cast<std::size_t>(var[v])]);
+  return out;
+}
 
 /// Same bytes whatever the thread count: Debian's default BLAS (netlib) is
 /// single-threaded; if an OpenBLAS provides libblas.so.3 instead
@@ -303,7 +343,8 @@ PgpTopology make_topology(const Mesh& mesh) {
 // position of every edge's and vertex's entry so that refilling the values
 // for new alphas costs one pass (no triplet sort).
 struct PgpPattern {
-  std::vector<int> var;              // per vertex: unknown index or -1
+  std::vector<int> var;              // per vertex: unknown index or -1 (fill-reducing order)
+  std::vector<int> natural;          // the same in vertex order (identifies the free set)
   int n = 0;                         // free vertices (4 real unknowns each)
   SpMat A;                           // pattern (values overwritten per fill)
   std::vector<std::ptrdiff_t> diag;  // per real unknown: position of (r,r)
@@ -425,6 +466,10 @@ struct PeriodicGlobalParameterization::Impl {
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
     pin_blas_threads();
     solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
+    // The unknowns come in nested-dissection order (nested_dissection_order):
+    // CHOLMOD keeps it (then postorders the elimination tree).
+    solver.cholmod().nmethods = 1;
+    solver.cholmod().method[0].ordering = CHOLMOD_NATURAL;
   }
 
   const PgpTopology& topology() {
@@ -547,13 +592,23 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   int count = 0;
   for (VertexIndex v : mesh.vertices())
     if (free_vertex[v.idx()]) var[v.idx()] = count++;
+  split(bd.field);
+  // The free set (hence its order) changes rarely: reorder only then.
+  std::vector<int> natural = var;
+  if (pattern && pattern->natural == natural)
+    var = pattern->var;
+  else
+    var = nested_dissection_order(var, count, t.ends);
+  split(bd.ordering);
   res.free_vertices = static_cast<std::size_t>(count);
   std::vector<std::uint8_t> parity(t.ends.size());
   for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
   const bool same_pattern = analyzed && pattern && pattern->var == var && pattern->parity == parity;
   res.reused_analysis = same_pattern;
-  if (!pattern || pattern->var != var || pattern->parity != parity)
+  if (!pattern || pattern->var != var || pattern->parity != parity) {
     pattern = std::make_unique<PgpPattern>(make_pattern(t, std::move(var), count, std::move(parity)));
+    pattern->natural = std::move(natural);
+  }
   analyzed = analyzed && same_pattern;
   const PgpPattern& P = *pattern;
   const int n = P.n;

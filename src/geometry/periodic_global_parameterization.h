@@ -112,10 +112,11 @@ struct PgpResult {
   struct Breakdown {
     double topology = 0;     ///< connectivity, areas, frames (first call only)
     double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
+    double ordering = 0;     ///< nested-dissection order of the free vertices (when the free set changed)
     double pattern = 0;      ///< sparsity pattern of the free set (when it changed)
     double start = 0;        ///< spanning-tree integration (initialisation only)
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
-    double analysis = 0;     ///< fill-reducing ordering + symbolic factorisation (0 when reused)
+    double analysis = 0;     ///< symbolic factorisation (0 when reused)
     double factorization = 0;  ///< numeric factorisation
     double solves = 0;       ///< all relaxation steps (right-hand side + solve)
     int steps = 0;           ///< relaxation steps run
