@@ -102,6 +102,7 @@ nlohmann::json breakdown(const PgpResult& r) {
           {"pattern", b.pattern},
           {"start", b.start},                 {"assembly", b.assembly},
           {"analysis", b.analysis},           {"factorization", b.factorization},
+          {"factor_flops", b.factor_flops},   {"factor_nonzeros", b.factor_nonzeros},
           {"solves", b.solves},               {"steps", b.steps},
           {"energy", b.energy},               {"corners", b.corners},
           {"reused_analysis", r.reused_analysis}, {"free_vertices", r.free_vertices}};
@@ -245,7 +246,14 @@ int main(int argc, char** argv) {
     interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
                              material_field_options());
     PeriodicGlobalParameterization pgp(mesh);
+    // The first call pays the ordering and the symbolic analysis (one-shot
+    // runs such as the CLI's); the best of 3 reuses them.
     PgpResult init;
+    Timer t_first;
+    const std::clock_t c_first = std::clock();
+    const PgpResult first = pgp.initialize();
+    g_last_cpu = double(std::clock() - c_first) / CLOCKS_PER_SEC;
+    emit(name, nf, "pgp_initialize_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
     const double t_init = best_of_3([&] { keep_fastest(init, pgp.initialize()); });
     emit(name, nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
     PgpSingularities sing;
@@ -277,6 +285,13 @@ int main(int argc, char** argv) {
     t_scale = best_of_3([&] { interpolate_scalar_field(mesh, {{seed, 0.7 * period}}, sopt); });
     emit(name, nf, "local_update_scale", t_scale, {{"area_faces", area.free_faces}});
     cpu_total += g_last_cpu;
+    {
+      Timer t_first;
+      const std::clock_t c_first = std::clock();
+      const PgpResult first = pgp.update(area);
+      g_last_cpu = double(std::clock() - c_first) / CLOCKS_PER_SEC;
+      emit(name, nf, "local_update_pgp_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
+    }
     t_pgp = best_of_3([&] { keep_fastest(last, pgp.update(area)); });
     emit(name, nf, "local_update_pgp", t_pgp,
          {{"area_faces", area.free_faces}, {"breakdown", breakdown(last)}});

@@ -452,6 +452,7 @@ struct PeriodicGlobalParameterization::Impl {
   std::unique_ptr<PgpTopology> topo;
   std::unique_ptr<PgpPattern> pattern;
   Cholesky solver;
+  std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
   // Field-dependent values of the last solve; a local update recomputes them
   // only next to the free faces (the only faces whose direction or scale
@@ -745,7 +746,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     if (!same_pattern || !analyzed) {
       solver.analyzePattern(A);
       if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
+      factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
     }
+    bd.factor_flops = factor_size[0];
+    bd.factor_nonzeros = factor_size[1];
     split(bd.analysis);
     if (failure.empty()) {
       solver.factorize(A);

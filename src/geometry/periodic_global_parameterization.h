@@ -118,6 +118,8 @@ struct PgpResult {
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
     double analysis = 0;     ///< symbolic factorisation (0 when reused)
     double factorization = 0;  ///< numeric factorisation
+    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count)
+    double factor_nonzeros = 0;  ///< in the Cholesky factor L
     double solves = 0;       ///< all relaxation steps (right-hand side + solve)
     int steps = 0;           ///< relaxation steps run
     double energy = 0;       ///< energies at the solution
