@@ -302,19 +302,23 @@ int main(int argc, char** argv) {
     // Singular fraction against the curvature field's smoothness: jet-fitting
     // rings and the fraction of faces constrained (8 edges per period).
     for (int rings : {2, 4})
-      for (double fraction : {0.01, 0.05, 0.1}) {
+      for (double fraction : {0.05, 0.1})
+      for (double smoothing : {0.0, 4.0, 16.0, 64.0}) {
         if (!field_sweep) break;
         PrincipalCurvatureOptions co;
         co.rings = rings;
         co.max_rings = std::max(co.max_rings, rings);
         compute_principal_curvatures(mesh, co);
-        interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), {});
+        DirectionFieldOptions fo;
+        fo.smoothing = smoothing;
+        interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), fo);
         interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, 8.0)}}, scale_field_options());
         PeriodicGlobalParameterization p2(mesh);
         p2.initialize();
         nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
         fig["rings"] = rings;
         fig["constrained_fraction"] = fraction;
+        fig["smoothing"] = smoothing;
         emit(name, nf, "singular_fraction_vs_curvature_field", 0.0, fig);
       }
 
