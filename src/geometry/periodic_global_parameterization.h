@@ -28,8 +28,14 @@
 // the two rotations by alpha), solved in the least squares sense,
 // F_PGP = sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2: a sparse symmetric
 // positive definite real form with 4x4 blocks (lower triangle assembled in a
-// precomputed order; CHOLMOD supernodal Cholesky, symbolic analysis reused while
-// the free set is unchanged). The paper writes R with the opposite
+// precomputed order; the free vertices ordered by METIS nested dissection of
+// the vertex graph, their 4 unknowns together; CHOLMOD supernodal Cholesky
+// keeping that order, ordering and symbolic analysis reused while the free
+// set and the cut parities are unchanged). CHOLMOD's dense kernels run on
+// the BLAS libcholmod is linked with: Debian's default netlib BLAS is
+// single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
+// at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
+// do not depend on the machine's cores. The paper writes R with the opposite
 // rotation sign and a 2 pi missing in the rounding of (4); we use the
 // self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -68,7 +74,8 @@
 // corner of face(h) at target(h)); absent scale/material maps read as 1 / 0.
 // After an update only corners of faces in the effect area are rewritten.
 // Throws InvalidInputError (missing direction map, non-positive scale, bad
-// options), SolverError (factorisation/solve failure).
+// options), SolverError (symbolic analysis/factorisation/solve failure).
+// PgpResult::breakdown gives the wall time of each step (bench_pgp prints it).
 
 #include <array>
 #include <complex>
