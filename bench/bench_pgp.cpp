@@ -38,6 +38,24 @@
 // (combed representatives differing by k != 0 quarter turns) and
 // distorted_at_cut (distorted faces with a vertex on a cut edge; fandisk
 // 157 of 391 after the coupling, 80% before).
+// CHOLMOD (issue 5, 2026-11-22, load 7-9 on the shared 2-core machine: wall
+// ~1.5-2x CPU; the lead re-measures quietly). armadillo_52k, wall / CPU s:
+//   PGP initialisation, best of 3    2.27 / 1.29   (Eigen SimplicialLDLT,
+//                                                  same load: 3.35 / 1.61)
+//     first call (ordering+analysis)  2.12 / 1.50
+//     breakdown (best run, wall): factorisation 1.16 (1.83e9 flops; AMD on
+//     the 4n scalar graph: 2.32e9), 16 solves 0.99, field 0.05, corners 0.04
+//   local update PGP (25% area)      0.29 / 0.16   (LDLT: 0.40 / 0.16);
+//     factorisation 0.19 of it (2.2e8 flops)
+// fandisk init 0.29 / 0.27, update 0.025 / 0.026; dragon_25k init
+// 0.59 / 0.46, update 0.091 / 0.055. The goals (0.5 s init, 0.1 s update at
+// 52K) are not met: the factorisation runs on Debian's netlib BLAS (no
+// optimised BLAS installed) at ~1.5 GFlop/s; fewer relaxation steps raise
+// the singular fraction (4 steps: armadillo 33.6%, 8: fandisk 9.9%, dragon
+// 60.0%; 32: armadillo 28.5%).
+// Singular faces on armadillo (--field-sweep, diagnosis in the
+// detect_singularities line): 55% lie within 3 edges of a field-singular
+// vertex; distorted faces are 9.4% of all and their rings triple that.
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
