@@ -38,3 +38,20 @@ if(NOT TARGET surftex_tetgen)
   target_compile_definitions(surftex_tetgen INTERFACE TETLIBRARY)
   add_library(TetGen::tet ALIAS surftex_tetgen)
 endif()
+
+# CHOLMOD (libsuitesparse-dev: supernodal Cholesky with AMD/METIS orderings,
+# used through Eigen's <Eigen/CholmodSupport>). Debian 12's SuiteSparse 5.12
+# ships no CMake config: find the header (in include/suitesparse) and the
+# libraries; libcholmod.so brings AMD, COLAMD, METIS, LAPACK and BLAS itself.
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY NAMES cholmod REQUIRED)
+find_library(SUITESPARSECONFIG_LIBRARY NAMES suitesparseconfig REQUIRED)
+# METIS (libmetis-dev, metis.h in /usr/include): the PGP orders its vertex
+# graph with METIS_NodeND itself.
+find_library(METIS_LIBRARY NAMES metis REQUIRED)
+if(NOT TARGET surftex_cholmod)
+  add_library(surftex_cholmod INTERFACE)
+  target_include_directories(surftex_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
+  target_link_libraries(surftex_cholmod INTERFACE ${CHOLMOD_LIBRARY} ${SUITESPARSECONFIG_LIBRARY} ${METIS_LIBRARY} ${CMAKE_DL_LIBS})
+  add_library(SuiteSparse::CHOLMOD_surftex ALIAS surftex_cholmod)
+endif()

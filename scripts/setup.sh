@@ -12,6 +12,7 @@ PKGS=(
   libboost-graph-dev libboost-dev
   libgtest-dev libgmock-dev
   libnanoflann-dev libtbb-dev libcli11-dev nlohmann-json3-dev libtinygltf-dev libstb-dev
+  libsuitesparse-dev libmetis-dev
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi

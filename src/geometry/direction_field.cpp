@@ -39,6 +39,9 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
                                                  const std::vector<DirectionConstraint>& constraints,
                                                  const DirectionFieldOptions& opt) {
   check_symmetry(opt.symmetry, "interpolate_direction_field");
+  if (!(opt.smoothing >= 0) || !std::isfinite(opt.smoothing))
+    throw InvalidInputError("interpolate_direction_field: smoothing must be >= 0, got " +
+                            std::to_string(opt.smoothing));
   require_triangle_mesh(mesh, "interpolate_direction_field");
   const int N = opt.symmetry;
   const std::size_t nf = mesh.num_faces();
@@ -190,6 +193,70 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
   for (FaceIndex g : order) final_theta[g.idx()] = solved[g.idx()];
   for (FaceIndex f : mesh.faces())
     if (locked[f.idx()]) final_theta[f.idx()] = theta[f.idx()];
+
+  // Optional smoothing: one implicit step of the same energy over every
+  // face of the area, constrained ones included (their constraint becomes
+  // soft): min E(u) + sum_f (D_f / smoothing) |u_f - u0_f|^2, u0 the field
+  // just interpolated, D_f the face's diagonal of E. Faces outside the area
+  // stay locked.
+  if (opt.smoothing > 0) {
+    using Cplx = std::complex<double>;
+    std::vector<int> sv(nf, -1);
+    int ns = 0;
+    for (FaceIndex f : mesh.faces())
+      if (is_free(f) && (locked[f.idx()] || reach[f.idx()])) sv[f.idx()] = ns++;
+    if (ns > 0) {
+      std::vector<Eigen::Triplet<Cplx>> trip;
+      trip.reserve(static_cast<std::size_t>(ns) * 4);
+      Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(ns);
+      std::vector<double> diag(static_cast<std::size_t>(ns), 0.0);
+      for (EdgeIndex e : mesh.edges()) {
+        if (mesh.is_border(e)) continue;
+        const HalfedgeIndex h = mesh.halfedge(e, 0);
+        const HalfedgeIndex o = mesh.opposite(h);
+        const std::size_t f = mesh.face(h).idx(), g = mesh.face(o).idx();
+        const int vf = sv[f], vg = sv[g];
+        if (vf < 0 && vg < 0) continue;
+        const double area = face_area(mesh, FaceIndex(f)) + face_area(mesh, FaceIndex(g));
+        const double len2 = (mesh.point(mesh.target(h)) - mesh.point(mesh.source(h))).squared_length();
+        const double w = area > 0 ? std::min(3 * len2 / area, 1e3) : 1e3;
+        const Cplx r = std::polar(1.0, N * (edge_angle(h, g) - edge_angle(h, f)));
+        if (vf >= 0) diag[vf] += w;
+        if (vg >= 0) diag[vg] += w;
+        if (vf >= 0 && vg >= 0) {
+          if (vg > vf)
+            trip.emplace_back(vg, vf, -w * r);
+          else
+            trip.emplace_back(vf, vg, -w * std::conj(r));
+        } else if (vg >= 0) {  // f outside the area
+          rhs[vg] += w * r * std::polar(1.0, N * final_theta[f]);
+        } else {
+          rhs[vf] += w * std::conj(r) * std::polar(1.0, N * final_theta[g]);
+        }
+      }
+      for (FaceIndex f : mesh.faces()) {
+        const int v = sv[f.idx()];
+        if (v < 0) continue;
+        const double pull = diag[v] > 0 ? diag[v] / opt.smoothing : 1.0;  // an isolated face keeps u0
+        trip.emplace_back(v, v, Cplx(diag[v] + pull, 0));
+        rhs[v] += pull * std::polar(1.0, N * final_theta[f.idx()]);
+      }
+      Eigen::SparseMatrix<Cplx> A(ns, ns);
+      A.setFromTriplets(trip.begin(), trip.end());
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<Cplx>> smoother(A);
+      if (smoother.info() != Eigen::Success)
+        throw SolverError("interpolate_direction_field: smoothing factorisation failed (" +
+                          std::to_string(ns) + " faces)");
+      const Eigen::VectorXcd x = smoother.solve(rhs);
+      if (smoother.info() != Eigen::Success)
+        throw SolverError("interpolate_direction_field: smoothing solve failed");
+      for (FaceIndex f : mesh.faces()) {
+        const int v = sv[f.idx()];
+        if (v < 0 || !(std::abs(x[v]) > 0)) continue;  // a zero keeps the interpolated angle
+        final_theta[f.idx()] = std::atan2(x[v].imag(), x[v].real()) / N;
+      }
+    }
+  }
   {
     // Smoothest edges first (Prim's algorithm on the dual graph, the cost of
     // crossing an edge = the angle left between the transported direction and

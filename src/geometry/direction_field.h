@@ -62,6 +62,14 @@ struct DirectionFieldOptions {
   /// Free faces; nullptr = the whole mesh. Faces outside are locked to the
   /// current content of direction_map.
   const EffectArea* area = nullptr;
+  /// >= 0. 0: constraints are exact (locked). > 0: after the interpolation,
+  /// one implicit smoothing step over the area's faces with the constraints
+  /// made soft, min E(u) + sum_f (D_f / smoothing) |u_f - u0_f|^2 (u0 the
+  /// interpolated field, D_f the face's diagonal of E): roughly a diffusion
+  /// over sqrt(smoothing) face rings. For noisy constraints (principal
+  /// directions), whose disagreements between nearby locked faces otherwise
+  /// become field singularities.
+  double smoothing = 0;
 };
 
 struct DirectionFieldResult {

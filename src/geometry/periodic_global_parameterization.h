@@ -28,8 +28,14 @@
 // the two rotations by alpha), solved in the least squares sense,
 // F_PGP = sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2: a sparse symmetric
 // positive definite real form with 4x4 blocks (lower triangle assembled in a
-// precomputed order; Eigen SimplicialLDLT, symbolic analysis reused while
-// the free set is unchanged). The paper writes R with the opposite
+// precomputed order; the free vertices ordered by METIS nested dissection of
+// the vertex graph, their 4 unknowns together; CHOLMOD supernodal Cholesky
+// keeping that order, ordering and symbolic analysis reused while the free
+// set and the cut parities are unchanged). CHOLMOD's dense kernels run on
+// the BLAS libcholmod is linked with: Debian's default netlib BLAS is
+// single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
+// at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
+// do not depend on the machine's cores. The paper writes R with the opposite
 // rotation sign and a 2 pi missing in the rounding of (4); we use the
 // self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -68,7 +74,8 @@
 // corner of face(h) at target(h)); absent scale/material maps read as 1 / 0.
 // After an update only corners of faces in the effect area are rewritten.
 // Throws InvalidInputError (missing direction map, non-positive scale, bad
-// options), SolverError (factorisation/solve failure).
+// options), SolverError (symbolic analysis/factorisation/solve failure).
+// PgpResult::breakdown gives the wall time of each step (bench_pgp prints it).
 
 #include <array>
 #include <complex>
@@ -108,6 +115,23 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
+  /// Wall-time breakdown of `seconds` (each step's own wall time, seconds):
+  struct Breakdown {
+    double topology = 0;     ///< connectivity, areas, frames (first call only)
+    double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
+    double ordering = 0;     ///< nested-dissection order of the free vertices (when the free set changed)
+    double pattern = 0;      ///< sparsity pattern of the free set (when it changed)
+    double start = 0;        ///< spanning-tree integration (initialisation only)
+    double assembly = 0;     ///< matrix values and locked-vertex right-hand side
+    double analysis = 0;     ///< symbolic factorisation (0 when reused)
+    double factorization = 0;  ///< numeric factorisation
+    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count)
+    double factor_nonzeros = 0;  ///< in the Cholesky factor L
+    double solves = 0;       ///< all relaxation steps (right-hand side + solve)
+    int steps = 0;           ///< relaxation steps run
+    double energy = 0;       ///< energies at the solution
+    double corners = 0;      ///< corner write-back (equation 4)
+  } breakdown;
 };
 
 /// Expected increase of (s,t) along each halfedge h (source -> target), in
