@@ -13,6 +13,10 @@ PKGS=(
   libgtest-dev libgmock-dev
   libnanoflann-dev libtbb-dev libcli11-dev nlohmann-json3-dev libtinygltf-dev libstb-dev
   libsuitesparse-dev libmetis-dev
+  # An optimised single-threaded BLAS/LAPACK behind CHOLMOD (PGP): takes over
+  # libblas.so.3 through Debian's alternatives; serial, so results do not
+  # depend on a BLAS thread count.
+  libopenblas0-serial
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
