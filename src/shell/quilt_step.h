@@ -47,6 +47,25 @@ struct QuiltStepOptions {
   /// one partner (see strongest_relations in the .cpp); false = the paper's
   /// "any surviving pair relates two elements".
   bool one_to_one = true;
+  /// Sub-cell refinement of the chosen grid translation (the paper restricts
+  /// t to grid units and notes that a finer discretisation gives a better
+  /// placement, section 2.4): levels of a 5 x 5 search around the best
+  /// translation, the first with steps of c/4, each next one with half the
+  /// step (the total shift stays within half a cell). 0 = grid units only (the
+  /// planar default: there every earlier placement lies on the same grid, so
+  /// a grid translation can match it exactly). On a surface the grid of each
+  /// patch is laid out from its own seed, not from the texture already
+  /// placed, so grid translations alone miss the old elements by up to half a
+  /// cell (for the weave: 0.3 thread spacings, more than a thread's radius)
+  /// and surface quilting sets this to 3. >= 0, <= 8.
+  int subcell_levels = 0;
+};
+
+/// Where quilt_step put the swatch: its bbox min at the corner of cell
+/// (oi, oj) shifted by (dx, dy) (frame units, |dx|, |dy| <= cell / 2).
+struct QuiltPlacement {
+  int oi = 0, oj = 0;
+  double dx = 0, dy = 0;
 };
 
 struct QuiltStepStats {
@@ -63,13 +82,15 @@ struct QuiltStepStats {
   void add(const QuiltStepStats& o);
 };
 
-/// Places the swatch (its bbox min at the origin of a cell) so that it covers
-/// every P_out cell, choosing the grid translation minimising eq. 3 over the
-/// output vertices in P_out; merges it into `elements` (entries of `alive` set
-/// to 0 for elements consumed, new elements appended with alive = 1; `z`
-/// coordinates are the swatch's). Marks the covered grid cells processed.
-/// Returns the chosen cell offset of the swatch origin (i, j).
-std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
+/// Places the swatch (its bbox min at the origin of a cell, then shifted by
+/// less than half a cell if opt.subcell_levels > 0) so that it covers every
+/// P_out cell, choosing the translation minimising eq. 3 over the output
+/// vertices in P_out; merges it into `elements` (entries of `alive` set to 0
+/// for elements consumed, new elements appended with alive = 1; `z`
+/// coordinates are the swatch's). Marks the covered grid cells (oi .. oi + sx
+/// - 1, oj .. oj + sy - 1) processed. Throws InvalidInputError on an empty or
+/// too large P_out or subcell_levels out of range.
+QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
                                std::vector<ElementMesh>& elements, std::vector<char>& alive,
                                std::mt19937_64& rng, const QuiltStepOptions& opt, QuiltStepStats& stats);
 

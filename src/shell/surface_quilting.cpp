@@ -588,7 +588,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     std::vector<ElementMesh> before = frame;
     std::vector<char> alive(n_in, 1);
     QuiltStepStats stats;
-    const auto [oi, oj] = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
+    const QuiltPlacement placed = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
     res.stats.add(stats);
 
     auto to_loc = [&](const P3& p) {
@@ -632,7 +632,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       }
     }
     // Processed: patch faces whose frame centroid lies in the footprint, and the seed.
-    const double fx0 = grid.x0 + oi * c, fy0 = grid.y0 + oj * c, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
+    const double fx0 = grid.x0 + placed.oi * c + placed.dx, fy0 = grid.y0 + placed.oj * c + placed.dy, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
     for (std::size_t k = 0; k < flat.faces.size(); ++k) {
       const double cxp = (ftris[k][0][0] + ftris[k][1][0] + ftris[k][2][0]) / 3;
       const double cyp = (ftris[k][0][1] + ftris[k][1][1] + ftris[k][2][1]) / 3;

@@ -84,7 +84,14 @@ struct SurfaceQuiltOptions {
   double cell_size = 0;
   /// P_out half-size in cells; 0 = a quarter of the swatch's smaller side in cells.
   int subpatch_radius = 0;
-  QuiltStepOptions step;
+  /// The planar step's options; here subcell_levels defaults to 3 (see
+  /// QuiltStepOptions::subcell_levels: each patch's grid starts at its seed,
+  /// not on the lattice of the texture already placed).
+  QuiltStepOptions step = [] {
+    QuiltStepOptions s;
+    s.subcell_levels = 3;
+    return s;
+  }();
   std::uint64_t seed = 1;
   ProgressCallback progress;
 };
