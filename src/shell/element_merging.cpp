@@ -165,6 +165,56 @@ ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, 
 }
 
 namespace {
+/// Removes the islands a graph cut can leave (section 2.7 wants "a cut path",
+/// one seam per crossing): connected components (across edges) of kept
+/// triangles that hold no triangle forced to SOURCE are deleted, then
+/// components of deleted triangles that hold no triangle forced to SINK are
+/// kept again. Where no triangle is forced to a side, its largest component
+/// stays. Without this, the guide links of B's cut (one per triangle, much
+/// stronger than the n-links) copy the noise of A's labels where the two
+/// elements do not coincide exactly, and B's cut opens several small loops
+/// around islands while A's opens one: the merge is refused ("cuts opened 1
+/// and 3 loops"), the usual refusal on finely tessellated weaves.
+void remove_cut_islands(const ElementMesh& m, const std::vector<signed char>& terminal, std::vector<char>& keep) {
+  const int nt = static_cast<int>(m.tris.size());
+  std::vector<std::vector<int>> nb(static_cast<std::size_t>(nt));
+  for (const DualEdge& e : dual_edges(m)) nb[e.t1].push_back(e.t2), nb[e.t2].push_back(e.t1);
+  for (const char side : {char(1), char(0)}) {
+    const signed char forced = side ? 1 : -1;
+    std::vector<int> comp(static_cast<std::size_t>(nt), -1);
+    std::vector<std::vector<int>> comps;
+    std::vector<char> anchored;
+    for (int t = 0; t < nt; ++t) {
+      if (keep[t] != side || comp[t] >= 0) continue;
+      const int id = static_cast<int>(comps.size());
+      comps.emplace_back();
+      anchored.push_back(0);
+      std::vector<int> stack{t};
+      comp[t] = id;
+      while (!stack.empty()) {
+        const int x = stack.back();
+        stack.pop_back();
+        comps[id].push_back(x);
+        if (terminal[x] == forced || terminal[x] == 2) anchored[id] = 1;
+        for (int y : nb[x])
+          if (keep[y] == side && comp[y] < 0) comp[y] = id, stack.push_back(y);
+      }
+    }
+    if (comps.empty()) continue;
+    bool any = false;
+    for (char a : anchored) any = any || a;
+    if (!any) {  // keep the largest component (first on ties)
+      std::size_t big = 0;
+      for (std::size_t k = 1; k < comps.size(); ++k)
+        if (comps[k].size() > comps[big].size()) big = k;
+      anchored[big] = 1;
+    }
+    for (std::size_t k = 0; k < comps.size(); ++k)
+      if (!anchored[k])
+        for (int t : comps[k]) keep[t] = side ? 0 : 1;
+  }
+}
+
 /// Kept part of `m` and the loops opened by the cut (loops made of edges that
 /// were interior in `m`), in the kept part's vertex numbering.
 void kept_part(const ElementMesh& m, const std::vector<char>& keep, ElementMesh& part,
@@ -225,6 +275,8 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
     r.reason = "cut of B infeasible";
     return r;
   }
+  remove_cut_islands(a, ca.terminal, ca.keep);
+  remove_cut_islands(b, cb.terminal, cb.keep);
   ElementMesh pa, pb;
   std::vector<std::vector<int>> la, lb;
   bool oka = false, okb = false;

@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <map>
@@ -335,6 +337,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
           add_in[e] = 0;
       } else {
         ++stats.stitch_refused;
+        if (std::getenv("S3Q_DEBUG")) std::fprintf(stderr, "refused: %s\n", r.reason.c_str());
         if (r.reason.find("infeasible") != std::string::npos)
           ++stats.refused_infeasible;
         else if (r.reason.find("loops") != std::string::npos)

@@ -397,6 +397,16 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   std::vector<int> constrained(nf, 0);  // processed vertex-neighbours
   std::vector<int> stamp(nf, -1), vstamp(b.pts.size(), -1);
   std::vector<int> patch_slot(nf, -1);  // face -> index in the current patch
+  // Where earlier swatch placements lie, at sub-face resolution: per base
+  // face, the barycentric coordinates (b1, b2) of points of earlier footprints
+  // (a lattice of spacing c/2 over each placed swatch's rectangle). A grid
+  // cell of a later patch is processed iff such a point falls in it. (Marking
+  // a cell processed when the base triangle under its centre is, as before,
+  // mislabels every cell a footprint's rim crosses when base triangles are as
+  // large as cells or larger -- on the 5K-face bunny they are about 1.5
+  // cells: old elements there counted as "new", input elements there were
+  // forced to stay on top of them, the cut opened no loop.)
+  std::vector<std::vector<std::array<double, 2>>> cover(static_cast<std::size_t>(nf));
   // Faces -> elements with a vertex on them (rebuilt lazily).
   int done = 0, step_id = 0;
   auto mark = [&](int f) {
@@ -489,8 +499,17 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         const int k = locator.locate(ctr, w);
         if (k < 0) continue;
         on_patch[j * grid.nx + i] = 1;
-        grid.processed[j * grid.nx + i] = processed[flat.faces[k]];
       }
+    // Processed cells: the earlier footprints' points on the patch, in the frame.
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      const auto& t = ftris[k];
+      for (const auto& bb : cover[static_cast<std::size_t>(flat.faces[k])]) {
+        const double b0 = 1 - bb[0] - bb[1];
+        const int cc = grid.cell_of(b0 * t[0][0] + bb[0] * t[1][0] + bb[1] * t[2][0],
+                                    b0 * t[0][1] + bb[0] * t[1][1] + bb[1] * t[2][1]);
+        if (cc >= 0) grid.processed[static_cast<std::size_t>(cc)] = 1;
+      }
+    }
     const int si = -ilo, sj = -jlo;  // the origin's cell
     for (int j = sj - r; j <= sj + r; ++j)
       for (int i = si - r; i <= si + r; ++i)
@@ -639,6 +658,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       if (cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1) mark(flat.faces[k]);
     }
     mark(seed);
+    // The footprint's points (section 2.3's processed cells, kept on the surface).
+    for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)
+      for (double x = fx0 + 0.25 * c; x < fx1; x += 0.5 * c) {
+        std::array<double, 3> w;
+        const int k = locator.locate({x, y}, w);
+        if (k >= 0) cover[static_cast<std::size_t>(flat.faces[static_cast<std::size_t>(k)])].push_back({w[1], w[2]});
+      }
     for (int f : flat.faces) patch_slot[f] = -1;
     res.seconds_step += ts.seconds();
     ++res.steps;
