@@ -4,8 +4,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <map>
@@ -167,11 +165,13 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
   // pattern search, deterministic (lowest cost, ties: first in row order).
   double dx = 0, dy = 0;
   if (!mv.empty() && opt.subcell_levels > 0) {
+    // Level 0: 5 x 5 offsets at steps of c/4 (covers +-c/2); then 3 x 3 at half the step each level.
     double step = c / 4;
     for (int level = 0; level < opt.subcell_levels; ++level, step *= 0.5) {
+      const int reach = level == 0 ? 2 : 1;
       std::vector<std::array<double, 2>> offs;
-      for (int b = -2; b <= 2; ++b)
-        for (int a = -2; a <= 2; ++a) {
+      for (int b = -reach; b <= reach; ++b)
+        for (int a = -reach; a <= reach; ++a) {
           const double x = dx + a * step, y = dy + b * step;
           if ((a || b) && std::abs(x) <= 0.5 * c + 1e-12 && std::abs(y) <= 0.5 * c + 1e-12) offs.push_back({x, y});
         }
@@ -180,8 +180,11 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         oc[k] = match_cost({t[0] + offs[k][0], t[1] + offs[k][1], t[2]});
       });
       stats.candidates += offs.size();
+      double bx = dx, by = dy;
       for (std::size_t k = 0; k < offs.size(); ++k)
-        if (oc[k] < picked_cost) picked_cost = oc[k], dx = offs[k][0], dy = offs[k][1];
+        if (oc[k] < picked_cost) picked_cost = oc[k], bx = offs[k][0], by = offs[k][1];
+      dx = bx;
+      dy = by;
     }
     t[0] += dx;
     t[1] += dy;
@@ -337,7 +340,6 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
           add_in[e] = 0;
       } else {
         ++stats.stitch_refused;
-        if (std::getenv("S3Q_DEBUG")) std::fprintf(stderr, "refused: %s\n", r.reason.c_str());
         if (r.reason.find("infeasible") != std::string::npos)
           ++stats.refused_infeasible;
         else if (r.reason.find("loops") != std::string::npos)
