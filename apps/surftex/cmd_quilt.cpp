@@ -206,6 +206,8 @@ int run_quilt(QuiltArgs& a) {
     rep["stretch_after"] = er.stretch.stretch_after;
     rep["outside_vertices"] = er.embed.outside;
     rep["elements_not_expressible"] = r.elements_not_expressible;
+    rep["elements_partial"] = r.elements_partial;
+    rep["seams_broken"] = r.seams_broken;
     rep["stitch_refused_loops"] = r.stats.refused_loops;
     rep["stitch_refused_border"] = r.stats.refused_border;
     rep["stitch_refused_infeasible"] = r.stats.refused_infeasible;

@@ -2,6 +2,7 @@
 #include "shell/element_merging.h"
 
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <unordered_map>
 #include <unordered_set>
@@ -165,6 +166,182 @@ ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, 
 }
 
 namespace {
+/// Removes the islands a graph cut can leave (section 2.7 wants "a cut path",
+/// one seam per crossing): connected components (across edges) of kept
+/// triangles that hold no triangle forced to SOURCE are deleted, then
+/// components of deleted triangles that hold no triangle forced to SINK are
+/// kept again. Where no triangle is forced to a side, its largest component
+/// stays. Without this, the guide links of B's cut (one per triangle, much
+/// stronger than the n-links) copy the noise of A's labels where the two
+/// elements do not coincide exactly, and B's cut opens several small loops
+/// around islands while A's opens one: the merge is refused ("cuts opened 1
+/// and 3 loops"), the usual refusal on finely tessellated weaves.
+void remove_cut_islands(const ElementMesh& m, const std::vector<signed char>& terminal, std::vector<char>& keep) {
+  const int nt = static_cast<int>(m.tris.size());
+  std::vector<std::vector<int>> nb(static_cast<std::size_t>(nt));
+  for (const DualEdge& e : dual_edges(m)) nb[e.t1].push_back(e.t2), nb[e.t2].push_back(e.t1);
+  for (const char side : {char(1), char(0)}) {
+    const signed char forced = side ? 1 : -1;
+    std::vector<int> comp(static_cast<std::size_t>(nt), -1);
+    std::vector<std::vector<int>> comps;
+    std::vector<char> anchored;
+    for (int t = 0; t < nt; ++t) {
+      if (keep[t] != side || comp[t] >= 0) continue;
+      const int id = static_cast<int>(comps.size());
+      comps.emplace_back();
+      anchored.push_back(0);
+      std::vector<int> stack{t};
+      comp[t] = id;
+      while (!stack.empty()) {
+        const int x = stack.back();
+        stack.pop_back();
+        comps[id].push_back(x);
+        if (terminal[x] == forced || terminal[x] == 2) anchored[id] = 1;
+        for (int y : nb[x])
+          if (keep[y] == side && comp[y] < 0) comp[y] = id, stack.push_back(y);
+      }
+    }
+    if (comps.empty()) continue;
+    bool any = false;
+    for (char a : anchored) any = any || a;
+    if (!any) {  // keep the largest component (first on ties)
+      std::size_t big = 0;
+      for (std::size_t k = 1; k < comps.size(); ++k)
+        if (comps[k].size() > comps[big].size()) big = k;
+      anchored[big] = 1;
+    }
+    for (std::size_t k = 0; k < comps.size(); ++k)
+      if (!anchored[k])
+        for (int t : comps[k]) keep[t] = side ? 0 : 1;
+  }
+}
+
+// True if every directed edge is used at most once, no triangle repeats a
+// vertex and the triangles around every vertex form one fan (connected across
+// edges at the vertex): what a Surface_mesh can hold. A zip can break this
+// where the kept parts have borders of their own (then the closedness test
+// below does not apply).
+bool is_manifold_oriented(const ElementMesh& m) {
+  std::unordered_set<std::uint64_t> directed;
+  std::vector<std::vector<int>> vt(m.points.size());
+  for (std::size_t t = 0; t < m.tris.size(); ++t) {
+    const Tri& tr = m.tris[t];
+    for (int k = 0; k < 3; ++k) {
+      const int a = tr[k], b = tr[(k + 1) % 3];
+      if (a == b) return false;
+      const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+      if (!directed.insert(key).second) return false;
+      vt[a].push_back(static_cast<int>(t));
+    }
+  }
+  for (std::size_t v = 0; v < vt.size(); ++v) {
+    const auto& ts = vt[v];
+    if (ts.size() < 2) continue;
+    std::vector<char> seen(ts.size(), 0);
+    std::vector<std::size_t> stack{0};
+    seen[0] = 1;
+    std::size_t reached = 1;
+    while (!stack.empty()) {
+      const std::size_t x = stack.back();
+      stack.pop_back();
+      for (std::size_t j = 0; j < ts.size(); ++j) {
+        if (seen[j]) continue;
+        bool adj = false;
+        for (int a : m.tris[ts[x]])
+          for (int b : m.tris[ts[j]]) adj = adj || (a == b && a != static_cast<int>(v));
+        if (adj) seen[j] = 1, ++reached, stack.push_back(j);
+      }
+    }
+    if (reached != ts.size()) return false;
+  }
+  return true;
+}
+
+// Deleted components (across edges) of a labelling and, per component, the
+// mean midpoint of its cut edges (edges between a kept and a deleted
+// triangle); components without a cut edge are left out.
+void deleted_components(const ElementMesh& m, const std::vector<char>& keep, std::vector<std::vector<int>>& comps,
+                        std::vector<P3>& centres) {
+  const int nt = static_cast<int>(m.tris.size());
+  std::vector<std::vector<int>> nb(static_cast<std::size_t>(nt));
+  std::vector<std::pair<int, P3>> cut;  // (deleted triangle, edge midpoint)
+  for (const DualEdge& e : dual_edges(m)) {
+    nb[e.t1].push_back(e.t2), nb[e.t2].push_back(e.t1);
+    if (keep[e.t1] != keep[e.t2]) {
+      const P3& p = m.points[e.vi];
+      const P3& q = m.points[e.vj];
+      cut.emplace_back(keep[e.t1] ? e.t2 : e.t1, P3{(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2});
+    }
+  }
+  std::vector<int> comp(static_cast<std::size_t>(nt), -1);
+  std::vector<std::vector<int>> all;
+  for (int t = 0; t < nt; ++t) {
+    if (keep[t] || comp[t] >= 0) continue;
+    const int id = static_cast<int>(all.size());
+    all.emplace_back();
+    std::vector<int> stack{t};
+    comp[t] = id;
+    while (!stack.empty()) {
+      const int x = stack.back();
+      stack.pop_back();
+      all[id].push_back(x);
+      for (int y : nb[x])
+        if (!keep[y] && comp[y] < 0) comp[y] = id, stack.push_back(y);
+    }
+  }
+  std::vector<P3> sum(all.size(), P3{0, 0, 0});
+  std::vector<int> cnt(all.size(), 0);
+  for (const auto& [t, p] : cut) {
+    const int id = comp[t];
+    for (int d = 0; d < 3; ++d) sum[id][d] += p[d];
+    ++cnt[id];
+  }
+  comps.clear();
+  centres.clear();
+  for (std::size_t k = 0; k < all.size(); ++k)
+    if (cnt[k] > 0) {
+      comps.push_back(std::move(all[k]));
+      centres.push_back({sum[k][0] / cnt[k], sum[k][1] / cnt[k], sum[k][2] / cnt[k]});
+    }
+}
+
+// Where the cuts of A and B open different numbers of seams (for example B,
+// pulled to SINK by the infinite rule at a vertex whose closest face of A lies
+// just across the overlap rim, gets a hole in the side of its tube that no
+// seam of A faces), the seams are paired greedily by distance and every
+// deleted component behind an unpaired seam is restored: a seam with no
+// partner cannot be stitched, and the paper's merge always yields one
+// connected element. (Our reading; the paper does not discuss the case.)
+// Returns the number of components restored.
+int restore_unpaired_cuts(const ElementMesh& a, std::vector<char>& keep_a, const ElementMesh& b,
+                          std::vector<char>& keep_b) {
+  std::vector<std::vector<int>> ca, cb;
+  std::vector<P3> pa, pb;
+  deleted_components(a, keep_a, ca, pa);
+  deleted_components(b, keep_b, cb, pb);
+  if (ca.size() == cb.size() || ca.empty() || cb.empty()) return 0;
+  std::vector<std::tuple<double, int, int>> cand;
+  for (std::size_t i = 0; i < pa.size(); ++i)
+    for (std::size_t j = 0; j < pb.size(); ++j)
+      cand.emplace_back(dist(pa[i], pb[j]), static_cast<int>(i), static_cast<int>(j));
+  std::sort(cand.begin(), cand.end());
+  std::vector<char> used_a(ca.size(), 0), used_b(cb.size(), 0);
+  for (const auto& [d, i, j] : cand)
+    if (!used_a[i] && !used_b[j]) used_a[i] = used_b[j] = 1;
+  int restored = 0;
+  for (std::size_t i = 0; i < ca.size(); ++i)
+    if (!used_a[i]) {
+      for (int t : ca[i]) keep_a[t] = 1;
+      ++restored;
+    }
+  for (std::size_t j = 0; j < cb.size(); ++j)
+    if (!used_b[j]) {
+      for (int t : cb[j]) keep_b[t] = 1;
+      ++restored;
+    }
+  return restored;
+}
+
 /// Kept part of `m` and the loops opened by the cut (loops made of edges that
 /// were interior in `m`), in the kept part's vertex numbering.
 void kept_part(const ElementMesh& m, const std::vector<char>& keep, ElementMesh& part,
@@ -225,6 +402,9 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
     r.reason = "cut of B infeasible";
     return r;
   }
+  remove_cut_islands(a, ca.terminal, ca.keep);
+  remove_cut_islands(b, cb.terminal, cb.keep);
+  restore_unpaired_cuts(a, ca.keep, b, cb.keep);
   ElementMesh pa, pb;
   std::vector<std::vector<int>> la, lb;
   bool oka = false, okb = false;
@@ -300,6 +480,10 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
   const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
   if (count_border_edges(merged) > border_before) {
     r.reason = "stitching would open new borders";
+    return r;
+  }
+  if (!is_manifold_oriented(merged)) {
+    r.reason = "stitched element is not manifold (border)";
     return r;
   }
   if (border_before == 0 && !is_closed_oriented(merged)) {

@@ -34,6 +34,12 @@
 // finite guide links: a triangle of B within match_distance of A is pulled to
 // SINK if its closest face of A was kept and to SOURCE if it was deleted, with
 // weight guide_factor * the largest n-link weight.
+// After the two cuts (issue #8): islands are removed (kept components with
+// no SOURCE-forced triangle deleted, deleted components with no SINK-forced
+// triangle kept again), and where the cuts open different numbers of seams
+// the deleted components behind seams with no partner (paired greedily by
+// distance) are restored (our reading: the paper's merge always succeeds and
+// does not discuss the case).
 // Stitching: the boundary loops the cuts opened are paired (nearest
 // centroids), each pair zipped by a triangle strip (advancing on the loop
 // whose next diagonal is shorter, orientations consistent with both sides),
@@ -93,8 +99,10 @@ struct MergeResult {
 
 /// Cuts A and B and stitches them. Refuses (stitched = false, reason set,
 /// `merged` empty) when a cut is infeasible, the cuts open different numbers of
-/// loops or none, or the result would have more border edges than A and B had
-/// (so elements closed in the swatch stay closed).
+/// loops or none, the result would have more border edges than A and B had
+/// (so elements closed in the swatch stay closed), or would not be manifold
+/// (a directed edge used twice, a pinched vertex: possible when A or B has
+/// borders of its own, e.g. the inner part of a long element on a surface).
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt = {});
 

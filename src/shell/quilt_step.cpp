@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -84,9 +85,11 @@ std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& cor
 }
 }  // namespace
 
-std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
-                               std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
-                               const QuiltStepOptions& opt, QuiltStepStats& stats) {
+QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
+                          std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
+                          const QuiltStepOptions& opt, QuiltStepStats& stats) {
+  if (opt.subcell_levels < 0 || opt.subcell_levels > 8)
+    throw InvalidInputError("quilt_step: subcell_levels must be in [0, 8] (" + std::to_string(opt.subcell_levels) + ")");
   Timer timer;
   const double c = grid.cell;
   const int sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
@@ -133,31 +136,61 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
   auto translation = [&](int oi, int oj) {
     return P3{grid.x0 + oi * c - swatch.bbox_min[0], grid.y0 + oj * c - swatch.bbox_min[1], 0.0};
   };
+  // E(t) (eq. 3): eq. 1 with the closest face (see element_correspondence.h), eq. 2, summed.
+  auto match_cost = [&](const P3& t) {
+    double e = 0;
+    for (std::size_t v = 0; v < mv.size(); ++v) {
+      const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]});
+      const P3& nf = fn[h.tri];
+      const double dn = std::sqrt((mn[v][0] - nf[0]) * (mn[v][0] - nf[0]) + (mn[v][1] - nf[1]) * (mn[v][1] - nf[1]) +
+                                  (mn[v][2] - nf[2]) * (mn[v][2] - nf[2]));
+      e += (1 + opt.lambda * h.distance) * (1 + dn);
+    }
+    return e;
+  };
   std::vector<double> cost(cand.size(), 0.0);
-  if (!mv.empty()) {
+  if (!mv.empty())
     tbb::parallel_for(std::size_t(0), cand.size(), [&](std::size_t k) {
-      const P3 t = translation(cand[k].first, cand[k].second);
-      double e = 0;
-      for (std::size_t v = 0; v < mv.size(); ++v) {
-        // Eq. 2 with the closest face (see element_correspondence.h), eq. 1, summed as eq. 3.
-        const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]});
-        const P3& nf = fn[h.tri];
-        const double dn = std::sqrt((mn[v][0] - nf[0]) * (mn[v][0] - nf[0]) + (mn[v][1] - nf[1]) * (mn[v][1] - nf[1]) +
-                                    (mn[v][2] - nf[2]) * (mn[v][2] - nf[2]));
-        e += (1 + opt.lambda * h.distance) * (1 + dn);
-      }
-      cost[k] = e;
+      cost[k] = match_cost(translation(cand[k].first, cand[k].second));
     });
-  }
   const double best = *std::min_element(cost.begin(), cost.end());
   std::vector<std::size_t> eligible;
   for (std::size_t k = 0; k < cand.size(); ++k)
     if (cost[k] <= best * (1 + opt.choice_tolerance) + 1e-12) eligible.push_back(k);
   const std::size_t pick = eligible[static_cast<std::size_t>(rng() % eligible.size())];
   const int oi = cand[pick].first, oj = cand[pick].second;
-  const P3 t = translation(oi, oj);
+  P3 t = translation(oi, oj);
+  double picked_cost = cost[pick];
+  // Sub-cell refinement (see QuiltStepOptions::subcell_levels): a 5 x 5
+  // pattern search, deterministic (lowest cost, ties: first in row order).
+  double dx = 0, dy = 0;
+  if (!mv.empty() && opt.subcell_levels > 0) {
+    // Level 0: 5 x 5 offsets at steps of c/4 (covers +-c/2); then 3 x 3 at half the step each level.
+    double step = c / 4;
+    for (int level = 0; level < opt.subcell_levels; ++level, step *= 0.5) {
+      const int reach = level == 0 ? 2 : 1;
+      std::vector<std::array<double, 2>> offs;
+      for (int b = -reach; b <= reach; ++b)
+        for (int a = -reach; a <= reach; ++a) {
+          const double x = dx + a * step, y = dy + b * step;
+          if ((a || b) && std::abs(x) <= 0.5 * c + 1e-12 && std::abs(y) <= 0.5 * c + 1e-12) offs.push_back({x, y});
+        }
+      std::vector<double> oc(offs.size());
+      tbb::parallel_for(std::size_t(0), offs.size(), [&](std::size_t k) {
+        oc[k] = match_cost({t[0] + offs[k][0], t[1] + offs[k][1], t[2]});
+      });
+      stats.candidates += offs.size();
+      double bx = dx, by = dy;
+      for (std::size_t k = 0; k < offs.size(); ++k)
+        if (oc[k] < picked_cost) picked_cost = oc[k], bx = offs[k][0], by = offs[k][1];
+      dx = bx;
+      dy = by;
+    }
+    t[0] += dx;
+    t[1] += dy;
+  }
   stats.candidates += cand.size();
-  stats.best_cost = cost[pick];
+  stats.best_cost = picked_cost;
   stats.seconds_match += timer.seconds();
   timer.reset();
 
@@ -334,7 +367,7 @@ std::pair<int, int> quilt_step(const Swatch& swatch, const TriangleDistance& swa
     for (int i = std::max(0, oi); i < std::min(grid.nx, oi + sx); ++i) grid.processed[j * grid.nx + i] = 1;
   stats.seconds_deform += t_deform;
   stats.seconds_merge += t_merge;
-  return {oi, oj};
+  return {oi, oj, dx, dy};
 }
 
 }  // namespace surftex

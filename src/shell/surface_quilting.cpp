@@ -12,6 +12,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <unordered_map>
 
@@ -289,6 +290,48 @@ class PatchLocator {
   std::vector<std::vector<int>> buckets_;
 };
 
+// Gives every vertex one fan: a vertex whose triangles form several fans
+// (groups connected across edges at the vertex; a pinch, which a
+// Surface_mesh cannot hold) gets a copy per extra fan.
+void split_pinched_vertices(std::vector<Tri>& tris, std::vector<SurfaceQuiltVertex>& loc) {
+  std::vector<std::vector<int>> vt(loc.size());
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int v : tris[t]) vt[static_cast<std::size_t>(v)].push_back(static_cast<int>(t));
+  const std::size_t nv = loc.size();
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto& ts = vt[v];
+    if (ts.size() < 2) continue;
+    std::vector<int> fan(ts.size(), -1);
+    int nfan = 0;
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+      if (fan[i] >= 0) continue;
+      fan[i] = nfan;
+      std::vector<std::size_t> stack{i};
+      while (!stack.empty()) {
+        const std::size_t x = stack.back();
+        stack.pop_back();
+        for (std::size_t j = 0; j < ts.size(); ++j) {
+          if (fan[j] >= 0) continue;
+          int shared = 0;  // vertices other than v in common
+          for (int a : tris[static_cast<std::size_t>(ts[x])])
+            for (int b2 : tris[static_cast<std::size_t>(ts[j])])
+              if (a == b2 && a != static_cast<int>(v)) ++shared;
+          if (shared > 0) fan[j] = nfan, stack.push_back(j);
+        }
+      }
+      ++nfan;
+    }
+    for (int f = 1; f < nfan; ++f) {
+      const int copy = static_cast<int>(loc.size());
+      loc.push_back(loc[v]);
+      for (std::size_t i = 0; i < ts.size(); ++i)
+        if (fan[i] == f)
+          for (int& a : tris[static_cast<std::size_t>(ts[i])])
+            if (a == static_cast<int>(v)) a = copy;
+    }
+  }
+}
+
 struct Element {
   ElementMesh mesh;                     // triangles (points unused between steps)
   std::vector<SurfaceQuiltVertex> loc;  // per vertex
@@ -397,6 +440,16 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   std::vector<int> constrained(nf, 0);  // processed vertex-neighbours
   std::vector<int> stamp(nf, -1), vstamp(b.pts.size(), -1);
   std::vector<int> patch_slot(nf, -1);  // face -> index in the current patch
+  // Where earlier swatch placements lie, at sub-face resolution: per base
+  // face, the barycentric coordinates (b1, b2) of points of earlier footprints
+  // (a lattice of spacing c/2 over each placed swatch's rectangle). A grid
+  // cell of a later patch is processed iff such a point falls in it. (Marking
+  // a cell processed when the base triangle under its centre is, as before,
+  // mislabels every cell a footprint's rim crosses when base triangles are as
+  // large as cells or larger -- on the 5K-face bunny they are about 1.5
+  // cells: old elements there counted as "new", input elements there were
+  // forced to stay on top of them, the cut opened no loop.)
+  std::vector<std::vector<std::array<double, 2>>> cover(static_cast<std::size_t>(nf));
   // Faces -> elements with a vertex on them (rebuilt lazily).
   int done = 0, step_id = 0;
   auto mark = [&](int f) {
@@ -489,8 +542,17 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         const int k = locator.locate(ctr, w);
         if (k < 0) continue;
         on_patch[j * grid.nx + i] = 1;
-        grid.processed[j * grid.nx + i] = processed[flat.faces[k]];
       }
+    // Processed cells: the earlier footprints' points on the patch, in the frame.
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      const auto& t = ftris[k];
+      for (const auto& bb : cover[static_cast<std::size_t>(flat.faces[k])]) {
+        const double b0 = 1 - bb[0] - bb[1];
+        const int cc = grid.cell_of(b0 * t[0][0] + bb[0] * t[1][0] + bb[1] * t[2][0],
+                                    b0 * t[0][1] + bb[0] * t[1][1] + bb[1] * t[2][1]);
+        if (cc >= 0) grid.processed[static_cast<std::size_t>(cc)] = 1;
+      }
+    }
     const int si = -ilo, sj = -jlo;  // the origin's cell
     for (int j = sj - r; j <= sj + r; ++j)
       for (int i = si - r; i <= si + r; ++i)
@@ -543,6 +605,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     std::vector<int> ids;  // global element ids in the frame
     std::vector<ElementMesh> frame;
     std::map<P3, SurfaceQuiltVertex> keep_loc;  // frame point -> local coordinates it came from
+    // Per frame element: empty inner = the whole element; else its inner
+    // triangles (in the frame, numbered by `orig`) and outer ones (left in
+    // local coordinates).
+    struct Partial {
+      std::vector<int> inner, outer, orig;
+    };
+    std::vector<Partial> partial;
     for (std::size_t e = 0; e < elements.size(); ++e) {
       Element& el = elements[e];
       if (!el.alive) continue;
@@ -553,42 +622,72 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
           break;
         }
       if (!touches) continue;
-      // An element reaching far beyond the patch (a long stitched thread, an
-      // element across an ear) cannot be expressed in this frame: its off-patch
-      // vertices would be projected onto the plane of a distant patch face,
-      // land at arbitrary frame points, possibly in the overlap, be moved
-      // there and come back as long spikes. Such elements are left as they are
-      // (not merged in this step).
-      bool expressible = true;
-      for (const auto& v : el.loc) {
-        if (patch_slot[v.face] >= 0) continue;
-        const int k = nearest_patch_face(v.face);
+      // Section 3.1 converts "the part of M_out inside this patch" to the
+      // frame. A vertex is expressible if it lies on the patch, or off it on a
+      // face within 60 degrees of, and within 2R of, the nearest patch face
+      // (farther vertices, projected onto the plane of a distant patch face,
+      // would land at arbitrary frame points, possibly in the overlap, be
+      // moved there and come back as long spikes). An element with vertices
+      // that are not (a long stitched thread, an element across an ear)
+      // enters the step with its triangles whose three vertices are
+      // expressible (its inner part); the rest stays in local coordinates and
+      // is joined back at the seam vertices afterwards (they lie far outside
+      // the footprint: the step keeps them where they are, see below).
+      // Leaving such elements out of the step entirely, as before, let the
+      // new swatch be laid on top of them (duplicated threads).
+      std::vector<char> ex(el.loc.size(), 1);
+      bool all_ex = true;
+      for (std::size_t v = 0; v < el.loc.size(); ++v) {
+        const auto& lv = el.loc[v];
+        if (patch_slot[lv.face] >= 0) continue;
+        const int k = nearest_patch_face(lv.face);
         const int g = flat.faces[static_cast<std::size_t>(k)];
-        const P3 d = sub3(base_point(b, v), b.centroid[g]);
-        if (dot3(b.normal[g], b.normal[v.face]) < kFrameCos || dot3(d, d) > 4 * R * R) {
-          expressible = false;
-          break;
-        }
+        const P3 d = sub3(base_point(b, lv), b.centroid[g]);
+        if (dot3(b.normal[g], b.normal[lv.face]) < kFrameCos || dot3(d, d) > 4 * R * R) ex[v] = 0, all_ex = false;
       }
-      if (!expressible) {
+      Partial part;
+      if (!all_ex) {
         ++res.elements_not_expressible;
-        continue;
+        for (std::size_t t = 0; t < el.mesh.tris.size(); ++t) {
+          const Tri& tr = el.mesh.tris[t];
+          (ex[tr[0]] && ex[tr[1]] && ex[tr[2]] ? part.inner : part.outer).push_back(static_cast<int>(t));
+        }
+        if (part.inner.empty()) continue;
+        ++res.elements_partial;
       }
       ElementMesh m;
-      m.tris = el.mesh.tris;
-      m.points.resize(el.loc.size());
-      for (std::size_t v = 0; v < el.loc.size(); ++v) {
-        m.points[v] = frame_of_loc(el.loc[v]);
-        keep_loc.emplace(m.points[v], el.loc[v]);
+      if (all_ex) {
+        m.tris = el.mesh.tris;
+        m.points.resize(el.loc.size());
+        for (std::size_t v = 0; v < el.loc.size(); ++v) {
+          m.points[v] = frame_of_loc(el.loc[v]);
+          keep_loc.emplace(m.points[v], el.loc[v]);
+        }
+      } else {
+        std::vector<int> sub(el.loc.size(), -1);
+        for (int t : part.inner)
+          for (int v : el.mesh.tris[static_cast<std::size_t>(t)]) {
+            if (sub[v] < 0) {
+              sub[v] = static_cast<int>(m.points.size());
+              part.orig.push_back(v);
+              m.points.push_back(frame_of_loc(el.loc[v]));
+              keep_loc.emplace(m.points.back(), el.loc[v]);
+            }
+          }
+        for (int t : part.inner) {
+          const Tri& tr = el.mesh.tris[static_cast<std::size_t>(t)];
+          m.tris.push_back({sub[tr[0]], sub[tr[1]], sub[tr[2]]});
+        }
       }
       ids.push_back(static_cast<int>(e));
+      partial.push_back(std::move(part));
       frame.push_back(std::move(m));
     }
     const std::size_t n_in = frame.size();
     std::vector<ElementMesh> before = frame;
     std::vector<char> alive(n_in, 1);
     QuiltStepStats stats;
-    const auto [oi, oj] = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
+    const QuiltPlacement placed = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
     res.stats.add(stats);
 
     auto to_loc = [&](const P3& p) {
@@ -607,13 +706,102 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       if (k < n_in) {
         Element& el = elements[ids[k]];
         if (!alive[k]) {
-          el.alive = false;
+          // Replaced by an input element (entirely in the overlap, 2.7); a
+          // partly expressed element keeps its outer part, so it stays whole.
+          if (partial[k].inner.empty()) el.alive = false;
           continue;
         }
         if (frame[k].tris == before[k].tris && frame[k].points == before[k].points) continue;
-        el.mesh.tris = frame[k].tris;
-        el.loc.resize(frame[k].points.size());
-        for (std::size_t v = 0; v < frame[k].points.size(); ++v) el.loc[v] = to_loc(frame[k].points[v]);
+        const Partial& pt = partial[k];
+        if (pt.inner.empty()) {
+          el.mesh.tris = frame[k].tris;
+          el.loc.resize(frame[k].points.size());
+          for (std::size_t v = 0; v < frame[k].points.size(); ++v) el.loc[v] = to_loc(frame[k].points[v]);
+          continue;
+        }
+        // Join the outer triangles back: a seam vertex (an original vertex
+        // of the inner part) is found in the new inner mesh at its unchanged
+        // frame point (vertices outside the overlap are locked by the
+        // deformations and kept by the cuts); one that was not is kept as it
+        // was (a gap, counted).
+        std::map<P3, int> at;
+        for (std::size_t v = 0; v < frame[k].points.size(); ++v) at.emplace(frame[k].points[v], static_cast<int>(v));
+        std::vector<int> now(el.loc.size(), -1);
+        for (std::size_t s2 = 0; s2 < pt.orig.size(); ++s2) {
+          auto it = at.find(before[k].points[s2]);
+          if (it != at.end()) now[static_cast<std::size_t>(pt.orig[s2])] = it->second;
+        }
+        std::vector<SurfaceQuiltVertex> loc(frame[k].points.size());
+        for (std::size_t v = 0; v < frame[k].points.size(); ++v) loc[v] = to_loc(frame[k].points[v]);
+        const std::size_t n_inner_v = loc.size();
+        std::vector<Tri> tris = frame[k].tris;
+        std::vector<char> was_inner(el.loc.size(), 0);
+        for (int ov : pt.orig) was_inner[static_cast<std::size_t>(ov)] = 1;
+        for (int t : pt.outer) {
+          Tri tr = el.mesh.tris[static_cast<std::size_t>(t)];
+          for (int& v : tr) {
+            if (now[static_cast<std::size_t>(v)] < 0) {
+              now[static_cast<std::size_t>(v)] = static_cast<int>(loc.size());
+              loc.push_back(el.loc[static_cast<std::size_t>(v)]);
+            }
+            v = now[static_cast<std::size_t>(v)];
+          }
+          tris.push_back(tr);
+        }
+        // The join is sound only if every inner triangle at a seam vertex
+        // came back unchanged (the seam's fans are whole again); else (a
+        // seam reached by the cut) the outer part becomes an element of its
+        // own rather than a pinched one (counted as a broken seam).
+        bool manifold = true;
+        {
+          std::vector<char> seam(el.loc.size(), 0);
+          for (int t : pt.outer)
+            for (int v : el.mesh.tris[static_cast<std::size_t>(t)])
+              if (was_inner[static_cast<std::size_t>(v)]) seam[static_cast<std::size_t>(v)] = 1;
+          std::set<std::array<int, 3>> have;
+          auto canon = [](Tri t) {
+            while (t[0] > t[1] || t[0] > t[2]) t = {t[1], t[2], t[0]};
+            return std::array<int, 3>{t[0], t[1], t[2]};
+          };
+          for (const Tri& t : frame[k].tris) have.insert(canon(t));
+          for (int t : pt.inner) {
+            const Tri& tr = el.mesh.tris[static_cast<std::size_t>(t)];
+            if (!seam[tr[0]] && !seam[tr[1]] && !seam[tr[2]]) continue;
+            Tri m2;
+            for (int q = 0; q < 3; ++q) {
+              m2[q] = now[static_cast<std::size_t>(tr[q])];
+              // (outer-only copies appended above have ids >= n_inner_v)
+              if (m2[q] < 0 || m2[q] >= static_cast<int>(n_inner_v)) manifold = false;
+            }
+            if (manifold && !have.count(canon(m2))) manifold = false;
+            if (!manifold) break;
+          }
+        }
+        if (!manifold) {
+          ++res.seams_broken;
+          const std::size_t n_inner_t = frame[k].tris.size();
+          Element rest;
+          std::vector<int> again(loc.size(), -1);
+          for (std::size_t t = n_inner_t; t < tris.size(); ++t) {
+            Tri tr = tris[t];
+            for (int& v : tr) {
+              if (again[static_cast<std::size_t>(v)] < 0) {
+                again[static_cast<std::size_t>(v)] = static_cast<int>(rest.loc.size());
+                rest.loc.push_back(loc[static_cast<std::size_t>(v)]);
+              }
+              v = again[static_cast<std::size_t>(v)];
+            }
+            rest.mesh.tris.push_back(tr);
+          }
+          tris.resize(n_inner_t);
+          loc.resize(n_inner_v);
+          split_pinched_vertices(rest.mesh.tris, rest.loc);
+          elements.push_back(std::move(rest));
+        }
+        split_pinched_vertices(tris, loc);
+        Element& el2 = elements[static_cast<std::size_t>(ids[k])];  // (push_back may have moved it)
+        el2.mesh.tris = std::move(tris);
+        el2.loc = std::move(loc);
       } else {
         if (!alive[k] || frame[k].tris.empty()) continue;
         double cxs = 0, cys = 0;
@@ -632,13 +820,20 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       }
     }
     // Processed: patch faces whose frame centroid lies in the footprint, and the seed.
-    const double fx0 = grid.x0 + oi * c, fy0 = grid.y0 + oj * c, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
+    const double fx0 = grid.x0 + placed.oi * c + placed.dx, fy0 = grid.y0 + placed.oj * c + placed.dy, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
     for (std::size_t k = 0; k < flat.faces.size(); ++k) {
       const double cxp = (ftris[k][0][0] + ftris[k][1][0] + ftris[k][2][0]) / 3;
       const double cyp = (ftris[k][0][1] + ftris[k][1][1] + ftris[k][2][1]) / 3;
       if (cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1) mark(flat.faces[k]);
     }
     mark(seed);
+    // The footprint's points (section 2.3's processed cells, kept on the surface).
+    for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)
+      for (double x = fx0 + 0.25 * c; x < fx1; x += 0.5 * c) {
+        std::array<double, 3> w{1, 0, 0};
+        const int k = locator.locate({x, y}, w);
+        if (k >= 0) cover[static_cast<std::size_t>(flat.faces[static_cast<std::size_t>(k)])].push_back({w[1], w[2]});
+      }
     for (int f : flat.faces) patch_slot[f] = -1;
     res.seconds_step += ts.seconds();
     ++res.steps;

@@ -30,9 +30,14 @@
 // 6. Output elements with a vertex on a patch triangle are expressed in the
 //    frame (vertices on other triangles: projected onto the plane of the
 //    patch triangle with the nearest centroid, barycentric coordinates
-//    extrapolated; an element with a vertex farther than 2R from that triangle
-//    or on a face at more than 60 degrees to it is left out of the step, see
-//    SurfaceQuiltResult::elements_not_expressible), quilt_step (quilt_step.h) runs, and new or changed
+//    extrapolated; of an element with a vertex farther than 2R from that
+//    triangle or on a face at more than 60 degrees to it only the triangles
+//    with three expressible vertices enter the step, the others are joined
+//    back afterwards at their unchanged seam vertices, see
+//    SurfaceQuiltResult::elements_partial), processed cells are those where
+//    points of earlier footprints fall (kept per base face at sub-face
+//    resolution), quilt_step (quilt_step.h, with sub-cell refinement of the
+//    translation) runs, and new or changed
 //    vertices are expressed again in local coordinates: base triangle +
 //    barycentric coordinates of the orthogonal projection (the flattening's
 //    triangle containing the frame point; outside the patch the triangle whose
@@ -84,6 +89,8 @@ struct SurfaceQuiltOptions {
   double cell_size = 0;
   /// P_out half-size in cells; 0 = a quarter of the swatch's smaller side in cells.
   int subpatch_radius = 0;
+  /// The planar step's options (subcell_levels matters here: each patch's
+  /// grid starts at its seed, not on the lattice of the texture already placed).
   QuiltStepOptions step;
   std::uint64_t seed = 1;
   ProgressCallback progress;
@@ -118,10 +125,15 @@ struct SurfaceQuiltResult {
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
-  /// Times an output element touching a patch was left out of its step because
-  /// a vertex lies off the patch, farther than the patch radius from (or at
+  /// Times an output element touching a patch had a vertex that cannot be
+  /// expressed in the patch frame: off the patch, farther than 2R from (or at
   /// more than 60 degrees to) the nearest patch face.
   std::size_t elements_not_expressible = 0;
+  /// Of those, the times the element entered the step with its inner part
+  /// (triangles with three expressible vertices), and the times its seam did
+  /// not come back from the step unchanged, so that the outer part became an
+  /// element of its own.
+  std::size_t elements_partial = 0, seams_broken = 0;
   QuiltStepStats stats;
   double seconds = 0, seconds_patch = 0, seconds_step = 0;
 };
