@@ -115,10 +115,12 @@ double GraphCut::solve() {
   for (std::size_t u = 0; u < n; ++u) {
     const bool s_inf = src_cap_[u] >= kInfinity, t_inf = sink_cap_[u] >= kInfinity;
     if (s_inf && t_inf) constant = kInfinity;  // infinite both ways: every cut is infinite
-    if (s_inf && !t_inf) {
+    if (s_inf && !t_inf) {  // its finite sink link is paid by every finite cut
       forced[u] = 1;
+      constant += sink_cap_[u];
     } else if (t_inf && !s_inf) {
       forced[u] = -1;
+      constant += src_cap_[u];
     } else {
       index[u] = nf++;
     }
