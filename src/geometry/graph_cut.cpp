@@ -37,17 +37,22 @@ using CsrEdge = boost::graph_traits<Csr>::edge_descriptor;
 
 }  // namespace
 
-GraphCut::GraphCut(int num_nodes) : n_(num_nodes) {
+GraphCut::GraphCut(int num_nodes) : n_(0) { reset(num_nodes); }
+
+void GraphCut::reset(int num_nodes) {
   if (num_nodes < 0)
     throw InvalidInputError("GraphCut: num_nodes must be >= 0, got " + std::to_string(num_nodes));
+  n_ = num_nodes;
   src_cap_.assign(static_cast<std::size_t>(n_), 0.0);
   sink_cap_.assign(static_cast<std::size_t>(n_), 0.0);
+  edges_.clear();
+  source_side_.clear();
+  solved_ = false;
 }
 
-void GraphCut::check_node(int u, const char* what) const {
-  if (u < 0 || u >= n_)
-    throw InvalidInputError(std::string("GraphCut: ") + what + " node " + std::to_string(u) +
-                            " out of range [0, " + std::to_string(n_) + ")");
+void GraphCut::throw_node_out_of_range(int u, const char* what) const {
+  throw InvalidInputError(std::string("GraphCut: ") + what + " node " + std::to_string(u) +
+                          " out of range [0, " + std::to_string(n_) + ")");
 }
 
 double GraphCut::clamp_capacity(double c, const char* what) {

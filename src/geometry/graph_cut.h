@@ -33,6 +33,11 @@ class GraphCut {
 
   int num_nodes() const { return n_; }
 
+  /// Starts over with an empty graph of `num_nodes` nodes, keeping the
+  /// storage (for callers that solve many small cuts). Throws like the
+  /// constructor.
+  void reset(int num_nodes);
+
   /// Reserves room for `edges` add_edge calls (optional; saves reallocations).
   void reserve_edges(std::size_t edges) { edges_.reserve(edges); }
 
@@ -61,7 +66,10 @@ class GraphCut {
     int u, v;
     double cap_uv, cap_vu;
   };
-  void check_node(int u, const char* what) const;
+  void check_node(int u, const char* what) const {
+    if (u < 0 || u >= n_) throw_node_out_of_range(u, what);
+  }
+  [[noreturn]] void throw_node_out_of_range(int u, const char* what) const;
   static double clamp_capacity(double c, const char* what);
 
   int n_;

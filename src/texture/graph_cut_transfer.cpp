@@ -67,9 +67,11 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
     w[k] = (mis[edges[k][0]] + mis[edges[k][1]]) *
            std::exp(-(a.distance * a.distance + b.distance * b.distance) / denom);
   }
-  GraphCut gc(n);
+  thread_local GraphCut gc(0);  // storage reused by the many small cuts of a pass
+  gc.reset(n);
   gc.reserve_edges(edges.size());
-  std::vector<char> paste(n, 1);
+  thread_local std::vector<char> paste;
+  paste.assign(n, 1);
   for (int i = 0; i < n; ++i) {
     const TransferNode& a = nodes[i];
     if (i == center || !a.colored) {
