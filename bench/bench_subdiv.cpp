@@ -22,6 +22,11 @@
 // (f533745, same load, process CPU of a one-pass run): r_scale 30 about 13.7 /
 // 32.6 CPU seconds. Quiet wall figures before: 6.9 / 15.3, 3.9 / 4.3,
 // 2.0 / 2.1 s.
+// Graph-cut transfer folded (forced nodes into the terminals, reused
+// GraphCut storage, one exp per node), same machine, load 9-10: r_scale 30
+// matching only / with graph cut 8.0 / 13.2 CPU s (before, same session,
+// load 10.5-12: 8.5 / 17.1); colour_hash unchanged (3b2885b33712e1a7 with
+// the cut, c5f52d01582f2f68 without, 2 threads).
 //
 // Usage: bench_subdiv [MESH] [TEXTURE] [THREADS] [R_SCALES] [CUT]: R_SCALES a
 // comma-separated list (default 30,100,200), CUT one of both (default), cut,

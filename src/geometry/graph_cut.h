@@ -15,6 +15,12 @@
 // mapped to kInfinity): such an edge is never cut while a finite cut exists.
 // Finite capacities should sum to far less than kInfinity (1e18) so that
 // residuals keep their precision; anything >= kInfinity counts as infinite.
+//
+// solve() folds every node with an infinite link to exactly one terminal
+// (e.g. the pinned target and the kept border of a texture cut) into that
+// terminal before running BK, so BK sees only the free nodes; a graph with
+// no source link or no sink link left is answered without BK (max flow 0).
+// Neither changes the flow or the partition (graph_cut.cpp gives the proof).
 
 #include <cstddef>
 #include <vector>
@@ -57,7 +63,9 @@ class GraphCut {
   double solve();
 
   /// After solve(): true if u is on the source side of the minimum cut (the
-  /// nodes reachable from the source in the residual graph); false otherwise.
+  /// nodes reachable from the source in the residual graph, i.e. the source
+  /// side of the smallest minimum cut); false otherwise. When solve()
+  /// returned infinity only the forced nodes' sides are meaningful.
   /// Throws InvalidInputError before solve() or for u out of range.
   bool is_source_side(int u) const;
 
