@@ -248,3 +248,26 @@ TEST(GraphCut, FoldedForcedNodesGiveTheUnfoldedLabelsAndFlow) {
     }
   }
 }
+
+// reset() gives an empty graph again: a reused GraphCut solves like a new one.
+TEST(GraphCut, ResetSolvesLikeANewGraph) {
+  std::mt19937_64 rng(99);
+  GraphCut reused(0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 1 + trial % 9;
+    const RandomGraph g = random_graph(rng, n);
+    GraphCut fresh(n);
+    reused.reset(n);
+    EXPECT_EQ(reused.num_nodes(), n);
+    for (GraphCut* gc : {&fresh, &reused}) {
+      for (const auto& e : g.edges) gc->add_edge(e.u, e.v, e.cuv, e.cvu);
+      for (int u = 0; u < n; ++u) gc->add_terminal(u, g.cs[u], g.ct[u]);
+      gc->add_terminal(0, GraphCut::kInfinity, 0);
+    }
+    ASSERT_EQ(fresh.solve(), reused.solve()) << "trial " << trial;
+    for (int u = 0; u < n; ++u) ASSERT_EQ(fresh.is_source_side(u), reused.is_source_side(u)) << "trial " << trial;
+  }
+  EXPECT_THROW(reused.reset(-1), InvalidInputError);
+  reused.reset(3);
+  EXPECT_THROW(reused.is_source_side(0), InvalidInputError);  // nothing solved after a reset
+}
