@@ -22,6 +22,11 @@
 // (f533745, same load, process CPU of a one-pass run): r_scale 30 about 13.7 /
 // 32.6 CPU seconds. Quiet wall figures before: 6.9 / 15.3, 3.9 / 4.3,
 // 2.0 / 2.1 s.
+// Graph-cut transfer folded (forced nodes into the terminals, reused
+// GraphCut storage, one exp per node), same machine, load 9-10: r_scale 30
+// matching only / with graph cut 8.0 / 13.2 CPU s (before, same session,
+// load 10.5-12: 8.5 / 17.1); colour_hash unchanged (3b2885b33712e1a7 with
+// the cut, c5f52d01582f2f68 without, 2 threads).
 //
 // Usage: bench_subdiv [MESH] [TEXTURE] [THREADS] [R_SCALES] [CUT]: R_SCALES a
 // comma-separated list (default 30,100,200), CUT one of both (default), cut,
@@ -30,7 +35,9 @@
 #include <tbb/info.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -122,8 +129,19 @@ int main(int argc, char** argv) {
       const SynthesisPassStats st = synthesis_pass(mesh, ex, index, order, colored, rs / unit_paper, 0, o, rng);
       const double secs = tp.seconds();
       const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
+      // FNV-1a of the output colours' bytes: a change in any cut shows here.
+      std::uint64_t hash = 1469598103934665603ull;
+      for (VertexIndex v : mesh.vertices())
+        for (int k = 0; k < 3; ++k) {
+          const float f = col[v][k];
+          unsigned char b[sizeof f];
+          std::memcpy(b, &f, sizeof f);
+          for (unsigned char x : b) hash = (hash ^ x) * 1099511628211ull;
+        }
+      char hex[17];
+      std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
       nlohmann::json j{{"mesh", mesh_path}, {"texture", tex_path}, {"vertices", nv}, {"inv_mean_edge", 1.0 / ebar}, {"inv_mean_edge_bbox_units", 1.0 / ebar_box},
-                       {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs}, {"cpu_seconds_pass", cpu},
+                       {"r_scale", rs}, {"graph_cut", cut}, {"seconds_pass", secs}, {"cpu_seconds_pass", cpu}, {"colour_hash", hex},
                        {"seconds_region", st.seconds_region}, {"seconds_match", st.seconds_match},
                        {"seconds_transfer", st.seconds_transfer}, {"matched", st.matched},
                        {"mean_k", st.mean_k}, {"threads", threads}, {"level_relative_region", o.level_relative_region},

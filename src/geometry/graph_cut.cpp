@@ -35,32 +35,24 @@ using Csr = boost::compressed_sparse_row_graph<boost::directedS, boost::no_prope
                                                boost::no_property, std::uint32_t, std::uint32_t>;
 using CsrEdge = boost::graph_traits<Csr>::edge_descriptor;
 
-struct ArcList {
-  std::vector<std::uint32_t> from, to;  ///< arcs in insertion order (pairs: 2i, 2i+1 reverse each other)
-  std::vector<double> cap;
-  void add_pair(std::size_t u, std::size_t v, double cuv, double cvu) {
-    from.push_back(static_cast<std::uint32_t>(u));
-    to.push_back(static_cast<std::uint32_t>(v));
-    cap.push_back(cuv);
-    from.push_back(static_cast<std::uint32_t>(v));
-    to.push_back(static_cast<std::uint32_t>(u));
-    cap.push_back(cvu);
-  }
-};
-
 }  // namespace
 
-GraphCut::GraphCut(int num_nodes) : n_(num_nodes) {
+GraphCut::GraphCut(int num_nodes) : n_(0) { reset(num_nodes); }
+
+void GraphCut::reset(int num_nodes) {
   if (num_nodes < 0)
     throw InvalidInputError("GraphCut: num_nodes must be >= 0, got " + std::to_string(num_nodes));
+  n_ = num_nodes;
   src_cap_.assign(static_cast<std::size_t>(n_), 0.0);
   sink_cap_.assign(static_cast<std::size_t>(n_), 0.0);
+  edges_.clear();
+  source_side_.clear();
+  solved_ = false;
 }
 
-void GraphCut::check_node(int u, const char* what) const {
-  if (u < 0 || u >= n_)
-    throw InvalidInputError(std::string("GraphCut: ") + what + " node " + std::to_string(u) +
-                            " out of range [0, " + std::to_string(n_) + ")");
+void GraphCut::throw_node_out_of_range(int u, const char* what) const {
+  throw InvalidInputError(std::string("GraphCut: ") + what + " node " + std::to_string(u) +
+                          " out of range [0, " + std::to_string(n_) + ")");
 }
 
 double GraphCut::clamp_capacity(double c, const char* what) {
@@ -92,12 +84,13 @@ double GraphCut::solve() {
   if (solved_) throw InvalidInputError("GraphCut: solve() called twice");
   solved_ = true;
   const std::size_t n = static_cast<std::size_t>(n_);
-  const std::size_t s = n, t = n + 1;
   // Per-thread buffers: many small cuts (one per vertex in subdivision
   // synthesis) reuse their storage instead of allocating it every time.
   struct Scratch {
-    ArcList arcs;
-    std::vector<std::uint32_t> start, pos, next;
+    std::vector<signed char> forced;    ///< +1 forced to the source, -1 to the sink, 0 free
+    std::vector<std::uint32_t> index;   ///< compact index of a free node
+    std::vector<double> term_s, term_t; ///< folded terminal capacities of the free nodes
+    std::vector<std::uint32_t> start, next, queue;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
     std::vector<double> capacity, residual;
     std::vector<CsrEdge> reverse, predecessor;
@@ -105,56 +98,149 @@ double GraphCut::solve() {
     std::vector<long> distance;
   };
   thread_local Scratch scr;
-  ArcList& arcs = scr.arcs;
-  arcs.from.clear();
-  arcs.to.clear();
-  arcs.cap.clear();
-  // A node's two terminal links: only the part exceeding the smaller one
-  // matters for the cut (min(cs, ct) is paid either way); keeping both would
-  // be correct too, this just shortens augmenting paths.
+
+  // 1. Fold the forced nodes into the terminals. A node with an infinite link
+  // to one terminal only (and a finite cut exists) is on that terminal's side
+  // of every finite cut, so it is that terminal as far as the cut is
+  // concerned: an edge u->v from a source-forced u to a free v is paid exactly
+  // when v is on the sink side, i.e. it is a source link of v; v->u is never
+  // paid. Likewise for sink-forced nodes, and an edge between a source-forced
+  // and a sink-forced node is paid by every cut (a constant). The folded graph
+  // has the same finite cuts, restricted to the free nodes, with the same
+  // capacities; so the same max-flow value and the same minimal source set
+  // (the nodes reachable from the source in the residual graph of any maximum
+  // flow, which is what BK reports and which is unique), hence the same
+  // labels, with fewer nodes and edges.
+  auto& forced = scr.forced;
+  auto& index = scr.index;
+  forced.assign(n, 0);
+  index.assign(n, 0);
+  std::uint32_t nf = 0;
   double constant = 0.0;
   for (std::size_t u = 0; u < n; ++u) {
-    double cs = src_cap_[u], ct = sink_cap_[u];
-    double m = std::min(cs, ct);
+    const bool s_inf = src_cap_[u] >= kInfinity, t_inf = sink_cap_[u] >= kInfinity;
+    if (s_inf && t_inf) constant = kInfinity;  // infinite both ways: every cut is infinite
+    if (s_inf && !t_inf) {  // its finite sink link is paid by every finite cut
+      forced[u] = 1;
+      constant += sink_cap_[u];
+    } else if (t_inf && !s_inf) {
+      forced[u] = -1;
+      constant += src_cap_[u];
+    } else {
+      index[u] = nf++;
+    }
+  }
+  auto& term_s = scr.term_s;
+  auto& term_t = scr.term_t;
+  term_s.resize(nf);
+  term_t.resize(nf);
+  for (std::size_t u = 0; u < n; ++u)
+    if (forced[u] == 0) {
+      term_s[index[u]] = src_cap_[u];
+      term_t[index[u]] = sink_cap_[u];
+    }
+  const std::size_t nn = std::size_t(nf) + 2;
+  const std::uint32_t s = nf, t = nf + 1;
+  auto& start = scr.start;
+  start.assign(nn + 1, 0);  // start[u + 1] counts u's out-arcs first
+  auto add_to = [](double& c, double x) { c = std::min(kInfinity, c + x); };
+  for (const Edge& e : edges_) {
+    if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
+    const int fu = forced[static_cast<std::size_t>(e.u)], fv = forced[static_cast<std::size_t>(e.v)];
+    const std::uint32_t iu = index[static_cast<std::size_t>(e.u)], iv = index[static_cast<std::size_t>(e.v)];
+    if (fu == 0 && fv == 0) {
+      ++start[iu + 1];
+      ++start[iv + 1];
+    } else if (fu == 0) {  // v forced
+      if (fv > 0) add_to(term_s[iu], e.cap_vu);
+      else add_to(term_t[iu], e.cap_uv);
+    } else if (fv == 0) {  // u forced
+      if (fu > 0) add_to(term_s[iv], e.cap_uv);
+      else add_to(term_t[iv], e.cap_vu);
+    } else if (fu != fv) {
+      add_to(constant, fu > 0 ? e.cap_uv : e.cap_vu);
+    }
+  }
+  // A node's two terminal links: only the part exceeding the smaller one
+  // matters for the cut (min(cs, ct) is paid either way).
+  bool any_source = false, any_sink = false;
+  for (std::uint32_t u = 0; u < nf; ++u) {
+    const double m = std::min(term_s[u], term_t[u]);
     if (m >= kInfinity) {
-      // Infinite both ways: every cut is infinite.
       constant = kInfinity;
+      term_s[u] = term_t[u] = 0.0;
       continue;
     }
-    constant += m;
-    cs -= m;
-    ct -= m;
-    if (cs > 0.0) arcs.add_pair(s, u, cs, 0.0);
-    if (ct > 0.0) arcs.add_pair(u, t, ct, 0.0);
+    add_to(constant, m);
+    term_s[u] -= m;
+    term_t[u] -= m;
+    if (term_s[u] > 0.0) ++start[s + 1], ++start[u + 1], any_source = true;
+    if (term_t[u] > 0.0) ++start[u + 1], ++start[t + 1], any_sink = true;
+  }
+  source_side_.assign(n, 0);
+  for (std::size_t u = 0; u < n; ++u) source_side_[u] = forced[u] > 0 ? 1 : 0;
+  auto finish = [&](double flow) {
+    const double total = flow + constant;
+    return total >= kInfinity ? std::numeric_limits<double>::infinity() : total;
+  };
+  // 2. Without a source link or without a sink link no path joins the
+  // terminals: the max flow is 0 and the source side is what the source
+  // reaches through positive capacities (BK's source tree when it stops),
+  // which is empty without source links. Skip the max-flow then.
+  if (!any_source) return finish(0.0);
+
+  // 3. CSR arrays: arcs sorted by source (counting sort; every node's arcs in
+  // the order they are added: terminal links by node, then the edges).
+  for (std::size_t u = 0; u < nn; ++u) start[u + 1] += start[u];
+  const std::size_t na = start[nn];
+  auto& next = scr.next;
+  next.assign(start.begin(), start.end() - 1);
+  auto& sorted = scr.sorted;
+  auto& capacity = scr.capacity;
+  auto& reverse = scr.reverse;
+  sorted.resize(na);
+  capacity.resize(na);
+  reverse.resize(na);
+  auto add_pair = [&](std::uint32_t u, std::uint32_t v, double cuv, double cvu) {
+    const std::uint32_t a = next[u]++, b = next[v]++;
+    sorted[a] = {u, v};
+    sorted[b] = {v, u};
+    capacity[a] = cuv;
+    capacity[b] = cvu;
+    reverse[a] = CsrEdge(v, b);
+    reverse[b] = CsrEdge(u, a);
+  };
+  for (std::uint32_t u = 0; u < nf; ++u) {
+    if (term_s[u] > 0.0) add_pair(s, u, term_s[u], 0.0);
+    if (term_t[u] > 0.0) add_pair(u, t, term_t[u], 0.0);
   }
   for (const Edge& e : edges_) {
     if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
-    arcs.add_pair(static_cast<std::size_t>(e.u), static_cast<std::size_t>(e.v), e.cap_uv, e.cap_vu);
+    if (forced[static_cast<std::size_t>(e.u)] != 0 || forced[static_cast<std::size_t>(e.v)] != 0) continue;
+    add_pair(index[static_cast<std::size_t>(e.u)], index[static_cast<std::size_t>(e.v)], e.cap_uv, e.cap_vu);
   }
-  // Stable counting sort of the arcs by source: CSR position of arc i.
-  const std::size_t nn = n + 2, na = arcs.from.size();
-  std::vector<std::uint32_t>& start = scr.start;
-  std::vector<std::uint32_t>& pos = scr.pos;
-  start.assign(nn + 1, 0);
-  pos.resize(na);
-  for (std::uint32_t f : arcs.from) ++start[f + 1];
-  for (std::size_t u = 0; u < nn; ++u) start[u + 1] += start[u];
-  scr.next.assign(start.begin(), start.end() - 1);
-  for (std::size_t i = 0; i < na; ++i) pos[i] = scr.next[arcs.from[i]]++;
-  auto& sorted = scr.sorted;
-  auto& capacity = scr.capacity;
-  auto& residual = scr.residual;
-  sorted.resize(na);
-  capacity.resize(na);
-  residual.assign(na, 0.0);
-  for (std::size_t i = 0; i < na; ++i) {
-    sorted[pos[i]] = {arcs.from[i], arcs.to[i]};
-    capacity[pos[i]] = arcs.cap[i];
+  if (!any_sink) {
+    // No arc enters the sink: flow 0, residual = capacity; BFS from the source.
+    auto& queue = scr.queue;
+    queue.assign(1, s);
+    std::vector<boost::default_color_type>& seen = scr.color;
+    seen.assign(nn, boost::white_color);
+    seen[s] = boost::black_color;
+    for (std::size_t q = 0; q < queue.size(); ++q)
+      for (std::uint32_t a = start[queue[q]]; a < start[queue[q] + 1]; ++a) {
+        const std::uint32_t v = sorted[a].second;
+        if (capacity[a] > 0.0 && seen[v] != boost::black_color) {
+          seen[v] = boost::black_color;
+          queue.push_back(v);
+        }
+      }
+    for (std::size_t u = 0; u < n; ++u)
+      if (forced[u] == 0) source_side_[u] = seen[index[u]] == boost::black_color ? 1 : 0;
+    return finish(0.0);
   }
   const Csr g(boost::edges_are_sorted, sorted.begin(), sorted.end(), static_cast<std::uint32_t>(nn));
-  std::vector<CsrEdge>& reverse = scr.reverse;
-  reverse.resize(na);
-  for (std::size_t i = 0; i < na; ++i) reverse[pos[i]] = CsrEdge(arcs.from[i ^ 1], pos[i ^ 1]);
+  auto& residual = scr.residual;
+  residual.assign(na, 0.0);
   std::vector<CsrEdge>& predecessor = scr.predecessor;
   std::vector<boost::default_color_type>& color = scr.color;
   std::vector<long>& distance = scr.distance;
@@ -169,14 +255,10 @@ double GraphCut::solve() {
       boost::make_iterator_property_map(reverse.begin(), eidx),
       boost::make_iterator_property_map(predecessor.begin(), vidx),
       boost::make_iterator_property_map(color.begin(), vidx),
-      boost::make_iterator_property_map(distance.begin(), vidx), vidx, static_cast<std::uint32_t>(s),
-      static_cast<std::uint32_t>(t));
-  source_side_.assign(n, 0);
+      boost::make_iterator_property_map(distance.begin(), vidx), vidx, s, t);
   for (std::size_t u = 0; u < n; ++u)
-    source_side_[u] = color[u] == boost::black_color ? 1 : 0;
-  double total = flow + constant;
-  if (total >= kInfinity) return std::numeric_limits<double>::infinity();
-  return total;
+    if (forced[u] == 0) source_side_[u] = color[index[u]] == boost::black_color ? 1 : 0;
+  return finish(flow);
 }
 
 bool GraphCut::is_source_side(int u) const {

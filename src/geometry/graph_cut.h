@@ -15,6 +15,12 @@
 // mapped to kInfinity): such an edge is never cut while a finite cut exists.
 // Finite capacities should sum to far less than kInfinity (1e18) so that
 // residuals keep their precision; anything >= kInfinity counts as infinite.
+//
+// solve() folds every node with an infinite link to exactly one terminal
+// (e.g. the pinned target and the kept border of a texture cut) into that
+// terminal before running BK, so BK sees only the free nodes; a graph with
+// no source link or no sink link left is answered without BK (max flow 0).
+// Neither changes the flow or the partition (graph_cut.cpp gives the proof).
 
 #include <cstddef>
 #include <vector>
@@ -32,6 +38,11 @@ class GraphCut {
   explicit GraphCut(int num_nodes);
 
   int num_nodes() const { return n_; }
+
+  /// Starts over with an empty graph of `num_nodes` nodes, keeping the
+  /// storage (for callers that solve many small cuts). Throws like the
+  /// constructor.
+  void reset(int num_nodes);
 
   /// Reserves room for `edges` add_edge calls (optional; saves reallocations).
   void reserve_edges(std::size_t edges) { edges_.reserve(edges); }
@@ -52,7 +63,9 @@ class GraphCut {
   double solve();
 
   /// After solve(): true if u is on the source side of the minimum cut (the
-  /// nodes reachable from the source in the residual graph); false otherwise.
+  /// nodes reachable from the source in the residual graph, i.e. the source
+  /// side of the smallest minimum cut); false otherwise. When solve()
+  /// returned infinity only the forced nodes' sides are meaningful.
   /// Throws InvalidInputError before solve() or for u out of range.
   bool is_source_side(int u) const;
 
@@ -61,7 +74,10 @@ class GraphCut {
     int u, v;
     double cap_uv, cap_vu;
   };
-  void check_node(int u, const char* what) const;
+  void check_node(int u, const char* what) const {
+    if (u < 0 || u >= n_) throw_node_out_of_range(u, what);
+  }
+  [[noreturn]] void throw_node_out_of_range(int u, const char* what) const;
   static double clamp_capacity(double c, const char* what);
 
   int n_;

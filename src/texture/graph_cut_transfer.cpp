@@ -19,9 +19,14 @@ double mismatch(const TransferNode& n) {
   return std::sqrt(s);
 }
 
+// exp(-(x_A^2 + x_B^2) / (sigma r^2)) = g(A) g(B) with g(X) = exp(-x_X^2 / (sigma r^2)):
+// one exp per node instead of one per edge (graph_cut_transfer and
+// transfer_seam_cost compute W the same way, so their costs agree exactly).
+double falloff(const TransferNode& a, double denom) { return std::exp(-(a.distance * a.distance) / denom); }
+
 double edge_weight(const TransferNode& a, const TransferNode& b, double r, double sigma) {
-  const double m = mismatch(a) + mismatch(b);
-  return m * std::exp(-(a.distance * a.distance + b.distance * b.distance) / (sigma * r * r));
+  const double denom = sigma * r * r;
+  return (mismatch(a) + mismatch(b)) * (falloff(a, denom) * falloff(b, denom));
 }
 
 void check(const std::vector<TransferNode>& nodes, const std::vector<std::array<int, 2>>& edges, double r,
@@ -56,20 +61,24 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
     throw InvalidInputError("graph_cut_transfer: center " + std::to_string(center) + " out of range");
   // Mismatches once per node, weights once per edge (each W is used by the
   // graph and by both seam costs).
-  thread_local std::vector<double> mis, w;
+  thread_local std::vector<double> mis, fall, w;
   mis.resize(n);
-  for (int i = 0; i < n; ++i) mis[i] = mismatch(nodes[i]);
-  w.resize(edges.size());
+  fall.resize(n);
   const double denom = opt.sigma * r * r;
-  for (std::size_t k = 0; k < edges.size(); ++k) {
-    const TransferNode& a = nodes[edges[k][0]];
-    const TransferNode& b = nodes[edges[k][1]];
-    w[k] = (mis[edges[k][0]] + mis[edges[k][1]]) *
-           std::exp(-(a.distance * a.distance + b.distance * b.distance) / denom);
+  for (int i = 0; i < n; ++i) {
+    mis[i] = mismatch(nodes[i]);
+    fall[i] = falloff(nodes[i], denom);
   }
-  GraphCut gc(n);
+  w.resize(edges.size());
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const int a = edges[k][0], b = edges[k][1];
+    w[k] = (mis[a] + mis[b]) * (fall[a] * fall[b]);
+  }
+  thread_local GraphCut gc(0);  // storage reused by the many small cuts of a pass
+  gc.reset(n);
   gc.reserve_edges(edges.size());
-  std::vector<char> paste(n, 1);
+  thread_local std::vector<char> paste;
+  paste.assign(n, 1);
   for (int i = 0; i < n; ++i) {
     const TransferNode& a = nodes[i];
     if (i == center || !a.colored) {

@@ -153,3 +153,121 @@ TEST(GraphCut, InvalidArgumentsThrow) {
   gc.solve();
   EXPECT_THROW(gc.solve(), InvalidInputError);
 }
+
+namespace {
+
+// Random graph with integer capacities (exact sums, so labels compare bit for
+// bit) and some nodes forced: +1 infinite source link, -1 infinite sink link.
+RandomGraph random_integer_graph(std::mt19937_64& rng, int n, bool sink_links) {
+  RandomGraph g = random_graph(rng, n);
+  for (auto& e : g.edges) e.cuv = std::floor(e.cuv), e.cvu = std::floor(e.cvu);
+  for (int u = 0; u < n; ++u) {
+    g.cs[u] = std::floor(g.cs[u]);
+    g.ct[u] = sink_links ? std::floor(g.ct[u]) : 0.0;
+  }
+  return g;
+}
+
+// The minimum over cuts that respect `forced`, and the intersection of the
+// source sides of all minimum cuts (the unique smallest one: the nodes the
+// source reaches in the residual graph of a maximum flow).
+std::pair<double, unsigned> smallest_min_cut(const RandomGraph& g, const std::vector<int>& forced) {
+  double best = std::numeric_limits<double>::infinity();
+  unsigned side = 0;
+  for (unsigned mask = 0; mask < (1u << g.n); ++mask) {
+    bool ok = true;
+    for (int u = 0; u < g.n; ++u)
+      if ((forced[u] > 0 && !((mask >> u) & 1u)) || (forced[u] < 0 && ((mask >> u) & 1u))) ok = false;
+    if (!ok) continue;
+    const double c = cut_capacity(g, mask);
+    if (c < best) {
+      best = c;
+      side = mask;
+    } else if (c == best) {
+      side &= mask;
+    }
+  }
+  return {best, side};
+}
+
+}  // namespace
+
+// solve() folds nodes with one infinite terminal link into that terminal.
+// The labels and flow are those of the unfolded graph: the brute-force
+// smallest minimum cut, and a graph folded by hand with no forced node.
+TEST(GraphCut, FoldedForcedNodesGiveTheUnfoldedLabelsAndFlow) {
+  std::mt19937_64 rng(2024);
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 1 + trial % 11;
+    const bool sink_links = trial % 4 != 3;  // every 4th: no sink link (the BFS shortcut)
+    RandomGraph g = random_integer_graph(rng, n, sink_links);
+    std::vector<int> forced(n, 0);
+    for (int u = 0; u < n; ++u) {
+      const auto r = rng() % 6;
+      forced[u] = r == 0 ? 1 : (r == 1 && sink_links ? -1 : 0);
+    }
+    GraphCut gc(n);
+    for (const auto& e : g.edges) gc.add_edge(e.u, e.v, e.cuv, e.cvu);
+    for (int u = 0; u < n; ++u) {
+      gc.add_terminal(u, g.cs[u], g.ct[u]);
+      if (forced[u] > 0) gc.add_terminal(u, GraphCut::kInfinity, 0);
+      if (forced[u] < 0) gc.add_terminal(u, 0, std::numeric_limits<double>::infinity());
+    }
+    const double flow = gc.solve();
+    const auto [best, side] = smallest_min_cut(g, forced);
+    ASSERT_EQ(flow, best) << "trial " << trial;
+    for (int u = 0; u < n; ++u) {
+      ASSERT_EQ(gc.is_source_side(u), ((side >> u) & 1u) != 0) << "trial " << trial << " u " << u;
+    }
+
+    // The same graph folded by hand: free nodes only.
+    std::vector<int> id(n, -1);
+    int nf = 0;
+    for (int u = 0; u < n; ++u)
+      if (forced[u] == 0) id[u] = nf++;
+    GraphCut folded(nf);
+    double constant = 0;
+    for (int u = 0; u < n; ++u) {
+      if (forced[u] == 0) folded.add_terminal(id[u], g.cs[u], g.ct[u]);
+      if (forced[u] > 0) constant += g.ct[u];  // a forced node's finite link is always cut
+      if (forced[u] < 0) constant += g.cs[u];
+    }
+    for (const auto& e : g.edges) {
+      const int fu = forced[e.u], fv = forced[e.v];
+      if (fu == 0 && fv == 0) folded.add_edge(id[e.u], id[e.v], e.cuv, e.cvu);
+      else if (fu == 0) folded.add_terminal(id[e.u], fv > 0 ? e.cvu : 0.0, fv < 0 ? e.cuv : 0.0);
+      else if (fv == 0) folded.add_terminal(id[e.v], fu > 0 ? e.cuv : 0.0, fu < 0 ? e.cvu : 0.0);
+      else if (fu > 0 && fv < 0) constant += e.cuv;
+      else if (fu < 0 && fv > 0) constant += e.cvu;
+    }
+    ASSERT_EQ(folded.solve() + constant, flow) << "trial " << trial;
+    for (int u = 0; u < n; ++u) {
+      if (forced[u] == 0) {
+        ASSERT_EQ(folded.is_source_side(id[u]), gc.is_source_side(u)) << "trial " << trial;
+      }
+    }
+  }
+}
+
+// reset() gives an empty graph again: a reused GraphCut solves like a new one.
+TEST(GraphCut, ResetSolvesLikeANewGraph) {
+  std::mt19937_64 rng(99);
+  GraphCut reused(0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 1 + trial % 9;
+    const RandomGraph g = random_graph(rng, n);
+    GraphCut fresh(n);
+    reused.reset(n);
+    EXPECT_EQ(reused.num_nodes(), n);
+    for (GraphCut* gc : {&fresh, &reused}) {
+      for (const auto& e : g.edges) gc->add_edge(e.u, e.v, e.cuv, e.cvu);
+      for (int u = 0; u < n; ++u) gc->add_terminal(u, g.cs[u], g.ct[u]);
+      gc->add_terminal(0, GraphCut::kInfinity, 0);
+    }
+    ASSERT_EQ(fresh.solve(), reused.solve()) << "trial " << trial;
+    for (int u = 0; u < n; ++u) ASSERT_EQ(fresh.is_source_side(u), reused.is_source_side(u)) << "trial " << trial;
+  }
+  EXPECT_THROW(reused.reset(-1), InvalidInputError);
+  reused.reset(3);
+  EXPECT_THROW(reused.is_source_side(0), InvalidInputError);  // nothing solved after a reset
+}
