@@ -380,6 +380,8 @@ class GraphcutSynthesizer {
       fill_entire();
     else
       fill_grid();
+    res.patch_width = pw_;
+    res.patch_height = ph_;
     res.fill_patches = fill_patches_;
     res.seam_cost_after_fill = canvas_.seam_cost();
     refine(res);

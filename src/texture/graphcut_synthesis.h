@@ -64,7 +64,12 @@ struct GraphcutOptions {
   /// [64, 192], at most s, where s = min(exemplar width, exemplar height)
   /// (few, large patches: fewer seams, larger verbatim regions; FFT matching
   /// makes their size free, section 4.1); always clipped to the
-  /// exemplar and output sizes. Ignored
+  /// exemplar and output sizes. With patch_size and overlap both automatic
+  /// and a non-periodic output, each side is then lowered to the largest
+  /// 3 L / (2n + 1) (L = output side) not above it, so that n patches
+  /// overlapping by a third cover the output exactly instead of the last one
+  /// being pushed back over its neighbour (a 256 output: 154, not 192
+  /// overlapping by 128). Ignored
   /// by EntirePatch (the patch is the exemplar). Range 0 or >= 4.
   int patch_size = 0;
   /// Overlap between neighbouring patches of the fill pass in pixels, 0 =
@@ -147,6 +152,7 @@ struct GraphcutResult {
   std::vector<int> source_x, source_y;  ///< exemplar pixel of each output pixel
   double seam_cost_after_fill = 0;   ///< total seam cost when the output was first full
   double seam_cost_final = 0;        ///< after the refinement passes
+  int patch_width = 0, patch_height = 0;  ///< patch side used (after the automatic choice)
   int fill_patches = 0;              ///< patches placed by the fill pass
   int refinement_tried = 0;          ///< refinement patches tried
   int refinement_accepted = 0;       ///< ... kept (seam cost did not increase)
