@@ -77,6 +77,13 @@ struct GraphcutOptions {
   int overlap = 0;
   /// Refinement passes after the output is filled (each places as many
   /// patches as the fill pass did, at the highest-seam-error pixels). Range >= 0.
+  /// Measured: passes after the first mostly repeat it (with a small k the
+  /// draw is nearly the best match, so a pass whose patches were all
+  /// rejected re-tries the same ones): 1 and 3 passes gave the same seam cost
+  /// on gravel_gray_512, rock_512, red_checked_384, tree_bark_512 (256
+  /// output), 1, 4 and 12 the same 32-px mud tile. Excluding the
+  /// translations already at the worst seam from the draw was tried and
+  /// gave higher seam costs (wood_512 128-px tile 21.8 -> 32.5), not kept.
   int refinement_passes = 1;
   /// Temperature k of the placement probability exp(-C/(k sigma^2)): small =
   /// nearly always the best match, large = nearly random. Range > 0.
