@@ -79,8 +79,8 @@ SubcommandRegistrar reg{
            ->required()
            ->check(CLI::Range(8, 8192));
        app.add_option("--patch", a->patch,
-                      "Patch side in pixels; 0 = automatic: min(64, exemplar sides, size/2) "
-                      "(0 or 4..4096, default 0)")
+                      "Patch side in pixels; 0 = automatic: min(7 size/8, 3/4 of the shorter "
+                      "exemplar side), at least 4 (0 or 4..4096, default 0)")
            ->check(CLI::Range(0, 4096));
        app.add_option("--overlap", a->overlap,
                       "Overlap of neighbouring patches in pixels, smaller than the patch; "

@@ -24,7 +24,13 @@ struct TileOptions {
   /// exemplar structure (wood grain, a check pattern's period) is copied over
   /// long stretches and the few seams can be placed where they cost least
   /// (measured at size 128: wood_512 seam cost 50 -> 24 and wrap-seam ratio
-  /// 1.34 -> 0.63 against the earlier min(64, size/2)). Range 0 or >= 4
+  /// 1.34 -> 0.63 against the earlier min(64, size/2)). No floor on the
+  /// band left outside a patch was added: the 32-px key tiles of
+  /// material_tile (32-px resampled exemplars) already get 24 px (3/4 of the
+  /// exemplar, overlap 8), and the 1.64 wrap ratio of the mud key there is a
+  /// crack of the exemplar along the wrap column, which holds no seam
+  /// (texture/wrap_seam_ratio.h). 24 vs 28 px for 32-px tiles of full-size
+  /// exemplars is not measured on all textures yet. Range 0 or >= 4
   /// (clipped to size - 1).
   int patch_size = 0;
   /// Overlap of the fill patches, 0 = automatic (patch/3). Range >= 0, < patch.

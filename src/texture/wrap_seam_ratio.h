@@ -20,6 +20,18 @@
 // the dots_large tile's ratio is 1.69 / 0.85 / 1.60 and dots_purple's 1.40 /
 // 1.86 / 0.89 while the total seam cost is 0 in all six: the figure follows
 // the phase of the dots relative to the one wrap line, not seam quality.
+// Small tiles make it worse: a 32x32 key tile of material_tile (32x32
+// resample of cracked_mud_100, seed derive_seed(5, 1001)) has ratio 1.64
+// while its wrap column holds no graph-cut seam (all 32 pairs are exemplar
+// neighbours copied verbatim); a crack of the exemplar runs along it (that
+// column's jump is 2.27x the mean, the column before it 2.08x). Over 18
+// such 32-px tiles (3 textures x 6 seeds) the seam cost on the wrap lines
+// equals that of an average line (18.3 vs 17.0; test
+// TileableTile.At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines).
+// Same at 128 px: the default 128x128 tile (seed 1) of water_caustics_300
+// has ratio 1.71; its wrap row holds 2 seam pairs of 128 (the rest are
+// exemplar neighbours) and ranks 4th of the tile's 128 rows, behind rows of
+// verbatim caustic edges, its wrap column (2 seam pairs) ranks 25th.
 // A phase-robust variant (the wrap line compared with the distribution of
 // per-line means, or with source-matched exemplar pairs) is not done yet.
 

@@ -85,9 +85,12 @@ TEST(MaterialTile, EveryLayerTilesAndTheEndsAreTheKeys) {
 TEST(MaterialTile, SynthesisedKeyTilesTileAndKeepTheHistogram) {
   // Real, non-tiling inputs: the key tiles are synthesised toroidally.
   MaterialTileOptions o = small_options();
-  // Always 64 px, also under the sanitizers: at 32 px the automatic patch side
-  // (7/8 of the tile, 28 px) leaves the toroidal synthesis almost no overlap
-  // and the mud key's wrap ratio reaches 1.64 (known, open in issue 3).
+  // Always 64 px, also under the sanitizers: at 32 px the mud key's wrap
+  // ratio is 1.64 although its wrap column holds no graph-cut seam (a crack
+  // of the exemplar runs along it; patch side 24 = 3/4 of the 32-px
+  // resample, overlap 8). The wrap-line sample of 64 pairs is too small at
+  // that size; see texture/wrap_seam_ratio.h and
+  // TileableTile.At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines.
   o.size = 64;
   o.keys_are_tileable = false;
   std::vector<MaterialKey> keys = {

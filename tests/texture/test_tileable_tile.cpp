@@ -8,6 +8,8 @@
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "test_support.h"
+#include "texture/graphcut_synthesis.h"
+#include "texture/material_tile.h"
 #include "texture/tileable_tile.h"
 #include "texture/wrap_seam_ratio.h"
 
@@ -16,7 +18,7 @@ using namespace surftex;
 namespace {
 bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
 
-Image crop(const Image& img, int x0, int y0, int w, int h) {
+Image crop_corner(const Image& img, int x0, int y0, int w, int h) {
   Image out(w, h, img.channels);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
@@ -49,7 +51,7 @@ TEST(TileableTile, RealTexturesTileSeamlessly) {
   const int size = sanitized() ? 64 : 96;
   for (const auto& name : names) {
     Image full = read_image(test::shared_data("textures/" + name));
-    Image ex = crop(full, 0, 0, 64, 64);
+    Image ex = crop_corner(full, 0, 0, 64, 64);
     const double crop_ratio = wrap_seam_ratio(ex);
     TileOptions o;
     TileResult t = make_tileable_detailed(ex, size, o);
@@ -68,7 +70,7 @@ TEST(TileableTile, RealTexturesTileSeamlessly) {
 TEST(TileableTile, AnisotropicAndRegularTexturesTileAt128) {
   if (sanitized()) GTEST_SKIP() << "real-size case, Release only";
   for (const char* name : {"wood_512.png", "red_checked_384.png"}) {
-    Image ex = crop(read_image(test::shared_data(std::string("textures/") + name)), 0, 0, 256, 256);
+    Image ex = crop_corner(read_image(test::shared_data(std::string("textures/") + name)), 0, 0, 256, 256);
     TileResult t = make_tileable_detailed(ex, 128, TileOptions{});
     EXPECT_LE(t.wrap_seam_ratio, 1.3) << name;
     TileOptions small;
@@ -79,7 +81,7 @@ TEST(TileableTile, AnisotropicAndRegularTexturesTileAt128) {
 }
 
 TEST(TileableTile, DeterministicAndValidated) {
-  Image ex = crop(read_image(test::shared_data("textures/cracked_mud_100.png")), 0, 0, 48, 48);
+  Image ex = crop_corner(read_image(test::shared_data("textures/cracked_mud_100.png")), 0, 0, 48, 48);
   TileOptions o;
   o.seed = 9;
   Image a = make_tileable(ex, 40, o), b = make_tileable(ex, 40, o);
@@ -93,4 +95,56 @@ TEST(TileableTile, DeterministicAndValidated) {
   o.overlap = 0;
   o.k = -1;
   EXPECT_THROW(make_tileable(ex, 40, o), InvalidInputError);
+}
+
+// Small tiles (the 32-px key tiles of material_tile under the sanitizers).
+// The mud key tile's wrap ratio of 1.64 at 32 px was blamed on a lack of
+// overlap; measured, its wrap column holds no graph-cut seam at all (every
+// wrap pair is a pair of exemplar neighbours, copied verbatim): a crack of the
+// exemplar runs along that column (texture/wrap_seam_ratio.h, limitation).
+// What must hold is that the cut is optimised across the wrap like anywhere
+// else: over several seeds, the seam cost (Kwatra eq. 1) of the wrap lines
+// is no higher than that of an average line of the torus. A tile whose wrap
+// were pasted straight would carry a seam on all 32 pairs of each wrap line.
+TEST(TileableTile, At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines) {
+  const int s = 32;
+  std::vector<std::string> names = {"cracked_mud_100.png", "brick_small_96.png", "leather_64.png"};
+  const int seeds = sanitized() ? 2 : 6;
+  double wrap_cost = 0.0, line_cost = 0.0;
+  for (const auto& name : names) {
+    Image ex = square_resample(read_image(test::shared_data("textures/" + name)), s);
+    for (int seed = 1; seed <= seeds; ++seed) {
+      GraphcutOptions g;  // what make_tileable runs for a 32-px tile of a 32-px exemplar
+      g.patch_size = 24;
+      g.refinement_passes = 4;
+      g.periodic_output = true;
+      g.seed = static_cast<std::uint64_t>(seed);
+      GraphcutResult r = graphcut_synthesize_detailed(ex, s, s, g);
+      TileOptions to;
+      to.seed = g.seed;
+      ASSERT_EQ(make_tileable(ex, s, to).data, r.image.data) << "the test mirrors make_tileable";
+      // Seam cost of one line: each neighbour pair across it pasted into a
+      // 2x1 (column line) or 1x2 (row line) canvas from its two sources.
+      auto line = [&](bool column, int k) {
+        double c = 0.0;
+        for (int t = 0; t < s; ++t) {
+          const int x = column ? k : t, y = column ? t : k;
+          const int nx = column ? (k + 1) % s : t, ny = column ? t : (k + 1) % s;
+          const std::size_t a = static_cast<std::size_t>(y) * s + x, b = static_cast<std::size_t>(ny) * s + nx;
+          GraphcutCanvas pair(ex, column ? 2 : 1, column ? 1 : 2, false);
+          pair.place_straight({0, 0, r.source_x[a], r.source_y[a], 1, 1});
+          pair.place_straight({column ? 1 : 0, column ? 0 : 1, r.source_x[b], r.source_y[b], 1, 1});
+          c += pair.seam_cost();
+        }
+        return c;
+      };
+      for (int k = 0; k < s; ++k) {
+        const double c = line(true, k) + line(false, k);
+        line_cost += c / s;
+        if (k == s - 1) wrap_cost += c;
+      }
+    }
+  }
+  EXPECT_GT(line_cost, 0.0);  // guard: these tiles do have seams
+  EXPECT_LE(wrap_cost, 1.5 * line_cost) << "wrap " << wrap_cost << " mean line " << line_cost;
 }
