@@ -18,7 +18,7 @@ struct TileArgs {
   int size = 0;
   int patch = 0;
   int overlap = 0;
-  int passes = 2;
+  int passes = TileOptions{}.refinement_passes;
   CommonOptions common;
 };
 
@@ -87,7 +87,8 @@ SubcommandRegistrar reg{
                       "0 = automatic: patch/3 (0..4095, default 0)")
            ->check(CLI::Range(0, 4095));
        app.add_option("--passes", a->passes,
-                      "Seam-repair passes after the tile is filled (0..100, default 2)")
+                      "Seam-repair passes after the tile is filled (0..100, default " +
+                          std::to_string(TileOptions{}.refinement_passes) + ", as the library)")
            ->check(CLI::Range(0, 100));
        app.add_option("--preview", a->preview,
                       "Also write the tile repeated 2x2 to this image (to check the seams)");
