@@ -396,6 +396,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.max_area_distortion > 1)) bad("max_area_distortion must be > 1", o.max_area_distortion);
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
+  if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -450,6 +451,10 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   // cells: old elements there counted as "new", input elements there were
   // forced to stay on top of them, the cut opened no loop.)
   std::vector<std::vector<std::array<double, 2>>> cover(static_cast<std::size_t>(nf));
+  // Per base face: the unit 3D tangent along which the swatch's +y ran in
+  // the first placement that processed it (zero before), for the transported
+  // orientation of later patches (step 4).
+  std::vector<P3> face_dir(static_cast<std::size_t>(nf), P3{0, 0, 0});
   // Faces -> elements with a vertex on them (rebuilt lazily).
   int done = 0, step_id = 0;
   auto mark = [&](int f) {
@@ -487,11 +492,42 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     const auto& st = b.faces[seed];
     const V2 q0 = flat.uv[flat.local[st[0]]], q1 = flat.uv[flat.local[st[1]]], q2 = flat.uv[flat.local[st[2]]];
     double rot_c = 1, rot_s = 0;
-    if (opt.field == SurfaceQuiltOptions::Field::kUp) {
+    {
+      // The tangent direction the swatch's +y should follow at the seed
+      // (section 3.1: the guidance field aligns the grid). With Field::kUp it
+      // is the projection of `up` on the seed's plane, but where that is
+      // shorter than opt.transport_below (near the poles of the field, where
+      // its direction turns fast and finally is undefined) the +y directions
+      // of the earlier placements on this patch's faces are carried over
+      // instead (projected on the seed's plane and averaged by area: a
+      // discrete parallel transport from the neighbouring texture, our choice;
+      // the paper leaves the field's singularities to the user). With
+      // Field::kNone every patch takes the transported direction when there
+      // is one. Without either the LSCM orientation is kept.
       const P3& n = b.normal[seed];
-      const double un = dot3(up, n);
-      const P3 d{up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
-      if (norm3(d) > 0.2) {
+      P3 d{0, 0, 0};
+      if (opt.field == SurfaceQuiltOptions::Field::kUp) {
+        const double un = dot3(up, n);
+        d = {up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
+      }
+      const double dl = norm3(d);
+      const bool use_up = opt.field == SurfaceQuiltOptions::Field::kUp && dl >= opt.transport_below;
+      if (use_up && dl <= 0.2) d = {0, 0, 0};  // (transport_below < 0.2) too short to orient by
+      if (!use_up) {
+        P3 t{0, 0, 0};
+        for (int f : flat.faces) {
+          const P3& g = face_dir[static_cast<std::size_t>(f)];
+          const double gn = dot3(g, n);
+          for (int k = 0; k < 3; ++k) t[k] += b.area[f] * (g[k] - gn * n[k]);
+        }
+        if (norm3(t) > 0) {
+          d = t;
+          ++res.patches_transported;
+        } else if (dl <= 0.2) {
+          d = {0, 0, 0};  // no neighbour yet and no usable field: LSCM orientation
+        }
+      }
+      if (norm3(d) > 0) {
         // d = alpha e1 + beta e2 in the seed triangle, mapped to uv.
         const P3 e1 = sub3(b.pts[st[1]], b.pts[st[0]]), e2 = sub3(b.pts[st[2]], b.pts[st[0]]);
         const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2);
@@ -827,6 +863,23 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       if (cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1) mark(flat.faces[k]);
     }
     mark(seed);
+    // +y of this placement in 3D on every patch face it processed (first placement wins).
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      const int f = flat.faces[k];
+      P3& g = face_dir[static_cast<std::size_t>(f)];
+      if (!processed[f] || norm3(g) > 0) continue;
+      // 3D = p0 + E M^-1 (uv - q0), E = [e1 e2], M = [q1 - q0, q2 - q0]; direction of (0, 1).
+      const auto& tk = ftris[k];
+      const double m11 = tk[1][0] - tk[0][0], m12 = tk[2][0] - tk[0][0], m21 = tk[1][1] - tk[0][1], m22 = tk[2][1] - tk[0][1];
+      const double det = m11 * m22 - m12 * m21;
+      if (det == 0) continue;
+      const double a1 = -m12 / det, a2 = m11 / det;  // M^-1 (0, 1)
+      const auto& tri = b.faces[f];
+      const P3 e1 = sub3(b.pts[tri[1]], b.pts[tri[0]]), e2 = sub3(b.pts[tri[2]], b.pts[tri[0]]);
+      const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
+      const double l = norm3(v);
+      if (l > 0) g = {v[0] / l, v[1] / l, v[2] / l};
+    }
     // The footprint's points (section 2.3's processed cells, kept on the surface).
     for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)
       for (double x = fx0 + 0.25 * c; x < fx1; x += 0.5 * c) {

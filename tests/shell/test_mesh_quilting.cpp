@@ -13,6 +13,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/errors.h"
 #include "geometry/properties.h"
+#include "geometry/self_intersections.h"
 #include "shell/element_correspondence.h"
 #include "shell/element_deformation.h"
 #include "shell/element_merging.h"
@@ -255,6 +256,54 @@ TEST(ElementMerging, StitchedThreadIsOneClosedComponent) {
   for (const P3& p : r.merged.points) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
   EXPECT_LT(lo, -0.4);
   EXPECT_GT(hi, 5.4);
+}
+
+// Regression (issue #8): two threads running side by side, 1.5 radii apart
+// across the plane or 2.2 radii apart in height (a thread of the swatch placed
+// next to, not on, the old one, within the merge's match distance). Without
+// the geometric checks both cuts open one loop and the zip joins them: a
+// kinked element crossing itself (14 and 381 face pairs when this test was
+// written). Section 2.7 stitches corresponding elements whose cuts face each
+// other; these are refused.
+TEST(ElementMerging, ThreadsSideBySideAreNotZipped) {
+  const double radius = WeaveOptions{}.radius;  // 0.12
+  for (const auto& [axis, offset] : {std::pair<int, double>{1, 1.5 * radius}, {2, 2.2 * radius}}) {
+    const ElementMesh a = thread(0);
+    ElementMesh b = thread(2.0);
+    for (P3& p : b.points) p[axis] += offset;
+    const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band);
+    EXPECT_FALSE(r.stitched) << "offset " << offset << " along axis " << axis << ": zipped " << r.loops << " loops";
+    EXPECT_EQ(r.reason.rfind("misaligned", 0), 0u) << r.reason;
+    // The same pair without the checks: the zip they prevent crosses itself.
+    MergeOptions off;
+    off.max_loop_offset = off.max_loop_radius_ratio = off.max_loop_angle_deg = 0;
+    off.refuse_self_intersecting = false;
+    const MergeResult z = merge_elements(a, Region::kOld, b, Region::kNew, band, off);
+    ASSERT_TRUE(z.stitched) << z.reason;
+    Mesh zm;
+    mesh_from_elements({z.merged}, zm);
+    const std::size_t crossing = count_self_intersections(zm);
+    std::cout << "[ side by side ] axis " << axis << ", offset " << offset << ": refused (" << r.reason
+              << "); unchecked zip crosses itself in " << crossing << " face pairs\n";
+    EXPECT_GT(crossing, 0u);
+  }
+}
+
+// A stitch whose loops face each other but whose zip still crosses the
+// element (B half a radius off: the cut loops pass the loop test, the zip's
+// triangles cut through the tube) is refused by the self-intersection test.
+TEST(ElementMerging, SelfIntersectingStitchIsRefused) {
+  const ElementMesh a = thread(0);
+  ElementMesh b = thread(2.0);
+  for (P3& p : b.points) p[1] += 0.5 * WeaveOptions{}.radius;
+  const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band);
+  if (r.stitched) {
+    Mesh m;
+    mesh_from_elements({r.merged}, m);
+    EXPECT_EQ(count_self_intersections(m), 0u);
+  } else {
+    EXPECT_EQ(r.reason.rfind("self-intersecting", 0), 0u) << r.reason;
+  }
 }
 
 struct QuiltCase {
