@@ -306,6 +306,26 @@ TEST(ElementMerging, SelfIntersectingStitchIsRefused) {
   }
 }
 
+// Regression (issue #8): on the plane, stitches whose zip folds over the
+// element (misaligned threads, restored cut pieces lying on the other
+// element) gave 47 intersecting face pairs within elements on this 2 x 2
+// swatch quilt; the merge now refuses them.
+TEST(PlanarQuiltingWeave, StitchedThreadsDoNotCrossThemselves) {
+  const Swatch s = small_weave(1);
+  Mesh out;
+  const double size = test::sanitized() ? 1.5 : 2.0;
+  const QuiltResult r = quilt_plane(s, size * s.length(), size * s.width(), out);
+  auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+  std::size_t within = 0, between = 0;
+  for (const FacePair& fp : self_intersecting_faces(out))
+    (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])] ? within : between) += 1;
+  std::cout << "[ plane weave ] faces " << out.number_of_faces() << ", stitched " << r.stats.stitched << ", refused "
+            << r.stats.stitch_refused << " (geometry " << r.stats.refused_geometry << "), intersecting pairs within "
+            << within << ", between " << between << "\n";
+  EXPECT_GT(r.stats.stitched, 0u);
+  EXPECT_LE(static_cast<double>(within), 1e-3 * static_cast<double>(out.number_of_faces()));
+}
+
 struct QuiltCase {
   const char* name;
   Swatch (*make)(std::uint64_t);
