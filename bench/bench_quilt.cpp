@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
           {"refused_geometry", r.stats.refused_geometry}, {"out_replaced", r.stats.out_replaced},
           {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
           {"elements_not_expressible", r.elements_not_expressible}, {"elements_partial", r.elements_partial},
-          {"seams_broken", r.seams_broken},
+          {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}});

@@ -197,6 +197,7 @@ int run_quilt(QuiltArgs& a) {
     rep["steps"] = r.steps;
     rep["patches_shrunk"] = r.patches_shrunk;
     rep["patches_transported"] = r.patches_transported;
+    rep["elements_past_border"] = r.elements_past_border;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["charts"] = er.atlas.num_charts;

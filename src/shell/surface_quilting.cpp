@@ -360,22 +360,21 @@ std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
 // Moves a location with negative barycentric coordinates (a vertex beyond the
 // patch it was made on) onto the face that contains it: walks across the edge
 // opposite the most negative coordinate, projecting the point onto each new
-// face's plane. Past a border edge of the base mesh the location stays on the
-// border face, extrapolated in its plane (issue #8: clamping it to the face,
-// as before, collapsed every element hanging over an open end onto the
-// border line -- flat ribbons, and on the 30 x 12 open cylinder of the tests
-// 7511 of 7544 intersecting face pairs within elements; the paper does not
-// discuss borders). After 64 steps the coordinates are clamped to the face.
-void settle_location(const Base& b, SurfaceQuiltVertex& v) {
+// face's plane; after 64 steps the coordinates are clamped to the face.
+// Returns false, leaving the location on the border face extrapolated in its
+// plane, if the walk leaves the base mesh across a border edge (the caller
+// removes such elements; clamping them onto the border line, as before,
+// flattened every element hanging over an open end into a ribbon).
+bool settle_location(const Base& b, SurfaceQuiltVertex& v) {
   constexpr double kEps = 1e-9;
   for (int it = 0; it < 64; ++it) {
     const std::array<double, 3> w{1 - v.b1 - v.b2, v.b1, v.b2};
     int j = 0;
     for (int k = 1; k < 3; ++k)
       if (w[k] < w[j]) j = k;
-    if (w[j] >= -kEps) return;
+    if (w[j] >= -kEps) return true;
     const int g = b.edge_nb[v.face][(j + 1) % 3];
-    if (g < 0) return;  // past a border edge: stays extrapolated in this face's plane (see above)
+    if (g < 0) return false;
     const P3 p = base_point(b, v);
     const auto wg = project_bary(b, g, p);
     v.face = g;
@@ -386,6 +385,7 @@ void settle_location(const Base& b, SurfaceQuiltVertex& v) {
   const double sum = w[0] + w[1] + w[2];
   if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
   else v.b1 = v.b2 = 1.0 / 3;
+  return true;
 }
 
 void check_options(const SurfaceQuiltOptions& o) {
@@ -400,6 +400,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.max_area_distortion > 1)) bad("max_area_distortion must be > 1", o.max_area_distortion);
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
+  if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
@@ -903,11 +904,29 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   out.z_max = swatch.bbox_max[2];
   for (const Element& el : elements) {
     if (!el.alive || el.mesh.tris.empty()) continue;
-    const int base_index = static_cast<int>(out.vertices.size());
-    for (SurfaceQuiltVertex v : el.loc) {
-      settle_location(b, v);
-      out.vertices.push_back(v);
+    // Elements reaching past a border of the base mesh are removed (issue #8;
+    // the paper removes "visually-displeasing elements" in a postprocessing
+    // step, section 4, and does not discuss borders): clamped onto the border
+    // they were flat ribbons (the open cylinder of the tests: 7511 of 7544
+    // intersecting face pairs within elements), extrapolated past it they
+    // leave the shell (the concave valley test).
+    // An element with at most opt.max_past_border of its vertices past a
+    // border keeps them, clamped onto the border face (a short flattened tip).
+    std::vector<SurfaceQuiltVertex> settled(el.loc.begin(), el.loc.end());
+    std::size_t past = 0;
+    for (SurfaceQuiltVertex& v : settled)
+      if (!settle_location(b, v)) {
+        ++past;
+        std::array<double, 3> w{std::max(0.0, 1 - v.b1 - v.b2), std::max(0.0, v.b1), std::max(0.0, v.b2)};
+        const double sum = w[0] + w[1] + w[2];
+        if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
+      }
+    if (static_cast<double>(past) > opt.max_past_border * static_cast<double>(settled.size())) {
+      ++res.elements_past_border;
+      continue;
     }
+    const int base_index = static_cast<int>(out.vertices.size());
+    for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
     for (const Tri& t : el.mesh.tris) {
       out.tris.push_back({t[0] + base_index, t[1] + base_index, t[2] + base_index});
       out.tri_element.push_back(out.elements);

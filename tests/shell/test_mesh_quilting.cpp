@@ -411,9 +411,9 @@ TEST(QuiltStep, OneToOneRelationsAreNoMoreThanAnyPairRelationsAndRefusalsAddUp) 
             << any.stats.related << ", stitched " << any.stats.stitched << ", refused " << any.stats.stitch_refused
             << "\n";
   EXPECT_EQ(one.stats.stitch_refused,
-            one.stats.refused_loops + one.stats.refused_border + one.stats.refused_infeasible);
+            one.stats.refused_loops + one.stats.refused_border + one.stats.refused_infeasible + one.stats.refused_geometry);
   EXPECT_EQ(any.stats.stitch_refused,
-            any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible);
+            any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible + any.stats.refused_geometry);
   EXPECT_GT(one.stats.related, 0u);
   // Once weave threads stitch (issue #8) each output thread relates to one
   // input thread, so the weave ties; interlocked chain mail rings do not.
@@ -449,9 +449,12 @@ TEST(QuiltStep, PlanarWeaveStitchesMostMergesIntoLongerClosedThreads) {
   const std::size_t tried = r.stats.stitched + r.stats.stitch_refused;
   std::cout << "[ weave ] stitched " << r.stats.stitched << ", refused " << r.stats.stitch_refused << " (loops "
             << r.stats.refused_loops << ", border " << r.stats.refused_border << ", infeasible "
-            << r.stats.refused_infeasible << ")\n";
+            << r.stats.refused_infeasible << ", geometry " << r.stats.refused_geometry << ")\n";
   ASSERT_GT(tried, 0u);
-  EXPECT_GT(2 * r.stats.stitched, tried);
+  // At least 40%: since issue #8's stitch checks, zips that would cross their
+  // element are refused as well (44 of 99 stitched, 6 refused by the checks,
+  // when this bound was set; "most" before).
+  EXPECT_GT(5 * r.stats.stitched, 2 * tried);
   EXPECT_EQ(border_edges(out), 0u);  // the swatch's threads are closed tubes
   const Swatch q = make_swatch(out);
   for (const SwatchElement& e : q.elements) EXPECT_TRUE(e.closed);
