@@ -52,6 +52,10 @@
 //    dropped (their base triangles are quilted later). Patch triangles whose
 //    centroid lies in the placed swatch's footprint, and the seed, become
 //    processed.
+// At the end every location is moved onto the base face that contains it
+// (walking across edges); elements with more than max_past_border of their
+// vertices past a border of the base mesh are removed (issue #8: our choice,
+// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border).
 // Finally surface_quilt_to_texture expresses every vertex in the base mesh
 // atlas's texture space (u, v, w), w = (z - z_min) / (z_max - z_min) of the
 // swatch, ready for embed_in_shell (section 3.2); surface_quilt_displaced is
