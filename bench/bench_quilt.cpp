@@ -10,6 +10,8 @@
 // self-intersections).
 // Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
 //                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
+//                    [variant: fixed (default) | baseline = issue #8's stitch checks and
+//                     transported orientation off, for before/after comparisons]
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
   const double rel = argc > 3 ? std::atof(argv[3]) : 0.12;
   const long edges = argc > 4 ? std::atol(argv[4]) : 7500;
   const std::string kind = argc > 5 ? argv[5] : "weave";
+  const std::string variant = argc > 6 ? argv[6] : "fixed";
   const fs::path dir = fs::temp_directory_path() / ("surftex-bench-quilt-" + std::to_string(::getpid()));
   try {
     fs::create_directories(dir);
@@ -85,16 +88,21 @@ int main(int argc, char** argv) {
     SurfaceQuiltOptions qo;
     qo.relative_size = rel;
     qo.up = {0, 1, 0};  // the bunny's up axis
+    if (variant == "baseline") {
+      qo.transport_below = 0;
+      qo.step.check_stitch_geometry = false;
+    }
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
-          {"patches_shrunk", r.patches_shrunk}, {"max_patch_distortion", r.max_patch_distortion},
+          {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported}, {"max_patch_distortion", r.max_patch_distortion},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
-          {"refused_border", r.stats.refused_border}, {"out_replaced", r.stats.out_replaced},
+          {"refused_border", r.stats.refused_border},
+          {"refused_geometry", r.stats.refused_geometry}, {"out_replaced", r.stats.out_replaced},
           {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
           {"elements_not_expressible", r.elements_not_expressible}, {"elements_partial", r.elements_partial},
-          {"seams_broken", r.seams_broken},
+          {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}});

@@ -196,6 +196,8 @@ int run_quilt(QuiltArgs& a) {
     rep["vertices"] = out.number_of_vertices();
     rep["steps"] = r.steps;
     rep["patches_shrunk"] = r.patches_shrunk;
+    rep["patches_transported"] = r.patches_transported;
+    rep["elements_past_border"] = r.elements_past_border;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["charts"] = er.atlas.num_charts;
@@ -210,6 +212,7 @@ int run_quilt(QuiltArgs& a) {
     rep["seams_broken"] = r.seams_broken;
     rep["stitch_refused_loops"] = r.stats.refused_loops;
     rep["stitch_refused_border"] = r.stats.refused_border;
+    rep["stitch_refused_geometry"] = r.stats.refused_geometry;
     rep["stitch_refused_infeasible"] = r.stats.refused_infeasible;
     if (er.embed.checked) {
       rep["self_intersections"] = er.embed.self_intersecting_pairs;

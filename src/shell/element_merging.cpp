@@ -9,6 +9,8 @@
 
 #include "geometry/errors.h"
 #include "geometry/graph_cut.h"
+#include "geometry/mesh.h"
+#include "geometry/self_intersections.h"
 #include "shell/element_deformation.h"
 #include "shell/triangle_distance.h"
 
@@ -383,6 +385,69 @@ P3 loop_centroid(const ElementMesh& m, const std::vector<int>& l) {
     for (int d = 0; d < 3; ++d) c[d] += m.points[v][d] / static_cast<double>(l.size());
   return c;
 }
+// Mean distance of a loop's vertices from its centroid.
+double loop_radius(const ElementMesh& m, const std::vector<int>& l, const P3& c) {
+  double r = 0;
+  for (int v : l) r += dist(m.points[v], c);
+  return l.empty() ? 0 : r / static_cast<double>(l.size());
+}
+// Newell area vector of a loop (right-hand rule along the loop's order).
+P3 loop_area_vector(const ElementMesh& m, const std::vector<int>& l) {
+  P3 n{0, 0, 0};
+  for (std::size_t k = 0; k < l.size(); ++k) {
+    const P3& p = m.points[l[k]];
+    const P3& q = m.points[l[(k + 1) % l.size()]];
+    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+  }
+  return n;
+}
+// Why loop i of A and loop j of B (as cut, before B is reversed) cannot be
+// zipped, or "" if they can (see MergeOptions::max_loop_offset). A's loop runs
+// with A's kept part on its left, so its area vector points back into A; B's
+// points back into B: facing cuts have opposite area vectors, and the axis
+// n = (nb - na)/|..| points from A's cut towards B's kept part. The offset is
+// split along n: sideways it must stay under max_loop_offset x r; along n
+// (a gap between the cuts, or an overlap when negative) under twice that.
+std::string loop_pair_mismatch(const ElementMesh& pa, const std::vector<int>& la, const ElementMesh& pb,
+                               const std::vector<int>& lb, const MergeOptions& opt) {
+  const double kPi = 3.14159265358979323846;
+  const P3 ca = loop_centroid(pa, la), cb = loop_centroid(pb, lb);
+  const double ra = loop_radius(pa, la, ca), rb = loop_radius(pb, lb, cb), r = std::max(ra, rb);
+  if (opt.max_loop_radius_ratio > 0 && std::min(ra, rb) * opt.max_loop_radius_ratio < r)
+    return "misaligned loops: radii " + std::to_string(ra) + " and " + std::to_string(rb);
+  const P3 na = loop_area_vector(pa, la), nb = loop_area_vector(pb, lb);
+  const double len_a = dist(na, P3{0, 0, 0}), len_b = dist(nb, P3{0, 0, 0});
+  P3 axis{0, 0, 0};
+  if (len_a > 0 && len_b > 0) {
+    const double cosang = -(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]) / (len_a * len_b);
+    if (opt.max_loop_angle_deg > 0 && cosang < std::cos(opt.max_loop_angle_deg * kPi / 180.0))
+      return "misaligned loops: normals " + std::to_string(std::acos(std::clamp(cosang, -1.0, 1.0)) * 180.0 / kPi) +
+             " degrees apart";
+    for (int d = 0; d < 3; ++d) axis[d] = nb[d] / len_b - na[d] / len_a;
+    const double l = dist(axis, P3{0, 0, 0});
+    if (l > 0)
+      for (double& x : axis) x /= l;
+  }
+  if (opt.max_loop_offset > 0) {
+    const P3 off{cb[0] - ca[0], cb[1] - ca[1], cb[2] - ca[2]};
+    const double along = off[0] * axis[0] + off[1] * axis[1] + off[2] * axis[2];
+    const double side = dist(off, P3{along * axis[0], along * axis[1], along * axis[2]});
+    if (side > opt.max_loop_offset * r || std::abs(along) > 2 * opt.max_loop_offset * r)
+      return "misaligned loops: centroids " + std::to_string(side) + " apart sideways and " + std::to_string(along) +
+             " along the cut normal, loop radius " + std::to_string(r);
+  }
+  return "";
+}
+std::size_t element_self_intersections(const ElementMesh& m) {
+  if (m.tris.empty()) return 0;
+  Mesh mesh;
+  mesh_from_elements({m}, mesh);
+  SelfIntersectionOptions so;
+  so.parallel = false;  // called from parallel quilting work; the count is the same
+  return count_self_intersections(mesh, so);
+}
 }  // namespace
 
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
@@ -429,6 +494,13 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
   std::vector<char> bused(lb.size(), 0);
   for (auto& [d, i, j] : cand)
     if (pair_of[i] < 0 && !bused[j]) pair_of[i] = j, bused[j] = 1;
+  for (std::size_t i = 0; i < la.size(); ++i) {
+    const std::string why = loop_pair_mismatch(pa, la[i], pb, lb[pair_of[i]], opt);
+    if (!why.empty()) {
+      r.reason = why;
+      return r;
+    }
+  }
   ElementMesh merged = pa;
   const int off = static_cast<int>(pa.points.size());
   append(merged, pb);
@@ -498,6 +570,17 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
     merged.points = laplacian_deform(merged, cons, locked, lo);
   } catch (const SolverError&) {
     // A component without constraint or lock: keep the undeformed zip.
+  }
+  if (opt.refuse_self_intersecting) {
+    const std::size_t after = element_self_intersections(merged);
+    if (after > 0) {
+      const std::size_t before = element_self_intersections(pa) + element_self_intersections(pb);
+      if (after > before) {
+        r.reason = "self-intersecting stitch: " + std::to_string(after) + " crossing face pairs, parts had " +
+                   std::to_string(before);
+        return r;
+      }
+    }
   }
   r.stitched = true;
   r.loops = static_cast<int>(la.size());

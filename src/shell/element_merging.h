@@ -69,6 +69,23 @@ struct MergeOptions {
   double guide_factor = 100;
   /// mu of the stitching deformation (eq. 5); > 0.
   double mu = 1.0;
+  /// Geometric test of every zipped loop pair (section 2.7 stitches two
+  /// elements whose cut paths are "close to each other"; the paper has no
+  /// threshold, these are ours): the loops' centroids at most
+  /// `max_loop_offset` x the larger loop radius apart sideways (across the
+  /// cut normal) and twice that along it, their mean radii within
+  /// a factor `max_loop_radius_ratio`, and their normals (Newell area vectors,
+  /// B's reversed as zipped) at most `max_loop_angle_deg` apart. 0 disables a
+  /// test. Loops that fail are threads of different elements or of one
+  /// element misaligned across a patch seam: zipping them kinks the element
+  /// and makes it cross itself.
+  double max_loop_offset = 1.0;
+  double max_loop_radius_ratio = 2.0;
+  double max_loop_angle_deg = 60.0;
+  /// Refuse a stitch whose result (after the stitching deformation) has more
+  /// self-intersecting face pairs (exact predicates) than the two kept parts
+  /// had: a zip that folds over or runs through the element.
+  bool refuse_self_intersecting = true;
 };
 
 struct ElementCut {
@@ -102,7 +119,11 @@ struct MergeResult {
 /// loops or none, the result would have more border edges than A and B had
 /// (so elements closed in the swatch stay closed), or would not be manifold
 /// (a directed edge used twice, a pinched vertex: possible when A or B has
-/// borders of its own, e.g. the inner part of a long element on a surface).
+/// borders of its own, e.g. the inner part of a long element on a surface),
+/// when a loop pair fails the geometric test (MergeOptions::max_loop_offset
+/// and the next two; reason starts with "misaligned") or when the stitched
+/// element crosses itself more than its parts did (reason starts with
+/// "self-intersecting").
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt = {});
 

@@ -37,6 +37,7 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   refused_infeasible += o.refused_infeasible;
   refused_loops += o.refused_loops;
   refused_border += o.refused_border;
+  refused_geometry += o.refused_geometry;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
   in_added += o.in_added;
@@ -329,6 +330,10 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
       const ElementMesh& x = is_out ? (deformed_out.count(e) ? deformed_out[e] : elements[e]) : placed[e];
       MergeOptions mo;
       mo.mu = opt.mu;
+      if (!opt.check_stitch_geometry) {
+        mo.max_loop_offset = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;
+        mo.refuse_self_intersecting = false;
+      }
       MergeResult r = merge_elements(acc, acc_side, x, is_out ? Region::kOld : Region::kNew, region, mo);
       if (r.stitched) {
         acc = std::move(r.merged);
@@ -342,6 +347,8 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         ++stats.stitch_refused;
         if (r.reason.find("infeasible") != std::string::npos)
           ++stats.refused_infeasible;
+        else if (r.reason.rfind("misaligned", 0) == 0 || r.reason.rfind("self-intersecting", 0) == 0)
+          ++stats.refused_geometry;
         else if (r.reason.find("loops") != std::string::npos)
           ++stats.refused_loops;
         else

@@ -42,6 +42,11 @@ struct QuiltStepOptions {
   /// on top of it: overlapping duplicates are worse than a small gap. The
   /// paper has no refusals (its merge always succeeds).
   bool drop_refused_inputs = true;
+  /// Geometric checks of each stitch (MergeOptions::max_loop_offset and the
+  /// next three, at their defaults): zip only loop pairs that face each other
+  /// and refuse stitches that cross themselves. false = off (the state before
+  /// issue #8's fix, for comparisons).
+  bool check_stitch_geometry = true;
   /// Keep only mutually strongest relations (most vertex-face pairs) between
   /// output and input elements, so that each element is merged with at most
   /// one partner (see strongest_relations in the .cpp); false = the paper's
@@ -77,8 +82,9 @@ struct QuiltStepStats {
   std::size_t stitched = 0, stitch_refused = 0;  ///< merges (2.7)
   /// Refusals by reason (MergeResult::reason): an infeasible cut, cuts that
   /// opened no or different numbers of loops (or non-simple borders), a
-  /// stitch that would open borders or break closedness.
-  std::size_t refused_infeasible = 0, refused_loops = 0, refused_border = 0;
+  /// stitch that would open borders or break closedness, and (geometry)
+  /// loop pairs too far apart or turned, or a stitch crossing itself.
+  std::size_t refused_infeasible = 0, refused_loops = 0, refused_border = 0, refused_geometry = 0;
   std::size_t out_replaced = 0, in_dropped = 0, in_added = 0;
   double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
   void add(const QuiltStepStats& o);

@@ -360,18 +360,21 @@ std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
 // Moves a location with negative barycentric coordinates (a vertex beyond the
 // patch it was made on) onto the face that contains it: walks across the edge
 // opposite the most negative coordinate, projecting the point onto each new
-// face's plane; at a border edge (or after 64 steps) the coordinates are
-// clamped to the face.
-void settle_location(const Base& b, SurfaceQuiltVertex& v) {
+// face's plane; after 64 steps the coordinates are clamped to the face.
+// Returns false, leaving the location on the border face extrapolated in its
+// plane, if the walk leaves the base mesh across a border edge (the caller
+// removes such elements; clamping them onto the border line, as before,
+// flattened every element hanging over an open end into a ribbon).
+bool settle_location(const Base& b, SurfaceQuiltVertex& v) {
   constexpr double kEps = 1e-9;
   for (int it = 0; it < 64; ++it) {
     const std::array<double, 3> w{1 - v.b1 - v.b2, v.b1, v.b2};
     int j = 0;
     for (int k = 1; k < 3; ++k)
       if (w[k] < w[j]) j = k;
-    if (w[j] >= -kEps) return;
+    if (w[j] >= -kEps) return true;
     const int g = b.edge_nb[v.face][(j + 1) % 3];
-    if (g < 0) break;
+    if (g < 0) return false;
     const P3 p = base_point(b, v);
     const auto wg = project_bary(b, g, p);
     v.face = g;
@@ -382,6 +385,7 @@ void settle_location(const Base& b, SurfaceQuiltVertex& v) {
   const double sum = w[0] + w[1] + w[2];
   if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
   else v.b1 = v.b2 = 1.0 / 3;
+  return true;
 }
 
 void check_options(const SurfaceQuiltOptions& o) {
@@ -396,6 +400,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.max_area_distortion > 1)) bad("max_area_distortion must be > 1", o.max_area_distortion);
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
+  if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
+  if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -450,6 +456,10 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   // cells: old elements there counted as "new", input elements there were
   // forced to stay on top of them, the cut opened no loop.)
   std::vector<std::vector<std::array<double, 2>>> cover(static_cast<std::size_t>(nf));
+  // Per base face: the unit 3D tangent along which the swatch's +y ran in
+  // the first placement that processed it (zero before), for the transported
+  // orientation of later patches (step 4).
+  std::vector<P3> face_dir(static_cast<std::size_t>(nf), P3{0, 0, 0});
   // Faces -> elements with a vertex on them (rebuilt lazily).
   int done = 0, step_id = 0;
   auto mark = [&](int f) {
@@ -487,11 +497,42 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     const auto& st = b.faces[seed];
     const V2 q0 = flat.uv[flat.local[st[0]]], q1 = flat.uv[flat.local[st[1]]], q2 = flat.uv[flat.local[st[2]]];
     double rot_c = 1, rot_s = 0;
-    if (opt.field == SurfaceQuiltOptions::Field::kUp) {
+    {
+      // The tangent direction the swatch's +y should follow at the seed
+      // (section 3.1: the guidance field aligns the grid). With Field::kUp it
+      // is the projection of `up` on the seed's plane, but where that is
+      // shorter than opt.transport_below (near the poles of the field, where
+      // its direction turns fast and finally is undefined) the +y directions
+      // of the earlier placements on this patch's faces are carried over
+      // instead (projected on the seed's plane and averaged by area: a
+      // discrete parallel transport from the neighbouring texture, our choice;
+      // the paper leaves the field's singularities to the user). With
+      // Field::kNone every patch takes the transported direction when there
+      // is one. Without either the LSCM orientation is kept.
       const P3& n = b.normal[seed];
-      const double un = dot3(up, n);
-      const P3 d{up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
-      if (norm3(d) > 0.2) {
+      P3 d{0, 0, 0};
+      if (opt.field == SurfaceQuiltOptions::Field::kUp) {
+        const double un = dot3(up, n);
+        d = {up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
+      }
+      const double dl = norm3(d);
+      const bool use_up = opt.field == SurfaceQuiltOptions::Field::kUp && dl >= opt.transport_below;
+      if (use_up && dl <= 0.2) d = {0, 0, 0};  // (transport_below < 0.2) too short to orient by
+      if (!use_up) {
+        P3 t{0, 0, 0};
+        for (int f : flat.faces) {
+          const P3& g = face_dir[static_cast<std::size_t>(f)];
+          const double gn = dot3(g, n);
+          for (int k = 0; k < 3; ++k) t[k] += b.area[f] * (g[k] - gn * n[k]);
+        }
+        if (norm3(t) > 0) {
+          d = t;
+          ++res.patches_transported;
+        } else if (dl <= 0.2) {
+          d = {0, 0, 0};  // no neighbour yet and no usable field: LSCM orientation
+        }
+      }
+      if (norm3(d) > 0) {
         // d = alpha e1 + beta e2 in the seed triangle, mapped to uv.
         const P3 e1 = sub3(b.pts[st[1]], b.pts[st[0]]), e2 = sub3(b.pts[st[2]], b.pts[st[0]]);
         const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2);
@@ -827,6 +868,23 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       if (cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1) mark(flat.faces[k]);
     }
     mark(seed);
+    // +y of this placement in 3D on every patch face it processed (first placement wins).
+    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+      const int f = flat.faces[k];
+      P3& g = face_dir[static_cast<std::size_t>(f)];
+      if (!processed[f] || norm3(g) > 0) continue;
+      // 3D = p0 + E M^-1 (uv - q0), E = [e1 e2], M = [q1 - q0, q2 - q0]; direction of (0, 1).
+      const auto& tk = ftris[k];
+      const double m11 = tk[1][0] - tk[0][0], m12 = tk[2][0] - tk[0][0], m21 = tk[1][1] - tk[0][1], m22 = tk[2][1] - tk[0][1];
+      const double det = m11 * m22 - m12 * m21;
+      if (det == 0) continue;
+      const double a1 = -m12 / det, a2 = m11 / det;  // M^-1 (0, 1)
+      const auto& tri = b.faces[f];
+      const P3 e1 = sub3(b.pts[tri[1]], b.pts[tri[0]]), e2 = sub3(b.pts[tri[2]], b.pts[tri[0]]);
+      const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
+      const double l = norm3(v);
+      if (l > 0) g = {v[0] / l, v[1] / l, v[2] / l};
+    }
     // The footprint's points (section 2.3's processed cells, kept on the surface).
     for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)
       for (double x = fx0 + 0.25 * c; x < fx1; x += 0.5 * c) {
@@ -846,11 +904,29 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   out.z_max = swatch.bbox_max[2];
   for (const Element& el : elements) {
     if (!el.alive || el.mesh.tris.empty()) continue;
-    const int base_index = static_cast<int>(out.vertices.size());
-    for (SurfaceQuiltVertex v : el.loc) {
-      settle_location(b, v);
-      out.vertices.push_back(v);
+    // Elements reaching past a border of the base mesh are removed (issue #8;
+    // the paper removes "visually-displeasing elements" in a postprocessing
+    // step, section 4, and does not discuss borders): clamped onto the border
+    // they were flat ribbons (the open cylinder of the tests: 7511 of 7544
+    // intersecting face pairs within elements), extrapolated past it they
+    // leave the shell (the concave valley test).
+    // An element with at most opt.max_past_border of its vertices past a
+    // border keeps them, clamped onto the border face (a short flattened tip).
+    std::vector<SurfaceQuiltVertex> settled(el.loc.begin(), el.loc.end());
+    std::size_t past = 0;
+    for (SurfaceQuiltVertex& v : settled)
+      if (!settle_location(b, v)) {
+        ++past;
+        std::array<double, 3> w{std::max(0.0, 1 - v.b1 - v.b2), std::max(0.0, v.b1), std::max(0.0, v.b2)};
+        const double sum = w[0] + w[1] + w[2];
+        if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
+      }
+    if (static_cast<double>(past) > opt.max_past_border * static_cast<double>(settled.size())) {
+      ++res.elements_past_border;
+      continue;
     }
+    const int base_index = static_cast<int>(out.vertices.size());
+    for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
     for (const Tri& t : el.mesh.tris) {
       out.tris.push_back({t[0] + base_index, t[1] + base_index, t[2] + base_index});
       out.tri_element.push_back(out.elements);

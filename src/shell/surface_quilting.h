@@ -20,8 +20,13 @@
 // 4. Orientation: with Field::kUp the projection of `up` on the seed
 //    triangle is mapped through the seed's flattening and the patch rotated so
 //    that it points along +y of the swatch (the paper's guidance vector field,
-//    here a projected constant vector); where the projection is shorter than
-//    0.2 (|up| = 1) or with Field::kNone the LSCM orientation is kept.
+//    here a projected constant vector). Where the projection is shorter than
+//    transport_below (|up| = 1; near the field's poles) or with Field::kNone,
+//    the +y directions of the earlier placements on the patch's faces are
+//    projected on the seed's plane, averaged by area and used instead (a
+//    discrete parallel transport from the neighbouring texture, our choice
+//    for the field's singularities); with no earlier placement there, the
+//    up projection if longer than 0.2, else the LSCM orientation.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
 //    seed centroid at the origin; a grid of cells (as in mesh_quilting.h)
 //    over it; a cell is processed when the base triangle under its centre is.
@@ -47,6 +52,10 @@
 //    dropped (their base triangles are quilted later). Patch triangles whose
 //    centroid lies in the placed swatch's footprint, and the seed, become
 //    processed.
+// At the end every location is moved onto the base face that contains it
+// (walking across edges); elements with more than max_past_border of their
+// vertices past a border of the base mesh are removed (issue #8: our choice,
+// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border).
 // Finally surface_quilt_to_texture expresses every vertex in the base mesh
 // atlas's texture space (u, v, w), w = (z - z_min) / (z_max - z_min) of the
 // swatch, ready for embed_in_shell (section 3.2); surface_quilt_displaced is
@@ -77,6 +86,16 @@ struct SurfaceQuiltOptions {
   Field field = Field::kUp;
   /// The constant "up" vector of Field::kUp (normalised here; non-zero).
   std::array<double, 3> up{0, 0, 1};
+  /// Field::kUp: below this length of the projected up vector the patch's
+  /// orientation is transported from the earlier placements (see header,
+  /// step 4); in [0, 1], 0 = always the field (issue #8: 0.5).
+  double transport_below = 0.5;
+  /// Elements with more than this fraction of their vertices past a border
+  /// of the base mesh are removed at the end; the others keep those vertices
+  /// clamped onto the border (issue #8). In [0, 1]; 1 = keep all, clamped.
+  /// Default 0: on the open cylinder of the tests, 0.1 kept 2 more elements
+  /// and 303 more intersecting face pairs within elements (their tips).
+  double max_past_border = 0;
   /// Patch radius in swatch diagonals (scaled); > 0.
   double patch_radius = 1.0;
   /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
@@ -123,6 +142,7 @@ struct SurfaceQuiltResult {
   int elements = 0;
   std::size_t faces = 0, vertices = 0;
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
+  int patches_transported = 0; ///< patches oriented by the transported direction (step 4)
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
   /// Times an output element touching a patch had a vertex that cannot be
@@ -134,6 +154,9 @@ struct SurfaceQuiltResult {
   /// not come back from the step unchanged, so that the outer part became an
   /// element of its own.
   std::size_t elements_partial = 0, seams_broken = 0;
+  /// Elements removed at the end because too much of them lies past a
+  /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
+  std::size_t elements_past_border = 0;
   QuiltStepStats stats;
   double seconds = 0, seconds_patch = 0, seconds_step = 0;
 };

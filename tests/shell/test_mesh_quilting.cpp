@@ -13,6 +13,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/errors.h"
 #include "geometry/properties.h"
+#include "geometry/self_intersections.h"
 #include "shell/element_correspondence.h"
 #include "shell/element_deformation.h"
 #include "shell/element_merging.h"
@@ -257,6 +258,74 @@ TEST(ElementMerging, StitchedThreadIsOneClosedComponent) {
   EXPECT_GT(hi, 5.4);
 }
 
+// Regression (issue #8): two threads running side by side, 1.5 radii apart
+// across the plane or 2.2 radii apart in height (a thread of the swatch placed
+// next to, not on, the old one, within the merge's match distance). Without
+// the geometric checks both cuts open one loop and the zip joins them: a
+// kinked element crossing itself (14 and 381 face pairs when this test was
+// written). Section 2.7 stitches corresponding elements whose cuts face each
+// other; these are refused.
+TEST(ElementMerging, ThreadsSideBySideAreNotZipped) {
+  const double radius = WeaveOptions{}.radius;  // 0.12
+  for (const auto& [axis, offset] : {std::pair<int, double>{1, 1.5 * radius}, {2, 2.2 * radius}}) {
+    const ElementMesh a = thread(0);
+    ElementMesh b = thread(2.0);
+    for (P3& p : b.points) p[axis] += offset;
+    const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band);
+    EXPECT_FALSE(r.stitched) << "offset " << offset << " along axis " << axis << ": zipped " << r.loops << " loops";
+    EXPECT_EQ(r.reason.rfind("misaligned", 0), 0u) << r.reason;
+    // The same pair without the checks: the zip they prevent crosses itself.
+    MergeOptions off;
+    off.max_loop_offset = off.max_loop_radius_ratio = off.max_loop_angle_deg = 0;
+    off.refuse_self_intersecting = false;
+    const MergeResult z = merge_elements(a, Region::kOld, b, Region::kNew, band, off);
+    ASSERT_TRUE(z.stitched) << z.reason;
+    Mesh zm;
+    mesh_from_elements({z.merged}, zm);
+    const std::size_t crossing = count_self_intersections(zm);
+    std::cout << "[ side by side ] axis " << axis << ", offset " << offset << ": refused (" << r.reason
+              << "); unchecked zip crosses itself in " << crossing << " face pairs\n";
+    EXPECT_GT(crossing, 0u);
+  }
+}
+
+// A stitch whose loops face each other but whose zip still crosses the
+// element (B half a radius off: the cut loops pass the loop test, the zip's
+// triangles cut through the tube) is refused by the self-intersection test.
+TEST(ElementMerging, SelfIntersectingStitchIsRefused) {
+  const ElementMesh a = thread(0);
+  ElementMesh b = thread(2.0);
+  for (P3& p : b.points) p[1] += 0.5 * WeaveOptions{}.radius;
+  const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band);
+  if (r.stitched) {
+    Mesh m;
+    mesh_from_elements({r.merged}, m);
+    EXPECT_EQ(count_self_intersections(m), 0u);
+  } else {
+    EXPECT_EQ(r.reason.rfind("self-intersecting", 0), 0u) << r.reason;
+  }
+}
+
+// Regression (issue #8): on the plane, stitches whose zip folds over the
+// element (misaligned threads, restored cut pieces lying on the other
+// element) gave 47 intersecting face pairs within elements on this 2 x 2
+// swatch quilt; the merge now refuses them.
+TEST(PlanarQuiltingWeave, StitchedThreadsDoNotCrossThemselves) {
+  const Swatch s = small_weave(1);
+  Mesh out;
+  const double size = test::sanitized() ? 1.5 : 2.0;
+  const QuiltResult r = quilt_plane(s, size * s.length(), size * s.width(), out);
+  auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+  std::size_t within = 0, between = 0;
+  for (const FacePair& fp : self_intersecting_faces(out))
+    (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])] ? within : between) += 1;
+  std::cout << "[ plane weave ] faces " << out.number_of_faces() << ", stitched " << r.stats.stitched << ", refused "
+            << r.stats.stitch_refused << " (geometry " << r.stats.refused_geometry << "), intersecting pairs within "
+            << within << ", between " << between << "\n";
+  EXPECT_GT(r.stats.stitched, 0u);
+  EXPECT_LE(static_cast<double>(within), 1e-3 * static_cast<double>(out.number_of_faces()));
+}
+
 struct QuiltCase {
   const char* name;
   Swatch (*make)(std::uint64_t);
@@ -342,9 +411,9 @@ TEST(QuiltStep, OneToOneRelationsAreNoMoreThanAnyPairRelationsAndRefusalsAddUp) 
             << any.stats.related << ", stitched " << any.stats.stitched << ", refused " << any.stats.stitch_refused
             << "\n";
   EXPECT_EQ(one.stats.stitch_refused,
-            one.stats.refused_loops + one.stats.refused_border + one.stats.refused_infeasible);
+            one.stats.refused_loops + one.stats.refused_border + one.stats.refused_infeasible + one.stats.refused_geometry);
   EXPECT_EQ(any.stats.stitch_refused,
-            any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible);
+            any.stats.refused_loops + any.stats.refused_border + any.stats.refused_infeasible + any.stats.refused_geometry);
   EXPECT_GT(one.stats.related, 0u);
   // Once weave threads stitch (issue #8) each output thread relates to one
   // input thread, so the weave ties; interlocked chain mail rings do not.
@@ -380,9 +449,12 @@ TEST(QuiltStep, PlanarWeaveStitchesMostMergesIntoLongerClosedThreads) {
   const std::size_t tried = r.stats.stitched + r.stats.stitch_refused;
   std::cout << "[ weave ] stitched " << r.stats.stitched << ", refused " << r.stats.stitch_refused << " (loops "
             << r.stats.refused_loops << ", border " << r.stats.refused_border << ", infeasible "
-            << r.stats.refused_infeasible << ")\n";
+            << r.stats.refused_infeasible << ", geometry " << r.stats.refused_geometry << ")\n";
   ASSERT_GT(tried, 0u);
-  EXPECT_GT(2 * r.stats.stitched, tried);
+  // At least 40%: since issue #8's stitch checks, zips that would cross their
+  // element are refused as well (44 of 99 stitched, 6 refused by the checks,
+  // when this bound was set; "most" before).
+  EXPECT_GT(5 * r.stats.stitched, 2 * tried);
   EXPECT_EQ(border_edges(out), 0u);  // the swatch's threads are closed tubes
   const Swatch q = make_swatch(out);
   for (const SwatchElement& e : q.elements) EXPECT_TRUE(e.closed);

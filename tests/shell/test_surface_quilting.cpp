@@ -295,7 +295,11 @@ TEST(SurfaceQuilting, CylinderWeaveThreadsAreStitchedAcrossPatchesAndStayClosed)
             << ", border " << r.stats.refused_border << "), partial " << r.elements_partial << ", seams broken "
             << r.seams_broken << "\n";
   ASSERT_GT(tried, 5u);
-  EXPECT_GT(static_cast<double>(r.stats.stitched), 0.3 * static_cast<double>(tried));
+  // At least 12% stitched. (Before issue #8's stitch checks about half were;
+  // the refused ones are zips that crossed their own element: with the checks
+  // off, 76 stitched of 193, 552 intersecting pairs within elements; on,
+  // 27 of 159 and 33, before elements past the open ends were removed.)
+  EXPECT_GT(static_cast<double>(r.stats.stitched), 0.12 * static_cast<double>(tried));
   // Threads grow longer than the swatch's (they continue across patches).
   EXPECT_LT(r.elements, static_cast<int>(sw.elements.size()) * r.steps / 2);
   Mesh displaced;
@@ -312,6 +316,10 @@ TEST(SurfaceQuilting, CylinderWeaveThreadsAreStitchedAcrossPatchesAndStayClosed)
   EXPECT_GE(frac, 0.9);  // the swatch's threads are closed tubes
   // Overlapping threads of different elements (duplicates, misplaced patches).
   EXPECT_LT(static_cast<double>(between), 0.15 * static_cast<double>(displaced.number_of_faces()));
+  // Regression (issue #8): threads hanging over the cylinder's open ends were
+  // clamped onto the border line (flat ribbons): 7511 pairs within elements
+  // of 20690 faces; now such elements are removed: 18 of 9324.
+  EXPECT_LT(static_cast<double>(within), 0.02 * static_cast<double>(displaced.number_of_faces()));
 }
 
 }  // namespace
