@@ -257,8 +257,16 @@ int run_quilt(QuiltArgs& a) {
     std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
                  static_cast<std::size_t>(out.number_of_faces()), total.seconds(), a.output.c_str());
     if (rep.contains("stretch_before"))
-      std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n", rep["stretch_before"].get<double>(),
-                   rep["stretch_after"].get<double>(), rep["self_intersections"].dump().c_str());
+    {
+      const auto& si = rep["self_intersections"];
+      std::string what = "not checked (--no-check)";
+      if (!si.is_null())
+        what = si.dump() + " intersecting face pairs (" +
+               rep["self_intersections_within_elements"].dump() + " within elements, " +
+               rep["self_intersections_between_elements"].dump() + " between)";
+      std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n",
+                   rep["stretch_before"].get<double>(), rep["stretch_after"].get<double>(), what.c_str());
+    }
   }
   return 0;
 }
