@@ -134,40 +134,53 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
     return frames[x].angle_of(e);
   };
 
-  std::vector<double> solved(nf, 0.0);
-  if (n_var > 0) {
-    // Complex Hermitian form (u_f as one complex number; half the unknowns
-    // and a quarter of the entries of the equivalent real 2x2-block system):
-    // for the residual u_g - r u_f, r = exp(i N (a_g - a_f)): A(f,f) += w,
-    // A(g,g) += w, A(g,f) = -w r, A(f,g) = -w conj(r); lower triangle stored.
-    using Cplx = std::complex<double>;
-    std::vector<Eigen::Triplet<Cplx>> trip;
-    trip.reserve(static_cast<std::size_t>(n_var) * 4);
-    Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(n_var);
+  // The smoothness energy E over the interior edges as a complex Hermitian
+  // form (u_f as one complex number; half the unknowns and a quarter of the
+  // entries of the equivalent real 2x2-block system) on the unknowns `v`
+  // (face -> index, or -1): for the residual u_g - r u_f, r = exp(i N (a_g -
+  // a_f)): A(f,f) += w, A(g,g) += w, A(g,f) = -w r, A(f,g) = -w conj(r). The
+  // strictly lower off-diagonal entries go to `trip`, the terms of neighbours
+  // that are not unknowns (angle from `known`) to `rhs`; the diagonal is
+  // returned, one sum per unknown, for the caller to complete.
+  using Cplx = std::complex<double>;
+  auto assemble_energy = [&](const std::vector<int>& v, const std::vector<double>& known, int n,
+                             std::vector<Eigen::Triplet<Cplx>>& trip, Eigen::VectorXcd& rhs) {
+    std::vector<double> diag(static_cast<std::size_t>(n), 0.0);
+    trip.reserve(static_cast<std::size_t>(n) * 4);
+    rhs = Eigen::VectorXcd::Zero(n);
     for (EdgeIndex e : mesh.edges()) {
       if (mesh.is_border(e)) continue;
       const HalfedgeIndex h = mesh.halfedge(e, 0);
       const HalfedgeIndex o = mesh.opposite(h);
       const std::size_t f = mesh.face(h).idx(), g = mesh.face(o).idx();
-      const int vf = var[f], vg = var[g];
+      const int vf = v[f], vg = v[g];
       if (vf < 0 && vg < 0) continue;
       const double area = face_area(mesh, FaceIndex(f)) + face_area(mesh, FaceIndex(g));
       const double len2 = (mesh.point(mesh.target(h)) - mesh.point(mesh.source(h))).squared_length();
       const double w = area > 0 ? std::min(3 * len2 / area, 1e3) : 1e3;
       const Cplx r = std::polar(1.0, N * (edge_angle(h, g) - edge_angle(h, f)));
-      if (vf >= 0) trip.emplace_back(vf, vf, Cplx(w, 0));
-      if (vg >= 0) trip.emplace_back(vg, vg, Cplx(w, 0));
+      if (vf >= 0) diag[vf] += w;
+      if (vg >= 0) diag[vg] += w;
       if (vf >= 0 && vg >= 0) {
         if (vg > vf)
           trip.emplace_back(vg, vf, -w * r);
         else
           trip.emplace_back(vf, vg, -w * std::conj(r));
-      } else if (vg >= 0) {  // f locked: rhs_g += w r u_f
-        rhs[vg] += w * r * std::polar(1.0, N * theta[f]);
-      } else {  // g locked: rhs_f += w conj(r) u_g
-        rhs[vf] += w * std::conj(r) * std::polar(1.0, N * theta[g]);
+      } else if (vg >= 0) {  // f known: rhs_g += w r u_f
+        rhs[vg] += w * r * std::polar(1.0, N * known[f]);
+      } else {  // g known: rhs_f += w conj(r) u_g
+        rhs[vf] += w * std::conj(r) * std::polar(1.0, N * known[g]);
       }
     }
+    return diag;
+  };
+
+  std::vector<double> solved(nf, 0.0);
+  if (n_var > 0) {
+    std::vector<Eigen::Triplet<Cplx>> trip;
+    Eigen::VectorXcd rhs;
+    const std::vector<double> diag = assemble_energy(var, theta, n_var, trip, rhs);
+    for (int v = 0; v < n_var; ++v) trip.emplace_back(v, v, Cplx(diag[static_cast<std::size_t>(v)], 0));
     Eigen::SparseMatrix<Cplx> A(n_var, n_var);
     A.setFromTriplets(trip.begin(), trip.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<Cplx>> solver(A);
@@ -200,40 +213,14 @@ DirectionFieldResult interpolate_direction_field(Mesh& mesh,
   // just interpolated, D_f the face's diagonal of E. Faces outside the area
   // stay locked.
   if (opt.smoothing > 0) {
-    using Cplx = std::complex<double>;
     std::vector<int> sv(nf, -1);
     int ns = 0;
     for (FaceIndex f : mesh.faces())
       if (is_free(f) && (locked[f.idx()] || reach[f.idx()])) sv[f.idx()] = ns++;
     if (ns > 0) {
       std::vector<Eigen::Triplet<Cplx>> trip;
-      trip.reserve(static_cast<std::size_t>(ns) * 4);
-      Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(ns);
-      std::vector<double> diag(static_cast<std::size_t>(ns), 0.0);
-      for (EdgeIndex e : mesh.edges()) {
-        if (mesh.is_border(e)) continue;
-        const HalfedgeIndex h = mesh.halfedge(e, 0);
-        const HalfedgeIndex o = mesh.opposite(h);
-        const std::size_t f = mesh.face(h).idx(), g = mesh.face(o).idx();
-        const int vf = sv[f], vg = sv[g];
-        if (vf < 0 && vg < 0) continue;
-        const double area = face_area(mesh, FaceIndex(f)) + face_area(mesh, FaceIndex(g));
-        const double len2 = (mesh.point(mesh.target(h)) - mesh.point(mesh.source(h))).squared_length();
-        const double w = area > 0 ? std::min(3 * len2 / area, 1e3) : 1e3;
-        const Cplx r = std::polar(1.0, N * (edge_angle(h, g) - edge_angle(h, f)));
-        if (vf >= 0) diag[vf] += w;
-        if (vg >= 0) diag[vg] += w;
-        if (vf >= 0 && vg >= 0) {
-          if (vg > vf)
-            trip.emplace_back(vg, vf, -w * r);
-          else
-            trip.emplace_back(vf, vg, -w * std::conj(r));
-        } else if (vg >= 0) {  // f outside the area
-          rhs[vg] += w * r * std::polar(1.0, N * final_theta[f]);
-        } else {
-          rhs[vf] += w * std::conj(r) * std::polar(1.0, N * final_theta[g]);
-        }
-      }
+      Eigen::VectorXcd rhs;
+      const std::vector<double> diag = assemble_energy(sv, final_theta, ns, trip, rhs);
       for (FaceIndex f : mesh.faces()) {
         const int v = sv[f.idx()];
         if (v < 0) continue;
