@@ -168,6 +168,35 @@ ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, 
 }
 
 namespace {
+/// Connected components (across edges, `nb` = the dual graph's neighbours) of
+/// the triangles labelled `side` in `keep`: comp[t] = component id (-1 for
+/// the other triangles), members[id] = its triangles in flood order.
+struct TriangleComponents {
+  std::vector<int> comp;
+  std::vector<std::vector<int>> members;
+};
+TriangleComponents triangle_components(const std::vector<std::vector<int>>& nb, const std::vector<char>& keep,
+                                       char side) {
+  const int nt = static_cast<int>(keep.size());
+  TriangleComponents r;
+  r.comp.assign(static_cast<std::size_t>(nt), -1);
+  for (int t = 0; t < nt; ++t) {
+    if (keep[t] != side || r.comp[t] >= 0) continue;
+    const int id = static_cast<int>(r.members.size());
+    r.members.emplace_back();
+    std::vector<int> stack{t};
+    r.comp[t] = id;
+    while (!stack.empty()) {
+      const int x = stack.back();
+      stack.pop_back();
+      r.members[id].push_back(x);
+      for (int y : nb[x])
+        if (keep[y] == side && r.comp[y] < 0) r.comp[y] = id, stack.push_back(y);
+    }
+  }
+  return r;
+}
+
 /// Removes the islands a graph cut can leave (section 2.7 wants "a cut path",
 /// one seam per crossing): connected components (across edges) of kept
 /// triangles that hold no triangle forced to SOURCE are deleted, then
@@ -184,25 +213,12 @@ void remove_cut_islands(const ElementMesh& m, const std::vector<signed char>& te
   for (const DualEdge& e : dual_edges(m)) nb[e.t1].push_back(e.t2), nb[e.t2].push_back(e.t1);
   for (const char side : {char(1), char(0)}) {
     const signed char forced = side ? 1 : -1;
-    std::vector<int> comp(static_cast<std::size_t>(nt), -1);
-    std::vector<std::vector<int>> comps;
-    std::vector<char> anchored;
-    for (int t = 0; t < nt; ++t) {
-      if (keep[t] != side || comp[t] >= 0) continue;
-      const int id = static_cast<int>(comps.size());
-      comps.emplace_back();
-      anchored.push_back(0);
-      std::vector<int> stack{t};
-      comp[t] = id;
-      while (!stack.empty()) {
-        const int x = stack.back();
-        stack.pop_back();
-        comps[id].push_back(x);
-        if (terminal[x] == forced || terminal[x] == 2) anchored[id] = 1;
-        for (int y : nb[x])
-          if (keep[y] == side && comp[y] < 0) comp[y] = id, stack.push_back(y);
-      }
-    }
+    const TriangleComponents tc = triangle_components(nb, keep, side);
+    const std::vector<std::vector<int>>& comps = tc.members;
+    std::vector<char> anchored(comps.size(), 0);
+    for (std::size_t k = 0; k < comps.size(); ++k)
+      for (int x : comps[k])
+        if (terminal[x] == forced || terminal[x] == 2) anchored[k] = 1;
     if (comps.empty()) continue;
     bool any = false;
     for (char a : anchored) any = any || a;
@@ -275,22 +291,9 @@ void deleted_components(const ElementMesh& m, const std::vector<char>& keep, std
       cut.emplace_back(keep[e.t1] ? e.t2 : e.t1, P3{(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2});
     }
   }
-  std::vector<int> comp(static_cast<std::size_t>(nt), -1);
-  std::vector<std::vector<int>> all;
-  for (int t = 0; t < nt; ++t) {
-    if (keep[t] || comp[t] >= 0) continue;
-    const int id = static_cast<int>(all.size());
-    all.emplace_back();
-    std::vector<int> stack{t};
-    comp[t] = id;
-    while (!stack.empty()) {
-      const int x = stack.back();
-      stack.pop_back();
-      all[id].push_back(x);
-      for (int y : nb[x])
-        if (!keep[y] && comp[y] < 0) comp[y] = id, stack.push_back(y);
-    }
-  }
+  TriangleComponents tc = triangle_components(nb, keep, 0);
+  const std::vector<int>& comp = tc.comp;
+  std::vector<std::vector<int>>& all = tc.members;
   std::vector<P3> sum(all.size(), P3{0, 0, 0});
   std::vector<int> cnt(all.size(), 0);
   for (const auto& [t, p] : cut) {
