@@ -5,6 +5,7 @@
 
 #include "geometry/mesh.h"
 #include "geometry/read_mesh.h"
+#include "geometry/repair_mesh_json.h"
 #include "geometry/timer.h"
 #include "surftex/command.h"
 
@@ -110,19 +111,7 @@ SubcommandRegistrar reg{
          r["closed"] = t.closed;
          if (t.closed) r["genus"] = (2 * static_cast<long long>(t.components) - t.euler) / 2;
          else r["genus"] = nullptr;
-         r["repair"] = {{"duplicate_points_merged", c.duplicate_points_merged},
-                        {"degenerate_polygons_removed", c.degenerate_polygons_removed},
-                        {"duplicate_polygons_removed", c.duplicate_polygons_removed},
-                        {"isolated_points_removed", c.isolated_points_removed},
-                        {"polygons_simplified", c.polygons_simplified},
-                        {"pinched_polygons_split", c.pinched_polygons_split},
-                        {"points_duplicated_to_orient", c.points_duplicated_to_orient},
-                        {"oriented", c.oriented},
-                        {"faces_triangulated", c.faces_triangulated},
-                        {"faces_fan_triangulated", c.faces_fan_triangulated},
-                        {"short_polygons_dropped", c.short_polygons_dropped},
-                        {"uv_corners", c.uv_corners},
-                        {"uv_corners_dropped", c.uv_corners_dropped}};
+         r["repair"] = to_json(c);
          r["timings"] = {{"read_seconds", seconds}};
          write_report(*common, "info", r);
          return 0;

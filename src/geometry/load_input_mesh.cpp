@@ -41,12 +41,6 @@ bool polygons_usable(const Mesh& m) {
   return true;
 }
 
-void add(std::string& s, std::size_t n, const char* what) {
-  if (n == 0) return;
-  if (!s.empty()) s += ", ";
-  s += std::to_string(n) + " " + what;
-}
-
 }  // namespace
 
 LoadInputReport load_input_mesh(const std::string& path, Mesh& mesh, const LoadInputOptions& opt) {
@@ -67,18 +61,20 @@ LoadInputReport load_input_mesh(const std::string& path, Mesh& mesh, const LoadI
     throw TopologyError("cannot use mesh '" + path + "': " + r.repair.refusal);
   const RepairDone& d = r.repair.done;
   std::string s;
-  add(s, d.untriangulable_faces_removed, "untriangulable faces removed");
-  add(s, d.stitched_edges, "border edges stitched");
-  add(s, d.degenerate_faces_removed + d.degenerate_faces_deleted, "zero-area faces removed");
-  add(s, d.needles_collapsed, "needle triangles collapsed");
-  add(s, d.caps_flipped, "cap triangles flipped");
-  add(s, d.non_manifold_vertices_split, "vertices added splitting non-manifold vertices");
-  add(s, d.isolated_vertices_removed, "isolated vertices removed");
-  add(s, d.components_reoriented, "inward components reoriented");
-  r.repair_changes = d.untriangulable_faces_removed + d.stitched_edges + d.degenerate_faces_removed +
-                     d.degenerate_faces_deleted + d.needles_collapsed + d.caps_flipped +
-                     d.non_manifold_vertices_split + d.isolated_vertices_removed +
-                     d.components_reoriented;
+  auto note = [&](std::size_t n, const char* what) {  // count it and name it if it happened
+    if (n == 0) return;
+    r.repair_changes += n;
+    if (!s.empty()) s += ", ";
+    s += std::to_string(n) + " " + what;
+  };
+  note(d.untriangulable_faces_removed, "untriangulable faces removed");
+  note(d.stitched_edges, "border edges stitched");
+  note(d.degenerate_faces_removed + d.degenerate_faces_deleted, "zero-area faces removed");
+  note(d.needles_collapsed, "needle triangles collapsed");
+  note(d.caps_flipped, "cap triangles flipped");
+  note(d.non_manifold_vertices_split, "vertices added splitting non-manifold vertices");
+  note(d.isolated_vertices_removed, "isolated vertices removed");
+  note(d.components_reoriented, "inward components reoriented");
   r.summary = s;
   return r;
 }

@@ -60,12 +60,15 @@ nlohmann::json to_json(const SoupRepairCounts& c) {
                         {"degenerate_polygons_removed", c.degenerate_polygons_removed},
                         {"duplicate_polygons_removed", c.duplicate_polygons_removed},
                         {"isolated_points_removed", c.isolated_points_removed},
+                        {"polygons_simplified", c.polygons_simplified},
                         {"pinched_polygons_split", c.pinched_polygons_split},
                         {"points_duplicated_to_orient", c.points_duplicated_to_orient},
                         {"oriented", c.oriented},
                         {"faces_triangulated", c.faces_triangulated},
                         {"faces_fan_triangulated", c.faces_fan_triangulated},
                         {"short_polygons_dropped", c.short_polygons_dropped},
+                        {"uv_corners", c.uv_corners},
+                        {"uv_corners_dropped", c.uv_corners_dropped},
                         {"output_vertices", c.output_vertices},
                         {"output_faces", c.output_faces}};
 }
