@@ -35,9 +35,8 @@
 
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
-#include "geometry/rasterizer.h"
 #include "geometry/read_mesh.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "texture/patch_atlas.h"
 #include "texture/patch_seam_ratio.h"
@@ -93,15 +92,12 @@ int main(int argc, char** argv) {
   if (!out.empty()) {
     fs::create_directories(out);
     write_image(out + "/atlas.png", at.image);
-    RenderMeshOptions rmo;
-    rmo.corner_uvs = true;
-    const RenderMesh rm = make_render_mesh(mesh, rmo);
-    RenderOptions ro;
-    ro.width = ro.height = 1024;
-    ro.color_source = RenderOptions::ColorSource::Texture;
-    ro.texture = &at.image;
-    ro.wrap = RenderOptions::Wrap::Clamp;
-    write_image(out + "/render.png", render(rm, fit_camera(bounding_box(rm), 60.f, 15.f), ro).color);
+    ViewOptions view;
+    view.size = 1024;
+    view.azimuth_deg = 60.f;
+    view.elevation_deg = 15.f;
+    view.texture = &at.image;
+    write_image(out + "/render.png", render_view(mesh, view));
   }
   nlohmann::json j;
   j["bench"] = "patches_triceratops";

@@ -16,9 +16,8 @@
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
-#include "geometry/rasterizer.h"
 #include "geometry/read_mesh.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/embed_in_shell.h"
@@ -44,14 +43,12 @@ void add_box(Mesh& out, double u, double v, double a, double w0, double w1) {
 }
 
 void render_png(const Mesh& m, const std::string& path, float azimuth) {
-  RenderMeshOptions ro;
-  ro.vertex_colors = true;
-  const RenderMesh rm = make_render_mesh(m, ro);
-  RenderOptions opt;
-  opt.width = opt.height = 900;
-  opt.color_source = RenderOptions::ColorSource::VertexColors;
-  const Camera cam = fit_camera(bounding_box(rm), azimuth, 15.f);
-  write_image(path, render(rm, cam, opt).color);
+  ViewOptions view;
+  view.size = 900;
+  view.azimuth_deg = azimuth;
+  view.elevation_deg = 15.f;
+  view.colors = ViewOptions::Colors::VertexColors;
+  write_image(path, render_view(m, view));
 }
 }  // namespace
 

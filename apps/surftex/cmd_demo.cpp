@@ -15,8 +15,7 @@
 #include "geometry/output_file.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "geometry/rasterizer.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
@@ -55,14 +54,6 @@ void prepare_demo_dir(const std::string& dir, bool force) {
   }
   ensure_directory(dir);
   write_file_atomic((fs::path(dir) / kMarker).string(), "made by surftex demo\n", true);
-}
-
-void save_render(const Mesh& mesh, const std::string& path, const RenderMeshOptions& rmo,
-                 RenderOptions ro, float az, float el) {
-  RenderMesh rm = make_render_mesh(mesh, rmo);
-  ro.width = ro.height = 768;
-  Camera cam = fit_camera(bounding_box(rm), az, el);
-  write_image(path, render(rm, cam, ro).color);
 }
 
 // Step 1: image synthesis from a generated exemplar by the three 2D engines.
@@ -140,12 +131,12 @@ nlohmann::json step_textured_torus(DemoContext& ctx) {
   wo.texture = &ctx.tile;
   write_mesh(ctx.path("torus_tiled.obj"), torus, wo);
   write_mesh(ctx.path("torus_tiled.glb"), torus, wo);
-  RenderMeshOptions rmo;
-  rmo.corner_uvs = true;
-  RenderOptions ro;
-  ro.color_source = RenderOptions::ColorSource::Texture;
-  ro.texture = &ctx.tile;
-  save_render(torus, ctx.path("torus_tiled.png"), rmo, ro, 20.f, 35.f);
+  ViewOptions view;
+  view.azimuth_deg = 20.f;
+  view.elevation_deg = 35.f;
+  view.texture = &ctx.tile;
+  view.wrap = RenderOptions::Wrap::Repeat;  // the tile repeats 4 x 2 times around the torus
+  write_image(ctx.path("torus_tiled.png"), render_view(torus, view));
   return {{"faces", torus.number_of_faces()}, {"files", {"torus_tiled.obj", "torus_tiled.glb", "torus_tiled.png"}}};
 }
 

@@ -16,9 +16,8 @@
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
 #include "geometry/primitive_meshes.h"
-#include "geometry/rasterizer.h"
 #include "geometry/read_mesh.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
@@ -121,16 +120,9 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
   wo.write_colors = false;
   write_mesh((fs::path(dir) / "mesh.obj").string(), mesh, wo);
   write_mesh((fs::path(dir) / "mesh.glb").string(), mesh, wo);
-  RenderMeshOptions rmo;
-  rmo.corner_uvs = true;
-  const RenderMesh rm = make_render_mesh(mesh, rmo);
-  RenderOptions ro;
-  ro.width = ro.height = 768;
-  ro.color_source = RenderOptions::ColorSource::Texture;
-  ro.texture = &atlas.image;
-  ro.wrap = RenderOptions::Wrap::Clamp;
-  write_image((fs::path(dir) / "render.png").string(),
-              render(rm, fit_camera(bounding_box(rm), 30.f, 20.f), ro).color);
+  ViewOptions view;
+  view.texture = &atlas.image;
+  write_image((fs::path(dir) / "render.png").string(), render_view(mesh, view));
   const double s_write = tout.seconds();
   nlohmann::json j;
   j["patches"] = r.flat.patches.size();

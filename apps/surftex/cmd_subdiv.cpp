@@ -18,9 +18,8 @@
 #include "geometry/polygon_util.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "geometry/rasterizer.h"
 #include "geometry/read_mesh.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
@@ -124,16 +123,11 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
                 {"mean_area_distortion", ar.mean_area_distortion}, {"flipped_faces", ar.flipped_faces},
                 {"seconds", t.seconds()}};
   t.reset();
-  RenderMeshOptions rmo;
-  rmo.vertex_colors = true;
-  RenderMesh rm = make_render_mesh(mesh, rmo);
-  RenderOptions ro;
-  ro.width = ro.height = 768;
-  ro.color_source = RenderOptions::ColorSource::VertexColors;
-  const Camera cam = fit_camera(bounding_box(rm), 30.f, 20.f);
+  ViewOptions view;
+  view.colors = ViewOptions::Colors::VertexColors;
   WriteImageOptions io;
   io.overwrite = force;
-  write_image(o.render, render(rm, cam, ro).color, io);
+  write_image(o.render, render_view(mesh, view), io);
   j["seconds_render"] = t.seconds();
   j["files"] = {o.ply, o.glb, o.obj, o.render};
   return j;
