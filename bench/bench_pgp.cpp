@@ -123,7 +123,8 @@ nlohmann::json breakdown(const PgpResult& r) {
           {"factor_flops", b.factor_flops},   {"factor_nonzeros", b.factor_nonzeros},
           {"solves", b.solves},               {"steps", b.steps},
           {"energy", b.energy},               {"corners", b.corners},
-          {"reused_analysis", r.reused_analysis}, {"free_vertices", r.free_vertices}};
+          {"reused_analysis", r.reused_analysis}, {"free_vertices", r.free_vertices},
+          {"blas_core", r.blas_core}};
 }
 
 /// Keeps the result of the fastest run (for its breakdown).

@@ -10,6 +10,8 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <mutex>
@@ -72,19 +74,64 @@ std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
   return out;
 }
 
-/// Same bytes whatever the thread count: Debian's default BLAS (netlib) is
-/// single-threaded; if an OpenBLAS provides libblas.so.3 instead
-/// (update-alternatives), its thread count (the machine's cores by default)
-/// could change the summation order of the supernodes' dense updates, so it
-/// is pinned to one thread (once per process; the supernodes are small, a
-/// single thread is what they would use anyway).
-void pin_blas_threads() {
-  static std::once_flag once;
-  std::call_once(once, [] {
+/// The BLAS behind CHOLMOD's dense supernode kernels, set up once per
+/// process before the first factorisation; returns the name of OpenBLAS's
+/// kernel set ("" for another BLAS).
+///  - Same bytes whatever the thread count: Debian's default BLAS (netlib) is
+///    single-threaded; an OpenBLAS providing libblas.so.3
+///    (update-alternatives) is pinned to one thread, since its thread count
+///    (the machine's cores by default) changes the bytes: measured with the
+///    pthread build on armadillo_52k, 1, 2, 3 and 4 BLAS threads gave four
+///    different solutions (its dpotrf blocks by thread count).
+///  - Kernels: OpenBLAS 0.3.21 (Debian 12) picks its kernels by CPU model
+///    and falls back to the generic SSE3 "Prescott" set on CPUs newer than
+///    it knows (this machine's Xeon with AVX-512: dgemm 12 GFlop/s instead
+///    of 63 with the SkylakeX set, dpotrf 15 instead of 29 on 600x600). When
+///    it reports Prescott on a CPU with AVX-512 (or AVX2+FMA) and the user has
+///    not chosen OPENBLAS_CORETYPE, it is re-initialised with the SkylakeX
+///    (Haswell) set through its dynamic-arch entry points (the documented
+///    OPENBLAS_CORETYPE variable, set for the call only). The kernels change
+///    the rounding of the factor (as on any other machine model), not the
+///    determinism: same machine, same bytes.
+const std::string& configure_blas() {
+  static const std::string core = [] {
     using SetThreads = void (*)(int);
     for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
       if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
-  });
+    using CoreName = char* (*)();
+    using Hook = void (*)();
+    void* name_fn = dlsym(RTLD_DEFAULT, "openblas_get_corename");
+    if (!name_fn) return std::string();
+    auto corename = [&] {
+      const char* c = reinterpret_cast<CoreName>(name_fn)();
+      return std::string(c ? c : "");
+    };
+    std::string current = corename();
+    std::string lower = current;
+    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    void* quit = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit");
+    void* init = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init");
+    if (lower != "prescott" || std::getenv("OPENBLAS_CORETYPE") || !quit || !init) return current;
+    const char* target = nullptr;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+      target = "SkylakeX";
+    else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+      target = "Haswell";
+#endif
+    if (!target) return current;
+    setenv("OPENBLAS_CORETYPE", target, 1);
+    reinterpret_cast<Hook>(quit)();
+    reinterpret_cast<Hook>(init)();
+    unsetenv("OPENBLAS_CORETYPE");
+    // re-pin (the thread count is kept by the re-initialisation, but cheaply sure)
+    for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
+      if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
+    return corename();
+  }();
+  return core;
 }
 using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
 using Mat4 = std::array<Vec4, 4>;    // [row][col]
@@ -456,6 +503,7 @@ struct PeriodicGlobalParameterization::Impl {
   Cholesky solver;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
+  std::string blas_core;  // OpenBLAS kernel set behind CHOLMOD ("" = another BLAS)
   // Field-dependent values of the last solve; a local update recomputes them
   // only next to the free faces (the only faces whose direction or scale
   // may have changed).
@@ -467,7 +515,7 @@ struct PeriodicGlobalParameterization::Impl {
   bool cache_valid = false;
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
-    pin_blas_threads();
+    blas_core = configure_blas();
     solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
     // The unknowns come in nested-dissection order (nested_dissection_order):
     // CHOLMOD keeps it (then postorders the elimination tree).
@@ -557,6 +605,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
                                                       const std::vector<char>* free_face, bool global) {
   Timer timer, lap;
   PgpResult res;
+  res.blas_core = blas_core;
   PgpResult::Breakdown& bd = res.breakdown;
   auto split = [&lap](double& into) {
     into += lap.seconds();

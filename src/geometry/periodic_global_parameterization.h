@@ -35,7 +35,10 @@
 // the BLAS libcholmod is linked with: Debian's default netlib BLAS is
 // single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
 // at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
-// do not depend on the machine's cores. The paper writes R with the opposite
+// do not depend on the machine's cores (its threaded build gives different
+// bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
+// and falls back to its generic SSE3 kernels, it is switched to its AVX-512
+// (or AVX2) kernels once per process (PgpResult::blas_core names the set). The paper writes R with the opposite
 // rotation sign and a 2 pi missing in the rounding of (4); we use the
 // self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -115,6 +118,9 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
+  /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
+  /// BLAS; see the BLAS note above).
+  std::string blas_core;
   /// Wall-time breakdown of `seconds` (each step's own wall time, seconds):
   struct Breakdown {
     double topology = 0;     ///< connectivity, areas, frames (first call only)
