@@ -455,10 +455,15 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
 /// then carries the holonomy).
 std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
   std::vector<std::uint8_t> cm(mesh.num_halfedges(), 0);
+  // Each vertex writes only the halfedges pointing to it: independent, so
+  // the vertices run in parallel (same bytes for any thread count).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_vertices(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
   std::vector<HalfedgeIndex> fan;
   std::vector<int> m;
-  for (VertexIndex v : mesh.vertices()) {
-    if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+  for (std::size_t vi = range.begin(); vi != range.end(); ++vi) {
+    const VertexIndex v(static_cast<Mesh::size_type>(vi));
+    if (mesh.is_removed(v) || mesh.halfedge(v) == Mesh::null_halfedge()) continue;
     fan.clear();
     for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) fan.push_back(h);
     const std::size_t d = fan.size();
@@ -488,6 +493,7 @@ std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<s
     for (std::size_t i = 0; i < d; ++i)
       if (m[i] >= 0) cm[fan[i].idx()] = static_cast<std::uint8_t>(m[i]);
   }
+  });
   return cm;
 }
 
@@ -500,6 +506,8 @@ struct PeriodicGlobalParameterization::Impl {
   bool initialized = false;
   std::unique_ptr<PgpTopology> topo;
   std::unique_ptr<PgpPattern> pattern;
+  /// Order of the initial free set computed ahead by prepare(): (natural, var).
+  std::unique_ptr<std::pair<std::vector<int>, std::vector<int>>> prepared;
   Cholesky solver;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
@@ -527,6 +535,7 @@ struct PeriodicGlobalParameterization::Impl {
     if (!topo || !topo->matches(mesh)) {
       topo = std::make_unique<PgpTopology>(make_topology(mesh));
       pattern.reset();
+      prepared.reset();
       analyzed = false;
       cache_valid = false;
     }
@@ -553,6 +562,17 @@ struct PeriodicGlobalParameterization::Impl {
     return {corner[o.idx()], corner[mesh.prev(o).idx()]};
   }
   PgpResult solve(const std::vector<char>& free_vertex, const std::vector<char>* free_face, bool global);
+  /// Free vertices of the initialisation: every vertex with an edge but one
+  /// reference vertex per component.
+  std::vector<char> initial_free_set();
+  /// Unknown index per vertex in vertex order, -1 if not free, and the count.
+  static std::vector<int> natural_numbering(const Mesh& mesh, const std::vector<char>& free_vertex, int& count) {
+    std::vector<int> natural(mesh.num_vertices(), -1);
+    count = 0;
+    for (VertexIndex v : mesh.vertices())
+      if (free_vertex[v.idx()]) natural[v.idx()] = count++;
+    return natural;
+  }
   void write_corners(const std::vector<std::array<double, 2>>& alpha, const std::vector<char>* free_face);
 };
 
@@ -615,75 +635,81 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   require_triangle_mesh(mesh, "periodic_global_parameterization");
   const PgpTopology& t = topology();
   split(bd.topology);
-  // Faces whose gradient may have changed (free faces) and edges whose alpha
-  // may have (edges of free faces): everything when no valid cache.
+  // The free unknowns in vertex order (identifies the free set).
+  int count = 0;
+  const std::vector<int> natural = natural_numbering(mesh, free_vertex, count);
+  res.free_vertices = static_cast<std::size_t>(count);
+  const std::vector<int>* known_order = nullptr;  // order of this free set computed before
+  if (pattern && pattern->natural == natural)
+    known_order = &pattern->var;
+  else if (prepared && prepared->first == natural)
+    known_order = &prepared->second;
+  split(bd.topology);
+
+  // Two independent pieces of work side by side: the fill-reducing order
+  // (one serial METIS call; it depends on the free set and the connectivity
+  // only, and is redone only when the free set changed) and the field's
+  // quantities (parallel loops over the faces and edges). Neither reads what
+  // the other writes, so the bytes do not depend on which thread runs what.
   std::vector<char> face_mask, edge_mask;
   const bool partial = free_face && cache_valid;
-  if (partial) {
-    face_mask.assign(t.nf, 0);
-    edge_mask.assign(t.ne, 0);
-    for (std::uint32_t f : t.faces) {
-      if (!(*free_face)[f]) continue;
-      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
-        edge_mask[mesh.edge(h).idx()] = 1;
-        face_mask[f] = 1;
-        // the opposite face's gradient enters the edge's alpha: unchanged
-        // unless free, so it is read from the cache
-      }
-    }
-  }
-  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
-  halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
-  corner = corner_matchings(mesh, quarter);
-  const auto ealpha = edge_alphas(alpha);
+  std::vector<int> var;
+  std::vector<std::array<double, 2>> ealpha;
   std::vector<std::array<int, 2>> turns(t.ends.size());
-  for (std::size_t k = 0; k < t.ends.size(); ++k) turns[k] = edge_turns(k);
-  split(bd.field);
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        var = known_order ? *known_order : nested_dissection_order(natural, count, t.ends);
+        bd.ordering = tt.seconds();
+      },
+      [&] {
+        Timer tt;
+        // Faces whose gradient may have changed (free faces) and edges whose
+        // alpha may have (edges of free faces): everything when no valid cache.
+        if (partial) {
+          face_mask.assign(t.nf, 0);
+          edge_mask.assign(t.ne, 0);
+          for (std::uint32_t f : t.faces) {
+            if (!(*free_face)[f]) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
+              edge_mask[mesh.edge(h).idx()] = 1;
+              face_mask[f] = 1;
+              // the opposite face's gradient enters the edge's alpha: unchanged
+              // unless free, so it is read from the cache
+            }
+          }
+        }
+        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+        halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
+        corner = corner_matchings(mesh, quarter);
+        ealpha = edge_alphas(alpha);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) turns[k] = edge_turns(k);
+        });
+        bd.field = tt.seconds();
+      });
+  lap.reset();
 
-  std::vector<int> var(t.nv, -1);
-  int count = 0;
-  for (VertexIndex v : mesh.vertices())
-    if (free_vertex[v.idx()]) var[v.idx()] = count++;
-  split(bd.field);
-  // The free set (hence its order) changes rarely: reorder only then.
-  std::vector<int> natural = var;
-  if (pattern && pattern->natural == natural)
-    var = pattern->var;
-  else
-    var = nested_dissection_order(var, count, t.ends);
-  split(bd.ordering);
-  res.free_vertices = static_cast<std::size_t>(count);
   std::vector<std::uint8_t> parity(t.ends.size());
   for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
-  const bool same_pattern = analyzed && pattern && pattern->var == var && pattern->parity == parity;
+  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity;
+  const bool same_pattern = analyzed && !rebuild;
   res.reused_analysis = same_pattern;
-  if (!pattern || pattern->var != var || pattern->parity != parity) {
-    pattern = std::make_unique<PgpPattern>(make_pattern(t, std::move(var), count, std::move(parity)));
-    pattern->natural = std::move(natural);
-  }
-  analyzed = analyzed && same_pattern;
-  const PgpPattern& P = *pattern;
-  const int n = P.n;
-  split(bd.pattern);
-
+  analyzed = same_pattern;
   // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
   // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
   // the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
   // (edge_map): A(i,i) += w I, A(j,j) += w I, A(j,i) = -w M, A(i,j) = -w M^T;
   // lower triangle stored. `b` collects the locked neighbours' terms.
   auto state = [&](std::size_t v) -> Vec4 { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; };
+  const int n = count;
+  const int n4 = 4 * n;
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
   std::vector<Mat4> maps(t.ends.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k != r.end(); ++k)
-      if (!partial || edge_mask[t.edges[k]] || P.var[t.ends[k][0]] >= 0 || P.var[t.ends[k][1]] >= 0)
-        maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
-  });
-  split(bd.field);
-  const int n4 = 4 * n;
   auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
+    const PgpPattern& P = *pattern;
     A = P.A;
     double* val = A.valuePtr();
     std::fill(val, val + A.nonZeros(), 0.0);
@@ -729,52 +755,92 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   for (double m : t.mass) trace_m += m;
   const double unit = trace_m > 0 ? trace_w / trace_m : 1.0;
 
-  if (global) {
-    // Integrate the alphas along a breadth-first spanning tree from each
-    // component's reference vertex (locked_vertex, else the lowest), through
-    // the frames: exact on the tree edges, the holonomy of the field (what
-    // forces singularities) piles up where the tree's branches meet; the
-    // relaxation below spreads it into vortices.
-    std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
-    for (std::size_t k = 0; k < t.ends.size(); ++k) {
-      adj[t.ends[k][0]].push_back({t.ends[k][1], k});
-      adj[t.ends[k][1]].push_back({t.ends[k][0], k});
-    }
-    std::vector<char> seen(t.nv, 0);
-    std::vector<St> st(t.nv, St{0, 0});
-    std::vector<std::uint32_t> q;
-    std::vector<std::uint32_t> roots{opt.locked_vertex};
-    for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
-    for (std::uint32_t v0 : roots) {
-      if (seen[v0]) continue;
-      seen[v0] = 1;
-      q.assign(1, v0);
-      for (std::size_t qi = 0; qi < q.size(); ++qi) {
-        const std::uint32_t i = q[qi];
-        for (auto [j, k] : adj[i]) {
-          if (seen[j]) continue;
-          seen[j] = 1;
-          const int ma = turns[k][0], mb = turns[k][1];
-          if (t.ends[k][0] == i) {
-            const St c = turn_st(st[i], -ma);
-            st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
-          } else {
-            const St c = turn_st(st[i], -mb);
-            st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
+  auto integrate_start = [&] {
+    if (global) {
+      // Integrate the alphas along a breadth-first spanning tree from each
+      // component's reference vertex (locked_vertex, else the lowest), through
+      // the frames: exact on the tree edges, the holonomy of the field (what
+      // forces singularities) piles up where the tree's branches meet; the
+      // relaxation below spreads it into vortices.
+      std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
+      for (std::size_t k = 0; k < t.ends.size(); ++k) {
+        adj[t.ends[k][0]].push_back({t.ends[k][1], k});
+        adj[t.ends[k][1]].push_back({t.ends[k][0], k});
+      }
+      std::vector<char> seen(t.nv, 0);
+      std::vector<St> st(t.nv, St{0, 0});
+      std::vector<std::uint32_t> q;
+      std::vector<std::uint32_t> roots{opt.locked_vertex};
+      for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
+      for (std::uint32_t v0 : roots) {
+        if (seen[v0]) continue;
+        seen[v0] = 1;
+        q.assign(1, v0);
+        for (std::size_t qi = 0; qi < q.size(); ++qi) {
+          const std::uint32_t i = q[qi];
+          for (auto [j, k] : adj[i]) {
+            if (seen[j]) continue;
+            seen[j] = 1;
+            const int ma = turns[k][0], mb = turns[k][1];
+            if (t.ends[k][0] == i) {
+              const St c = turn_st(st[i], -ma);
+              st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
+            } else {
+              const St c = turn_st(st[i], -mb);
+              st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
+            }
+            q.push_back(j);
           }
-          q.push_back(j);
         }
       }
+      for (std::size_t v = 0; v < t.nv; ++v) {
+        zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
+        zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
+      }
     }
-    for (std::size_t v = 0; v < t.nv; ++v) {
-      zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
-      zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
-    }
-  }
-  split(bd.start);
+  };
 
+  // Again two independent pieces side by side: the sparsity pattern and its
+  // symbolic analysis (they depend on the order and the cut parities only;
+  // redone only when those changed) and the edge maps with the
+  // spanning-tree start (field values only).
   std::string failure;
-  if (n > 0) {
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        if (rebuild) {
+          pattern = std::make_unique<PgpPattern>(make_pattern(t, var, count, parity));
+          pattern->natural = natural;
+        }
+        bd.pattern = tt.seconds();
+        tt.reset();
+        if (n > 0 && !same_pattern) {
+          // Symbolic analysis of the pattern alone (values are filled later).
+          solver.analyzePattern(pattern->A);
+          if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
+          factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
+        }
+        bd.analysis = tt.seconds();
+      },
+      [&] {
+        Timer tt;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k)
+            if (!partial || edge_mask[t.edges[k]] || var[t.ends[k][0]] >= 0 || var[t.ends[k][1]] >= 0)
+              maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
+        });
+        bd.field += tt.seconds();
+        tt.reset();
+        integrate_start();
+        bd.start = tt.seconds();
+      });
+  lap.reset();
+  const PgpPattern& P = *pattern;
+  bd.factor_flops = factor_size[0];
+  bd.factor_nonzeros = factor_size[1];
+
+  if (n > 0 && failure.empty()) {
     SpMat A;
     Eigen::VectorXd b, mass;
     Eigen::VectorXd x(n4);
@@ -794,15 +860,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     const double shift = opt.stiffness * unit;
     fill(shift, A, b, mass);
     split(bd.assembly);
-    if (!same_pattern || !analyzed) {
-      solver.analyzePattern(A);
-      if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
-      factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
-    }
-    bd.factor_flops = factor_size[0];
-    bd.factor_nonzeros = factor_size[1];
-    split(bd.analysis);
-    if (failure.empty()) {
+    {
       solver.factorize(A);
       if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
     }
@@ -872,6 +930,30 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   return res;
 }
 
+std::vector<char> PeriodicGlobalParameterization::Impl::initial_free_set() {
+  const std::size_t nv = mesh.num_vertices();
+  // Every vertex with an edge is free; the phase is fixed afterwards.
+  const PgpTopology& t = topology();
+  std::vector<char> free_vertex(nv, 0);
+  for (const auto& ij : t.ends) free_vertex[ij[0]] = free_vertex[ij[1]] = 1;
+  // One locked vertex per component (the paper's): locked_vertex for its
+  // component, the lowest index otherwise. With s and t coupled through the
+  // frames a constant shift of (s,t) is no symmetry any more, so the phase is
+  // fixed in the solve instead of afterwards.
+  {
+    std::vector<char> has(static_cast<std::size_t>(t.components), 0);
+    auto lock = [&](std::size_t v) {
+      const int c = t.component[v];
+      if (c < 0 || has[c]) return;
+      has[c] = 1;
+      free_vertex[v] = 0;
+    };
+    lock(opt.locked_vertex);
+    for (VertexIndex v : mesh.vertices()) lock(v.idx());
+  }
+  return free_vertex;
+}
+
 PeriodicGlobalParameterization::PeriodicGlobalParameterization(Mesh& mesh, PgpOptions options)
     : impl_(std::make_unique<Impl>(mesh, std::move(options))) {
   check_options(impl_->opt);
@@ -888,28 +970,21 @@ PgpResult PeriodicGlobalParameterization::initialize() {
                             std::to_string(nv) + " vertices)");
   impl_->zs.assign(nv, Cplx(1, 0));
   impl_->zt.assign(nv, Cplx(1, 0));
-  // Every vertex with an edge is free; the phase is fixed afterwards.
-  const PgpTopology& t = impl_->topology();
-  std::vector<char> free_vertex(nv, 0);
-  for (const auto& ij : t.ends) free_vertex[ij[0]] = free_vertex[ij[1]] = 1;
-  // One locked vertex per component (the paper's): locked_vertex for its
-  // component, the lowest index otherwise. With s and t coupled through the
-  // frames a constant shift of (s,t) is no symmetry any more, so the phase is
-  // fixed in the solve instead of afterwards.
-  {
-    std::vector<char> has(static_cast<std::size_t>(t.components), 0);
-    auto lock = [&](std::size_t v) {
-      const int c = t.component[v];
-      if (c < 0 || has[c]) return;
-      has[c] = 1;
-      free_vertex[v] = 0;
-    };
-    lock(impl_->opt.locked_vertex);
-    for (VertexIndex v : mesh.vertices()) lock(v.idx());
-  }
+  const std::vector<char> free_vertex = impl_->initial_free_set();
   PgpResult r = impl_->solve(free_vertex, nullptr, true);
   impl_->initialized = true;
   return r;
+}
+
+void PeriodicGlobalParameterization::prepare() {
+  Mesh& mesh = impl_->mesh;
+  require_triangle_mesh(mesh, "periodic_global_parameterization");
+  if (impl_->opt.locked_vertex >= mesh.num_vertices() || mesh.is_removed(VertexIndex(impl_->opt.locked_vertex)))
+    return;  // initialize() reports it
+  int count = 0;
+  std::vector<int> natural = Impl::natural_numbering(mesh, impl_->initial_free_set(), count);
+  std::vector<int> var = nested_dissection_order(natural, count, impl_->topology().ends);
+  impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
 }
 
 PgpResult PeriodicGlobalParameterization::update(const EffectArea& area) {

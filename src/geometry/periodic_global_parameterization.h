@@ -161,6 +161,14 @@ class PeriodicGlobalParameterization {
   PeriodicGlobalParameterization(const PeriodicGlobalParameterization&) = delete;
   PeriodicGlobalParameterization& operator=(const PeriodicGlobalParameterization&) = delete;
 
+  /// Optional, ahead of initialize(): the work of the initialisation that
+  /// depends on the connectivity only (topology, fill-reducing order of the
+  /// free vertices, ~0.1 s at 52K triangles), for a caller to run while it
+  /// computes the direction field (e.g. with tbb::parallel_invoke). It reads
+  /// the mesh's connectivity and points and no property map, and adds none;
+  /// the mesh must not change afterwards (else initialize() redoes it).
+  /// initialize() gives the same bytes with or without it.
+  void prepare();
   /// Global solve (one locked vertex per component); writes every corner.
   PgpResult initialize();
   /// Local solve: vertices outside area.vertex_free keep their previous
