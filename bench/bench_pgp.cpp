@@ -57,6 +57,7 @@
 // detect_singularities line): 55% lie within 3 edges of a field-singular
 // vertex; distorted faces are 9.4% of all and their rings triple that.
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <ctime>
@@ -317,6 +318,35 @@ int main(int argc, char** argv) {
     cpu_total += g_last_cpu;
     g_last_cpu = cpu_total;
     emit(name, nf, "local_update_total", t_dir + t_scale + t_pgp, {{"area_faces", area.free_faces}});
+    // The whole update as one timed run, as the pipeline (material-map
+    // --update) does it: orientation and scale side by side (independent
+    // maps), then the PGP. "new_area": each of the 3 runs a new constraint
+    // at another seed vertex, hence another effect area (ordering, pattern
+    // and symbolic analysis redone: the PGP's first-call path);
+    // "same_area": the area of the first run again (analysis reused).
+    {
+      PgpResult last_whole;
+      auto whole = [&](std::uint32_t s) {
+        const EffectArea a2 = compute_effect_area(mesh, {s}, eo);
+        DirectionFieldOptions d2;
+        d2.area = &a2;
+        ScalarFieldOptions s2 = scale_field_options();
+        s2.area = &a2;
+        const std::uint32_t f2 = static_cast<std::uint32_t>(mesh.face(mesh.halfedge(VertexIndex(s))).idx());
+        tbb::parallel_invoke([&] { interpolate_direction_field(mesh, {{f2, {0.0, 1.0, 1.0}}}, d2); },
+                             [&] { interpolate_scalar_field(mesh, {{s, 0.7 * period}}, s2); });
+        last_whole = pgp.update(a2);
+      };
+      int run = 0;
+      const std::uint32_t nvtx = static_cast<std::uint32_t>(mesh.number_of_vertices());
+      const double t_new = best_of_3([&] { whole((seed + (++run) * (nvtx / 7)) % nvtx); });
+      emit(name, nf, "local_update_whole_new_area", t_new,
+           {{"note", "effect area computed inside the timer; orientation || scale, then PGP"},
+            {"breakdown", breakdown(last_whole)}});
+      whole(seed);
+      const double t_same = best_of_3([&] { whole(seed); });
+      emit(name, nf, "local_update_whole_same_area", t_same, {{"breakdown", breakdown(last_whole)}});
+    }
 
     // Singular fraction against the curvature field's smoothness: jet-fitting
     // rings and the fraction of faces constrained (8 edges per period).
