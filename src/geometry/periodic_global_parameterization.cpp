@@ -33,6 +33,19 @@ using SpMat = Eigen::SparseMatrix<double>;
 // supernode kernels go through the BLAS libcholmod is linked with.
 using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
 
+/// METIS nested dissection of one graph (CSR, 0-based); iperm[v] = position
+/// of v. Returns false on a METIS failure.
+bool metis_order(std::vector<idx_t>& xadj, std::vector<idx_t>& adjncy, std::vector<idx_t>& iperm) {
+  idx_t nv = static_cast<idx_t>(xadj.size()) - 1;
+  iperm.assign(static_cast<std::size_t>(nv), 0);
+  if (nv == 0) return true;
+  std::vector<idx_t> perm(static_cast<std::size_t>(nv));
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_NUMBERING] = 0;
+  return METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) == METIS_OK;
+}
+
 /// Fill-reducing order of the free vertices: METIS nested dissection of the
 /// vertex graph (free vertices, edges between two of them), each vertex's
 /// 4 unknowns kept together. Ordering this graph (n nodes) instead of the
@@ -41,8 +54,19 @@ using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
 /// flops) and gives CHOLMOD supernodes of whole vertices; on armadillo_52k
 /// the factorisation takes 1.83e9 flops, against 2.32e9 with CHOLMOD's
 /// default AMD on the scalar graph (the 25% update area: 2.18e8 vs 2.22e8,
-/// no gain there). Deterministic (METIS' default seed). Returns var
-/// renumbered; on a METIS failure (or tiny systems) the input order is kept.
+/// no gain there). Measured alternatives (armadillo_52k, issue #5): METIS on
+/// the 2n-node graph of the (s,t) pairs (the parity double cover) 1.49e9
+/// flops, 1.39e9 with 3 separators per level, but 2.5-5x the ordering time
+/// and it depends on the field (cannot run beside it); full 4x4 blocks
+/// instead of the parity pattern 2.25e9; CHOLMOD's supernode relaxation
+/// (nrelax/zrelax) changed nothing measurable. Deterministic (METIS' default
+/// seed) provided no other thread calls rand() meanwhile: Debian's METIS 5.1
+/// draws its random numbers from libc's rand() (srand(seed) at each call),
+/// one global state. Two METIS calls side by side (the two halves of the top
+/// separator ordered in parallel, tried for issue #5) gave a different order
+/// on each run; surftex itself never calls rand() (seeded std::mt19937_64),
+/// so the order may run beside the field's work. Returns var renumbered; on
+/// a METIS failure (or tiny systems) the input order is kept.
 std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
                                          const std::vector<std::array<std::uint32_t, 2>>& ends) {
   if (n < 16) return var;
@@ -61,13 +85,9 @@ std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
     adjncy[degree[a]++] = b;
     adjncy[degree[b]++] = a;
   }
-  idx_t nv = n;
-  std::vector<idx_t> perm(static_cast<std::size_t>(n)), iperm(static_cast<std::size_t>(n));
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_NUMBERING] = 0;
-  if (METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) != METIS_OK)
-    return var;
+  std::vector<idx_t> iperm;
+  const bool ok = metis_order(xadj, adjncy, iperm);
+  if (!ok) return var;
   std::vector<int> out(var.size(), -1);
   for (std::size_t v = 0; v < var.size(); ++v)
     if (var[v] >= 0) out[v] = static_cast<int>(iperm[static_cast<std::size_t>(var[v])]);
