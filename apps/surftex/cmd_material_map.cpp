@@ -296,10 +296,11 @@ int run(const Args& a) {
                           {"faces", area.free_faces},
                           {"vertices", area.free_vertices}};
     // Orientation and scalar fields are independent (a face map, vertex
-    // maps that all exist after load_state): side by side.
+    // maps that all exist after load_state), and so is the PGP's order of
+    // the area's free vertices (connectivity only): side by side.
     t = Timer();
     double direction_seconds = 0, scalar_seconds = 0;
-    tbb::parallel_invoke([&] {
+    tbb::parallel_invoke([&] { pgp.prepare(area); }, [&] {
       Timer td;
       if (!c.directions.empty()) {
         DirectionFieldOptions dopt;

@@ -1007,6 +1007,15 @@ void PeriodicGlobalParameterization::prepare() {
   impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
 }
 
+void PeriodicGlobalParameterization::prepare(const EffectArea& area) {
+  Mesh& mesh = impl_->mesh;
+  if (area.vertex_free.size() != mesh.num_vertices()) return;  // update() reports it
+  int count = 0;
+  std::vector<int> natural = Impl::natural_numbering(mesh, area.vertex_free, count);
+  std::vector<int> var = nested_dissection_order(natural, count, impl_->topology().ends);
+  impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
+}
+
 PgpResult PeriodicGlobalParameterization::update(const EffectArea& area) {
   if (!impl_->initialized)
     throw InvalidInputError("PeriodicGlobalParameterization::update called before initialize()");

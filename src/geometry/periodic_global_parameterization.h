@@ -177,6 +177,10 @@ class PeriodicGlobalParameterization {
   /// the mesh must not change afterwards (else initialize() redoes it).
   /// initialize() gives the same bytes with or without it.
   void prepare();
+  /// The same ahead of update(area): the order of the area's free vertices,
+  /// for a caller to compute while it interpolates the orientation and scale
+  /// in the area (update() then reuses it; same bytes).
+  void prepare(const EffectArea& area);
   /// Global solve (one locked vertex per component); writes every corner.
   PgpResult initialize();
   /// Local solve: vertices outside area.vertex_free keep their previous

@@ -273,9 +273,10 @@ TEST(PeriodicGlobalParameterization, SameBytesWithOneOrTwoThreadsOnFandiskInitAn
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
 
-// prepare() (connectivity-only work, run here while the direction field is
-// interpolated, as the material-map pipeline does) changes no byte of the
-// initialisation, and the initialisation then skips the ordering.
+// prepare() and prepare(area) (connectivity-only work, run here while the
+// direction field is interpolated, as the material-map pipeline does) change
+// no byte of the initialisation and of a local update, which then skip the
+// ordering.
 TEST(PeriodicGlobalParameterization, PrepareAheadGivesTheSameBytes) {
   auto run = [](bool ahead) {
     Mesh m;
@@ -292,6 +293,24 @@ TEST(PeriodicGlobalParameterization, PrepareAheadGivesTheSameBytes) {
       EXPECT_LT(r.breakdown.ordering, 1e-3);  // the prepared order is reused
     }
     std::vector<double> out{r.energy_s, r.energy_t};
+    // A local update, its area's order prepared beside the new orientation.
+    EffectAreaOptions eo;
+    eo.radius = 2.0;
+    const EffectArea area = compute_effect_area(m, {700}, eo);
+    DirectionFieldOptions dopt;
+    dopt.area = &area;
+    const auto cf = static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(700))).idx());
+    auto local = [&] { interpolate_direction_field(m, {{cf, {1, 1, 1}}}, dopt); };
+    if (ahead)
+      tbb::parallel_invoke(local, [&] { pgp.prepare(area); });
+    else
+      local();
+    const PgpResult u = pgp.update(area);
+    EXPECT_GT(u.free_vertices, 30u);  // METIS orders it (>= 16)
+    if (ahead) {
+      EXPECT_LT(u.breakdown.ordering, 1e-3);
+    }
+    out.insert(out.end(), {u.energy_s, u.energy_t});
     auto stm = find(m, kCornerSTM).first;
     for (HalfedgeIndex h : m.halfedges())
       if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
