@@ -676,47 +676,6 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   std::vector<int> var;
   std::vector<std::array<double, 2>> ealpha;
   std::vector<std::array<int, 2>> turns(t.ends.size());
-  tbb::parallel_invoke(
-      [&] {
-        Timer tt;
-        var = known_order ? *known_order : nested_dissection_order(natural, count, t.ends);
-        bd.ordering = tt.seconds();
-      },
-      [&] {
-        Timer tt;
-        // Faces whose gradient may have changed (free faces) and edges whose
-        // alpha may have (edges of free faces): everything when no valid cache.
-        if (partial) {
-          face_mask.assign(t.nf, 0);
-          edge_mask.assign(t.ne, 0);
-          for (std::uint32_t f : t.faces) {
-            if (!(*free_face)[f]) continue;
-            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
-              edge_mask[mesh.edge(h).idx()] = 1;
-              face_mask[f] = 1;
-              // the opposite face's gradient enters the edge's alpha: unchanged
-              // unless free, so it is read from the cache
-            }
-          }
-        }
-        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
-        halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
-        corner = corner_matchings(mesh, quarter);
-        ealpha = edge_alphas(alpha);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t k = r.begin(); k != r.end(); ++k) turns[k] = edge_turns(k);
-        });
-        bd.field = tt.seconds();
-      });
-  lap.reset();
-
-  std::vector<std::uint8_t> parity(t.ends.size());
-  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
-  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity;
-  const bool same_pattern = analyzed && !rebuild;
-  res.reused_analysis = same_pattern;
-  analyzed = same_pattern;
   // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
   // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
   // the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
@@ -728,6 +687,14 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
   std::vector<Mat4> maps(t.ends.size());
+  auto compute_maps = [&](const std::vector<int>* order) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+        if (!order || edge_mask[t.edges[k]] || (*order)[t.ends[k][0]] >= 0 || (*order)[t.ends[k][1]] >= 0)
+          maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
+    });
+  };
   auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
     const PgpPattern& P = *pattern;
     A = P.A;
@@ -820,11 +787,65 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     }
   };
 
-  // Again two independent pieces side by side: the sparsity pattern and its
-  // symbolic analysis (they depend on the order and the cut parities only;
-  // redone only when those changed) and the edge maps with the
-  // spanning-tree start (field values only).
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        var = known_order ? *known_order : nested_dissection_order(natural, count, t.ends);
+        bd.ordering = tt.seconds();
+      },
+      [&] {
+        Timer tt;
+        // Faces whose gradient may have changed (free faces) and edges whose
+        // alpha may have (edges of free faces): everything when no valid cache.
+        if (partial) {
+          face_mask.assign(t.nf, 0);
+          edge_mask.assign(t.ne, 0);
+          for (std::uint32_t f : t.faces) {
+            if (!(*free_face)[f]) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
+              edge_mask[mesh.edge(h).idx()] = 1;
+              face_mask[f] = 1;
+              // the opposite face's gradient enters the edge's alpha: unchanged
+              // unless free, so it is read from the cache
+            }
+          }
+        }
+        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+        halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
+        corner = corner_matchings(mesh, quarter);
+        ealpha = edge_alphas(alpha);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) turns[k] = edge_turns(k);
+        });
+        if (!partial) {
+          // Every edge map is read (no locked region): computed here, beside
+          // the ordering, with the spanning-tree start.
+          compute_maps(nullptr);
+          bd.field = tt.seconds();
+          tt.reset();
+          integrate_start();
+          bd.start = tt.seconds();
+        } else {
+          bd.field = tt.seconds();
+        }
+      });
+  lap.reset();
+
+  std::vector<std::uint8_t> parity(t.ends.size());
+  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
+  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity;
+  const bool same_pattern = analyzed && !rebuild;
+  res.reused_analysis = same_pattern;
+  analyzed = same_pattern;
+  // Then the sparsity pattern (it depends on the order and the cut parities
+  // only; rebuilt only when those changed) beside the edge maps of a local
+  // update (only those next to its free vertices), and the pattern's
+  // symbolic analysis beside the assembly of the values.
   std::string failure;
+  SpMat A;
+  Eigen::VectorXd b, mass;
+  const double shift = opt.stiffness * unit;
   tbb::parallel_invoke(
       [&] {
         Timer tt;
@@ -833,9 +854,18 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
           pattern->natural = natural;
         }
         bd.pattern = tt.seconds();
-        tt.reset();
+      },
+      [&] {
+        if (!partial) return;
+        Timer tt;
+        compute_maps(&var);
+        bd.field += tt.seconds();
+      });
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
         if (n > 0 && !same_pattern) {
-          // Symbolic analysis of the pattern alone (values are filled later).
+          // Symbolic analysis of the pattern alone (the values come beside).
           solver.analyzePattern(pattern->A);
           if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
           factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
@@ -844,16 +874,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       },
       [&] {
         Timer tt;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t k = r.begin(); k != r.end(); ++k)
-            if (!partial || edge_mask[t.edges[k]] || var[t.ends[k][0]] >= 0 || var[t.ends[k][1]] >= 0)
-              maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
-        });
-        bd.field += tt.seconds();
-        tt.reset();
-        integrate_start();
-        bd.start = tt.seconds();
+        if (n > 0) fill(shift, A, b, mass);
+        bd.assembly = tt.seconds();
       });
   lap.reset();
   const PgpPattern& P = *pattern;
@@ -861,8 +883,6 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   bd.factor_nonzeros = factor_size[1];
 
   if (n > 0 && failure.empty()) {
-    SpMat A;
-    Eigen::VectorXd b, mass;
     Eigen::VectorXd x(n4);
     for (std::size_t v = 0; v < t.nv; ++v)
       if (P.var[v] >= 0) {
@@ -877,13 +897,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
     // fandisk), and F's smallest eigenvector localises where the field's curl
     // is low, its tail not following the field (80% distorted faces on a torus).
-    const double shift = opt.stiffness * unit;
-    fill(shift, A, b, mass);
-    split(bd.assembly);
-    {
-      solver.factorize(A);
-      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
-    }
+    solver.factorize(A);
+    if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
     split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
     Eigen::VectorXd rhs(n4);

@@ -33,9 +33,9 @@
 // keeping that order, ordering and symbolic analysis reused while the free
 // set and the cut parities are unchanged). The connectivity-only work runs
 // beside the field-dependent work on a second thread (the METIS order beside
-// the gradients and alphas, the pattern and its symbolic analysis beside the
-// edge maps and the start; same bytes on any number of threads), and
-// prepare() lets a caller start it while the direction field is computed. CHOLMOD's dense kernels run on
+// the gradients, alphas, edge maps and the start; the symbolic analysis
+// beside the assembly; same bytes on any number of threads), and prepare()
+// lets a caller start the order while the direction field is computed. CHOLMOD's dense kernels run on
 // the BLAS libcholmod is linked with: Debian's default netlib BLAS is
 // single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
 // at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
@@ -126,10 +126,11 @@ struct PgpResult {
   /// BLAS; see the BLAS note above).
   std::string blas_core;
   /// Wall-time breakdown of `seconds` (each step's own wall time, seconds).
-  /// Two pairs of steps run side by side (tbb::parallel_invoke), so the sum
-  /// exceeds `seconds` on several threads: `ordering` beside `field`'s
-  /// gradients/alphas/matchings, and `pattern` + `analysis` beside the edge
-  /// maps (counted in `field`) + `start`.
+  /// Three pairs of steps run side by side (tbb::parallel_invoke), so the
+  /// sum exceeds `seconds` on several threads: `ordering` beside `field`
+  /// (gradients, alphas, matchings and, when every edge map is read, the
+  /// edge maps) + `start`; `pattern` beside a local update's edge maps
+  /// (counted in `field`); `analysis` beside `assembly`.
   struct Breakdown {
     double topology = 0;     ///< connectivity, areas, frames (first call only)
     double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
