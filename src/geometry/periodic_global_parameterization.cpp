@@ -582,6 +582,13 @@ struct PeriodicGlobalParameterization::Impl {
     return {corner[o.idx()], corner[mesh.prev(o).idx()]};
   }
   PgpResult solve(const std::vector<char>& free_vertex, const std::vector<char>* free_face, bool global);
+  /// The order of this free set (unknown index per vertex in vertex order)
+  /// computed before (last solve or prepare()), nullptr if none.
+  const std::vector<int>* known_order(const std::vector<int>& natural) const {
+    if (pattern && pattern->natural == natural) return &pattern->var;
+    if (prepared && prepared->first == natural) return &prepared->second;
+    return nullptr;
+  }
   /// Free vertices of the initialisation: every vertex with an edge but one
   /// reference vertex per component.
   std::vector<char> initial_free_set();
@@ -659,11 +666,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   int count = 0;
   const std::vector<int> natural = natural_numbering(mesh, free_vertex, count);
   res.free_vertices = static_cast<std::size_t>(count);
-  const std::vector<int>* known_order = nullptr;  // order of this free set computed before
-  if (pattern && pattern->natural == natural)
-    known_order = &pattern->var;
-  else if (prepared && prepared->first == natural)
-    known_order = &prepared->second;
+  const std::vector<int>* order_known = known_order(natural);
   split(bd.topology);
 
   // Two independent pieces of work side by side: the fill-reducing order
@@ -790,7 +793,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   tbb::parallel_invoke(
       [&] {
         Timer tt;
-        var = known_order ? *known_order : nested_dissection_order(natural, count, t.ends);
+        var = order_known ? *order_known : nested_dissection_order(natural, count, t.ends);
         bd.ordering = tt.seconds();
       },
       [&] {
@@ -1018,6 +1021,7 @@ void PeriodicGlobalParameterization::prepare() {
     return;  // initialize() reports it
   int count = 0;
   std::vector<int> natural = Impl::natural_numbering(mesh, impl_->initial_free_set(), count);
+  if (impl_->known_order(natural)) return;  // ordered already
   std::vector<int> var = nested_dissection_order(natural, count, impl_->topology().ends);
   impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
 }
@@ -1027,7 +1031,9 @@ void PeriodicGlobalParameterization::prepare(const EffectArea& area) {
   if (area.vertex_free.size() != mesh.num_vertices()) return;  // update() reports it
   int count = 0;
   std::vector<int> natural = Impl::natural_numbering(mesh, area.vertex_free, count);
-  std::vector<int> var = nested_dissection_order(natural, count, impl_->topology().ends);
+  const PgpTopology& t = impl_->topology();
+  if (impl_->known_order(natural)) return;  // same free set as before: ordered already
+  std::vector<int> var = nested_dissection_order(natural, count, t.ends);
   impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
 }
 
