@@ -473,8 +473,12 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
 /// fan both ways from the reference face, accumulating the edge matchings
 /// (around a field singularity the walk stops where it started: one spoke
 /// then carries the holonomy).
-std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
-  std::vector<std::uint8_t> cm(mesh.num_halfedges(), 0);
+/// Into `cm` (resized to the halfedges); with `vertex_mask`, only the
+/// vertices set in it are recomputed (a vertex's matchings depend on the
+/// edge matchings of its own edges only), the others keep their entries.
+void corner_matchings_into(const Mesh& mesh, const std::vector<std::uint8_t>& quarter,
+                           const std::vector<char>* vertex_mask, std::vector<std::uint8_t>& cm) {
+  cm.resize(mesh.num_halfedges(), 0);
   // Each vertex writes only the halfedges pointing to it: independent, so
   // the vertices run in parallel (same bytes for any thread count).
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_vertices(), 4096),
@@ -482,8 +486,10 @@ std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<s
   std::vector<HalfedgeIndex> fan;
   std::vector<int> m;
   for (std::size_t vi = range.begin(); vi != range.end(); ++vi) {
+    if (vertex_mask && !(*vertex_mask)[vi]) continue;
     const VertexIndex v(static_cast<Mesh::size_type>(vi));
     if (mesh.is_removed(v) || mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) cm[h.idx()] = 0;
     fan.clear();
     for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) fan.push_back(h);
     const std::size_t d = fan.size();
@@ -514,6 +520,11 @@ std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<s
       if (m[i] >= 0) cm[fan[i].idx()] = static_cast<std::uint8_t>(m[i]);
   }
   });
+}
+
+std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
+  std::vector<std::uint8_t> cm;
+  corner_matchings_into(mesh, quarter, nullptr, cm);
   return cm;
 }
 
@@ -815,7 +826,15 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         }
         face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
         halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
-        corner = corner_matchings(mesh, quarter);
+        if (partial) {
+          // Only the vertices of edges whose matching may have changed.
+          std::vector<char> vertex_mask(t.nv, 0);
+          for (std::size_t k = 0; k < t.ends.size(); ++k)
+            if (edge_mask[t.edges[k]]) vertex_mask[t.ends[k][0]] = vertex_mask[t.ends[k][1]] = 1;
+          corner_matchings_into(mesh, quarter, &vertex_mask, corner);
+        } else {
+          corner = corner_matchings(mesh, quarter);
+        }
         ealpha = edge_alphas(alpha);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
                           [&](const tbb::blocked_range<std::size_t>& r) {
