@@ -70,9 +70,10 @@
 // What changed: (1) OpenBLAS 0.3.21 does not know this Xeon (AVX-512) and
 // ran its generic SSE3 kernels (dgemm 12 GFlop/s; 63 with SkylakeX):
 // switched once per process; (2) the METIS order runs beside the field's
-// gradients/alphas/matchings, the pattern + symbolic analysis beside the edge
-// maps + start; (3) prepare()/prepare(area) for callers that can start the
-// order earlier (material-map, local_update_whole_*). Same bytes before and
+// gradients/alphas/matchings, edge maps and spanning-tree start, the
+// symbolic analysis beside the assembly, corner matchings in parallel (only
+// near the area in an update); (3) prepare()/prepare(area) for callers that
+// can start the order earlier (material-map, local_update_whole_*). Same bytes before and
 // after (2) and (3); (1) changes the rounding of the factor (the kernels).
 // Singular fraction unchanged: fandisk 9.58%, dragon_25k 58.43%,
 // armadillo_52k 29.59%.
