@@ -35,16 +35,16 @@
 // beside the field-dependent work on a second thread (the METIS order beside
 // the gradients, alphas, edge maps and the start; the symbolic analysis
 // beside the assembly; same bytes on any number of threads), and prepare()
-// lets a caller start the order while the direction field is computed. CHOLMOD's dense kernels run on
-// the BLAS libcholmod is linked with: Debian's default netlib BLAS is
+// lets a caller start the order while the direction field is computed.
+// CHOLMOD's dense kernels run on the BLAS libcholmod is linked with: Debian's default netlib BLAS is
 // single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
 // at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
 // do not depend on the machine's cores (its threaded build gives different
 // bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
 // and falls back to its generic SSE3 kernels, it is switched to its AVX-512
-// (or AVX2) kernels once per process (PgpResult::blas_core names the set). The paper writes R with the opposite
-// rotation sign and a 2 pi missing in the rounding of (4); we use the
-// self-consistent signs.
+// (or AVX2) kernels once per process (PgpResult::blas_core names the set).
+// The paper writes R with the opposite rotation sign and a 2 pi missing in
+// the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
 //     minimiser decays away from the locked vertex (median |z| ~ 3e-3 on
 //     fandisk) and its phase stops following the field; F's smallest
