@@ -38,8 +38,9 @@
 // lets a caller start the order while the direction field is computed.
 // CHOLMOD's dense kernels run on the BLAS libcholmod is linked with:
 // Debian's default netlib BLAS is single-threaded (and slow: the
-// factorisation dominates, about 1.8e9 flops at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
-// do not depend on the machine's cores (its threaded build gives different
+// factorisation dominates, about 1.8e9 flops at 52K triangles); an OpenBLAS
+// is pinned to one thread so that the bytes do not depend on the machine's
+// cores (its threaded build gives different
 // bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
 // and falls back to its generic SSE3 kernels, it is switched to its AVX-512
 // (or AVX2) kernels once per process (PgpResult::blas_core names the set).
