@@ -15,7 +15,12 @@ PKGS=(
   libsuitesparse-dev libmetis-dev
   # An optimised single-threaded BLAS/LAPACK behind CHOLMOD (PGP): takes over
   # libblas.so.3 through Debian's alternatives; serial, so results do not
-  # depend on a BLAS thread count.
+  # depend on a BLAS thread count (the pthread build gives different bytes
+  # per thread count: measured). OpenBLAS 0.3.21 does not know recent Xeons
+  # (AVX-512) and falls back to its generic "Prescott" kernels (5x slower
+  # dgemm); the PGP switches it to its SkylakeX/Haswell kernels at run time
+  # unless OPENBLAS_CORETYPE is set (periodic_global_parameterization.cpp,
+  # configure_blas).
   libopenblas0-serial
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.

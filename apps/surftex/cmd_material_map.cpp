@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/parallel_invoke.h>
+
 #include "geometry/direction_field.h"
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
@@ -239,23 +241,34 @@ int run(const Args& a) {
     std::vector<DirectionConstraint> dirs = c.directions;
     std::string field_source = "strokes";
     DirectionFieldOptions dopt;  // strokes and a constant vector: exact
-    if (dirs.empty()) {
-      field_source = a.field;
-      if (a.field == "curvature") {
-        // Principal directions are noisy: the constraints are made soft by a
-        // smoothing step (over ~8 face rings), which removes field
-        // singularities where nearby constraints disagree; armadillo_52k:
-        // 313 -> 243 field-singular vertices, singular faces 33.8% -> 28.2%
-        // (bench_pgp --field-sweep; 4-ring jets would give 26.7% for ~3x
-        // the curvature time).
-        compute_principal_curvatures(mesh);
-        dirs = constraints_from_principal_directions(mesh, 0.1);
-        dopt.smoothing = 64;
+    // The PGP's connectivity-only work (topology, METIS order) runs beside
+    // the curvature and direction field (it reads no property map).
+    double prepare_seconds = 0;
+    auto field = [&] {
+      if (dirs.empty()) {
+        field_source = a.field;
+        if (a.field == "curvature") {
+          // Principal directions are noisy: the constraints are made soft by a
+          // smoothing step (over ~8 face rings), which removes field
+          // singularities where nearby constraints disagree; armadillo_52k:
+          // 313 -> 243 field-singular vertices, singular faces 33.8% -> 28.2%
+          // (bench_pgp --field-sweep; 4-ring jets would give 26.7% for ~3x
+          // the curvature time).
+          compute_principal_curvatures(mesh);
+          dirs = constraints_from_principal_directions(mesh, 0.1);
+          dopt.smoothing = 64;
+        }
+        if (dirs.empty()) dirs = constraints_from_constant_vector(mesh, {0.0, 1.0, 0.0});
       }
-      if (dirs.empty()) dirs = constraints_from_constant_vector(mesh, {0.0, 1.0, 0.0});
-    }
-    interpolate_direction_field(mesh, dirs, dopt);
-    sec["direction_field"] = t.seconds();
+      interpolate_direction_field(mesh, dirs, dopt);
+    };
+    tbb::parallel_invoke(field, [&] {
+      Timer tp;
+      pgp.prepare();
+      prepare_seconds = tp.seconds();
+    });
+    sec["direction_field"] = t.seconds();  // with the PGP preparation alongside
+    sec["pgp_prepare"] = prepare_seconds;
     rep["field_source"] = field_source;
     rep["direction_constraints"] = dirs.size();
     t = Timer();
@@ -282,25 +295,36 @@ int run(const Args& a) {
     rep["effect_area"] = {{"radius", std::isfinite(c.effect_radius) ? nlohmann::json(c.effect_radius) : nlohmann::json()},
                           {"faces", area.free_faces},
                           {"vertices", area.free_vertices}};
+    // Orientation and scalar fields are independent (a face map, vertex
+    // maps that all exist after load_state), and so is the PGP's order of
+    // the area's free vertices (connectivity only): side by side.
     t = Timer();
-    if (!c.directions.empty()) {
-      DirectionFieldOptions dopt;
-      dopt.area = &area;
-      interpolate_direction_field(mesh, c.directions, dopt);
-    }
-    sec["direction_field"] = t.seconds();
-    t = Timer();
-    if (!c.scale.empty()) {
-      ScalarFieldOptions so = scale_field_options(1e-9 * default_scale, default_scale);
-      so.area = &area;
-      interpolate_scalar_field(mesh, c.scale, so);
-    }
-    if (!c.material.empty()) {
-      ScalarFieldOptions so = material_field_options();
-      so.area = &area;
-      interpolate_scalar_field(mesh, c.material, so);
-    }
-    sec["scalar_fields"] = t.seconds();
+    double direction_seconds = 0, scalar_seconds = 0;
+    tbb::parallel_invoke([&] { pgp.prepare(area); }, [&] {
+      Timer td;
+      if (!c.directions.empty()) {
+        DirectionFieldOptions dopt;
+        dopt.area = &area;
+        interpolate_direction_field(mesh, c.directions, dopt);
+      }
+      direction_seconds = td.seconds();
+    }, [&] {
+      Timer ts;
+      if (!c.scale.empty()) {
+        ScalarFieldOptions so = scale_field_options(1e-9 * default_scale, default_scale);
+        so.area = &area;
+        interpolate_scalar_field(mesh, c.scale, so);
+      }
+      if (!c.material.empty()) {
+        ScalarFieldOptions so = material_field_options();
+        so.area = &area;
+        interpolate_scalar_field(mesh, c.material, so);
+      }
+      scalar_seconds = ts.seconds();
+    });
+    sec["direction_field"] = direction_seconds;
+    sec["scalar_fields"] = scalar_seconds;
+    sec["fields_wall"] = t.seconds();
     t = Timer();
     pgp.write_corners();  // the loaded mesh has no corners yet; those outside the area stay as written now
     pgp.update(area);

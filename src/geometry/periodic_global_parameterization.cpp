@@ -10,6 +10,8 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <mutex>
@@ -31,6 +33,19 @@ using SpMat = Eigen::SparseMatrix<double>;
 // supernode kernels go through the BLAS libcholmod is linked with.
 using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
 
+/// METIS nested dissection of one graph (CSR, 0-based); iperm[v] = position
+/// of v. Returns false on a METIS failure.
+bool metis_order(std::vector<idx_t>& xadj, std::vector<idx_t>& adjncy, std::vector<idx_t>& iperm) {
+  idx_t nv = static_cast<idx_t>(xadj.size()) - 1;
+  iperm.assign(static_cast<std::size_t>(nv), 0);
+  if (nv == 0) return true;
+  std::vector<idx_t> perm(static_cast<std::size_t>(nv));
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_NUMBERING] = 0;
+  return METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) == METIS_OK;
+}
+
 /// Fill-reducing order of the free vertices: METIS nested dissection of the
 /// vertex graph (free vertices, edges between two of them), each vertex's
 /// 4 unknowns kept together. Ordering this graph (n nodes) instead of the
@@ -39,8 +54,19 @@ using Cholesky = Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower>;
 /// flops) and gives CHOLMOD supernodes of whole vertices; on armadillo_52k
 /// the factorisation takes 1.83e9 flops, against 2.32e9 with CHOLMOD's
 /// default AMD on the scalar graph (the 25% update area: 2.18e8 vs 2.22e8,
-/// no gain there). Deterministic (METIS' default seed). Returns var
-/// renumbered; on a METIS failure (or tiny systems) the input order is kept.
+/// no gain there). Measured alternatives (armadillo_52k, issue #5): METIS on
+/// the 2n-node graph of the (s,t) pairs (the parity double cover) 1.49e9
+/// flops, 1.39e9 with 3 separators per level, but 2.5-5x the ordering time
+/// and it depends on the field (cannot run beside it); full 4x4 blocks
+/// instead of the parity pattern 2.25e9; CHOLMOD's supernode relaxation
+/// (nrelax/zrelax) changed nothing measurable. Deterministic (METIS' default
+/// seed) provided no other thread calls rand() meanwhile: Debian's METIS 5.1
+/// draws its random numbers from libc's rand() (srand(seed) at each call),
+/// one global state. Two METIS calls side by side (the two halves of the top
+/// separator ordered in parallel, tried for issue #5) gave a different order
+/// on each run; surftex itself never calls rand() (seeded std::mt19937_64),
+/// so the order may run beside the field's work. Returns var renumbered; on
+/// a METIS failure (or tiny systems) the input order is kept.
 std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
                                          const std::vector<std::array<std::uint32_t, 2>>& ends) {
   if (n < 16) return var;
@@ -59,32 +85,73 @@ std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
     adjncy[degree[a]++] = b;
     adjncy[degree[b]++] = a;
   }
-  idx_t nv = n;
-  std::vector<idx_t> perm(static_cast<std::size_t>(n)), iperm(static_cast<std::size_t>(n));
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_NUMBERING] = 0;
-  if (METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) != METIS_OK)
-    return var;
+  std::vector<idx_t> iperm;
+  const bool ok = metis_order(xadj, adjncy, iperm);
+  if (!ok) return var;
   std::vector<int> out(var.size(), -1);
   for (std::size_t v = 0; v < var.size(); ++v)
     if (var[v] >= 0) out[v] = static_cast<int>(iperm[static_cast<std::size_t>(var[v])]);
   return out;
 }
 
-/// Same bytes whatever the thread count: Debian's default BLAS (netlib) is
-/// single-threaded; if an OpenBLAS provides libblas.so.3 instead
-/// (update-alternatives), its thread count (the machine's cores by default)
-/// could change the summation order of the supernodes' dense updates, so it
-/// is pinned to one thread (once per process; the supernodes are small, a
-/// single thread is what they would use anyway).
-void pin_blas_threads() {
-  static std::once_flag once;
-  std::call_once(once, [] {
+/// The BLAS behind CHOLMOD's dense supernode kernels, set up once per
+/// process before the first factorisation; returns the name of OpenBLAS's
+/// kernel set ("" for another BLAS).
+///  - Same bytes whatever the thread count: Debian's default BLAS (netlib) is
+///    single-threaded; an OpenBLAS providing libblas.so.3
+///    (update-alternatives) is pinned to one thread, since its thread count
+///    (the machine's cores by default) changes the bytes: measured with the
+///    pthread build on armadillo_52k, 1, 2, 3 and 4 BLAS threads gave four
+///    different solutions (its dpotrf blocks by thread count).
+///  - Kernels: OpenBLAS 0.3.21 (Debian 12) picks its kernels by CPU model
+///    and falls back to the generic SSE3 "Prescott" set on CPUs newer than
+///    it knows (this machine's Xeon with AVX-512: dgemm 12 GFlop/s instead
+///    of 63 with the SkylakeX set, dpotrf 15 instead of 29 on 600x600). When
+///    it reports Prescott on a CPU with AVX-512 (or AVX2+FMA) and the user has
+///    not chosen OPENBLAS_CORETYPE, it is re-initialised with the SkylakeX
+///    (Haswell) set through its dynamic-arch entry points (the documented
+///    OPENBLAS_CORETYPE variable, set for the call only). The kernels change
+///    the rounding of the factor (as on any other machine model), not the
+///    determinism: same machine, same bytes.
+const std::string& configure_blas() {
+  static const std::string core = [] {
     using SetThreads = void (*)(int);
     for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
       if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
-  });
+    using CoreName = char* (*)();
+    using Hook = void (*)();
+    void* name_fn = dlsym(RTLD_DEFAULT, "openblas_get_corename");
+    if (!name_fn) return std::string();
+    auto corename = [&] {
+      const char* c = reinterpret_cast<CoreName>(name_fn)();
+      return std::string(c ? c : "");
+    };
+    std::string current = corename();
+    std::string lower = current;
+    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    void* quit = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit");
+    void* init = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init");
+    if (lower != "prescott" || std::getenv("OPENBLAS_CORETYPE") || !quit || !init) return current;
+    const char* target = nullptr;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+      target = "SkylakeX";
+    else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+      target = "Haswell";
+#endif
+    if (!target) return current;
+    setenv("OPENBLAS_CORETYPE", target, 1);
+    reinterpret_cast<Hook>(quit)();
+    reinterpret_cast<Hook>(init)();
+    unsetenv("OPENBLAS_CORETYPE");
+    // re-pin (the thread count is kept by the re-initialisation, but cheaply sure)
+    for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
+      if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
+    return corename();
+  }();
+  return core;
 }
 using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
 using Mat4 = std::array<Vec4, 4>;    // [row][col]
@@ -406,12 +473,23 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
 /// fan both ways from the reference face, accumulating the edge matchings
 /// (around a field singularity the walk stops where it started: one spoke
 /// then carries the holonomy).
-std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
-  std::vector<std::uint8_t> cm(mesh.num_halfedges(), 0);
+/// Into `cm` (resized to the halfedges); with `vertex_mask`, only the
+/// vertices set in it are recomputed (a vertex's matchings depend on the
+/// edge matchings of its own edges only), the others keep their entries.
+void corner_matchings_into(const Mesh& mesh, const std::vector<std::uint8_t>& quarter,
+                           const std::vector<char>* vertex_mask, std::vector<std::uint8_t>& cm) {
+  cm.resize(mesh.num_halfedges(), 0);
+  // Each vertex writes only the halfedges pointing to it: independent, so
+  // the vertices run in parallel (same bytes for any thread count).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.num_vertices(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
   std::vector<HalfedgeIndex> fan;
   std::vector<int> m;
-  for (VertexIndex v : mesh.vertices()) {
-    if (mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+  for (std::size_t vi = range.begin(); vi != range.end(); ++vi) {
+    if (vertex_mask && !(*vertex_mask)[vi]) continue;
+    const VertexIndex v(static_cast<Mesh::size_type>(vi));
+    if (mesh.is_removed(v) || mesh.halfedge(v) == Mesh::null_halfedge()) continue;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) cm[h.idx()] = 0;
     fan.clear();
     for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) fan.push_back(h);
     const std::size_t d = fan.size();
@@ -441,6 +519,12 @@ std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<s
     for (std::size_t i = 0; i < d; ++i)
       if (m[i] >= 0) cm[fan[i].idx()] = static_cast<std::uint8_t>(m[i]);
   }
+  });
+}
+
+std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<std::uint8_t>& quarter) {
+  std::vector<std::uint8_t> cm;
+  corner_matchings_into(mesh, quarter, nullptr, cm);
   return cm;
 }
 
@@ -453,9 +537,12 @@ struct PeriodicGlobalParameterization::Impl {
   bool initialized = false;
   std::unique_ptr<PgpTopology> topo;
   std::unique_ptr<PgpPattern> pattern;
+  /// Order of the initial free set computed ahead by prepare(): (natural, var).
+  std::unique_ptr<std::pair<std::vector<int>, std::vector<int>>> prepared;
   Cholesky solver;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
+  std::string blas_core;  // OpenBLAS kernel set behind CHOLMOD ("" = another BLAS)
   // Field-dependent values of the last solve; a local update recomputes them
   // only next to the free faces (the only faces whose direction or scale
   // may have changed).
@@ -467,7 +554,7 @@ struct PeriodicGlobalParameterization::Impl {
   bool cache_valid = false;
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
-    pin_blas_threads();
+    blas_core = configure_blas();
     solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
     // The unknowns come in nested-dissection order (nested_dissection_order):
     // CHOLMOD keeps it (then postorders the elimination tree).
@@ -479,6 +566,7 @@ struct PeriodicGlobalParameterization::Impl {
     if (!topo || !topo->matches(mesh)) {
       topo = std::make_unique<PgpTopology>(make_topology(mesh));
       pattern.reset();
+      prepared.reset();
       analyzed = false;
       cache_valid = false;
     }
@@ -505,6 +593,24 @@ struct PeriodicGlobalParameterization::Impl {
     return {corner[o.idx()], corner[mesh.prev(o).idx()]};
   }
   PgpResult solve(const std::vector<char>& free_vertex, const std::vector<char>* free_face, bool global);
+  /// The order of this free set (unknown index per vertex in vertex order)
+  /// computed before (last solve or prepare()), nullptr if none.
+  const std::vector<int>* known_order(const std::vector<int>& natural) const {
+    if (pattern && pattern->natural == natural) return &pattern->var;
+    if (prepared && prepared->first == natural) return &prepared->second;
+    return nullptr;
+  }
+  /// Free vertices of the initialisation: every vertex with an edge but one
+  /// reference vertex per component.
+  std::vector<char> initial_free_set();
+  /// Unknown index per vertex in vertex order, -1 if not free, and the count.
+  static std::vector<int> natural_numbering(const Mesh& mesh, const std::vector<char>& free_vertex, int& count) {
+    std::vector<int> natural(mesh.num_vertices(), -1);
+    count = 0;
+    for (VertexIndex v : mesh.vertices())
+      if (free_vertex[v.idx()]) natural[v.idx()] = count++;
+    return natural;
+  }
   void write_corners(const std::vector<std::array<double, 2>>& alpha, const std::vector<char>* free_face);
 };
 
@@ -557,6 +663,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
                                                       const std::vector<char>* free_face, bool global) {
   Timer timer, lap;
   PgpResult res;
+  res.blas_core = blas_core;
   PgpResult::Breakdown& bd = res.breakdown;
   auto split = [&lap](double& into) {
     into += lap.seconds();
@@ -566,75 +673,44 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   require_triangle_mesh(mesh, "periodic_global_parameterization");
   const PgpTopology& t = topology();
   split(bd.topology);
-  // Faces whose gradient may have changed (free faces) and edges whose alpha
-  // may have (edges of free faces): everything when no valid cache.
+  // The free unknowns in vertex order (identifies the free set).
+  int count = 0;
+  const std::vector<int> natural = natural_numbering(mesh, free_vertex, count);
+  res.free_vertices = static_cast<std::size_t>(count);
+  const std::vector<int>* order_known = known_order(natural);
+  split(bd.topology);
+
+  // Two independent pieces of work side by side: the fill-reducing order
+  // (one serial METIS call; it depends on the free set and the connectivity
+  // only, and is redone only when the free set changed) and the field's
+  // quantities (parallel loops over the faces and edges). Neither reads what
+  // the other writes, so the bytes do not depend on which thread runs what.
   std::vector<char> face_mask, edge_mask;
   const bool partial = free_face && cache_valid;
-  if (partial) {
-    face_mask.assign(t.nf, 0);
-    edge_mask.assign(t.ne, 0);
-    for (std::uint32_t f : t.faces) {
-      if (!(*free_face)[f]) continue;
-      for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
-        edge_mask[mesh.edge(h).idx()] = 1;
-        face_mask[f] = 1;
-        // the opposite face's gradient enters the edge's alpha: unchanged
-        // unless free, so it is read from the cache
-      }
-    }
-  }
-  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
-  halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
-  corner = corner_matchings(mesh, quarter);
-  const auto ealpha = edge_alphas(alpha);
+  std::vector<int> var;
+  std::vector<std::array<double, 2>> ealpha;
   std::vector<std::array<int, 2>> turns(t.ends.size());
-  for (std::size_t k = 0; k < t.ends.size(); ++k) turns[k] = edge_turns(k);
-  split(bd.field);
-
-  std::vector<int> var(t.nv, -1);
-  int count = 0;
-  for (VertexIndex v : mesh.vertices())
-    if (free_vertex[v.idx()]) var[v.idx()] = count++;
-  split(bd.field);
-  // The free set (hence its order) changes rarely: reorder only then.
-  std::vector<int> natural = var;
-  if (pattern && pattern->natural == natural)
-    var = pattern->var;
-  else
-    var = nested_dissection_order(var, count, t.ends);
-  split(bd.ordering);
-  res.free_vertices = static_cast<std::size_t>(count);
-  std::vector<std::uint8_t> parity(t.ends.size());
-  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
-  const bool same_pattern = analyzed && pattern && pattern->var == var && pattern->parity == parity;
-  res.reused_analysis = same_pattern;
-  if (!pattern || pattern->var != var || pattern->parity != parity) {
-    pattern = std::make_unique<PgpPattern>(make_pattern(t, std::move(var), count, std::move(parity)));
-    pattern->natural = std::move(natural);
-  }
-  analyzed = analyzed && same_pattern;
-  const PgpPattern& P = *pattern;
-  const int n = P.n;
-  split(bd.pattern);
-
   // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
   // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
   // the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
   // (edge_map): A(i,i) += w I, A(j,j) += w I, A(j,i) = -w M, A(i,j) = -w M^T;
   // lower triangle stored. `b` collects the locked neighbours' terms.
   auto state = [&](std::size_t v) -> Vec4 { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; };
+  const int n = count;
+  const int n4 = 4 * n;
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
   std::vector<Mat4> maps(t.ends.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k != r.end(); ++k)
-      if (!partial || edge_mask[t.edges[k]] || P.var[t.ends[k][0]] >= 0 || P.var[t.ends[k][1]] >= 0)
-        maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
-  });
-  split(bd.field);
-  const int n4 = 4 * n;
+  auto compute_maps = [&](const std::vector<int>* order) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+        if (!order || edge_mask[t.edges[k]] || (*order)[t.ends[k][0]] >= 0 || (*order)[t.ends[k][1]] >= 0)
+          maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
+    });
+  };
   auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
+    const PgpPattern& P = *pattern;
     A = P.A;
     double* val = A.valuePtr();
     std::fill(val, val + A.nonZeros(), 0.0);
@@ -680,54 +756,155 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   for (double m : t.mass) trace_m += m;
   const double unit = trace_m > 0 ? trace_w / trace_m : 1.0;
 
-  if (global) {
-    // Integrate the alphas along a breadth-first spanning tree from each
-    // component's reference vertex (locked_vertex, else the lowest), through
-    // the frames: exact on the tree edges, the holonomy of the field (what
-    // forces singularities) piles up where the tree's branches meet; the
-    // relaxation below spreads it into vortices.
-    std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
-    for (std::size_t k = 0; k < t.ends.size(); ++k) {
-      adj[t.ends[k][0]].push_back({t.ends[k][1], k});
-      adj[t.ends[k][1]].push_back({t.ends[k][0], k});
-    }
-    std::vector<char> seen(t.nv, 0);
-    std::vector<St> st(t.nv, St{0, 0});
-    std::vector<std::uint32_t> q;
-    std::vector<std::uint32_t> roots{opt.locked_vertex};
-    for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
-    for (std::uint32_t v0 : roots) {
-      if (seen[v0]) continue;
-      seen[v0] = 1;
-      q.assign(1, v0);
-      for (std::size_t qi = 0; qi < q.size(); ++qi) {
-        const std::uint32_t i = q[qi];
-        for (auto [j, k] : adj[i]) {
-          if (seen[j]) continue;
-          seen[j] = 1;
-          const int ma = turns[k][0], mb = turns[k][1];
-          if (t.ends[k][0] == i) {
-            const St c = turn_st(st[i], -ma);
-            st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
-          } else {
-            const St c = turn_st(st[i], -mb);
-            st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
+  auto integrate_start = [&] {
+    if (global) {
+      // Integrate the alphas along a breadth-first spanning tree from each
+      // component's reference vertex (locked_vertex, else the lowest), through
+      // the frames: exact on the tree edges, the holonomy of the field (what
+      // forces singularities) piles up where the tree's branches meet; the
+      // relaxation below spreads it into vortices.
+      std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
+      for (std::size_t k = 0; k < t.ends.size(); ++k) {
+        adj[t.ends[k][0]].push_back({t.ends[k][1], k});
+        adj[t.ends[k][1]].push_back({t.ends[k][0], k});
+      }
+      std::vector<char> seen(t.nv, 0);
+      std::vector<St> st(t.nv, St{0, 0});
+      std::vector<std::uint32_t> q;
+      std::vector<std::uint32_t> roots{opt.locked_vertex};
+      for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
+      for (std::uint32_t v0 : roots) {
+        if (seen[v0]) continue;
+        seen[v0] = 1;
+        q.assign(1, v0);
+        for (std::size_t qi = 0; qi < q.size(); ++qi) {
+          const std::uint32_t i = q[qi];
+          for (auto [j, k] : adj[i]) {
+            if (seen[j]) continue;
+            seen[j] = 1;
+            const int ma = turns[k][0], mb = turns[k][1];
+            if (t.ends[k][0] == i) {
+              const St c = turn_st(st[i], -ma);
+              st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
+            } else {
+              const St c = turn_st(st[i], -mb);
+              st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
+            }
+            q.push_back(j);
           }
-          q.push_back(j);
         }
       }
+      for (std::size_t v = 0; v < t.nv; ++v) {
+        zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
+        zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
+      }
     }
-    for (std::size_t v = 0; v < t.nv; ++v) {
-      zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
-      zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
-    }
-  }
-  split(bd.start);
+  };
 
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        var = order_known ? *order_known : nested_dissection_order(natural, count, t.ends);
+        bd.ordering = tt.seconds();
+      },
+      [&] {
+        Timer tt;
+        // Faces whose gradient may have changed (free faces) and edges whose
+        // alpha may have (edges of free faces): everything when no valid cache.
+        if (partial) {
+          face_mask.assign(t.nf, 0);
+          edge_mask.assign(t.ne, 0);
+          for (std::uint32_t f : t.faces) {
+            if (!(*free_face)[f]) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
+              edge_mask[mesh.edge(h).idx()] = 1;
+              face_mask[f] = 1;
+              // the opposite face's gradient enters the edge's alpha: unchanged
+              // unless free, so it is read from the cache
+            }
+          }
+        }
+        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+        halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
+        if (partial) {
+          // Only the vertices of edges whose matching may have changed.
+          std::vector<char> vertex_mask(t.nv, 0);
+          for (std::size_t k = 0; k < t.ends.size(); ++k)
+            if (edge_mask[t.edges[k]]) vertex_mask[t.ends[k][0]] = vertex_mask[t.ends[k][1]] = 1;
+          corner_matchings_into(mesh, quarter, &vertex_mask, corner);
+        } else {
+          corner = corner_matchings(mesh, quarter);
+        }
+        ealpha = edge_alphas(alpha);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) turns[k] = edge_turns(k);
+        });
+        if (!partial) {
+          // Every edge map is read (no locked region): computed here, beside
+          // the ordering, with the spanning-tree start.
+          compute_maps(nullptr);
+          bd.field = tt.seconds();
+          tt.reset();
+          integrate_start();
+          bd.start = tt.seconds();
+        } else {
+          bd.field = tt.seconds();
+        }
+      });
+  lap.reset();
+
+  std::vector<std::uint8_t> parity(t.ends.size());
+  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
+  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity;
+  const bool same_pattern = analyzed && !rebuild;
+  res.reused_analysis = same_pattern;
+  analyzed = same_pattern;
+  // Then the sparsity pattern (it depends on the order and the cut parities
+  // only; rebuilt only when those changed) beside the edge maps of a local
+  // update (only those next to its free vertices), and the pattern's
+  // symbolic analysis beside the assembly of the values.
   std::string failure;
-  if (n > 0) {
-    SpMat A;
-    Eigen::VectorXd b, mass;
+  SpMat A;
+  Eigen::VectorXd b, mass;
+  const double shift = opt.stiffness * unit;
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        if (rebuild) {
+          pattern = std::make_unique<PgpPattern>(make_pattern(t, var, count, parity));
+          pattern->natural = natural;
+        }
+        bd.pattern = tt.seconds();
+      },
+      [&] {
+        if (!partial) return;
+        Timer tt;
+        compute_maps(&var);
+        bd.field += tt.seconds();
+      });
+  tbb::parallel_invoke(
+      [&] {
+        Timer tt;
+        if (n > 0 && !same_pattern) {
+          // Symbolic analysis of the pattern alone (the values come beside).
+          solver.analyzePattern(pattern->A);
+          if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
+          factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
+        }
+        bd.analysis = tt.seconds();
+      },
+      [&] {
+        Timer tt;
+        if (n > 0) fill(shift, A, b, mass);
+        bd.assembly = tt.seconds();
+      });
+  lap.reset();
+  const PgpPattern& P = *pattern;
+  bd.factor_flops = factor_size[0];
+  bd.factor_nonzeros = factor_size[1];
+
+  if (n > 0 && failure.empty()) {
     Eigen::VectorXd x(n4);
     for (std::size_t v = 0; v < t.nv; ++v)
       if (P.var[v] >= 0) {
@@ -742,21 +919,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
     // fandisk), and F's smallest eigenvector localises where the field's curl
     // is low, its tail not following the field (80% distorted faces on a torus).
-    const double shift = opt.stiffness * unit;
-    fill(shift, A, b, mass);
-    split(bd.assembly);
-    if (!same_pattern || !analyzed) {
-      solver.analyzePattern(A);
-      if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
-      factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
-    }
-    bd.factor_flops = factor_size[0];
-    bd.factor_nonzeros = factor_size[1];
-    split(bd.analysis);
-    if (failure.empty()) {
-      solver.factorize(A);
-      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
-    }
+    solver.factorize(A);
+    if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
     split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
     Eigen::VectorXd rhs(n4);
@@ -823,24 +987,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   return res;
 }
 
-PeriodicGlobalParameterization::PeriodicGlobalParameterization(Mesh& mesh, PgpOptions options)
-    : impl_(std::make_unique<Impl>(mesh, std::move(options))) {
-  check_options(impl_->opt);
-}
-
-PeriodicGlobalParameterization::~PeriodicGlobalParameterization() = default;
-
-PgpResult PeriodicGlobalParameterization::initialize() {
-  Mesh& mesh = impl_->mesh;
+std::vector<char> PeriodicGlobalParameterization::Impl::initial_free_set() {
   const std::size_t nv = mesh.num_vertices();
-  if (impl_->opt.locked_vertex >= nv || mesh.is_removed(VertexIndex(impl_->opt.locked_vertex)))
-    throw InvalidInputError("periodic_global_parameterization: locked_vertex " +
-                            std::to_string(impl_->opt.locked_vertex) + " out of range (" +
-                            std::to_string(nv) + " vertices)");
-  impl_->zs.assign(nv, Cplx(1, 0));
-  impl_->zt.assign(nv, Cplx(1, 0));
   // Every vertex with an edge is free; the phase is fixed afterwards.
-  const PgpTopology& t = impl_->topology();
+  const PgpTopology& t = topology();
   std::vector<char> free_vertex(nv, 0);
   for (const auto& ij : t.ends) free_vertex[ij[0]] = free_vertex[ij[1]] = 1;
   // One locked vertex per component (the paper's): locked_vertex for its
@@ -855,12 +1005,59 @@ PgpResult PeriodicGlobalParameterization::initialize() {
       has[c] = 1;
       free_vertex[v] = 0;
     };
-    lock(impl_->opt.locked_vertex);
+    lock(opt.locked_vertex);
     for (VertexIndex v : mesh.vertices()) lock(v.idx());
   }
+  return free_vertex;
+}
+
+PeriodicGlobalParameterization::PeriodicGlobalParameterization(Mesh& mesh, PgpOptions options)
+    : impl_(std::make_unique<Impl>(mesh, std::move(options))) {
+  check_options(impl_->opt);
+}
+
+PeriodicGlobalParameterization::~PeriodicGlobalParameterization() = default;
+
+PgpResult PeriodicGlobalParameterization::initialize() {
+  Mesh& mesh = impl_->mesh;
+  const std::size_t nv = mesh.num_vertices();
+  if (impl_->opt.locked_vertex >= nv || mesh.is_removed(VertexIndex(impl_->opt.locked_vertex)))
+    throw InvalidInputError("periodic_global_parameterization: locked_vertex " +
+                            std::to_string(impl_->opt.locked_vertex) + " out of range (" +
+                            std::to_string(nv) + " vertices)");
+  Timer before;
+  impl_->zs.assign(nv, Cplx(1, 0));
+  impl_->zt.assign(nv, Cplx(1, 0));
+  const std::vector<char> free_vertex = impl_->initial_free_set();  // builds the topology on a first call
+  const double topology_seconds = before.seconds();
   PgpResult r = impl_->solve(free_vertex, nullptr, true);
+  r.breakdown.topology += topology_seconds;
+  r.seconds += topology_seconds;
   impl_->initialized = true;
   return r;
+}
+
+void PeriodicGlobalParameterization::prepare() {
+  Mesh& mesh = impl_->mesh;
+  require_triangle_mesh(mesh, "periodic_global_parameterization");
+  if (impl_->opt.locked_vertex >= mesh.num_vertices() || mesh.is_removed(VertexIndex(impl_->opt.locked_vertex)))
+    return;  // initialize() reports it
+  int count = 0;
+  std::vector<int> natural = Impl::natural_numbering(mesh, impl_->initial_free_set(), count);
+  if (impl_->known_order(natural)) return;  // ordered already
+  std::vector<int> var = nested_dissection_order(natural, count, impl_->topology().ends);
+  impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
+}
+
+void PeriodicGlobalParameterization::prepare(const EffectArea& area) {
+  Mesh& mesh = impl_->mesh;
+  if (area.vertex_free.size() != mesh.num_vertices()) return;  // update() reports it
+  int count = 0;
+  std::vector<int> natural = Impl::natural_numbering(mesh, area.vertex_free, count);
+  const PgpTopology& t = impl_->topology();
+  if (impl_->known_order(natural)) return;  // same free set as before: ordered already
+  std::vector<int> var = nested_dissection_order(natural, count, t.ends);
+  impl_->prepared = std::make_unique<std::pair<std::vector<int>, std::vector<int>>>(std::move(natural), std::move(var));
 }
 
 PgpResult PeriodicGlobalParameterization::update(const EffectArea& area) {

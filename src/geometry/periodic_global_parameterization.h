@@ -31,13 +31,21 @@
 // precomputed order; the free vertices ordered by METIS nested dissection of
 // the vertex graph, their 4 unknowns together; CHOLMOD supernodal Cholesky
 // keeping that order, ordering and symbolic analysis reused while the free
-// set and the cut parities are unchanged). CHOLMOD's dense kernels run on
-// the BLAS libcholmod is linked with: Debian's default netlib BLAS is
-// single-threaded (and slow: the factorisation dominates, about 1.8e9 flops
-// at 52K triangles); an OpenBLAS is pinned to one thread so that the bytes
-// do not depend on the machine's cores. The paper writes R with the opposite
-// rotation sign and a 2 pi missing in the rounding of (4); we use the
-// self-consistent signs.
+// set and the cut parities are unchanged). The connectivity-only work runs
+// beside the field-dependent work on a second thread (the METIS order beside
+// the gradients, alphas, edge maps and the start; the symbolic analysis
+// beside the assembly; same bytes on any number of threads), and prepare()
+// lets a caller start the order while the direction field is computed.
+// CHOLMOD's dense kernels run on the BLAS libcholmod is linked with:
+// Debian's default netlib BLAS is single-threaded (and slow: the
+// factorisation dominates, about 1.8e9 flops at 52K triangles); an OpenBLAS
+// is pinned to one thread so that the bytes do not depend on the machine's
+// cores (its threaded build gives different
+// bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
+// and falls back to its generic SSE3 kernels, it is switched to its AVX-512
+// (or AVX2) kernels once per process (PgpResult::blas_core names the set).
+// The paper writes R with the opposite rotation sign and a 2 pi missing in
+// the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
 //     minimiser decays away from the locked vertex (median |z| ~ 3e-3 on
 //     fandisk) and its phase stops following the field; F's smallest
@@ -115,7 +123,15 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
-  /// Wall-time breakdown of `seconds` (each step's own wall time, seconds):
+  /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
+  /// BLAS; see the BLAS note above).
+  std::string blas_core;
+  /// Wall-time breakdown of `seconds` (each step's own wall time, seconds).
+  /// Three pairs of steps run side by side (tbb::parallel_invoke), so the
+  /// sum exceeds `seconds` on several threads: `ordering` beside `field`
+  /// (gradients, alphas, matchings and, when every edge map is read, the
+  /// edge maps) + `start`; `pattern` beside a local update's edge maps
+  /// (counted in `field`); `analysis` beside `assembly`.
   struct Breakdown {
     double topology = 0;     ///< connectivity, areas, frames (first call only)
     double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
@@ -155,6 +171,18 @@ class PeriodicGlobalParameterization {
   PeriodicGlobalParameterization(const PeriodicGlobalParameterization&) = delete;
   PeriodicGlobalParameterization& operator=(const PeriodicGlobalParameterization&) = delete;
 
+  /// Optional, ahead of initialize(): the work of the initialisation that
+  /// depends on the connectivity only (topology, fill-reducing order of the
+  /// free vertices, ~0.1 s at 52K triangles), for a caller to run while it
+  /// computes the direction field (e.g. with tbb::parallel_invoke). It reads
+  /// the mesh's connectivity and points and no property map, and adds none;
+  /// the mesh must not change afterwards (else initialize() redoes it).
+  /// initialize() gives the same bytes with or without it.
+  void prepare();
+  /// The same ahead of update(area): the order of the area's free vertices,
+  /// for a caller to compute while it interpolates the orientation and scale
+  /// in the area (update() then reuses it; same bytes).
+  void prepare(const EffectArea& area);
   /// Global solve (one locked vertex per component); writes every corner.
   PgpResult initialize();
   /// Local solve: vertices outside area.vertex_free keep their previous

@@ -2,10 +2,14 @@
 // Simplified PGP (Ray et al. 2009 section 2.3) and local updates (2.1).
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 
 #include <tbb/global_control.h>
+#include <tbb/parallel_invoke.h>
+
+#include <cstdlib>
 
 #include "geometry/direction_field.h"
 #include "geometry/effect_area.h"
@@ -13,7 +17,9 @@
 #include "geometry/periodic_global_parameterization.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
+#include "geometry/read_mesh.h"
 #include "geometry/scalar_field_interpolation.h"
+#include "test_support.h"
 
 namespace surftex {
 namespace {
@@ -228,6 +234,114 @@ TEST(PeriodicGlobalParameterization, SameBytesWithOneOrManyThreads) {
   const auto a = run(1), b = run(4);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
+}
+
+// The solver overlaps its connectivity-only work (METIS order, pattern,
+// symbolic analysis) with the field's (gradients, alphas, edge maps, start):
+// on a real mesh with quarter-turn cuts, an initialisation and a local update
+// give the same bytes on one thread and on two (where the overlaps run side
+// by side).
+TEST(PeriodicGlobalParameterization, SameBytesWithOneOrTwoThreadsOnFandiskInitAndUpdate) {
+  auto run = [](int threads) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    Mesh m;
+    read_mesh(test::shared_data("meshes/fandisk.off"), m);
+    interpolate_direction_field(m, constraints_from_constant_vector(m, {0.3, 0.1, 1.0}), {});
+    interpolate_scalar_field(m, {{0, pgp_default_scale(m, 8.0)}}, scale_field_options());
+    PeriodicGlobalParameterization pgp(m);
+    const PgpResult r = pgp.initialize();
+    EXPECT_FALSE(r.reused_analysis);
+    std::vector<double> out{r.energy_s, r.energy_t};
+    EffectAreaOptions eo;
+    eo.max_faces = m.number_of_faces() / 4;
+    const EffectArea area = compute_effect_area(m, {static_cast<std::uint32_t>(m.number_of_vertices() / 3)}, eo);
+    DirectionFieldOptions dopt;
+    dopt.area = &area;
+    const auto cf = static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(m.number_of_vertices() / 3))).idx());
+    interpolate_direction_field(m, {{cf, {0.0, 1.0, 1.0}}}, dopt);
+    const PgpResult u = pgp.update(area);
+    out.insert(out.end(), {u.energy_s, u.energy_t});
+    for (const auto* z : {&pgp.z_s(), &pgp.z_t()})
+      for (const auto& c : *z) out.insert(out.end(), {c.real(), c.imag()});
+    auto stm = find(m, kCornerSTM).first;
+    for (HalfedgeIndex h : m.halfedges())
+      if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
+    return out;
+  };
+  const auto a = run(1), b = run(2);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
+}
+
+// prepare() and prepare(area) (connectivity-only work, run here while the
+// direction field is interpolated, as the material-map pipeline does) change
+// no byte of the initialisation and of a local update, which then skip the
+// ordering.
+TEST(PeriodicGlobalParameterization, PrepareAheadGivesTheSameBytes) {
+  auto run = [](bool ahead) {
+    Mesh m;
+    make_torus(m, 3.0, 1.0, 48, 24);
+    interpolate_scalar_field(m, {{0, 0.5}, {300, 0.8}}, scale_field_options());
+    PeriodicGlobalParameterization pgp(m);
+    auto field = [&] { interpolate_direction_field(m, {{0, {0, 1, 0}}, {1500, {0, 0, 1}}}, {}); };
+    if (ahead)
+      tbb::parallel_invoke(field, [&] { pgp.prepare(); });
+    else
+      field();
+    const PgpResult r = pgp.initialize();
+    if (ahead) {
+      EXPECT_LT(r.breakdown.ordering, 1e-3);  // the prepared order is reused
+    }
+    std::vector<double> out{r.energy_s, r.energy_t};
+    // A local update, its area's order prepared beside the new orientation.
+    EffectAreaOptions eo;
+    eo.radius = 2.0;
+    const EffectArea area = compute_effect_area(m, {700}, eo);
+    DirectionFieldOptions dopt;
+    dopt.area = &area;
+    const auto cf = static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(700))).idx());
+    auto local = [&] { interpolate_direction_field(m, {{cf, {1, 1, 1}}}, dopt); };
+    if (ahead)
+      tbb::parallel_invoke(local, [&] { pgp.prepare(area); });
+    else
+      local();
+    const PgpResult u = pgp.update(area);
+    EXPECT_GT(u.free_vertices, 30u);  // METIS orders it (>= 16)
+    if (ahead) {
+      EXPECT_LT(u.breakdown.ordering, 1e-3);
+    }
+    out.insert(out.end(), {u.energy_s, u.energy_t});
+    auto stm = find(m, kCornerSTM).first;
+    for (HalfedgeIndex h : m.halfedges())
+      if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
+    return out;
+  };
+  const auto a = run(false), b = run(true);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
+}
+
+// CHOLMOD's dense kernels run on OpenBLAS's optimised kernel set, not on its
+// generic SSE3 fallback (which OpenBLAS 0.3.21 picks on CPUs newer than it
+// knows: 5x slower dgemm on this machine's AVX-512 Xeon). Only meaningful
+// with an OpenBLAS, on a CPU with AVX2+FMA, and without a user's
+// OPENBLAS_CORETYPE.
+TEST(PeriodicGlobalParameterization, BlasRunsOptimisedKernelsWhereTheCpuHasThem) {
+  Mesh m;
+  make_grid(m, 6, 6);
+  interpolate_direction_field(m, {{0, {1, 0, 0}}}, {});
+  const PgpResult r = periodic_global_parameterization(m);
+  if (r.blas_core.empty()) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  if (std::getenv("OPENBLAS_CORETYPE")) GTEST_SKIP() << "OPENBLAS_CORETYPE set by the user";
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) GTEST_SKIP() << "no AVX2+FMA";
+  std::string lower = r.blas_core;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  EXPECT_NE(lower, "prescott") << r.blas_core;
+#else
+  GTEST_SKIP() << "x86-64 only";
+#endif
 }
 
 TEST(PeriodicGlobalParameterization, RejectsBadInput) {
