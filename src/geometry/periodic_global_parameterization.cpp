@@ -18,6 +18,7 @@
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
 #include "geometry/mesh_util.h"
+#include "geometry/pgp_curl_correction.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
 
@@ -141,6 +142,12 @@ void check_options(const PgpOptions& o) {
   if (!(o.stiffness > 0) || !std::isfinite(o.stiffness))
     throw InvalidInputError("periodic_global_parameterization: stiffness must be > 0, got " +
                             std::to_string(o.stiffness));
+  if (!(o.curl_stiffness > 0) || !std::isfinite(o.curl_stiffness))
+    throw InvalidInputError("periodic_global_parameterization: curl_stiffness must be > 0, got " +
+                            std::to_string(o.curl_stiffness));
+  if (!(o.curl_max_factor >= 1) || !std::isfinite(o.curl_max_factor))
+    throw InvalidInputError("periodic_global_parameterization: curl_max_factor must be >= 1, got " +
+                            std::to_string(o.curl_max_factor));
 }
 
 std::vector<FaceFrame> all_frames(const Mesh& mesh) {
@@ -155,9 +162,22 @@ std::vector<FaceFrame> all_frames(const Mesh& mesh) {
   return frames;
 }
 
-/// g = d / S^T per face (only where `mask` is set when given), written into `g`.
+PgpCurlCorrectionOptions curl_options(const PgpOptions& o) {
+  PgpCurlCorrectionOptions c;
+  c.symmetry = o.symmetry;
+  c.stiffness = o.curl_stiffness;
+  c.max_factor = o.curl_max_factor;
+  c.direction_map = o.direction_map;
+  return c;
+}
+
+/// g = d / S^T per face (only where `mask` is set when given), written into
+/// `g`; times the curl-correction factor when o.curl_correction (computed
+/// over the whole mesh by `corrector`, which keeps its factorisation, or a
+/// one-shot one; the faces outside `mask` keep their previous gradient).
 void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceFrame>& frames,
-                         const std::vector<char>* mask, std::vector<FaceGrad>& g) {
+                         const std::vector<char>* mask, std::vector<FaceGrad>& g,
+                         PgpCurlCorrector* corrector = nullptr) {
   auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
   if (!dir.second)
     throw InvalidInputError("periodic_global_parameterization: face map '" + o.direction_map +
@@ -188,6 +208,13 @@ void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vecto
       g[fi] = {ds / s, dt / s};
     }
   });
+  if (o.curl_correction) {
+    PgpCurlCorrector one_shot(curl_options(o));
+    const PgpCurlCorrection c = (corrector ? *corrector : one_shot).compute(mesh);
+    for (std::size_t fi = 0; fi < g.size(); ++fi)
+      if (!mesh.is_removed(FaceIndex(static_cast<Mesh::size_type>(fi))) && (!mask || (*mask)[fi]))
+        g[fi] = {c.face_factor[fi] * g[fi].gs, c.face_factor[fi] * g[fi].gt};
+  }
 }
 
 std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
@@ -465,6 +492,11 @@ struct PeriodicGlobalParameterization::Impl {
   std::vector<std::uint8_t> corner;                 // per halfedge: face -> vertex frame turns
   std::vector<std::array<double, 2>> edge_energy;  // per live edge
   bool cache_valid = false;
+  std::unique_ptr<PgpCurlCorrector> curl;  // keeps its factorisation (opt.curl_correction)
+  PgpCurlCorrector* corrector() {
+    if (!curl) curl = std::make_unique<PgpCurlCorrector>(curl_options(opt));
+    return curl.get();
+  }
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
     pin_blas_threads();
@@ -583,7 +615,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       }
     }
   }
-  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad, opt.curl_correction ? corrector() : nullptr);
   halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
   corner = corner_matchings(mesh, quarter);
   const auto ealpha = edge_alphas(alpha);
@@ -902,7 +934,7 @@ std::array<double, 2> PeriodicGlobalParameterization::energies() {
   std::vector<FaceGrad> g;
   std::vector<std::array<double, 2>> alpha;
   std::vector<std::uint8_t> quarter;
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g, im.opt.curl_correction ? im.corrector() : nullptr);
   halfedge_alphas_into(im.mesh, im.opt, g, t.frames, nullptr, alpha, &quarter);
   const std::vector<std::uint8_t> corner = corner_matchings(im.mesh, quarter);
   std::array<double, 2> out{0, 0};
@@ -928,7 +960,7 @@ void PeriodicGlobalParameterization::write_corners() {
   require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
   Impl& im = *impl_;
   const PgpTopology& t = im.topology();
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad, im.opt.curl_correction ? im.corrector() : nullptr);
   halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha, &im.quarter);
   im.corner = corner_matchings(im.mesh, im.quarter);
   im.edge_energy.clear();

@@ -104,6 +104,13 @@ struct PgpOptions {
   /// singularities) be smaller but |z| sag; 0.01 measured best on spheres
   /// and real meshes (0.05: +1-6% singular faces, 0.2: +15-25%).
   double stiffness = 0.01;
+  /// Curl correction of the target gradients before the solve (Ray et al.
+  /// 2006; geometry/pgp_curl_correction.h): g = d/S is scaled per vertex by
+  /// the factor exp(phi) that makes it closest to curl-free, directions kept.
+  /// Off by default until measured better (see pgp_curl_correction.h).
+  bool curl_correction = false;
+  double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
+  double curl_max_factor = 4.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";
   std::string scale_map = "v:scale";
   std::string material_map = "v:material";
