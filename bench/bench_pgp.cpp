@@ -244,6 +244,22 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
     o.curl_correction = on != 0;
     if (const char* e = std::getenv("CURL_STIFF")) o.curl_stiffness = std::atof(e);
     if (const char* e = std::getenv("CURL_MAX")) o.curl_max_factor = std::atof(e);
+    nlohmann::json pre = nlohmann::json::object();
+    if (on) {
+      Timer tc;
+      PgpCurlCorrectionOptions co;
+      co.stiffness = o.curl_stiffness;
+      co.max_factor = o.curl_max_factor;
+      const PgpCurlCorrection c = pgp_curl_correction(mesh, co);
+      pre["correction_seconds_one_shot"] = tc.seconds();
+      PgpCurlCorrector reused(co);
+      reused.compute(mesh);
+      pre["correction_seconds_reused"] = best_of_3([&] { reused.compute(mesh); });
+      pre["correction_cpu_seconds_reused"] = g_last_cpu;
+      pre["factor_min"] = c.min_factor;
+      pre["factor_max"] = c.max_factor;
+      pre["clamped_vertices"] = c.clamped_vertices;
+    }
     PeriodicGlobalParameterization p(mesh, o);
     p.initialize();  // ordering and analysis paid once, as in the best of 3 above
     PgpResult best;
@@ -259,17 +275,7 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
     fig["vs_user_field"] = {{"singular_fraction", su.singular_fraction}, {"distorted_faces", du}};
     fig["circulation"] = total_circulation(mesh, o);
     fig["circulation_uncorrected"] = total_circulation(mesh, PgpOptions{});
-    if (on) {
-      Timer tc;
-      PgpCurlCorrectionOptions co;
-      co.stiffness = o.curl_stiffness;
-      co.max_factor = o.curl_max_factor;
-      const PgpCurlCorrection c = pgp_curl_correction(mesh, co);
-      fig["correction_seconds_one_shot"] = tc.seconds();
-      fig["factor_min"] = c.min_factor;
-      fig["factor_max"] = c.max_factor;
-      fig["clamped_vertices"] = c.clamped_vertices;
-    }
+    fig.update(pre);
     fig["curl_correction"] = on != 0;
     fig["edges_per_period"] = edges_per_period;
     fig["breakdown"] = breakdown(best);

@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
+#include "geometry/direction_field_singularities.h"
 #include "geometry/errors.h"
 #include "geometry/mesh_util.h"
 
@@ -43,10 +45,74 @@ double matched_angle(const FaceFrame& fT, double tT, const FaceFrame& fU, double
 
 struct PgpCurlCorrector::Impl {
   PgpCurlCorrectionOptions opt;
-  Eigen::SimplicialLLT<SpMat> solver;
+  // Geometry, computed with the factorisation (the mesh must not change).
   std::size_t nv = 0, nf = 0;
-  bool factored = false;
+  bool ready = false;
+  std::vector<FaceFrame> frame;              // per face
+  std::vector<double> area;                  // per face
+  std::vector<double> mass;                  // per vertex: a third of its faces' area
+  std::vector<std::array<std::uint32_t, 3>> corner;  // per face: targets of h, next(h), next(next(h))
+  std::vector<double> edge_angle;            // per halfedge: angle of target - source in face(h)'s frame
+  Eigen::SimplicialLLT<SpMat> solver;
+
+  void prepare(const Mesh& mesh);
 };
+
+void PgpCurlCorrector::Impl::prepare(const Mesh& mesh) {
+  nv = mesh.num_vertices();
+  nf = mesh.num_faces();
+  frame.assign(nf, FaceFrame{});
+  area.assign(nf, 0.0);
+  corner.assign(nf, {0, 0, 0});
+  edge_angle.assign(mesh.num_halfedges(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+      const FaceIndex f(static_cast<Mesh::size_type>(fi));
+      if (mesh.is_removed(f)) continue;
+      frame[fi] = face_frame(mesh, f);
+      area[fi] = face_area(mesh, f);
+      HalfedgeIndex h = mesh.halfedge(f);
+      for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
+        corner[fi][c] = static_cast<std::uint32_t>(mesh.target(h).idx());
+        edge_angle[h.idx()] = frame[fi].angle_of(mesh.point(mesh.target(h)) - mesh.point(mesh.source(h)));
+      }
+    }
+  });
+  mass.assign(nv, 0.0);
+  double total_area = 0;
+  for (FaceIndex f : mesh.faces()) {
+    for (std::uint32_t v : corner[f.idx()]) mass[v] += area[f.idx()] / 3;
+    total_area += area[f.idx()];
+  }
+  if (!(total_area > 0))
+    throw InvalidInputError("pgp_curl_correction: the mesh has no face of positive area");
+  // Screened cotangent Laplacian L + mu M (sum_T A_T |grad phi|^2 = phi' L phi).
+  const double mu = opt.stiffness / total_area;
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(nv + 2 * mesh.num_edges());
+  std::vector<double> diag(nv, 0.0);
+  for (EdgeIndex e : mesh.edges()) {
+    const HalfedgeIndex h = mesh.halfedge(e, 0), op = mesh.opposite(h);
+    const double w = 0.5 * (cotan_opposite(mesh, h) + cotan_opposite(mesh, op));
+    const int i = static_cast<int>(mesh.source(h).idx()), j = static_cast<int>(mesh.target(h).idx());
+    trip.emplace_back(i, j, -w);
+    trip.emplace_back(j, i, -w);
+    diag[i] += w;
+    diag[j] += w;
+  }
+  for (std::size_t v = 0; v < nv; ++v) {
+    // Isolated (or removed) vertices: identity rows, phi = 0.
+    const double d = mass[v] > 0 ? diag[v] + mu * mass[v] : 1.0;
+    trip.emplace_back(static_cast<int>(v), static_cast<int>(v), d);
+  }
+  SpMat A(static_cast<Eigen::Index>(nv), static_cast<Eigen::Index>(nv));
+  A.setFromTriplets(trip.begin(), trip.end());
+  solver.compute(A);
+  if (solver.info() != Eigen::Success)
+    throw SolverError("pgp_curl_correction: factorisation of the screened Laplacian failed (" +
+                      std::to_string(nv) + " vertices)");
+  ready = true;
+}
 
 PgpCurlCorrector::PgpCurlCorrector(PgpCurlCorrectionOptions options) : impl_(std::make_unique<Impl>()) {
   check(options);
@@ -56,111 +122,78 @@ PgpCurlCorrector::PgpCurlCorrector(PgpCurlCorrectionOptions options) : impl_(std
 PgpCurlCorrector::~PgpCurlCorrector() = default;
 
 PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
-  const PgpCurlCorrectionOptions& o = impl_->opt;
+  Impl& im = *impl_;
+  const PgpCurlCorrectionOptions& o = im.opt;
   auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
   if (!dir.second)
     throw InvalidInputError("pgp_curl_correction: face map '" + o.direction_map +
                             "' absent (interpolate a direction field first)");
   require_triangle_mesh(mesh, "pgp_curl_correction");
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
+  if (!im.ready || im.nv != nv || im.nf != nf || im.edge_angle.size() != mesh.num_halfedges()) im.prepare(mesh);
   const double step = 2 * M_PI / o.symmetry;
 
-  // Per face: frame, area, unit d_s and its angle.
-  std::vector<FaceFrame> frame(nf);
-  std::vector<double> area(nf, 0.0), angle(nf, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
-      const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f)) continue;
-      frame[fi] = face_frame(mesh, f);
-      area[fi] = face_area(mesh, f);
-      const Vector3 d = dir.first[f];
-      angle[fi] = frame[fi].angle_of(normalized_or(d - (d * frame[fi].n) * frame[fi].n, frame[fi].e1));
-    }
-  });
-  // q_T = -curl(d_t) d_s + curl(d_s) d_t, and its right-hand side
-  // contribution q_T . (n x e_i) / 2 per corner (e_i the opposite edge, ccw).
+  // Faces with a vertex of nonzero field index: no target there (the exact
+  // factor would be a cone r^k; the PGP's vortex handles the singularity).
+  FieldIndexOptions fo;
+  fo.symmetry = o.symmetry;
+  fo.direction_map = o.direction_map;
+  const std::vector<int> index = direction_field_indices(mesh, fo);
+  // Per face: angle of the projected d_s in the face frame.
+  std::vector<double> angle(nf, 0.0);
   std::vector<std::array<double, 3>> rhs(nf, {0.0, 0.0, 0.0});
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
       const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f) || !(area[fi] > 0)) continue;
-      const FaceFrame& fT = frame[fi];
+      if (mesh.is_removed(f)) continue;
+      const Vector3 d = dir.first[f];
+      const FaceFrame& fr = im.frame[fi];
+      angle[fi] = fr.angle_of(normalized_or(d - (d * fr.n) * fr.n, fr.e1));
+    }
+  });
+  // q_T = -curl(d_t) d_s + curl(d_s) d_t, and its right-hand side
+  // contribution q_T . (n x e_c) / 2 per corner c (e_c the opposite edge, ccw).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+      const FaceIndex f(static_cast<Mesh::size_type>(fi));
+      if (mesh.is_removed(f) || !(im.area[fi] > 0)) continue;
+      const auto& cv = im.corner[fi];
+      if (index[cv[0]] != 0 || index[cv[1]] != 0 || index[cv[2]] != 0) continue;
+      const FaceFrame& fT = im.frame[fi];
       const Vector3 ds = fT.direction(angle[fi]), dt = CGAL::cross_product(fT.n, ds);
       double circ_s = 0, circ_t = 0;
-      const HalfedgeIndex h0 = mesh.halfedge(f);
-      const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
-      for (HalfedgeIndex h : hs) {
+      HalfedgeIndex h = mesh.halfedge(f);
+      for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
         const Vector3 ev = mesh.point(mesh.target(h)) - mesh.point(mesh.source(h));
         const HalfedgeIndex op = mesh.opposite(h);
         Vector3 us = ds, ut = dt;
         if (!mesh.is_border(op)) {
+          // The matching of the PGP's alphas, with the edge angles cached
+          // (ev in U's frame = the opposite halfedge's angle + pi).
           const std::size_t U = mesh.face(op).idx();
-          const FaceFrame& fU = frame[U];
-          us = fU.direction(matched_angle(fT, angle[fi], fU, angle[U], ev, step));
+          const FaceFrame& fU = im.frame[U];
+          const double transported = angle[fi] - im.edge_angle[h.idx()] + im.edge_angle[op.idx()] + M_PI;
+          us = fU.direction(angle[U] + std::round((transported - angle[U]) / step) * step);
           ut = CGAL::cross_product(fU.n, us);
         }
         circ_s += 0.5 * (ev * (ds + us));
         circ_t += 0.5 * (ev * (dt + ut));
       }
-      const Vector3 q = (-circ_t / area[fi]) * ds + (circ_s / area[fi]) * dt;
+      const double A = im.area[fi];
+      const Vector3 q = (-circ_t / A) * ds + (circ_s / A) * dt;
       for (int c = 0; c < 3; ++c) {
-        // Corner c = target(hs[c]); its opposite edge, ccw: hs[(c + 2) % 3]'s
-        // target... i.e. from target(hs[c+1]) to target(hs[c+2]).
-        const Vector3 e = mesh.point(mesh.target(hs[(c + 2) % 3])) - mesh.point(mesh.target(hs[(c + 1) % 3]));
+        const Vector3 e = mesh.point(VertexIndex(cv[(c + 2) % 3])) - mesh.point(VertexIndex(cv[(c + 1) % 3]));
         rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e));
       }
     }
   });
   Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nv));
-  std::vector<double> mass(nv, 0.0);
-  double total_area = 0;
-  for (FaceIndex f : mesh.faces()) {
-    const HalfedgeIndex h0 = mesh.halfedge(f);
-    const HalfedgeIndex hs[3] = {h0, mesh.next(h0), mesh.next(mesh.next(h0))};
-    for (int c = 0; c < 3; ++c) {
-      b[mesh.target(hs[c]).idx()] += rhs[f.idx()][c];
-      mass[mesh.target(hs[c]).idx()] += area[f.idx()] / 3;
-    }
-    total_area += area[f.idx()];
-  }
-  if (!(total_area > 0))
-    throw InvalidInputError("pgp_curl_correction: the mesh has no face of positive area");
-
-  if (!impl_->factored || impl_->nv != nv || impl_->nf != nf) {
-    // Screened cotangent Laplacian L + mu M (sum_T A_T |grad phi|^2 = phi' L phi).
-    const double mu = o.stiffness / total_area;
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(nv + 4 * mesh.num_edges());
-    std::vector<double> diag(nv, 0.0);
-    for (EdgeIndex e : mesh.edges()) {
-      const HalfedgeIndex h = mesh.halfedge(e, 0), op = mesh.opposite(h);
-      const double w = 0.5 * (cotan_opposite(mesh, h) + cotan_opposite(mesh, op));
-      const int i = static_cast<int>(mesh.source(h).idx()), j = static_cast<int>(mesh.target(h).idx());
-      trip.emplace_back(i, j, -w);
-      trip.emplace_back(j, i, -w);
-      diag[i] += w;
-      diag[j] += w;
-    }
-    for (std::size_t v = 0; v < nv; ++v) {
-      // Isolated (or removed) vertices: identity rows, phi = 0.
-      const double d = mass[v] > 0 ? diag[v] + mu * mass[v] : 1.0;
-      trip.emplace_back(static_cast<int>(v), static_cast<int>(v), d);
-    }
-    SpMat A(static_cast<Eigen::Index>(nv), static_cast<Eigen::Index>(nv));
-    A.setFromTriplets(trip.begin(), trip.end());
-    impl_->solver.compute(A);
-    if (impl_->solver.info() != Eigen::Success)
-      throw SolverError("pgp_curl_correction: factorisation of the screened Laplacian failed (" +
-                        std::to_string(nv) + " vertices)");
-    impl_->nv = nv;
-    impl_->nf = nf;
-    impl_->factored = true;
-  }
+  for (FaceIndex f : mesh.faces())  // serial: the same sums whatever the threads
+    for (int c = 0; c < 3; ++c) b[im.corner[f.idx()][c]] += rhs[f.idx()][c];
   for (std::size_t v = 0; v < nv; ++v)
-    if (!(mass[v] > 0)) b[static_cast<Eigen::Index>(v)] = 0;
-  const Eigen::VectorXd phi = impl_->solver.solve(b);
-  if (impl_->solver.info() != Eigen::Success || !phi.allFinite())
+    if (!(im.mass[v] > 0)) b[static_cast<Eigen::Index>(v)] = 0;
+  const Eigen::VectorXd phi = im.solver.solve(b);
+  if (im.solver.info() != Eigen::Success || !phi.allFinite())
     throw SolverError("pgp_curl_correction: solve failed (" + std::to_string(nv) + " vertices)");
 
   PgpCurlCorrection out;
@@ -175,9 +208,8 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
   out.min_factor = std::numeric_limits<double>::infinity();
   out.max_factor = 0;
   for (FaceIndex f : mesh.faces()) {
-    double s = 0;
-    for (VertexIndex v : face_vertices(mesh, f)) s += out.log_factor[v.idx()];
-    const double k = std::exp(s / 3);
+    const auto& cv = im.corner[f.idx()];
+    const double k = std::exp((out.log_factor[cv[0]] + out.log_factor[cv[1]] + out.log_factor[cv[2]]) / 3);
     out.face_factor[f.idx()] = k;
     out.min_factor = std::min(out.min_factor, k);
     out.max_factor = std::max(out.max_factor, k);
