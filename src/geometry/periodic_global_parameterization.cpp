@@ -168,6 +168,7 @@ PgpCurlCorrectionOptions curl_options(const PgpOptions& o) {
   c.stiffness = o.curl_stiffness;
   c.max_factor = o.curl_max_factor;
   c.direction_map = o.direction_map;
+  c.scale_map = o.scale_map;
   return c;
 }
 
@@ -601,7 +602,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   // Faces whose gradient may have changed (free faces) and edges whose alpha
   // may have (edges of free faces): everything when no valid cache.
   std::vector<char> face_mask, edge_mask;
-  const bool partial = free_face && cache_valid;
+  // The curl correction is global (its factor changes a little everywhere
+  // when the field changes in the area): all gradients are then refreshed,
+  // so that an update equals a full rewrite from the same state.
+  const bool partial = free_face && cache_valid && !opt.curl_correction;
   if (partial) {
     face_mask.assign(t.nf, 0);
     edge_mask.assign(t.ne, 0);

@@ -108,7 +108,7 @@ struct PgpOptions {
   /// 2006; geometry/pgp_curl_correction.h): g = d/S is scaled per vertex by
   /// the factor exp(phi) that makes it closest to curl-free, directions kept.
   /// Off by default until measured better (see pgp_curl_correction.h).
-  bool curl_correction = false;
+  bool curl_correction = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 4.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";

@@ -139,6 +139,17 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
   fo.symmetry = o.symmetry;
   fo.direction_map = o.direction_map;
   const std::vector<int> index = direction_field_indices(mesh, fo);
+  // log S per vertex (absent map: S = 1); checked by the PGP, checked again here.
+  auto scale = mesh.property_map<VertexIndex, double>(o.scale_map);
+  std::vector<double> log_s(nv, 0.0);
+  if (scale.second)
+    for (VertexIndex v : mesh.vertices()) {
+      const double sv = scale.first[v];
+      if (!(sv > 0) || !std::isfinite(sv))
+        throw InvalidInputError("pgp_curl_correction: scale at vertex " + std::to_string(v.idx()) + " is " +
+                                std::to_string(sv) + " (must be > 0)");
+      log_s[v.idx()] = std::log(sv);
+    }
   // Per face: angle of the projected d_s in the face frame.
   std::vector<double> angle(nf, 0.0);
   std::vector<std::array<double, 3>> rhs(nf, {0.0, 0.0, 0.0});
@@ -158,8 +169,17 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
       const FaceIndex f(static_cast<Mesh::size_type>(fi));
       if (mesh.is_removed(f) || !(im.area[fi] > 0)) continue;
       const auto& cv = im.corner[fi];
-      if (index[cv[0]] != 0 || index[cv[1]] != 0 || index[cv[2]] != 0) continue;
       const FaceFrame& fT = im.frame[fi];
+      const double A = im.area[fi];
+      // Opposite edges (ccw) of the corners: grad of the hat function c is n x e_c / 2A.
+      std::array<Vector3, 3> e;
+      for (int c = 0; c < 3; ++c)
+        e[c] = mesh.point(VertexIndex(cv[(c + 2) % 3])) - mesh.point(VertexIndex(cv[(c + 1) % 3]));
+      Vector3 q(0, 0, 0);
+      for (int c = 0; c < 3; ++c) q = q + (log_s[cv[c]] / (2 * A)) * CGAL::cross_product(fT.n, e[c]);
+      const bool singular = index[cv[0]] != 0 || index[cv[1]] != 0 || index[cv[2]] != 0;
+      for (int c = 0; c < 3 && singular; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
+      if (singular) continue;
       const Vector3 ds = fT.direction(angle[fi]), dt = CGAL::cross_product(fT.n, ds);
       double circ_s = 0, circ_t = 0;
       HalfedgeIndex h = mesh.halfedge(f);
@@ -179,12 +199,8 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
         circ_s += 0.5 * (ev * (ds + us));
         circ_t += 0.5 * (ev * (dt + ut));
       }
-      const double A = im.area[fi];
-      const Vector3 q = (-circ_t / A) * ds + (circ_s / A) * dt;
-      for (int c = 0; c < 3; ++c) {
-        const Vector3 e = mesh.point(VertexIndex(cv[(c + 2) % 3])) - mesh.point(VertexIndex(cv[(c + 1) % 3]));
-        rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e));
-      }
+      q = q + (-circ_t / A) * ds + (circ_s / A) * dt;
+      for (int c = 0; c < 3; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
     }
   });
   Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nv));

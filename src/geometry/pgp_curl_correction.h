@@ -14,41 +14,46 @@
 // user's orientation is the constraint that matters; the scale is relative).
 //
 // What we do (the paper describes the idea, not a discretisation; these are
-// our choices). Corrected target g' = exp(phi) g with one log-factor phi per
-// vertex (piecewise linear; a face uses exp of its three vertices' mean). A
-// conformal frame (lambda d_s, lambda d_t) is curl-free iff
-//   grad log lambda = q,   q = -curl(d_t) d_s + curl(d_s) d_t
-// (from curl(lambda d) = lambda (grad log lambda x d + curl d) = 0 for both
-// unit fields; q does not change when the cross is relabelled by a quarter
-// or half turn). q is computed per face T from the discrete curl of the unit
-// frame: curl_T(d) = circulation of d around T / A_T, the circulation being
-// sum over T's edges e (counter-clockwise) of e . (d_T + d~_U) / 2, d~_U the
-// neighbour's representative of the N-symmetric cross nearest to d_T after
-// transport across e (the same matching as the PGP's alphas; d_U itself on a
-// border edge). Faces with a vertex of nonzero field index
-// (direction_field_singularities.h) get q_T = 0: the exact factor around a
-// singularity of index k is a cone r^k, which would only pile up scale change
-// (and clamping) where the PGP makes a vortex anyway (measured: fandisk 7.7% ->
-// 6.8% singular faces, armadillo_52k unchanged at 23.1%, clamped vertices
-// 168 -> 99). Then phi minimises the screened Dirichlet problem
-//   sum_T A_T |grad phi_T - q_T|^2 + mu sum_i M_i phi_i^2,
+// our choices). Corrected target g' = exp(phi) g = exp(phi) d / S with one
+// log-factor phi per vertex (piecewise linear; a face uses exp of its three
+// vertices' mean). With d_s, d_t a unit orthonormal frame,
+//   curl(lambda d) = lambda (grad log lambda x d + curl d),
+// so (lambda d_s, lambda d_t) is curl-free iff grad log lambda = q with
+//   q = -curl(d_t) d_s + curl(d_s) d_t
+// (q does not change when the cross is relabelled by a quarter or half turn),
+// and g' is curl-free iff grad phi = q + grad log S. q is computed per face T
+// from the discrete curl of the unit frame: curl_T(d) = circulation of d
+// around T / A_T, the circulation being the sum over T's edges e
+// (counter-clockwise) of e . (d_T + d~_U) / 2, d~_U the neighbour's
+// representative of the N-symmetric cross nearest to d_T after transport
+// across e (the same matching as the PGP's alphas; d_T itself on a border
+// edge); grad log S is the linear interpolant's. Faces with a vertex of
+// nonzero field index (direction_field_singularities.h) keep only grad log S:
+// the exact factor around a singularity of index k is a cone r^k, which would
+// pile up scale change (and clamping) where the PGP makes a vortex anyway
+// (measured: fandisk 7.7% -> 6.8% singular faces, armadillo_52k unchanged at
+// 23.1%, clamped vertices 168 -> 99). Then phi minimises the screened
+// Dirichlet problem
+//   sum_T A_T |grad phi_T - (q_T + grad log S_T)|^2 + mu sum_i M_i phi_i^2,
 //   mu = stiffness / (total area),
 // (cotangent Laplacian plus lumped mass, one sparse Cholesky; the mass term
-// fixes the free constant and keeps the mean factor near 1: with the default
-// stiffness its screening length is the size of the mesh). The part of q that
-// is not a gradient (Gaussian curvature, field singularities) cannot be
-// removed this way and is left to the PGP. phi is finally clamped to
-// [-log max_factor, log max_factor] (strongly curved places, e.g. the
-// armadillo's fingers, still ask for large factors).
-// The user's scale S is kept as given (its variation is not "corrected": a
-// scale constraint is the user's wish, and its curl is what the paper's
-// T-junctions resolve).
+// fixes the free constant and pulls the factor towards 1, i.e. towards the
+// user's scale: variations of the user's S over distances longer than the
+// screening length sqrt(area / stiffness) are kept, shorter ones are traded
+// for integrability like the field's own curl). A scale that already makes
+// g curl-free (S proportional to the distance from the axis on a torus with
+// a parallels field) gives phi ~ 0. The part of q that is not a gradient
+// (Gaussian curvature, field singularities) cannot be removed this way and
+// is left to the PGP. phi is finally clamped to [-log max_factor,
+// log max_factor] (strongly curved places, e.g. the armadillo's fingers,
+// still ask for large factors).
 //
 // Units: phi is dimensionless (the factor multiplies g, in periods per mesh
 // unit); q is in 1/mesh units; curl in 1/mesh units^2.
 //
-// Reads the face map `direction_map` (Vector3 d_s). Writes nothing on the
-// mesh. Throws InvalidInputError (map absent, options out of range),
+// Reads the face map `direction_map` (Vector3 d_s) and the vertex map
+// `scale_map` (S > 0; absent = 1). Writes nothing on the mesh. Throws
+// InvalidInputError (direction map absent, S <= 0, options out of range),
 // SolverError (factorisation or solve failure).
 
 #include <array>
@@ -71,6 +76,7 @@ struct PgpCurlCorrectionOptions {
   /// The factor exp(phi) is clamped to [1/max_factor, max_factor] (>= 1).
   double max_factor = 4.0;
   std::string direction_map = "f:dir";
+  std::string scale_map = "v:scale";  ///< S per vertex (absent: 1)
 };
 
 struct PgpCurlCorrection {

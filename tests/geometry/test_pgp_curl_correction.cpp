@@ -80,10 +80,24 @@ TEST(PgpCurlCorrection, TorusFactorIsTheConformalScale) {
   EXPECT_LT(spread(k_rho), 0.02) << "raw spread " << spread(k);
 }
 
+// The same torus with the period proportional to rho: g is already
+// curl-free, so the correction leaves it (factor ~ constant ~ 1).
+TEST(PgpCurlCorrection, IntegrableScaleIsLeftAlone) {
+  Mesh m;
+  make_parallel_torus(m);
+  auto scale = m.property_map<VertexIndex, double>("v:scale").first;
+  for (VertexIndex v : m.vertices()) scale[v] = 2 * M_PI * std::hypot(m.point(v).x(), m.point(v).y()) / 24;
+  const PgpCurlCorrection c = pgp_curl_correction(m);
+  EXPECT_LT(spread(c.face_factor), 0.01);
+  EXPECT_GT(c.min_factor, 0.9);
+  EXPECT_LT(c.max_factor, 1.1);
+}
+
 TEST(PgpCurlCorrection, TorusCurlDropsAndTJunctionsDisappear) {
   Mesh m;
   make_parallel_torus(m);
   PgpOptions off, on;
+  off.curl_correction = false;
   on.curl_correction = true;
   const double before = total_circulation(m, off), after = total_circulation(m, on);
   EXPECT_GT(before, 0);
@@ -126,12 +140,13 @@ TEST(PgpCurlCorrection, PlanarRadialFieldGetsTheLogPolarFactor) {
   }
   EXPECT_GT(spread(raw), 0.2);
   EXPECT_LT(spread(k_r), 0.02) << "raw spread " << spread(raw);
-  PgpOptions on;
+  PgpOptions off, on;
+  off.curl_correction = false;
   on.curl_correction = true;
   on.curl_stiffness = weak.stiffness;
   // Measured 10.36 -> 1.23 periods (the signed sum of the t part 10.1 ->
   // 0.30; what remains is the alternating error of piecewise-constant factors).
-  EXPECT_LT(total_circulation(m, on), total_circulation(m, {}) / 5);
+  EXPECT_LT(total_circulation(m, on), total_circulation(m, off) / 5);
 }
 
 // A curl-free target (constant field on a plane) is left alone: factor 1.
@@ -142,9 +157,10 @@ TEST(PgpCurlCorrection, GradientFieldIsUnchanged) {
   interpolate_scalar_field(m, {{0, 0.3}}, scale_field_options());
   const PgpCurlCorrection c = pgp_curl_correction(m);
   for (double k : c.face_factor) EXPECT_NEAR(k, 1.0, 1e-9);
-  PgpOptions on;
+  PgpOptions off, on;
+  off.curl_correction = false;
   on.curl_correction = true;
-  const auto g0 = pgp_face_gradients(m, {}), g1 = pgp_face_gradients(m, on);
+  const auto g0 = pgp_face_gradients(m, off), g1 = pgp_face_gradients(m, on);
   for (std::size_t f = 0; f < g0.size(); ++f)
     for (int a = 0; a < 2; ++a)
       for (int d = 0; d < 3; ++d) EXPECT_NEAR(g0[f][a][d], g1[f][a][d], 1e-9);
