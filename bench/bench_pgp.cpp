@@ -242,8 +242,6 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
   for (int on = 0; on < 2; ++on) {
     PgpOptions o;
     o.curl_correction = on != 0;
-    if (const char* e = std::getenv("CURL_STIFF")) o.curl_stiffness = std::atof(e);
-    if (const char* e = std::getenv("CURL_MAX")) o.curl_max_factor = std::atof(e);
     nlohmann::json pre = nlohmann::json::object();
     if (on) {
       Timer tc;
@@ -288,11 +286,14 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
 int main(int argc, char** argv) {
   std::vector<std::string> meshes;
   bool sweep = true, field_sweep = false, curl_only = false;
+  PgpOptions pgp_options;  // the defaults (curl correction on) unless --no-curl-correction
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-sweep")
       sweep = false;
     else if (std::string(argv[i]) == "--curl-only")
       curl_only = true;
+    else if (std::string(argv[i]) == "--no-curl-correction")
+      pgp_options.curl_correction = false;
     else if (std::string(argv[i]) == "--field-sweep")
       field_sweep = true;
     else
@@ -316,7 +317,7 @@ int main(int argc, char** argv) {
       // The curvature field of the runs below, then only the curl figures.
       compute_principal_curvatures(mesh);
       interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, 0.05), {});
-      for (double k : {8.0, 16.0}) if (!std::getenv("CURL_ONLY8") || k == 8.0) curl_correction_figures(mesh, name, k);
+      for (double k : {4.0, 8.0, 16.0}) curl_correction_figures(mesh, name, k);
       continue;
     }
     emit(name, nf, "principal_curvatures",
@@ -334,7 +335,7 @@ int main(int argc, char** argv) {
     interpolate_scalar_field(mesh, {{0, period}}, scale_field_options());
     interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
                              material_field_options());
-    PeriodicGlobalParameterization pgp(mesh);
+    PeriodicGlobalParameterization pgp(mesh, pgp_options);
     // The first call pays the ordering and the symbolic analysis (one-shot
     // runs such as the CLI's); the best of 3 reuses them.
     PgpResult init;
@@ -346,7 +347,9 @@ int main(int argc, char** argv) {
     const double t_init = best_of_3([&] { keep_fastest(init, pgp.initialize()); });
     emit(name, nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
     PgpSingularities sing;
-    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
+    PgpSingularityOptions sing_options;
+    sing_options.pgp = pgp_options;
+    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh, sing_options); });
     {
       nlohmann::json fig = singularity_figures(mesh, sing);
       fig["diagnosis"] = singular_face_diagnosis(mesh, sing);
@@ -402,9 +405,9 @@ int main(int argc, char** argv) {
         fo.smoothing = smoothing;
         interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), fo);
         interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, 8.0)}}, scale_field_options());
-        PeriodicGlobalParameterization p2(mesh);
+        PeriodicGlobalParameterization p2(mesh, pgp_options);
         p2.initialize();
-        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
+        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
         fig["rings"] = rings;
         fig["constrained_fraction"] = fraction;
         fig["smoothing"] = smoothing;
@@ -417,9 +420,9 @@ int main(int argc, char** argv) {
     for (double k : {4.0, 8.0, 16.0}) {
       interpolate_direction_field(mesh, field ? curv : strokes, {});
       interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
-      PeriodicGlobalParameterization p2(mesh);
+      PeriodicGlobalParameterization p2(mesh, pgp_options);
       p2.initialize();
-      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
+      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
       fig["edges_per_period"] = k;
       fig["field"] = field ? "curvature" : "strokes";
       emit(name, nf, "singular_fraction_vs_period", 0.0, fig);

@@ -302,6 +302,18 @@ std::vector<std::array<std::array<double, 3>, 2>> pgp_face_gradients(const Mesh&
   return out;
 }
 
+PgpTarget pgp_target(const Mesh& mesh, const PgpOptions& o) {
+  check_options(o);
+  std::vector<FaceFrame> frames;
+  const auto g = face_gradients(mesh, o, &frames);
+  PgpTarget out;
+  out.alphas = halfedge_alphas(mesh, o, g, frames);
+  out.gradients.resize(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i)
+    out.gradients[i] = {{{g[i].gs.x(), g[i].gs.y(), g[i].gs.z()}, {g[i].gt.x(), g[i].gt.y(), g[i].gt.z()}}};
+  return out;
+}
+
 namespace {
 
 // Connectivity and geometry of the mesh as the solver sees it, computed once

@@ -249,5 +249,49 @@ TEST(PgpCurlCorrection, LocalUpdateKeepsTheOutside) {
   EXPECT_GT(changed, area.free_vertices / 2);
 }
 
+// Without the correction a local update recomputes gradients and alphas only
+// next to the free faces (cache elsewhere): its corners inside the area must
+// still equal a full rewrite from the same state (the default now refreshes
+// everything; this keeps the cached path covered).
+TEST(PgpCurlCorrection, WithoutItTheUpdateCacheMatchesAFullRewrite) {
+  Mesh m;
+  make_torus(m, 3.0, 1.0, 48, 24);
+  interpolate_direction_field(m, {{0, {0, 1, 0}}, {700, {0, 0, 1}}}, {});
+  interpolate_scalar_field(m, {{0, 0.5}, {300, 0.8}}, scale_field_options());
+  PgpOptions off;
+  off.curl_correction = false;
+  PeriodicGlobalParameterization pgp(m, off);
+  pgp.initialize();
+  const auto zs0 = pgp.z_s();
+  EffectAreaOptions eo;
+  eo.radius = 1.2;
+  const EffectArea area = compute_effect_area(m, {600}, eo);
+  ASSERT_GT(area.free_faces, 50u);
+  DirectionFieldOptions dopt;
+  dopt.area = &area;
+  const FaceIndex cf = m.face(m.halfedge(VertexIndex(600)));
+  interpolate_direction_field(m, {{static_cast<std::uint32_t>(cf.idx()), {1, 1, 1}}}, dopt);
+  pgp.update(area);
+  for (VertexIndex v : m.vertices()) {
+    const auto a = pgp.z_s()[v.idx()], b = zs0[v.idx()];
+    if (!area.vertex_free[v.idx()]) {
+      EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
+    }
+  }
+  auto stm = find(m, kCornerSTM).first;
+  Mesh copy = m;
+  PeriodicGlobalParameterization fresh(copy, off);
+  fresh.set_state(pgp.z_s(), pgp.z_t());
+  fresh.write_corners();
+  auto stm2 = find(copy, kCornerSTM).first;
+  std::size_t compared = 0;
+  for (FaceIndex f : m.faces()) {
+    if (!area.face_free[f.idx()]) continue;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(m.halfedge(f), m))
+      for (int k = 0; k < 3; ++k, ++compared) EXPECT_EQ(stm[h][k], stm2[h][k]);
+  }
+  EXPECT_GT(compared, 0u);
+}
+
 }  // namespace
 }  // namespace surftex
