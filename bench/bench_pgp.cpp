@@ -267,12 +267,15 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
     nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, so));
     fig["diagnosis"] = singular_face_diagnosis(mesh, detect_pgp_singularities(mesh, so));
     PgpSingularityOptions user;
+    user.pgp.curl_correction = false;
     const PgpSingularities su = detect_pgp_singularities(mesh, user);
     std::size_t du = 0;
     for (char x : su.distorted_face) du += x;
     fig["vs_user_field"] = {{"singular_fraction", su.singular_fraction}, {"distorted_faces", du}};
     fig["circulation"] = total_circulation(mesh, o);
-    fig["circulation_uncorrected"] = total_circulation(mesh, PgpOptions{});
+    PgpOptions uncorrected;
+    uncorrected.curl_correction = false;
+    fig["circulation_uncorrected"] = total_circulation(mesh, uncorrected);
     fig.update(pre);
     fig["curl_correction"] = on != 0;
     fig["edges_per_period"] = edges_per_period;
