@@ -56,6 +56,31 @@
 // Singular faces on armadillo (--field-sweep, diagnosis in the
 // detect_singularities line): 55% lie within 3 edges of a field-singular
 // vertex; distorted faces are 9.4% of all and their rings triple that.
+// Curl correction (issue #5, pgp_curl_correction.h; --curl-only prints one
+// line per mesh, period and setting; --no-curl-correction turns it off for
+// the main runs). 2026-11-22, shared machine, load 6.5-7.7 (uptime before /
+// after), one --curl-only run 61 s wall / 32 s user. Singular fraction
+// (faces with a singular vertex = three-lookup faces) off -> on, curvature
+// field, by mean edges per period; in brackets the same with the distortion
+// measured against the user's uncorrected g:
+//                   4                    8                    16
+//   fandisk         7.4 -> 4.9 (5.6)     9.6 -> 6.8 (8.4)     17.6 -> 14.5 (16.6)
+//   dragon_25k     49.1 -> 44.6 (50.9)  58.4 -> 54.0 (58.9)   75.4 -> 71.6 (74.3)
+//   armadillo_52k  23.8 -> 15.3 (24.5)  29.6 -> 23.1 (33.9)   47.3 -> 39.6 (51.7)
+// Distorted faces alone at 8 edges: fandisk 391 -> 237, dragon 5800 -> 5105,
+// armadillo 4899 -> 3808 (of 12.9K, 25.0K, 52.0K). Factor range: fandisk
+// 0.51..1.48, dragon 0.40..4 (6 vertices clamped), armadillo 0.32..4 (99).
+// Total |circulation| of the target (periods): fandisk 29.3 -> 22.5,
+// armadillo 300.8 -> 283.5, dragon 193.5 -> 201.8 (its ~800 field
+// singularities dominate; the per-face curl of the factor's steps adds).
+// Cost: the correction with its factorisation reused 0.007 / 0.019 / 0.038-
+// 0.047 s CPU (fandisk / dragon / armadillo), one-shot (with the
+// factorisation) 0.04 / 0.04-0.16 / 0.15-0.22 s wall; PGP initialisation
+// (best of 3) armadillo 0.54-0.57 -> 0.61-0.67 s CPU (about +8%, noisy),
+// fandisk 0.122-0.128 -> 0.130. With the correction a local update refreshes
+// every face's gradient (the factor is global): local_update_pgp armadillo
+// 0.083 -> 0.150 s CPU, dragon 0.032 -> 0.067, fandisk 0.017 -> 0.026
+// (--no-sweep runs, load 6).
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
