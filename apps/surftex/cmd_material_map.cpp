@@ -136,7 +136,8 @@ bool state_curl_correction(const nlohmann::json& j) {
   return it != j.end() && it->is_boolean() && it->get<bool>();
 }
 
-double load_state(const nlohmann::json& j, const std::string& path, Mesh& mesh, PeriodicGlobalParameterization& pgp) {
+double load_state(const nlohmann::json& j, const std::string& path, Mesh& mesh,
+                  PeriodicGlobalParameterization& pgp) {
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
   const auto zs = state_array(j, "z_s", 2 * nv, path), zt = state_array(j, "z_t", 2 * nv, path);
   const auto d = state_array(j, "direction", 3 * nf, path);
@@ -411,9 +412,10 @@ SubcommandRegistrar reg{
        app.add_option("--bump", a->bump, "Normal-map strength: tilt per unit height slope (0..10, default 0.03)")
            ->check(CLI::Range(0.0, 10.0));
        app.add_flag("--no-curl-correction", a->no_curl_correction,
-                    "Solve the PGP for the target gradients d/S as given, without the curl correction (Ray et al. "
-                    "2006) that rescales them towards curl-free (default: corrected; fewer singular faces, the "
-                    "period locally rescaled by up to 4x). With --update the state's setting is used");
+                    "Solve the PGP for the target gradients d/S as given, without the curl correction "
+                    "(Ray et al. 2006) that rescales them towards curl-free (default: corrected; fewer "
+                    "singular faces, the period locally rescaled by up to 4x). With --update the state's "
+                    "setting is used");
        add_common_options(app, a->common);
        return [a] { return run(*a); };
      }}};

@@ -631,7 +631,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       }
     }
   }
-  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad, opt.curl_correction ? corrector() : nullptr);
+  face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad, corrector());
   halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
   corner = corner_matchings(mesh, quarter);
   const auto ealpha = edge_alphas(alpha);
@@ -950,7 +950,7 @@ std::array<double, 2> PeriodicGlobalParameterization::energies() {
   std::vector<FaceGrad> g;
   std::vector<std::array<double, 2>> alpha;
   std::vector<std::uint8_t> quarter;
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g, im.opt.curl_correction ? im.corrector() : nullptr);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, g, t.frames, nullptr, alpha, &quarter);
   const std::vector<std::uint8_t> corner = corner_matchings(im.mesh, quarter);
   std::array<double, 2> out{0, 0};
@@ -976,7 +976,7 @@ void PeriodicGlobalParameterization::write_corners() {
   require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
   Impl& im = *impl_;
   const PgpTopology& t = im.topology();
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad, im.opt.curl_correction ? im.corrector() : nullptr);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha, &im.quarter);
   im.corner = corner_matchings(im.mesh, im.quarter);
   im.edge_energy.clear();

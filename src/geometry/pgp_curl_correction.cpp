@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/pgp_curl_correction.h"
 
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -23,11 +23,13 @@ using SpMat = Eigen::SparseMatrix<double>;
 
 void check(const PgpCurlCorrectionOptions& o) {
   if (o.symmetry != 1 && o.symmetry != 2 && o.symmetry != 4)
-    throw InvalidInputError("pgp_curl_correction: symmetry must be 1, 2 or 4, got " + std::to_string(o.symmetry));
+    throw InvalidInputError("pgp_curl_correction: symmetry must be 1, 2 or 4, got " +
+                            std::to_string(o.symmetry));
   if (!(o.stiffness > 0) || !std::isfinite(o.stiffness))
     throw InvalidInputError("pgp_curl_correction: stiffness must be > 0, got " + std::to_string(o.stiffness));
   if (!(o.max_factor >= 1) || !std::isfinite(o.max_factor))
-    throw InvalidInputError("pgp_curl_correction: max_factor must be >= 1, got " + std::to_string(o.max_factor));
+    throw InvalidInputError("pgp_curl_correction: max_factor must be >= 1, got " +
+                            std::to_string(o.max_factor));
 }
 
 /// Quarter-turn-free matching of the PGP (halfedge_alphas): the representative
@@ -48,11 +50,11 @@ struct PgpCurlCorrector::Impl {
   // Geometry, computed with the factorisation (the mesh must not change).
   std::size_t nv = 0, nf = 0;
   bool ready = false;
-  std::vector<FaceFrame> frame;              // per face
-  std::vector<double> area;                  // per face
-  std::vector<double> mass;                  // per vertex: a third of its faces' area
+  std::vector<FaceFrame> frame;                      // per face
+  std::vector<double> area;                          // per face
+  std::vector<double> mass;                          // per vertex: a third of its faces' area
   std::vector<std::array<std::uint32_t, 3>> corner;  // per face: targets of h, next(h), next(next(h))
-  std::vector<double> edge_angle;            // per halfedge: angle of target - source in face(h)'s frame
+  std::vector<double> edge_angle;  // per halfedge: angle of target - source in face(h)'s frame
   Eigen::SimplicialLLT<SpMat> solver;
 
   void prepare(const Mesh& mesh);
@@ -65,19 +67,20 @@ void PgpCurlCorrector::Impl::prepare(const Mesh& mesh) {
   area.assign(nf, 0.0);
   corner.assign(nf, {0, 0, 0});
   edge_angle.assign(mesh.num_halfedges(), 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
-      const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f)) continue;
-      frame[fi] = face_frame(mesh, f);
-      area[fi] = face_area(mesh, f);
-      HalfedgeIndex h = mesh.halfedge(f);
-      for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
-        corner[fi][c] = static_cast<std::uint32_t>(mesh.target(h).idx());
-        edge_angle[h.idx()] = frame[fi].angle_of(mesh.point(mesh.target(h)) - mesh.point(mesh.source(h)));
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+          const FaceIndex f(static_cast<Mesh::size_type>(fi));
+          if (mesh.is_removed(f)) continue;
+          frame[fi] = face_frame(mesh, f);
+          area[fi] = face_area(mesh, f);
+          HalfedgeIndex h = mesh.halfedge(f);
+          for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
+            corner[fi][c] = static_cast<std::uint32_t>(mesh.target(h).idx());
+            edge_angle[h.idx()] = frame[fi].angle_of(mesh.point(mesh.target(h)) - mesh.point(mesh.source(h)));
+          }
+        }
+      });
   mass.assign(nv, 0.0);
   double total_area = 0;
   for (FaceIndex f : mesh.faces()) {
@@ -130,7 +133,8 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
                             "' absent (interpolate a direction field first)");
   require_triangle_mesh(mesh, "pgp_curl_correction");
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
-  if (!im.ready || im.nv != nv || im.nf != nf || im.edge_angle.size() != mesh.num_halfedges()) im.prepare(mesh);
+  if (!im.ready || im.nv != nv || im.nf != nf || im.edge_angle.size() != mesh.num_halfedges())
+    im.prepare(mesh);
   const double step = 2 * M_PI / o.symmetry;
 
   // Faces with a vertex of nonzero field index: no target there (the exact
@@ -153,56 +157,58 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
   // Per face: angle of the projected d_s in the face frame.
   std::vector<double> angle(nf, 0.0);
   std::vector<std::array<double, 3>> rhs(nf, {0.0, 0.0, 0.0});
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
-      const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f)) continue;
-      const Vector3 d = dir.first[f];
-      const FaceFrame& fr = im.frame[fi];
-      angle[fi] = fr.angle_of(normalized_or(d - (d * fr.n) * fr.n, fr.e1));
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+                        const FaceIndex f(static_cast<Mesh::size_type>(fi));
+                        if (mesh.is_removed(f)) continue;
+                        const Vector3 d = dir.first[f];
+                        const FaceFrame& fr = im.frame[fi];
+                        angle[fi] = fr.angle_of(normalized_or(d - (d * fr.n) * fr.n, fr.e1));
+                      }
+                    });
   // q_T = -curl(d_t) d_s + curl(d_s) d_t, and its right-hand side
   // contribution q_T . (n x e_c) / 2 per corner c (e_c the opposite edge, ccw).
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
-      const FaceIndex f(static_cast<Mesh::size_type>(fi));
-      if (mesh.is_removed(f) || !(im.area[fi] > 0)) continue;
-      const auto& cv = im.corner[fi];
-      const FaceFrame& fT = im.frame[fi];
-      const double A = im.area[fi];
-      // Opposite edges (ccw) of the corners: grad of the hat function c is n x e_c / 2A.
-      std::array<Vector3, 3> e;
-      for (int c = 0; c < 3; ++c)
-        e[c] = mesh.point(VertexIndex(cv[(c + 2) % 3])) - mesh.point(VertexIndex(cv[(c + 1) % 3]));
-      Vector3 q(0, 0, 0);
-      for (int c = 0; c < 3; ++c) q = q + (log_s[cv[c]] / (2 * A)) * CGAL::cross_product(fT.n, e[c]);
-      const bool singular = index[cv[0]] != 0 || index[cv[1]] != 0 || index[cv[2]] != 0;
-      for (int c = 0; c < 3 && singular; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
-      if (singular) continue;
-      const Vector3 ds = fT.direction(angle[fi]), dt = CGAL::cross_product(fT.n, ds);
-      double circ_s = 0, circ_t = 0;
-      HalfedgeIndex h = mesh.halfedge(f);
-      for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
-        const Vector3 ev = mesh.point(mesh.target(h)) - mesh.point(mesh.source(h));
-        const HalfedgeIndex op = mesh.opposite(h);
-        Vector3 us = ds, ut = dt;
-        if (!mesh.is_border(op)) {
-          // The matching of the PGP's alphas, with the edge angles cached
-          // (ev in U's frame = the opposite halfedge's angle + pi).
-          const std::size_t U = mesh.face(op).idx();
-          const FaceFrame& fU = im.frame[U];
-          const double transported = angle[fi] - im.edge_angle[h.idx()] + im.edge_angle[op.idx()] + M_PI;
-          us = fU.direction(angle[U] + std::round((transported - angle[U]) / step) * step);
-          ut = CGAL::cross_product(fU.n, us);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t fi = r.begin(); fi != r.end(); ++fi) {
+          const FaceIndex f(static_cast<Mesh::size_type>(fi));
+          if (mesh.is_removed(f) || !(im.area[fi] > 0)) continue;
+          const auto& cv = im.corner[fi];
+          const FaceFrame& fT = im.frame[fi];
+          const double A = im.area[fi];
+          // Opposite edges (ccw) of the corners: grad of the hat function c is n x e_c / 2A.
+          std::array<Vector3, 3> e;
+          for (int c = 0; c < 3; ++c)
+            e[c] = mesh.point(VertexIndex(cv[(c + 2) % 3])) - mesh.point(VertexIndex(cv[(c + 1) % 3]));
+          Vector3 q(0, 0, 0);
+          for (int c = 0; c < 3; ++c) q = q + (log_s[cv[c]] / (2 * A)) * CGAL::cross_product(fT.n, e[c]);
+          const bool singular = index[cv[0]] != 0 || index[cv[1]] != 0 || index[cv[2]] != 0;
+          for (int c = 0; c < 3 && singular; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
+          if (singular) continue;
+          const Vector3 ds = fT.direction(angle[fi]), dt = CGAL::cross_product(fT.n, ds);
+          double circ_s = 0, circ_t = 0;
+          HalfedgeIndex h = mesh.halfedge(f);
+          for (int c = 0; c < 3; ++c, h = mesh.next(h)) {
+            const Vector3 ev = mesh.point(mesh.target(h)) - mesh.point(mesh.source(h));
+            const HalfedgeIndex op = mesh.opposite(h);
+            Vector3 us = ds, ut = dt;
+            if (!mesh.is_border(op)) {
+              // The matching of the PGP's alphas, with the edge angles cached
+              // (ev in U's frame = the opposite halfedge's angle + pi).
+              const std::size_t U = mesh.face(op).idx();
+              const FaceFrame& fU = im.frame[U];
+              const double transported = angle[fi] - im.edge_angle[h.idx()] + im.edge_angle[op.idx()] + M_PI;
+              us = fU.direction(angle[U] + std::round((transported - angle[U]) / step) * step);
+              ut = CGAL::cross_product(fU.n, us);
+            }
+            circ_s += 0.5 * (ev * (ds + us));
+            circ_t += 0.5 * (ev * (dt + ut));
+          }
+          q = q + (-circ_t / A) * ds + (circ_s / A) * dt;
+          for (int c = 0; c < 3; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
         }
-        circ_s += 0.5 * (ev * (ds + us));
-        circ_t += 0.5 * (ev * (dt + ut));
-      }
-      q = q + (-circ_t / A) * ds + (circ_s / A) * dt;
-      for (int c = 0; c < 3; ++c) rhs[fi][c] = 0.5 * (q * CGAL::cross_product(fT.n, e[c]));
-    }
-  });
+      });
   Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nv));
   for (FaceIndex f : mesh.faces())  // serial: the same sums whatever the threads
     for (int c = 0; c < 3; ++c) b[im.corner[f.idx()][c]] += rhs[f.idx()][c];

@@ -80,8 +80,8 @@ struct PgpCurlCorrectionOptions {
 };
 
 struct PgpCurlCorrection {
-  std::vector<double> log_factor;   ///< phi per vertex index (0 for isolated vertices)
-  std::vector<double> face_factor;  ///< exp(mean phi of its vertices) per face index
+  std::vector<double> log_factor;         ///< phi per vertex index (0 for isolated vertices)
+  std::vector<double> face_factor;        ///< exp(mean phi of its vertices) per face index
   double min_factor = 1, max_factor = 1;  ///< over the faces
   std::size_t clamped_vertices = 0;       ///< vertices whose phi hit the clamp
 };
