@@ -62,14 +62,18 @@
 // after), one --curl-only run 61 s wall / 32 s user. Singular fraction
 // (faces with a singular vertex = three-lookup faces) off -> on, curvature
 // field, by mean edges per period; in brackets the same with the distortion
-// measured against the user's uncorrected g:
+// measured against the user's uncorrected g (default max factor 2; the
+// second row with max factor 4):
 //                   4                    8                    16
 //   fandisk         7.4 -> 4.9 (5.6)     9.6 -> 6.8 (8.4)     17.6 -> 14.5 (16.6)
-//   dragon_25k     49.1 -> 44.6 (50.9)  58.4 -> 54.0 (58.9)   75.4 -> 71.6 (74.3)
-//   armadillo_52k  23.8 -> 15.3 (24.5)  29.6 -> 23.1 (33.9)   47.3 -> 39.6 (51.7)
-// Distorted faces alone at 8 edges: fandisk 391 -> 237, dragon 5800 -> 5105,
-// armadillo 4899 -> 3808 (of 12.9K, 25.0K, 52.0K). Factor range: fandisk
-// 0.51..1.48, dragon 0.40..4 (6 vertices clamped), armadillo 0.32..4 (99).
+//   dragon_25k     49.1 -> 44.8 (50.6)  58.4 -> 54.3 (58.8)   75.4 -> 72.1 (74.4)
+//       max 4            44.6 (50.9)          54.0 (58.9)           71.6 (74.3)
+//   armadillo_52k  23.8 -> 16.7 (25.6)  29.6 -> 24.0 (33.2)   47.3 -> 39.7 (50.9)
+//       max 4            15.3 (24.5)          23.1 (33.9)           39.6 (51.7)
+// Distorted faces alone at 8 edges: fandisk 391 -> 237, dragon 5800 -> 5130,
+// armadillo 4899 -> 3978 (of 12.9K, 25.0K, 52.0K). Factor range: fandisk
+// 0.52..1.48 (1 vertex clamped), dragon 0.5..2 (417), armadillo 0.5..2
+// (1222); with max 4: dragon 0.40..4 (6), armadillo 0.32..4 (99).
 // Total |circulation| of the target (periods): fandisk 29.3 -> 22.5,
 // armadillo 300.8 -> 283.5, dragon 193.5 -> 201.8 (its ~800 field
 // singularities dominate; the per-face curl of the factor's steps adds).

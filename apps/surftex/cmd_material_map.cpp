@@ -414,7 +414,7 @@ SubcommandRegistrar reg{
        app.add_flag("--no-curl-correction", a->no_curl_correction,
                     "Solve the PGP for the target gradients d/S as given, without the curl correction "
                     "(Ray et al. 2006) that rescales them towards curl-free (default: corrected; fewer "
-                    "singular faces, the period locally rescaled by up to 4x). With --update the state's "
+                    "singular faces, the period locally rescaled by up to 2x). With --update the state's "
                     "setting is used");
        add_common_options(app, a->common);
        return [a] { return run(*a); };

@@ -113,15 +113,15 @@ struct PgpOptions {
   /// 2006; geometry/pgp_curl_correction.h): g = d/S is scaled per vertex by
   /// the factor exp(phi) that brings it closest to curl-free, directions
   /// kept. On by default: singular faces (section 3, curvature field, 8 mean
-  /// edges per period) fandisk 9.6% -> 6.8%, dragon_25k 58.4% -> 54.0%,
-  /// armadillo_52k 29.6% -> 23.1% (bench_pgp --curl-only), for about +8% of
+  /// edges per period) fandisk 9.6% -> 6.8%, dragon_25k 58.4% -> 54.3%,
+  /// armadillo_52k 29.6% -> 24.0% (bench_pgp --curl-only), for about +8% of
   /// the initialisation's CPU time; the period is then locally rescaled
-  /// (armadillo: factors 0.32..4, clamped at curl_max_factor). With it a
+  /// (armadillo: factors 0.5..2, clamped at curl_max_factor). With it a
   /// local update refreshes the gradients of every face (the factor is
   /// global), so an update equals a full rewrite from the same state.
   bool curl_correction = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
-  double curl_max_factor = 4.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
+  double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";
   std::string scale_map = "v:scale";
   std::string material_map = "v:material";

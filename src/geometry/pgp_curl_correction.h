@@ -32,7 +32,7 @@
 // the exact factor around a singularity of index k is a cone r^k, which would
 // pile up scale change (and clamping) where the PGP makes a vortex anyway
 // (measured: fandisk 7.7% -> 6.8% singular faces, armadillo_52k unchanged at
-// 23.1%, clamped vertices 168 -> 99). Then phi minimises the screened
+// 23.1%, clamped vertices 168 -> 99, with max_factor 4). Then phi minimises the screened
 // Dirichlet problem
 //   sum_T A_T |grad phi_T - (q_T + grad log S_T)|^2 + mu sum_i M_i phi_i^2,
 //   mu = stiffness / (total area),
@@ -45,8 +45,13 @@
 // a parallels field) gives phi ~ 0. The part of q that is not a gradient
 // (Gaussian curvature, field singularities) cannot be removed this way and
 // is left to the PGP. phi is finally clamped to [-log max_factor,
-// log max_factor] (strongly curved places, e.g. the armadillo's fingers,
-// still ask for large factors).
+// log max_factor]: strongly curved places (the armadillo's fingers and head)
+// ask for large factors, and the clamp bounds how far the period departs from
+// the user's (measured at 8 mean edges per period, max_factor 4 -> 2:
+// armadillo_52k 23.1% -> 24.0% singular faces with factors 0.32..4 -> 0.5..2,
+// dragon_25k 54.0% -> 54.3%, fandisk unchanged at 6.8%). The rescaling is
+// visible: on the armadillo the checks of a checker tile are about twice as
+// large on the thighs as on the forearms (`surftex material-map`, renders).
 //
 // Units: phi is dimensionless (the factor multiplies g, in periods per mesh
 // unit); q is in 1/mesh units; curl in 1/mesh units^2.
@@ -74,7 +79,7 @@ struct PgpCurlCorrectionOptions {
   /// closer to 1 (screening length ~ sqrt(area / stiffness)).
   double stiffness = 1.0;
   /// The factor exp(phi) is clamped to [1/max_factor, max_factor] (>= 1).
-  double max_factor = 4.0;
+  double max_factor = 2.0;
   std::string direction_map = "f:dir";
   std::string scale_map = "v:scale";  ///< S per vertex (absent: 1)
 };

@@ -28,7 +28,7 @@
 // (section 4, Rendering). It is not the fraction of distorted triangles (the
 // first criterion alone), which is about a third of it (armadillo_52k, 8 mean
 // edges per period: 9.4% distorted, 29.6% three-lookup faces without the
-// curl correction; 7.3% and 23.1% with it). Our reading counts no more than
+// curl correction; 7.7% and 24.0% with it). Our reading counts no more than
 // the literal one: spokes only (the literal "contains an edge" would add the
 // rim edges), and the threshold relative to |g|^2 (the literal absolute 0.5
 // is stricter whenever the period S is shorter than 1 mesh unit, as |g| = 1/S).

@@ -193,8 +193,8 @@ TEST(PgpCurlCorrection, DeterministicAcrossThreadsAndReuse) {
   const auto [lo, hi] = std::minmax_element(a.begin(), a.end());
   EXPECT_LT(*lo, -0.05);
   EXPECT_GT(*hi, 0.05);
-  EXPECT_GE(*lo, -std::log(4.0) - 1e-12);
-  EXPECT_LE(*hi, std::log(4.0) + 1e-12);
+  EXPECT_GE(*lo, -std::log(PgpCurlCorrectionOptions{}.max_factor) - 1e-12);
+  EXPECT_LE(*hi, std::log(PgpCurlCorrectionOptions{}.max_factor) + 1e-12);
 }
 
 TEST(PgpCurlCorrection, RejectsBadOptionsAndMissingField) {
