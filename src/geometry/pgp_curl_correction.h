@@ -10,8 +10,11 @@
 // field on a curved surface, constant S): the PGP then cannot follow it and
 // concentrates the misfit in vortices and T-junctions, the singular zones of
 // section 3. The 2006 paper makes the target closer to curl-free before the
-// solve by changing the norm of the vectors and keeping their directions (the
-// user's orientation is the constraint that matters; the scale is relative).
+// solve; we read its correction as changing the norm of the vectors and
+// keeping their directions (the user's orientation is the constraint that
+// matters; the scale is relative). The 2006 paper is not in
+// ../shared/papers/: this reading is from memory of it and from the 2009
+// paper's summary, not checked against its text.
 //
 // What we do (the paper describes the idea, not a discretisation; these are
 // our choices). Corrected target g' = exp(phi) g = exp(phi) d / S with one
