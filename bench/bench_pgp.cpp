@@ -92,10 +92,40 @@
 // Singular faces on armadillo (--field-sweep, diagnosis in the
 // detect_singularities line): 55% lie within 3 edges of a field-singular
 // vertex; distorted faces are 9.4% of all and their rings triple that.
+// Curl correction (issue #5, pgp_curl_correction.h; --curl-only prints one
+// line per mesh, period and setting; --no-curl-correction turns it off for
+// the main runs). 2026-11-22, shared machine, load 6.5-7.7 (uptime before /
+// after), one --curl-only run 61 s wall / 32 s user. Singular fraction
+// (faces with a singular vertex = three-lookup faces) off -> on, curvature
+// field, by mean edges per period; in brackets the same with the distortion
+// measured against the user's uncorrected g (default max factor 2; the
+// second row with max factor 4):
+//                   4                    8                    16
+//   fandisk         7.4 -> 4.9 (5.6)     9.6 -> 6.8 (8.4)     17.6 -> 14.5 (16.6)
+//   dragon_25k     49.1 -> 44.8 (50.6)  58.4 -> 54.3 (58.8)   75.4 -> 72.1 (74.4)
+//       max 4            44.6 (50.9)          54.0 (58.9)           71.6 (74.3)
+//   armadillo_52k  23.8 -> 16.7 (25.6)  29.6 -> 24.0 (33.2)   47.3 -> 39.7 (50.9)
+//       max 4            15.3 (24.5)          23.1 (33.9)           39.6 (51.7)
+// Distorted faces alone at 8 edges: fandisk 391 -> 237, dragon 5800 -> 5130,
+// armadillo 4899 -> 3978 (of 12.9K, 25.0K, 52.0K). Factor range: fandisk
+// 0.52..1.48 (1 vertex clamped), dragon 0.5..2 (417), armadillo 0.5..2
+// (1222); with max 4: dragon 0.40..4 (6), armadillo 0.32..4 (99).
+// Total |circulation| of the target (periods): fandisk 29.3 -> 22.5,
+// armadillo 300.8 -> 283.5, dragon 193.5 -> 201.8 (its ~800 field
+// singularities dominate; the per-face curl of the factor's steps adds).
+// Cost: the correction with its factorisation reused 0.007 / 0.019 / 0.038-
+// 0.047 s CPU (fandisk / dragon / armadillo), one-shot (with the
+// factorisation) 0.04 / 0.04-0.16 / 0.15-0.22 s wall; PGP initialisation
+// (best of 3) armadillo 0.54-0.57 -> 0.61-0.67 s CPU (about +8%, noisy),
+// fandisk 0.122-0.128 -> 0.130. With the correction a local update refreshes
+// every face's gradient (the factor is global): local_update_pgp armadillo
+// 0.083 -> 0.150 s CPU, dragon 0.032 -> 0.067, fandisk 0.017 -> 0.026
+// (--no-sweep runs, load 6).
 #include <nlohmann/json.hpp>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <ctime>
 #include <cstdint>
 #include <functional>
@@ -110,6 +140,7 @@
 #include "geometry/effect_area.h"
 #include "geometry/mesh.h"
 #include "geometry/periodic_global_parameterization.h"
+#include "geometry/pgp_curl_correction.h"
 #include "geometry/pgp_singularities.h"
 #include "geometry/principal_curvatures.h"
 #include "geometry/read_mesh.h"
@@ -259,14 +290,80 @@ nlohmann::json singular_face_diagnosis(const Mesh& mesh, const PgpSingularities&
   return {{"by_distance_to_field_singularity", rows}, {"singular_by_mismatch_only", mismatch_only}};
 }
 
+/// Sum over faces of |circulation| of the target gradients (s and t), in
+/// periods: the misfit the PGP must absorb (0 for a gradient field).
+double total_circulation(const Mesh& mesh, const PgpOptions& o) {
+  double sum = 0;
+  for (const auto& c : pgp_face_circulation(mesh, o)) sum += std::abs(c[0]) + std::abs(c[1]);
+  return sum;
+}
+
+/// Singular fraction, curl and PGP initialisation time without and with the
+/// curl correction (Ray et al. 2006), at `edges_per_period`, on the field in
+/// place. The distortion test of section 3 is run against the target the PGP
+/// followed ("singular_fraction", charts consistent with the solve) and
+/// against the user's uncorrected g ("vs_user_field").
+void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_per_period) {
+  const std::size_t nf = mesh.number_of_faces();
+  interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, edges_per_period)}}, scale_field_options());
+  for (int on = 0; on < 2; ++on) {
+    PgpOptions o;
+    o.curl_correction = on != 0;
+    nlohmann::json pre = nlohmann::json::object();
+    if (on) {
+      Timer tc;
+      PgpCurlCorrectionOptions co;
+      co.stiffness = o.curl_stiffness;
+      co.max_factor = o.curl_max_factor;
+      const PgpCurlCorrection c = pgp_curl_correction(mesh, co);
+      pre["correction_seconds_one_shot"] = tc.seconds();
+      PgpCurlCorrector reused(co);
+      reused.compute(mesh);
+      pre["correction_seconds_reused"] = best_of_3([&] { reused.compute(mesh); });
+      pre["correction_cpu_seconds_reused"] = g_last_cpu;
+      pre["factor_min"] = c.min_factor;
+      pre["factor_max"] = c.max_factor;
+      pre["clamped_vertices"] = c.clamped_vertices;
+    }
+    PeriodicGlobalParameterization p(mesh, o);
+    p.initialize();  // ordering and analysis paid once, as in the best of 3 above
+    PgpResult best;
+    const double t = best_of_3([&] { keep_fastest(best, p.initialize()); });
+    PgpSingularityOptions so;
+    so.pgp = o;
+    nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, so));
+    fig["diagnosis"] = singular_face_diagnosis(mesh, detect_pgp_singularities(mesh, so));
+    PgpSingularityOptions user;
+    user.pgp.curl_correction = false;
+    const PgpSingularities su = detect_pgp_singularities(mesh, user);
+    std::size_t du = 0;
+    for (char x : su.distorted_face) du += x;
+    fig["vs_user_field"] = {{"singular_fraction", su.singular_fraction}, {"distorted_faces", du}};
+    fig["circulation"] = total_circulation(mesh, o);
+    PgpOptions uncorrected;
+    uncorrected.curl_correction = false;
+    fig["circulation_uncorrected"] = total_circulation(mesh, uncorrected);
+    fig.update(pre);
+    fig["curl_correction"] = on != 0;
+    fig["edges_per_period"] = edges_per_period;
+    fig["breakdown"] = breakdown(best);
+    emit(name, nf, "curl_correction", t, fig);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> meshes;
-  bool sweep = true, field_sweep = false;
+  bool sweep = true, field_sweep = false, curl_only = false;
+  PgpOptions pgp_options;  // the defaults (curl correction on) unless --no-curl-correction
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-sweep")
       sweep = false;
+    else if (std::string(argv[i]) == "--curl-only")
+      curl_only = true;
+    else if (std::string(argv[i]) == "--no-curl-correction")
+      pgp_options.curl_correction = false;
     else if (std::string(argv[i]) == "--field-sweep")
       field_sweep = true;
     else
@@ -286,6 +383,13 @@ int main(int argc, char** argv) {
     std::vector<DirectionConstraint> strokes;
     for (std::size_t i = 0; i < 20; ++i)
       strokes.push_back({static_cast<std::uint32_t>(i * nf / 20), {1.0, 0.3, 0.2}});
+    if (curl_only) {
+      // The curvature field of the runs below, then only the curl figures.
+      compute_principal_curvatures(mesh);
+      interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, 0.05), {});
+      for (double k : {4.0, 8.0, 16.0}) curl_correction_figures(mesh, name, k);
+      continue;
+    }
     emit(name, nf, "principal_curvatures",
          best_of_3([&] { compute_principal_curvatures(mesh); }));
     std::vector<DirectionConstraint> curv = constraints_from_principal_directions(mesh, 0.05);
@@ -301,7 +405,7 @@ int main(int argc, char** argv) {
     interpolate_scalar_field(mesh, {{0, period}}, scale_field_options());
     interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
                              material_field_options());
-    PeriodicGlobalParameterization pgp(mesh);
+    PeriodicGlobalParameterization pgp(mesh, pgp_options);
     // The first call pays the ordering and the symbolic analysis (one-shot
     // runs such as the CLI's); the best of 3 reuses them.
     PgpResult init;
@@ -313,7 +417,9 @@ int main(int argc, char** argv) {
     const double t_init = best_of_3([&] { keep_fastest(init, pgp.initialize()); });
     emit(name, nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
     PgpSingularities sing;
-    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh); });
+    PgpSingularityOptions sing_options;
+    sing_options.pgp = pgp_options;
+    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh, sing_options); });
     {
       nlohmann::json fig = singularity_figures(mesh, sing);
       fig["diagnosis"] = singular_face_diagnosis(mesh, sing);
@@ -400,9 +506,9 @@ int main(int argc, char** argv) {
         fo.smoothing = smoothing;
         interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), fo);
         interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, 8.0)}}, scale_field_options());
-        PeriodicGlobalParameterization p2(mesh);
+        PeriodicGlobalParameterization p2(mesh, pgp_options);
         p2.initialize();
-        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
+        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
         fig["rings"] = rings;
         fig["constrained_fraction"] = fraction;
         fig["smoothing"] = smoothing;
@@ -415,9 +521,9 @@ int main(int argc, char** argv) {
     for (double k : {4.0, 8.0, 16.0}) {
       interpolate_direction_field(mesh, field ? curv : strokes, {});
       interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
-      PeriodicGlobalParameterization p2(mesh);
+      PeriodicGlobalParameterization p2(mesh, pgp_options);
       p2.initialize();
-      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh));
+      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
       fig["edges_per_period"] = k;
       fig["field"] = field ? "curvature" : "strokes";
       emit(name, nf, "singular_fraction_vs_period", 0.0, fig);

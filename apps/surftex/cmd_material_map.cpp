@@ -55,6 +55,7 @@ struct Args {
   int render_size = 768;
   std::vector<float> view{30.f, 20.f};
   double bump = 0.03;
+  bool no_curl_correction = false;
   CommonOptions common;
 };
 
@@ -65,9 +66,10 @@ struct Args {
 const char* const kStateFormat = "surftex material-map state v2";
 
 void save_state(const std::string& path, const Mesh& mesh, const PeriodicGlobalParameterization& pgp,
-                double default_scale, bool overwrite) {
+                double default_scale, bool curl_correction, bool overwrite) {
   nlohmann::json j;
   j["format"] = kStateFormat;
+  j["curl_correction"] = curl_correction;
   j["vertices"] = mesh.num_vertices();
   j["faces"] = mesh.num_faces();
   j["default_scale"] = default_scale;
@@ -111,7 +113,7 @@ std::vector<double> state_array(const nlohmann::json& j, const char* key, std::s
   return v;
 }
 
-double load_state(const std::string& path, Mesh& mesh, PeriodicGlobalParameterization& pgp) {
+nlohmann::json read_state(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IOError("cannot open state file '" + path + "'");
   std::stringstream buf;
@@ -126,6 +128,18 @@ double load_state(const std::string& path, Mesh& mesh, PeriodicGlobalParameteriz
     throw InvalidInputError("state '" + path + "': not a material-map state of this version (field 'format' is '" +
                             j.value("format", std::string()) + "', expected '" + kStateFormat +
                             "'; re-run material-map without --update to make one)");
+  return j;
+}
+
+/// The curl correction the state was solved with (states written before it
+/// existed were solved without).
+bool state_curl_correction(const nlohmann::json& j) {
+  auto it = j.find("curl_correction");
+  return it != j.end() && it->is_boolean() && it->get<bool>();
+}
+
+double load_state(const nlohmann::json& j, const std::string& path, Mesh& mesh,
+                  PeriodicGlobalParameterization& pgp) {
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
   const auto zs = state_array(j, "z_s", 2 * nv, path), zt = state_array(j, "z_t", 2 * nv, path);
   const auto d = state_array(j, "direction", 3 * nf, path);
@@ -230,7 +244,14 @@ int run(const Args& a) {
   rep["vertices"] = mesh.number_of_vertices();
   rep["faces"] = mesh.number_of_faces();
 
-  PeriodicGlobalParameterization pgp(mesh);
+  // The curl correction of the PGP's target (pgp_curl_correction.h); an
+  // update keeps the one its state was solved with.
+  nlohmann::json state;
+  if (!a.update.empty()) state = read_state(a.state);
+  PgpOptions popt;
+  popt.curl_correction = a.update.empty() ? !a.no_curl_correction : state_curl_correction(state);
+  rep["curl_correction"] = popt.curl_correction;
+  PeriodicGlobalParameterization pgp(mesh, popt);
   double default_scale = 0;
   if (a.update.empty()) {
     t = Timer();
@@ -282,7 +303,7 @@ int run(const Args& a) {
     rep["mode"] = "initialize";
   } else {
     t = Timer();
-    default_scale = load_state(a.state, mesh, pgp);
+    default_scale = load_state(state, a.state, mesh, pgp);
     sec["read_state"] = t.seconds();
     t = Timer();
     const MaterialConstraints c = read_material_constraints(a.update, mesh);
@@ -334,7 +355,9 @@ int run(const Args& a) {
   rep["default_scale"] = default_scale;
 
   t = Timer();
-  const PgpSingularities sing = detect_pgp_singularities(mesh);
+  PgpSingularityOptions sopt;
+  sopt.pgp = popt;
+  const PgpSingularities sing = detect_pgp_singularities(mesh, sopt);
   sec["singularities"] = t.seconds();
   std::size_t distorted = 0, mismatched = 0, sv = 0;
   for (char x : sing.distorted_face) distorted += x;
@@ -358,7 +381,7 @@ int run(const Args& a) {
   write_image(a.out + "/render_plain.png", img.plain, io);
   write_image(a.out + "/render_fixed.png", img.fixed, io);
   write_image(a.out + "/render_normalmap.png", img.normal, io);
-  save_state(a.out + "/state.json", mesh, pgp, default_scale, a.common.force);
+  save_state(a.out + "/state.json", mesh, pgp, default_scale, popt.curl_correction, a.common.force);
   sec["total"] = total.seconds();
   rep["seconds"] = sec;
   rep["tile"] = {{"dir", a.tile}, {"layers", tile.layers.size()}, {"size", tile.size}};
@@ -412,6 +435,11 @@ SubcommandRegistrar reg{
        app.add_option("--view", a->view, "Render view: azimuth elevation in degrees (default 30 20)")->expected(2);
        app.add_option("--bump", a->bump, "Normal-map strength: tilt per unit height slope (0..10, default 0.03)")
            ->check(CLI::Range(0.0, 10.0));
+       app.add_flag("--no-curl-correction", a->no_curl_correction,
+                    "Solve the PGP for the target gradients d/S as given, without the curl correction "
+                    "(Ray et al. 2006) that rescales them towards curl-free (default: corrected; fewer "
+                    "singular faces, the period locally rescaled by up to 2x). With --update the state's "
+                    "setting is used");
        add_common_options(app, a->common);
        return [a] { return run(*a); };
      }}};

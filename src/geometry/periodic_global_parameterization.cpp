@@ -20,6 +20,7 @@
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
 #include "geometry/mesh_util.h"
+#include "geometry/pgp_curl_correction.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
 
@@ -208,6 +209,12 @@ void check_options(const PgpOptions& o) {
   if (!(o.stiffness > 0) || !std::isfinite(o.stiffness))
     throw InvalidInputError("periodic_global_parameterization: stiffness must be > 0, got " +
                             std::to_string(o.stiffness));
+  if (!(o.curl_stiffness > 0) || !std::isfinite(o.curl_stiffness))
+    throw InvalidInputError("periodic_global_parameterization: curl_stiffness must be > 0, got " +
+                            std::to_string(o.curl_stiffness));
+  if (!(o.curl_max_factor >= 1) || !std::isfinite(o.curl_max_factor))
+    throw InvalidInputError("periodic_global_parameterization: curl_max_factor must be >= 1, got " +
+                            std::to_string(o.curl_max_factor));
 }
 
 std::vector<FaceFrame> all_frames(const Mesh& mesh) {
@@ -222,9 +229,23 @@ std::vector<FaceFrame> all_frames(const Mesh& mesh) {
   return frames;
 }
 
-/// g = d / S^T per face (only where `mask` is set when given), written into `g`.
+PgpCurlCorrectionOptions curl_options(const PgpOptions& o) {
+  PgpCurlCorrectionOptions c;
+  c.symmetry = o.symmetry;
+  c.stiffness = o.curl_stiffness;
+  c.max_factor = o.curl_max_factor;
+  c.direction_map = o.direction_map;
+  c.scale_map = o.scale_map;
+  return c;
+}
+
+/// g = d / S^T per face (only where `mask` is set when given), written into
+/// `g`; times the curl-correction factor when o.curl_correction (computed
+/// over the whole mesh by `corrector`, which keeps its factorisation, or a
+/// one-shot one; the faces outside `mask` keep their previous gradient).
 void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceFrame>& frames,
-                         const std::vector<char>* mask, std::vector<FaceGrad>& g) {
+                         const std::vector<char>* mask, std::vector<FaceGrad>& g,
+                         PgpCurlCorrector* corrector = nullptr) {
   auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
   if (!dir.second)
     throw InvalidInputError("periodic_global_parameterization: face map '" + o.direction_map +
@@ -255,6 +276,13 @@ void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vecto
       g[fi] = {ds / s, dt / s};
     }
   });
+  if (o.curl_correction) {
+    PgpCurlCorrector one_shot(curl_options(o));
+    const PgpCurlCorrection c = (corrector ? *corrector : one_shot).compute(mesh);
+    for (std::size_t fi = 0; fi < g.size(); ++fi)
+      if (!mesh.is_removed(FaceIndex(static_cast<Mesh::size_type>(fi))) && (!mask || (*mask)[fi]))
+        g[fi] = {c.face_factor[fi] * g[fi].gs, c.face_factor[fi] * g[fi].gt};
+  }
 }
 
 std::vector<FaceGrad> face_gradients(const Mesh& mesh, const PgpOptions& o,
@@ -338,6 +366,18 @@ std::vector<std::array<std::array<double, 3>, 2>> pgp_face_gradients(const Mesh&
   std::vector<std::array<std::array<double, 3>, 2>> out(g.size());
   for (std::size_t i = 0; i < g.size(); ++i)
     out[i] = {{{g[i].gs.x(), g[i].gs.y(), g[i].gs.z()}, {g[i].gt.x(), g[i].gt.y(), g[i].gt.z()}}};
+  return out;
+}
+
+PgpTarget pgp_target(const Mesh& mesh, const PgpOptions& o) {
+  check_options(o);
+  std::vector<FaceFrame> frames;
+  const auto g = face_gradients(mesh, o, &frames);
+  PgpTarget out;
+  out.alphas = halfedge_alphas(mesh, o, g, frames);
+  out.gradients.resize(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i)
+    out.gradients[i] = {{{g[i].gs.x(), g[i].gs.y(), g[i].gs.z()}, {g[i].gt.x(), g[i].gt.y(), g[i].gt.z()}}};
   return out;
 }
 
@@ -552,6 +592,11 @@ struct PeriodicGlobalParameterization::Impl {
   std::vector<std::uint8_t> corner;                 // per halfedge: face -> vertex frame turns
   std::vector<std::array<double, 2>> edge_energy;  // per live edge
   bool cache_valid = false;
+  std::unique_ptr<PgpCurlCorrector> curl;  // keeps its factorisation (opt.curl_correction)
+  PgpCurlCorrector* corrector() {
+    if (!curl) curl = std::make_unique<PgpCurlCorrector>(curl_options(opt));
+    return curl.get();
+  }
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
     blas_core = configure_blas();
@@ -686,7 +731,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   // quantities (parallel loops over the faces and edges). Neither reads what
   // the other writes, so the bytes do not depend on which thread runs what.
   std::vector<char> face_mask, edge_mask;
-  const bool partial = free_face && cache_valid;
+  // The curl correction is global (its factor changes a little everywhere
+  // when the field changes in the area): all gradients are then refreshed,
+  // so that an update equals a full rewrite from the same state.
+  const bool partial = free_face && cache_valid && !opt.curl_correction;
   std::vector<int> var;
   std::vector<std::array<double, 2>> ealpha;
   std::vector<std::array<int, 2>> turns(t.ends.size());
@@ -824,7 +872,9 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
             }
           }
         }
-        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad);
+        // (the corrector solves with Eigen's own ordering: no METIS, no rand(),
+        // safe beside the ordering)
+        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad, corrector());
         halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
         if (partial) {
           // Only the vertices of edges whose matching may have changed.
@@ -1099,7 +1149,7 @@ std::array<double, 2> PeriodicGlobalParameterization::energies() {
   std::vector<FaceGrad> g;
   std::vector<std::array<double, 2>> alpha;
   std::vector<std::uint8_t> quarter;
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, g, t.frames, nullptr, alpha, &quarter);
   const std::vector<std::uint8_t> corner = corner_matchings(im.mesh, quarter);
   std::array<double, 2> out{0, 0};
@@ -1125,7 +1175,7 @@ void PeriodicGlobalParameterization::write_corners() {
   require_triangle_mesh(impl_->mesh, "periodic_global_parameterization");
   Impl& im = *impl_;
   const PgpTopology& t = im.topology();
-  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad);
+  face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha, &im.quarter);
   im.corner = corner_matchings(im.mesh, im.quarter);
   im.edge_energy.clear();

@@ -77,6 +77,11 @@
 // the jumps close agree exactly on their shared edge.
 // The material m of a corner is the vertex material.
 //
+// With options.curl_correction (default) the face gradients g are first
+// multiplied by the factor of pgp_curl_correction.h (Ray et al. 2006's curl
+// correction): every use of g above (alphas, corners, energies,
+// pgp_face_gradients, pgp_halfedge_alphas) sees the corrected target.
+//
 // Reads the face map direction_map (Vector3 d_s), the vertex maps scale_map
 // (S > 0) and material_map (m); writes the halfedge map stm_map (STM, the
 // corner of face(h) at target(h)); absent scale/material maps read as 1 / 0.
@@ -112,6 +117,19 @@ struct PgpOptions {
   /// singularities) be smaller but |z| sag; 0.01 measured best on spheres
   /// and real meshes (0.05: +1-6% singular faces, 0.2: +15-25%).
   double stiffness = 0.01;
+  /// Curl correction of the target gradients before the solve (Ray et al.
+  /// 2006; geometry/pgp_curl_correction.h): g = d/S is scaled per vertex by
+  /// the factor exp(phi) that brings it closest to curl-free, directions
+  /// kept. On by default: singular faces (section 3, curvature field, 8 mean
+  /// edges per period) fandisk 9.6% -> 6.8%, dragon_25k 58.4% -> 54.3%,
+  /// armadillo_52k 29.6% -> 24.0% (bench_pgp --curl-only), for about +8% of
+  /// the initialisation's CPU time; the period is then locally rescaled
+  /// (armadillo: factors 0.5..2, clamped at curl_max_factor). With it a
+  /// local update refreshes the gradients of every face (the factor is
+  /// global), so an update equals a full rewrite from the same state.
+  bool curl_correction = true;
+  double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
+  double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";
   std::string scale_map = "v:scale";
   std::string material_map = "v:material";
@@ -161,6 +179,14 @@ std::vector<std::array<double, 2>> pgp_halfedge_alphas(const Mesh& mesh, const P
 /// distortion test of section 3. Indexed by face `.idx()`.
 std::vector<std::array<std::array<double, 3>, 2>> pgp_face_gradients(const Mesh& mesh,
                                                                      const PgpOptions& options);
+
+/// Both of the above from one computation of the target (one curl
+/// correction instead of two).
+struct PgpTarget {
+  std::vector<std::array<std::array<double, 3>, 2>> gradients;  ///< as pgp_face_gradients
+  std::vector<std::array<double, 2>> alphas;                    ///< as pgp_halfedge_alphas
+};
+PgpTarget pgp_target(const Mesh& mesh, const PgpOptions& options);
 
 /// Stateful solver (geometry-central style): keeps the per-vertex complex
 /// coordinates and the symbolic analysis between local updates.

@@ -22,8 +22,9 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
   if (!found.second)
     throw InvalidInputError("detect_pgp_singularities: corner map '" + opt.pgp.stm_map + "' absent");
   const auto& stm = found.first;
-  const auto grads = pgp_face_gradients(mesh, opt.pgp);
-  const auto alpha = pgp_halfedge_alphas(mesh, opt.pgp);
+  const PgpTarget target = pgp_target(mesh, opt.pgp);
+  const auto& grads = target.gradients;
+  const auto& alpha = target.alphas;
 
   PgpSingularities out;
   out.distorted_face.assign(mesh.num_faces(), 0);

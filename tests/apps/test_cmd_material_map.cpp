@@ -117,3 +117,28 @@ TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
   EXPECT_NE(r.err.find("bad.json:2: strokes: must be an array"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/out4/report.json"));
 }
+
+// The curl correction (pgp_curl_correction.h) is on by default, can be turned
+// off, is stored in the state and an update keeps the state's setting.
+TEST(CmdMaterialMap, CurlCorrectionIsTheDefaultAndTheStateKeepsIt) {
+  const std::string dir = make_inputs(test::temp_dir("cmd-matmap-curl"));
+  const std::string base =
+      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 -q ";
+  ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/on'").exit_code, 0);
+  test::RunResult r = test::run_surftex(base + "--constraints '" + dir +
+                                        "/c1.json' --no-curl-correction -o '" + dir + "/off'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json on = nlohmann::json::parse(std::ifstream(dir + "/on/report.json"));
+  const nlohmann::json off = nlohmann::json::parse(std::ifstream(dir + "/off/report.json"));
+  EXPECT_EQ(on["curl_correction"], true);
+  EXPECT_EQ(off["curl_correction"], false);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/on/state.json"))["curl_correction"], true);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/off/state.json"))["curl_correction"], false);
+  // The two runs solve different targets.
+  EXPECT_NE(nlohmann::json::parse(std::ifstream(dir + "/on/state.json"))["z_s"],
+            nlohmann::json::parse(std::ifstream(dir + "/off/state.json"))["z_s"]);
+  r = test::run_surftex(base + "--update '" + dir + "/c2.json' --state '" + dir +
+                        "/off/state.json' -o '" + dir + "/update'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/update/report.json"))["curl_correction"], false);
+}
