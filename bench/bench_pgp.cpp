@@ -93,7 +93,7 @@
 // detect_singularities line): 55% lie within 3 edges of a field-singular
 // vertex; distorted faces are 9.4% of all and their rings triple that.
 // Curl correction (issue #5, pgp_curl_correction.h; --curl-only prints one
-// line per mesh, period and setting; --no-curl-correction turns it off for
+// line per mesh, period and setting; --curl-correction turns it on for
 // the main runs). 2026-11-22, shared machine, load 6.5-7.7 (uptime before /
 // after), one --curl-only run 61 s wall / 32 s user. Singular fraction
 // (faces with a singular vertex = three-lookup faces) off -> on, curvature
@@ -356,14 +356,14 @@ void curl_correction_figures(Mesh& mesh, const std::string& name, double edges_p
 int main(int argc, char** argv) {
   std::vector<std::string> meshes;
   bool sweep = true, field_sweep = false, curl_only = false;
-  PgpOptions pgp_options;  // the defaults (curl correction on) unless --no-curl-correction
+  PgpOptions pgp_options;  // the defaults (curl correction off) unless --curl-correction
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-sweep")
       sweep = false;
     else if (std::string(argv[i]) == "--curl-only")
       curl_only = true;
-    else if (std::string(argv[i]) == "--no-curl-correction")
-      pgp_options.curl_correction = false;
+    else if (std::string(argv[i]) == "--curl-correction")
+      pgp_options.curl_correction = true;
     else if (std::string(argv[i]) == "--field-sweep")
       field_sweep = true;
     else

@@ -55,7 +55,7 @@ struct Args {
   int render_size = 768;
   std::vector<float> view{30.f, 20.f};
   double bump = 0.03;
-  bool no_curl_correction = false;
+  bool curl_correction = false;
   CommonOptions common;
 };
 
@@ -249,7 +249,7 @@ int run(const Args& a) {
   nlohmann::json state;
   if (!a.update.empty()) state = read_state(a.state);
   PgpOptions popt;
-  popt.curl_correction = a.update.empty() ? !a.no_curl_correction : state_curl_correction(state);
+  popt.curl_correction = a.update.empty() ? a.curl_correction : state_curl_correction(state);
   rep["curl_correction"] = popt.curl_correction;
   PeriodicGlobalParameterization pgp(mesh, popt);
   double default_scale = 0;
@@ -435,11 +435,11 @@ SubcommandRegistrar reg{
        app.add_option("--view", a->view, "Render view: azimuth elevation in degrees (default 30 20)")->expected(2);
        app.add_option("--bump", a->bump, "Normal-map strength: tilt per unit height slope (0..10, default 0.03)")
            ->check(CLI::Range(0.0, 10.0));
-       app.add_flag("--no-curl-correction", a->no_curl_correction,
-                    "Solve the PGP for the target gradients d/S as given, without the curl correction "
-                    "(Ray et al. 2006) that rescales them towards curl-free (default: corrected; fewer "
-                    "singular faces, the period locally rescaled by up to 2x). With --update the state's "
-                    "setting is used");
+       app.add_flag("--curl-correction", a->curl_correction,
+                    "Rescale the PGP's target gradients d/S towards curl-free before the solve (Ray et al. "
+                    "2006): fewer singular faces (armadillo 29.6% -> 24.0%), but the period departs from "
+                    "the scale S by up to 2x and updates re-solve every gradient (default off: d/S as "
+                    "given, as in Ray et al. 2009). With --update the state's setting is used");
        add_common_options(app, a->common);
        return [a] { return run(*a); };
      }}};

@@ -77,7 +77,7 @@
 // the jumps close agree exactly on their shared edge.
 // The material m of a corner is the vertex material.
 //
-// With options.curl_correction (default) the face gradients g are first
+// With options.curl_correction (off by default) the face gradients g are first
 // multiplied by the factor of pgp_curl_correction.h (Ray et al. 2006's curl
 // correction): every use of g above (alphas, corners, energies,
 // pgp_face_gradients, pgp_halfedge_alphas) sees the corrected target.
@@ -120,14 +120,17 @@ struct PgpOptions {
   /// Curl correction of the target gradients before the solve (Ray et al.
   /// 2006; geometry/pgp_curl_correction.h): g = d/S is scaled per vertex by
   /// the factor exp(phi) that brings it closest to curl-free, directions
-  /// kept. On by default: singular faces (section 3, curvature field, 8 mean
+  /// kept. Measured: singular faces (section 3, curvature field, 8 mean
   /// edges per period) fandisk 9.6% -> 6.8%, dragon_25k 58.4% -> 54.3%,
   /// armadillo_52k 29.6% -> 24.0% (bench_pgp --curl-only), for about +8% of
-  /// the initialisation's CPU time; the period is then locally rescaled
-  /// (armadillo: factors 0.5..2, clamped at curl_max_factor). With it a
-  /// local update refreshes the gradients of every face (the factor is
-  /// global), so an update equals a full rewrite from the same state.
-  bool curl_correction = true;
+  /// the initialisation's CPU time. Off by default (the project's choice,
+  /// session 4): the period is then locally rescaled against the user's
+  /// scale S (armadillo: factors 0.5..2, visible on the renders), and a
+  /// local update must refresh the gradients of every face (the factor is
+  /// global): armadillo's PGP update 0.08 -> 0.15 s CPU, past the 0.1 s
+  /// budget of an interactive edit. Ray et al. 2009 section 2.3 uses the
+  /// target d/S as given.
+  bool curl_correction = false;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";

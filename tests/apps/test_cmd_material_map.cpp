@@ -118,15 +118,15 @@ TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/out4/report.json"));
 }
 
-// The curl correction (pgp_curl_correction.h) is on by default, can be turned
-// off, is stored in the state and an update keeps the state's setting.
-TEST(CmdMaterialMap, CurlCorrectionIsTheDefaultAndTheStateKeepsIt) {
+// The curl correction (pgp_curl_correction.h) is off by default, can be turned
+// on, is stored in the state and an update keeps the state's setting.
+TEST(CmdMaterialMap, CurlCorrectionIsOptInAndTheStateKeepsIt) {
   const std::string dir = make_inputs(test::temp_dir("cmd-matmap-curl"));
   const std::string base =
       "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 -q ";
-  ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/on'").exit_code, 0);
+  ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/off'").exit_code, 0);
   test::RunResult r = test::run_surftex(base + "--constraints '" + dir +
-                                        "/c1.json' --no-curl-correction -o '" + dir + "/off'");
+                                        "/c1.json' --curl-correction -o '" + dir + "/on'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json on = nlohmann::json::parse(std::ifstream(dir + "/on/report.json"));
   const nlohmann::json off = nlohmann::json::parse(std::ifstream(dir + "/off/report.json"));
@@ -138,7 +138,7 @@ TEST(CmdMaterialMap, CurlCorrectionIsTheDefaultAndTheStateKeepsIt) {
   EXPECT_NE(nlohmann::json::parse(std::ifstream(dir + "/on/state.json"))["z_s"],
             nlohmann::json::parse(std::ifstream(dir + "/off/state.json"))["z_s"]);
   r = test::run_surftex(base + "--update '" + dir + "/c2.json' --state '" + dir +
-                        "/off/state.json' -o '" + dir + "/update'");
+                        "/on/state.json' -o '" + dir + "/update'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/update/report.json"))["curl_correction"], false);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/update/report.json"))["curl_correction"], true);
 }
