@@ -483,6 +483,7 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
     return r;
   }
   if (la.empty() || la.size() != lb.size()) {
+    r.coincident = la.empty() && lb.empty();
     r.reason = "cuts opened " + std::to_string(la.size()) + " and " + std::to_string(lb.size()) + " loops";
     return r;
   }

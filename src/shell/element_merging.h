@@ -112,6 +112,11 @@ struct MergeResult {
   int loops = 0;           ///< boundary loops zipped
   double cost_a = 0, cost_b = 0;
   std::string reason;      ///< why stitching was refused (stitched == false)
+  /// Refused because neither cut opened a loop: wherever the two elements
+  /// meet they coincide (within match_distance) and neither continues past
+  /// the other there, so there is nothing to stitch (e.g. one chain-mail ring
+  /// seen by two overlapping patches); the caller keeps one of them whole.
+  bool coincident = false;
 };
 
 /// Cuts A and B and stitches them. Refuses (stitched = false, reason set,

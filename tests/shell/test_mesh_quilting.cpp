@@ -462,3 +462,39 @@ TEST(QuiltStep, PlanarWeaveStitchesMostMergesIntoLongerClosedThreads) {
 }
 }  // namespace
 }  // namespace surftex
+
+namespace surftex {
+namespace {
+// Issue #8, session 4: planar chain mail "stitched 0 of 43": 38 of the 43
+// were merges whose two cuts opened no loop at all -- the ring placed again by
+// the new patch lies on the ring already there wherever they meet, so there
+// is nothing to stitch; the ring already there is kept whole and the new copy
+// dropped (the ring is completed from one side). They are now counted as
+// coincident, not as refusals. The result must hold whole, closed rings and
+// no duplicated ring (duplicates would cross each other everywhere; the
+// swatch's rings keep a clearance and never touch).
+TEST(PlanarQuiltingChainmail, RingsPlacedAgainAreKeptWholeNotDuplicated) {
+  const Swatch s = small_chainmail();
+  PlanarQuiltOptions o;
+  o.seed = 3;
+  Mesh out;
+  const double size = test::sanitized() ? 1.5 : 2.2;
+  const QuiltResult r = quilt_plane(s, size * s.length(), size * s.width(), out, o);
+  auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+  std::size_t within = 0, between = 0;
+  for (const FacePair& fp : self_intersecting_faces(out))
+    (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])] ? within : between) += 1;
+  std::cout << "[ plane chainmail ] elements " << r.elements << ", faces " << out.number_of_faces() << ", stitched "
+            << r.stats.stitched << ", refused " << r.stats.stitch_refused << ", coincident " << r.stats.coincident
+            << ", intersecting pairs within " << within << ", between " << between << "\n";
+  EXPECT_GT(r.stats.coincident, 0u);
+  EXPECT_GT(r.stats.coincident, r.stats.stitch_refused);
+  EXPECT_EQ(border_edges(out), 0u);
+  const Swatch q = make_swatch(out);
+  for (const SwatchElement& e : q.elements) EXPECT_TRUE(e.closed);
+  // No ring is longer than the swatch's longest: rings are never stitched into chains.
+  EXPECT_LE(longest_element(q), 1.05 * longest_element(s));
+  EXPECT_LE(static_cast<double>(between), 1e-3 * static_cast<double>(out.number_of_faces()));
+}
+}  // namespace
+}  // namespace surftex
