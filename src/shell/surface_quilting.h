@@ -28,14 +28,14 @@
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
-//    seed centroid at the origin; a grid of cells (as in mesh_quilting.h)
-//    over it; a cell is processed when the base triangle under its centre is.
-//    P_out = cells within subpatch_radius (Chebyshev) of the seed cell whose
-//    centre lies on the patch.
-//    Then the turn of the frame about the seed centroid (SurfaceQuiltOptions::
-//    rotation_max_deg, our choice) whose best translation matches the texture
-//    already placed best (eq. 3, mean per vertex) is applied; the grid turns
-//    with the frame.
+//    seed centroid at the origin (a cell centre); a grid of cells (as in
+//    mesh_quilting.h) over it; processed cells as in step 6. P_out = cells
+//    within subpatch_radius (Chebyshev) of the seed cell whose centre lies on
+//    the patch. Then the frame is turned about the seed centroid by the angle
+//    (within +-rotation_max_deg of the field's direction, our choice: the
+//    paper searches translations only) whose best translation matches the
+//    texture already placed best (eq. 3, mean per vertex of P_out); the grid
+//    and P_out turn with the frame (SurfaceQuiltOptions::rotation_max_deg).
 // 6. Output elements with a vertex on a patch triangle are expressed in the
 //    frame (vertices on other triangles: projected onto the plane of the
 //    patch triangle with the nearest centroid, barycentric coordinates
