@@ -86,6 +86,14 @@ struct MergeOptions {
   /// self-intersecting face pairs (exact predicates) than the two kept parts
   /// had: a zip that folds over or runs through the element.
   bool refuse_self_intersecting = true;
+  /// When a stitch is refused for crossing itself, retry once with B's kept
+  /// part trimmed back behind A's cut where the two cut ends overlap (B's
+  /// kept triangles within two loop radii of a loop pair's axis whose
+  /// centroid lies less than half a mean edge of B in front of A's loop):
+  /// the ends then abut and the zip bridges a gap. Our addition (issue #8:
+  /// on curved surfaces most stitches refused for crossing themselves had
+  /// well-aligned loops whose kept parts already crossed each other).
+  bool trim_overlapping_ends = true;
 };
 
 struct ElementCut {
@@ -117,6 +125,8 @@ struct MergeResult {
   /// the other there, so there is nothing to stitch (e.g. one chain-mail ring
   /// seen by two overlapping patches); the caller keeps one of them whole.
   bool coincident = false;
+  /// Stitched after trimming B's overlapping cut end (MergeOptions::trim_overlapping_ends).
+  bool trimmed = false;
 };
 
 /// Cuts A and B and stitches them. Refuses (stitched = false, reason set,

@@ -34,6 +34,7 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   pruned_projection += o.pruned_projection;
   stitched += o.stitched;
   stitch_refused += o.stitch_refused;
+  stitched_trimmed += o.stitched_trimmed;
   refused_infeasible += o.refused_infeasible;
   refused_loops += o.refused_loops;
   refused_border += o.refused_border;
@@ -363,6 +364,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         acc = std::move(r.merged);
         if (!is_out) acc_side = Region::kOverlap;  // now owns old and new parts
         ++stats.stitched;
+        if (r.trimmed) ++stats.stitched_trimmed;
         if (is_out)
           alive[e] = 0;
         else

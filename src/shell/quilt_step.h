@@ -80,6 +80,7 @@ struct QuiltStepStats {
   double best_cost = 0;             ///< E(t) of the chosen translation (eq. 3)
   std::size_t pairs = 0, related = 0, pruned_normal = 0, pruned_distance = 0, pruned_projection = 0;
   std::size_t stitched = 0, stitch_refused = 0;  ///< merges (2.7)
+  std::size_t stitched_trimmed = 0;  ///< of the stitched, after trimming an overlapping cut end (MergeResult::trimmed)
   /// Refusals by reason (MergeResult::reason): an infeasible cut, cuts that
   /// opened no or different numbers of loops (or non-simple borders), a
   /// stitch that would open borders or break closedness, and (geometry)

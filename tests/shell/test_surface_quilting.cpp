@@ -337,9 +337,11 @@ namespace {
 // angle around the axis) translated swatches meet the old threads at an angle
 // and the loops of the cuts do not face each other. The placement search now
 // also turns the frame (SurfaceQuiltOptions::rotation_max_deg). Measured
-// (Release, seeds 1-4, relative size 0.35): translations only 30 of 516
-// merges stitched (5.8%, seeds 3.8-8.7%), misaligned-loop refusals 51% of the
-// merges tried; with the turns 51 of 519 (9.8%, seeds 8.9-11.2%), 37%.
+// (Release, seeds 1-4, relative size 0.35, with the trimmed cut ends of
+// MergeOptions::trim_overlapping_ends): translations only 68 of 489 merges
+// stitched (13.9%; seeds 1 and 2: 30 of 257, 11.7%; at most 16.4% for any two
+// seeds), turned 110 of 546 (20.1%; seeds 1 and 2: 64 of 291, 22.0%), and
+// between-element crossings 2627 -> 1842. Before the trimming: 5.8% -> 9.8%.
 TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, 30, 12);
@@ -355,9 +357,9 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) 
   o.up = {0.0, 0.6, 0.8};
   std::size_t stitched = 0, tried = 0;
   int turned = 0, steps = 0;
-  // (Under the sanitizers one seed at relative size 0.45: 9 of 98 stitched
-  // there, 5 of 85 with translations only.)
-  const std::vector<std::uint64_t> seeds = test::sanitized() ? std::vector<std::uint64_t>{1} : std::vector<std::uint64_t>{1, 2};
+  // (Under the sanitizers at relative size 0.45, seeds 1 and 2: turned 40 of
+  // 183 stitched, 21.9%; translations only 21 of 154, 13.6%.)
+  const std::vector<std::uint64_t> seeds{1, 2};
   for (std::uint64_t seed : seeds) {
     o.seed = seed;
     SurfaceQuilt q;
@@ -374,9 +376,8 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) 
   ASSERT_GT(tried, 20u);
   // Most placements find a better fit turned.
   EXPECT_GT(2 * turned, steps);
-  // Translations only (coincident merges not counted): 15 of 244 for seeds 1
-  // and 2 (6.1%), at most 7.4% for any two of seeds 1-4; turned: 27 of 241.
-  EXPECT_GT(static_cast<double>(stitched), 0.08 * static_cast<double>(tried));
+  // Translations only: at most 16.4% (see above).
+  EXPECT_GT(static_cast<double>(stitched), 0.18 * static_cast<double>(tried));
 }
 
 TEST(SurfaceQuilting, RotationSearchOptionsAreChecked) {
