@@ -45,7 +45,12 @@
 // whose next diagonal is shorter, orientations consistent with both sides),
 // then the merged element is deformed with eq. 5 constraints "average boundary
 // points" (each loop vertex pulled to the midpoint with its nearest vertex on
-// the paired loop), vertices outside the overlap region locked.
+// the paired loop), vertices outside the overlap region locked. A stitch that
+// crosses itself more than its parts did is refused; before refusing, it is
+// retried once with B's kept part trimmed back behind A's cut where the two
+// cut ends overlap (MergeOptions::trim_overlapping_ends, our addition).
+// Where neither cut opens a loop the elements coincide wherever they meet
+// (MergeResult::coincident): nothing to stitch, the caller keeps one whole.
 // Every graph cut goes through geometry/graph_cut.h.
 #include <functional>
 #include <string>
