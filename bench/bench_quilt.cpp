@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
           {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported},
           {"patches_turned", r.patches_turned}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
-          {"coincident", r.stats.coincident},
+          {"coincident", r.stats.coincident}, {"stitched_trimmed", r.stats.stitched_trimmed},
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
           {"refused_border", r.stats.refused_border},
           {"refused_geometry", r.stats.refused_geometry}, {"out_replaced", r.stats.out_replaced},

@@ -156,6 +156,7 @@ int run_quilt(QuiltArgs& a) {
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["coincident"] = r.stats.coincident;
+    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
     rep["seconds"] = {{"swatch", swatch_seconds}, {"quilt", r.seconds}, {"match", r.stats.seconds_match},
                       {"correspond", r.stats.seconds_correspond}, {"deform", r.stats.seconds_deform},
                       {"merge", r.stats.seconds_merge}};
@@ -205,6 +206,7 @@ int run_quilt(QuiltArgs& a) {
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["coincident"] = r.stats.coincident;
+    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
     rep["charts"] = er.atlas.num_charts;
     rep["tets"] = er.tets;
     rep["shell_height"] = er.shell_height;
