@@ -11,7 +11,19 @@
 // Usage: bench_quilt [tarball] [output folder for PLY/PNG] [relative swatch size]
 //                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
 //                    [variant: fixed (default) | baseline = issue #8's stitch checks and
-//                     transported orientation off, for before/after comparisons]
+//                     transported orientation off, for before/after comparisons |
+//                     translation = placements not turned (rotation_max_deg 0)]
+//
+// Issue #8, session 4 (turned placements, SurfaceQuiltOptions::rotation_max_deg;
+// measured under load 6.5-8.7, so CPU times matter, walls do not): default
+// "fixed": 193 steps, 151 turned (mean |turn| 7.0 deg), 29 stitched, 1303
+// refused, 9 coincident, 861K faces, intersecting pairs 39,652 within / 108,577
+// between elements, user CPU 88 s; "translation" (same code, turns off): 190
+// steps, 14 stitched, 1303 refused, 890K faces, 36,491 within / 132,195
+// between, user CPU 67 s; stretch 1.040 -> 1.037 in both. With the trimmed
+// cut ends (MergeOptions::trim_overlapping_ends) added, "fixed": 108 stitched,
+// 1281 refused, 11 coincident, 870K faces, 25,482 within / 111,282 between,
+// 8,240 vertices outside the shell (4,370 before), user CPU 92 s.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -92,11 +104,14 @@ int main(int argc, char** argv) {
       qo.transport_below = 0;
       qo.step.check_stitch_geometry = false;
     }
+    if (variant == "translation") qo.rotation_max_deg = 0;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
-    line({{"stage", "quilt"}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
-          {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported}, {"max_patch_distortion", r.max_patch_distortion},
+    line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
+          {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported},
+          {"patches_turned", r.patches_turned}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
+          {"coincident", r.stats.coincident}, {"stitched_trimmed", r.stats.stitched_trimmed},
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
           {"refused_border", r.stats.refused_border},
           {"refused_geometry", r.stats.refused_geometry}, {"out_replaced", r.stats.out_replaced},
@@ -105,7 +120,7 @@ int main(int argc, char** argv) {
           {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
-          {"seconds_merge", r.stats.seconds_merge}});
+          {"seconds_merge", r.stats.seconds_merge}, {"seconds_turn", r.seconds_turn}});
     EmbedSurfaceQuiltOptions eo;
     eo.stretch.iterations = 40;
     Mesh out;

@@ -38,7 +38,7 @@ std::string render_path_for(const std::string& out) {
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up";
   bool no_render = false, no_check = false;
-  double scale = 0, cell = 0, shell_height = 1.0;
+  double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0;
   std::vector<double> up{0, 0, 1};
   int subpatch = 0, stretch_iterations = 20;
   CommonOptions common;
@@ -155,6 +155,8 @@ int run_quilt(QuiltArgs& a) {
     rep["steps"] = r.steps;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
+    rep["coincident"] = r.stats.coincident;
+    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
     rep["seconds"] = {{"swatch", swatch_seconds}, {"quilt", r.seconds}, {"match", r.stats.seconds_match},
                       {"correspond", r.stats.seconds_correspond}, {"deform", r.stats.seconds_deform},
                       {"merge", r.stats.seconds_merge}};
@@ -173,6 +175,7 @@ int run_quilt(QuiltArgs& a) {
     o.up = {a.up[0], a.up[1], a.up[2]};
     o.cell_size = a.cell;
     o.subpatch_radius = a.subpatch;
+    o.rotation_max_deg = a.max_turn;
     o.seed = a.common.seed;
     o.progress = terminal_progress(a.common.quiet);
     SurfaceQuilt q;
@@ -197,9 +200,13 @@ int run_quilt(QuiltArgs& a) {
     rep["steps"] = r.steps;
     rep["patches_shrunk"] = r.patches_shrunk;
     rep["patches_transported"] = r.patches_transported;
+    rep["max_turn_deg"] = o.rotation_max_deg;
+    rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
+    rep["coincident"] = r.stats.coincident;
+    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
     rep["charts"] = er.atlas.num_charts;
     rep["tets"] = er.tets;
     rep["shell_height"] = er.shell_height;
@@ -308,6 +315,11 @@ SubcommandRegistrar reg_quilt{
            ->check(CLI::NonNegativeNumber);
        app.add_option("--subpatch", a->subpatch, "Output sub-patch half-size in cells; 0 = automatic (0..100, default 0)")
            ->check(CLI::Range(0, 100));
+       app.add_option("--max-turn", a->max_turn,
+                      "On a mesh: largest turn of a placement away from the field's direction, in degrees, "
+                      "searched in steps of 5 so that the swatch lines up with the texture already placed; "
+                      "0 = translations only (0..90, default 15)")
+           ->check(CLI::Range(0.0, 90.0));
        add_common_options(app, a->common);
        return [a] { return run_quilt(*a); };
      }}};

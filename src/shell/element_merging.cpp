@@ -453,38 +453,69 @@ std::size_t element_self_intersections(const ElementMesh& m) {
 }
 }  // namespace
 
-MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
-                           const MergeOptions& opt) {
-  MergeResult r;
+namespace {
+// Where a stitch crossed itself because the two cut ends overlap (A's kept
+// part reaches past B's cut into B's kept part: the loops face each other but
+// lie a little behind one another along the thread, and the end rings of
+// the two tubes run through each other), B's kept triangles near each such
+// loop pair that lie behind A's cut plane (centroid less than half a mean
+// edge of B in front of A's loop, along the axis from A's cut towards B's
+// kept part, and within two loop radii of that axis) are deleted, so that the
+// two ends abut and the zip bridges a gap instead of folding back. Writes the
+// trimmed labelling of B into `out` (a copy of keep_b) and returns the
+// number of triangles deleted. Our addition (issue #8): the paper's cut paths
+// are only "close to each other".
+std::size_t trim_overlapping_ends(const ElementMesh& pa, const std::vector<std::vector<int>>& la, const ElementMesh& pb,
+                                  const std::vector<std::vector<int>>& lb, const std::vector<int>& pair_of,
+                                  const ElementMesh& b, const std::vector<char>& keep_b, std::vector<char>& out) {
+  out = keep_b;
+  const double margin = 0.5 * mean_edge(b);
+  std::size_t deleted = 0;
+  for (std::size_t i = 0; i < la.size(); ++i) {
+    const std::vector<int>& l2 = lb[static_cast<std::size_t>(pair_of[i])];
+    const P3 ca = loop_centroid(pa, la[i]), cb = loop_centroid(pb, l2);
+    const double r = std::max(loop_radius(pa, la[i], ca), loop_radius(pb, l2, cb));
+    const P3 na = loop_area_vector(pa, la[i]), nb = loop_area_vector(pb, l2);
+    const double len_a = dist(na, P3{0, 0, 0}), len_b = dist(nb, P3{0, 0, 0});
+    if (!(len_a > 0 && len_b > 0 && r > 0)) continue;
+    P3 axis;
+    for (int d = 0; d < 3; ++d) axis[d] = nb[d] / len_b - na[d] / len_a;
+    const double l = dist(axis, P3{0, 0, 0});
+    if (!(l > 0)) continue;
+    for (double& x : axis) x /= l;
+    for (std::size_t t = 0; t < b.tris.size(); ++t) {
+      if (!out[t]) continue;
+      const P3 c = centroid(b, b.tris[t]);
+      const P3 off{c[0] - ca[0], c[1] - ca[1], c[2] - ca[2]};
+      const double along = off[0] * axis[0] + off[1] * axis[1] + off[2] * axis[2];
+      const double side = dist(off, P3{along * axis[0], along * axis[1], along * axis[2]});
+      if (along < margin && along > -4 * r && side < 2 * r) out[t] = 0, ++deleted;
+    }
+  }
+  return deleted;
+}
+
+// Zips the kept parts of A and B (labellings keep_a, keep_b) into `r` (see
+// merge_elements). If `trimmed` is given and the stitch is refused for
+// crossing itself, the trimmed labelling of B is written there (see
+// trim_overlapping_ends).
+void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, const ElementMesh& b,
+                       const std::vector<char>& keep_b, const RegionFn& region, const MergeOptions& opt,
+                       MergeResult& r, std::vector<char>* trimmed) {
   auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
-  const TriangleDistance ta(a), tb(b);
-  ElementCut ca = cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, nullptr);
-  r.cost_a = ca.cost;
-  if (!ca.feasible) {
-    r.reason = "cut of A infeasible";
-    return r;
-  }
-  ElementCut cb = cut_with_trees(b, tb, side_b, a, ta, side_a, region, opt, &ca.keep);
-  r.cost_b = cb.cost;
-  if (!cb.feasible) {
-    r.reason = "cut of B infeasible";
-    return r;
-  }
-  remove_cut_islands(a, ca.terminal, ca.keep);
-  remove_cut_islands(b, cb.terminal, cb.keep);
-  restore_unpaired_cuts(a, ca.keep, b, cb.keep);
   ElementMesh pa, pb;
   std::vector<std::vector<int>> la, lb;
   bool oka = false, okb = false;
-  kept_part(a, ca.keep, pa, la, oka);
-  kept_part(b, cb.keep, pb, lb, okb);
+  kept_part(a, keep_a, pa, la, oka);
+  kept_part(b, keep_b, pb, lb, okb);
   if (!oka || !okb) {
     r.reason = "cut border is not a set of simple loops";
-    return r;
+    return;
   }
   if (la.empty() || la.size() != lb.size()) {
+    r.coincident = la.empty() && lb.empty();
     r.reason = "cuts opened " + std::to_string(la.size()) + " and " + std::to_string(lb.size()) + " loops";
-    return r;
+    return;
   }
   // Pair loops greedily by centroid distance.
   std::vector<std::tuple<double, int, int>> cand;
@@ -501,7 +532,7 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
     const std::string why = loop_pair_mismatch(pa, la[i], pb, lb[pair_of[i]], opt);
     if (!why.empty()) {
       r.reason = why;
-      return r;
+      return;
     }
   }
   ElementMesh merged = pa;
@@ -555,15 +586,15 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
   const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
   if (count_border_edges(merged) > border_before) {
     r.reason = "stitching would open new borders";
-    return r;
+    return;
   }
   if (!is_manifold_oriented(merged)) {
     r.reason = "stitched element is not manifold (border)";
-    return r;
+    return;
   }
   if (border_before == 0 && !is_closed_oriented(merged)) {
     r.reason = "stitched element is not closed and consistently oriented";
-    return r;
+    return;
   }
   std::vector<char> locked(merged.points.size(), 0);
   for (std::size_t v = 0; v < merged.points.size(); ++v) locked[v] = !in_overlap(merged.points[v]);
@@ -581,13 +612,49 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
       if (after > before) {
         r.reason = "self-intersecting stitch: " + std::to_string(after) + " crossing face pairs, parts had " +
                    std::to_string(before);
-        return r;
+        if (trimmed) trim_overlapping_ends(pa, la, pb, lb, pair_of, b, keep_b, *trimmed);
+        return;
       }
     }
   }
   r.stitched = true;
   r.loops = static_cast<int>(la.size());
   r.merged = std::move(merged);
+  return;
+}
+}  // namespace
+
+MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
+                           const MergeOptions& opt) {
+  MergeResult r;
+  const TriangleDistance ta(a), tb(b);
+  ElementCut ca = cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, nullptr);
+  r.cost_a = ca.cost;
+  if (!ca.feasible) {
+    r.reason = "cut of A infeasible";
+    return r;
+  }
+  ElementCut cb = cut_with_trees(b, tb, side_b, a, ta, side_a, region, opt, &ca.keep);
+  r.cost_b = cb.cost;
+  if (!cb.feasible) {
+    r.reason = "cut of B infeasible";
+    return r;
+  }
+  remove_cut_islands(a, ca.terminal, ca.keep);
+  remove_cut_islands(b, cb.terminal, cb.keep);
+  restore_unpaired_cuts(a, ca.keep, b, cb.keep);
+  std::vector<char> trimmed;
+  stitch_kept_parts(a, ca.keep, b, cb.keep, region, opt, r, opt.trim_overlapping_ends ? &trimmed : nullptr);
+  if (!r.stitched && !trimmed.empty() && trimmed != cb.keep) {
+    MergeResult again;
+    again.cost_a = r.cost_a;
+    again.cost_b = r.cost_b;
+    stitch_kept_parts(a, ca.keep, b, trimmed, region, opt, again, nullptr);
+    if (again.stitched) {
+      again.trimmed = true;
+      return again;
+    }
+  }
   return r;
 }
 

@@ -45,7 +45,12 @@
 // whose next diagonal is shorter, orientations consistent with both sides),
 // then the merged element is deformed with eq. 5 constraints "average boundary
 // points" (each loop vertex pulled to the midpoint with its nearest vertex on
-// the paired loop), vertices outside the overlap region locked.
+// the paired loop), vertices outside the overlap region locked. A stitch that
+// crosses itself more than its parts did is refused; before refusing, it is
+// retried once with B's kept part trimmed back behind A's cut where the two
+// cut ends overlap (MergeOptions::trim_overlapping_ends, our addition).
+// Where neither cut opens a loop the elements coincide wherever they meet
+// (MergeResult::coincident): nothing to stitch, the caller keeps one whole.
 // Every graph cut goes through geometry/graph_cut.h.
 #include <functional>
 #include <string>
@@ -86,6 +91,14 @@ struct MergeOptions {
   /// self-intersecting face pairs (exact predicates) than the two kept parts
   /// had: a zip that folds over or runs through the element.
   bool refuse_self_intersecting = true;
+  /// When a stitch is refused for crossing itself, retry once with B's kept
+  /// part trimmed back behind A's cut where the two cut ends overlap (B's
+  /// kept triangles within two loop radii of a loop pair's axis whose
+  /// centroid lies less than half a mean edge of B in front of A's loop):
+  /// the ends then abut and the zip bridges a gap. Our addition (issue #8:
+  /// on curved surfaces most stitches refused for crossing themselves had
+  /// well-aligned loops whose kept parts already crossed each other).
+  bool trim_overlapping_ends = true;
 };
 
 struct ElementCut {
@@ -112,6 +125,13 @@ struct MergeResult {
   int loops = 0;           ///< boundary loops zipped
   double cost_a = 0, cost_b = 0;
   std::string reason;      ///< why stitching was refused (stitched == false)
+  /// Refused because neither cut opened a loop: wherever the two elements
+  /// meet they coincide (within match_distance) and neither continues past
+  /// the other there, so there is nothing to stitch (e.g. one chain-mail ring
+  /// seen by two overlapping patches); the caller keeps one of them whole.
+  bool coincident = false;
+  /// Stitched after trimming B's overlapping cut end (MergeOptions::trim_overlapping_ends).
+  bool trimmed = false;
 };
 
 /// Cuts A and B and stitches them. Refuses (stitched = false, reason set,

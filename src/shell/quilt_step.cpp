@@ -34,10 +34,12 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   pruned_projection += o.pruned_projection;
   stitched += o.stitched;
   stitch_refused += o.stitch_refused;
+  stitched_trimmed += o.stitched_trimmed;
   refused_infeasible += o.refused_infeasible;
   refused_loops += o.refused_loops;
   refused_border += o.refused_border;
   refused_geometry += o.refused_geometry;
+  coincident += o.coincident;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
   in_added += o.in_added;
@@ -86,12 +88,14 @@ std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& cor
 }
 }  // namespace
 
-QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
-                          std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
-                          const QuiltStepOptions& opt, QuiltStepStats& stats) {
+QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& swatch_tree, const QuiltGrid& grid,
+                                  const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
+                                  std::mt19937_64& rng, const QuiltStepOptions& opt, const QuiltPlacement* near) {
   if (opt.subcell_levels < 0 || opt.subcell_levels > 8)
     throw InvalidInputError("quilt_step: subcell_levels must be in [0, 8] (" + std::to_string(opt.subcell_levels) + ")");
-  Timer timer;
+  if (opt.max_match_vertices < 1)
+    throw InvalidInputError("quilt_step: max_match_vertices must be >= 1 (" + std::to_string(opt.max_match_vertices) + ")");
+  QuiltMatch res;
   const double c = grid.cell;
   const int sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
   const int sy = std::max(1, static_cast<int>(std::ceil(swatch.width() / c - 1e-9)));
@@ -132,8 +136,11 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
   }
   const auto fn = face_normals(swatch.mesh);
   std::vector<std::pair<int, int>> cand;
-  for (int oj = pj1 - sy + 1; oj <= pj0; ++oj)
-    for (int oi = pi1 - sx + 1; oi <= pi0; ++oi) cand.emplace_back(oi, oj);
+  if (near)  // only the given grid translation (then refined)
+    cand.emplace_back(near->oi, near->oj);
+  else
+    for (int oj = pj1 - sy + 1; oj <= pj0; ++oj)
+      for (int oi = pi1 - sx + 1; oi <= pi0; ++oi) cand.emplace_back(oi, oj);
   auto translation = [&](int oi, int oj) {
     return P3{grid.x0 + oi * c - swatch.bbox_min[0], grid.y0 + oj * c - swatch.bbox_min[1], 0.0};
   };
@@ -158,9 +165,9 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
   std::vector<std::size_t> eligible;
   for (std::size_t k = 0; k < cand.size(); ++k)
     if (cost[k] <= best * (1 + opt.choice_tolerance) + 1e-12) eligible.push_back(k);
-  const std::size_t pick = eligible[static_cast<std::size_t>(rng() % eligible.size())];
+  const std::size_t pick = near ? 0 : eligible[static_cast<std::size_t>(rng() % eligible.size())];
   const int oi = cand[pick].first, oj = cand[pick].second;
-  P3 t = translation(oi, oj);
+  const P3 t = translation(oi, oj);
   double picked_cost = cost[pick];
   // Sub-cell refinement (see QuiltStepOptions::subcell_levels): a 5 x 5
   // pattern search, deterministic (lowest cost, ties: first in row order).
@@ -180,18 +187,36 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
       tbb::parallel_for(std::size_t(0), offs.size(), [&](std::size_t k) {
         oc[k] = match_cost({t[0] + offs[k][0], t[1] + offs[k][1], t[2]});
       });
-      stats.candidates += offs.size();
+      res.candidates += offs.size();
       double bx = dx, by = dy;
       for (std::size_t k = 0; k < offs.size(); ++k)
         if (oc[k] < picked_cost) picked_cost = oc[k], bx = offs[k][0], by = offs[k][1];
       dx = bx;
       dy = by;
     }
-    t[0] += dx;
-    t[1] += dy;
   }
-  stats.candidates += cand.size();
-  stats.best_cost = picked_cost;
+  res.candidates += cand.size();
+  res.vertices = mv.size();
+  res.cost = picked_cost;
+  res.placement = {oi, oj, dx, dy};
+  return res;
+
+}
+
+QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
+                          std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
+                          const QuiltStepOptions& opt, QuiltStepStats& stats, const QuiltMatch* given) {
+  Timer timer;
+  const QuiltMatch match =
+      given ? *given : match_swatch_placement(swatch, swatch_tree, grid, elements, alive, rng, opt);
+  const double c = grid.cell;
+  const int sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
+  const int sy = std::max(1, static_cast<int>(std::ceil(swatch.width() / c - 1e-9)));
+  const int oi = match.placement.oi, oj = match.placement.oj;
+  const double dx = match.placement.dx, dy = match.placement.dy;
+  const P3 t{grid.x0 + oi * c - swatch.bbox_min[0] + dx, grid.y0 + oj * c - swatch.bbox_min[1] + dy, 0.0};
+  stats.candidates += match.candidates;
+  stats.best_cost = match.cost;
   stats.seconds_match += timer.seconds();
   timer.reset();
 
@@ -339,10 +364,18 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         acc = std::move(r.merged);
         if (!is_out) acc_side = Region::kOverlap;  // now owns old and new parts
         ++stats.stitched;
+        if (r.trimmed) ++stats.stitched_trimmed;
         if (is_out)
           alive[e] = 0;
         else
           add_in[e] = 0;
+      } else if (r.coincident) {  // nothing to stitch: keep the output element whole
+        ++stats.coincident;
+        if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
+        if (!is_out && add_in[e]) {
+          add_in[e] = 0;
+          ++stats.in_dropped;
+        }
       } else {
         ++stats.stitch_refused;
         if (r.reason.find("infeasible") != std::string::npos)

@@ -80,26 +80,58 @@ struct QuiltStepStats {
   double best_cost = 0;             ///< E(t) of the chosen translation (eq. 3)
   std::size_t pairs = 0, related = 0, pruned_normal = 0, pruned_distance = 0, pruned_projection = 0;
   std::size_t stitched = 0, stitch_refused = 0;  ///< merges (2.7)
+  std::size_t stitched_trimmed = 0;  ///< of the stitched, after trimming an overlapping cut end (MergeResult::trimmed)
   /// Refusals by reason (MergeResult::reason): an infeasible cut, cuts that
   /// opened no or different numbers of loops (or non-simple borders), a
   /// stitch that would open borders or break closedness, and (geometry)
   /// loop pairs too far apart or turned, or a stitch crossing itself.
   std::size_t refused_infeasible = 0, refused_loops = 0, refused_border = 0, refused_geometry = 0;
+  /// Merges with nothing to stitch (MergeResult::coincident: the input
+  /// element lies on the output one wherever they meet, e.g. the same
+  /// chain-mail ring placed again); the output element is kept whole and the
+  /// input one dropped, i.e. the element is completed from one side (section
+  /// 2.7 keeps one side whole where an element lies in the overlap). Not
+  /// counted in stitch_refused (until issue #8's session 4 they were, as
+  /// "loops": planar 3x3 chain mail, 38 of 43 refusals).
+  std::size_t coincident = 0;
   std::size_t out_replaced = 0, in_dropped = 0, in_added = 0;
   double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
   void add(const QuiltStepStats& o);
 };
 
-/// Places the swatch (its bbox min at the origin of a cell, then shifted by
-/// less than half a cell if opt.subcell_levels > 0) so that it covers every
-/// P_out cell, choosing the translation minimising eq. 3 over the output
-/// vertices in P_out; merges it into `elements` (entries of `alive` set to 0
+/// The outcome of geometry matching (section 2.4) for one grid.
+struct QuiltMatch {
+  QuiltPlacement placement;
+  double cost = 0;             ///< E(t) (eq. 3) of the chosen translation
+  std::size_t vertices = 0;    ///< output vertices of P_out summed in E(t)
+  std::size_t candidates = 0;  ///< translations evaluated
+};
+
+/// Section 2.4 alone: the translation of the swatch (bbox min at the corner
+/// of a cell, shifted by less than half a cell if opt.subcell_levels > 0)
+/// covering every P_out cell that minimises E(t) (eq. 3) over the output
+/// vertices in P_out (at most opt.max_match_vertices, evenly subsampled);
+/// among grid translations within opt.choice_tolerance of the best, one is
+/// drawn with `rng`. Changes nothing else. With no output vertex in P_out every
+/// cost is 0 (and one covering translation is drawn). With `near`, only its
+/// grid translation (near->oi, near->oj) is refined (no draw; its dx, dy are
+/// ignored): a local search, e.g. for the same texture seen in a slightly
+/// turned frame. Throws InvalidInputError on an empty or too large P_out,
+/// subcell_levels out of range or max_match_vertices < 1.
+QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& swatch_tree, const QuiltGrid& grid,
+                                  const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
+                                  std::mt19937_64& rng, const QuiltStepOptions& opt,
+                                  const QuiltPlacement* near = nullptr);
+
+/// Places the swatch where match_swatch_placement puts it (or at `given`, a
+/// match computed by the caller for this grid and these elements, e.g. the
+/// best of several frame rotations), so that it covers every
+/// P_out cell; merges it into `elements` (entries of `alive` set to 0
 /// for elements consumed, new elements appended with alive = 1; `z`
 /// coordinates are the swatch's). Marks the covered grid cells (oi .. oi + sx
-/// - 1, oj .. oj + sy - 1) processed. Throws InvalidInputError on an empty or
-/// too large P_out or subcell_levels out of range.
+/// - 1, oj .. oj + sy - 1) processed. Throws as match_swatch_placement.
 QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
-                               std::vector<ElementMesh>& elements, std::vector<char>& alive,
-                               std::mt19937_64& rng, const QuiltStepOptions& opt, QuiltStepStats& stats);
+                          std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
+                          const QuiltStepOptions& opt, QuiltStepStats& stats, const QuiltMatch* given = nullptr);
 
 }  // namespace surftex

@@ -402,6 +402,9 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
   if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
+  if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
+  if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
+  if (o.rotation_match_vertices < 1) bad("rotation_match_vertices must be >= 1", o.rotation_match_vertices);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -559,46 +562,51 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       patch_slot[flat.faces[k]] = static_cast<int>(k);
       for (int j = 0; j < 3; ++j) ftris[k][j] = flat.uv[flat.local[b.faces[flat.faces[k]][j]]];
     }
-    const PatchLocator locator(ftris, c);
-    // Grid over the patch plus one swatch on each side.
-    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-    for (auto& p : flat.uv) x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
-    QuiltGrid grid;
-    grid.cell = c;
-    // Align the grid so that the origin (seed centroid) is a cell centre.
-    const int ilo = static_cast<int>(std::floor(x0 / c - 0.5)) - sx, ihi = static_cast<int>(std::ceil(x1 / c + 0.5)) + sx;
-    const int jlo = static_cast<int>(std::floor(y0 / c - 0.5)) - sy, jhi = static_cast<int>(std::ceil(y1 / c + 0.5)) + sy;
-    grid.x0 = (ilo - 0.5) * c;
-    grid.y0 = (jlo - 0.5) * c;
-    grid.nx = ihi - ilo + 1;
-    grid.ny = jhi - jlo + 1;
-    const std::size_t ncell = static_cast<std::size_t>(grid.nx) * grid.ny;
-    grid.processed.assign(ncell, 0);
-    grid.subpatch.assign(ncell, 0);
-    std::vector<char> on_patch(ncell, 0);
-    for (int j = 0; j < grid.ny; ++j)
-      for (int i = 0; i < grid.nx; ++i) {
-        const V2 ctr{grid.x0 + (i + 0.5) * c, grid.y0 + (j + 0.5) * c};
-        std::array<double, 3> w;
-        const int k = locator.locate(ctr, w);
-        if (k < 0) continue;
-        on_patch[j * grid.nx + i] = 1;
-      }
-    // Processed cells: the earlier footprints' points on the patch, in the frame.
-    for (std::size_t k = 0; k < flat.faces.size(); ++k) {
-      const auto& t = ftris[k];
-      for (const auto& bb : cover[static_cast<std::size_t>(flat.faces[k])]) {
-        const double b0 = 1 - bb[0] - bb[1];
-        const int cc = grid.cell_of(b0 * t[0][0] + bb[0] * t[1][0] + bb[1] * t[2][0],
-                                    b0 * t[0][1] + bb[0] * t[1][1] + bb[1] * t[2][1]);
-        if (cc >= 0) grid.processed[static_cast<std::size_t>(cc)] = 1;
-      }
-    }
+    // The frame of the field's orientation (rotation 0 of step 5's search).
+    const PatchLocator locator0(ftris, c);
+    // Grid over the patch plus one swatch on each side, for the frame turned
+    // by `ang` (radians, counter-clockwise) about the seed centroid: the
+    // extent is the patch's radius (the same for every turn), the origin is a
+    // cell centre, cells are located and the earlier footprints' points
+    // mapped through the unturned frame.
+    double ext = 0;
+    for (const auto& p : flat.uv) ext = std::max(ext, std::hypot(p[0], p[1]));
+    const int ilo = static_cast<int>(std::floor(-ext / c - 0.5)) - sx, ihi = static_cast<int>(std::ceil(ext / c + 0.5)) + sx;
+    const int jlo = static_cast<int>(std::floor(-ext / c - 0.5)) - sy, jhi = static_cast<int>(std::ceil(ext / c + 0.5)) + sy;
     const int si = -ilo, sj = -jlo;  // the origin's cell
-    for (int j = sj - r; j <= sj + r; ++j)
-      for (int i = si - r; i <= si + r; ++i)
-        if (i >= 0 && j >= 0 && i < grid.nx && j < grid.ny && on_patch[j * grid.nx + i]) grid.subpatch[j * grid.nx + i] = 1;
-    grid.subpatch[sj * grid.nx + si] = 1;
+    auto make_grid = [&](double ang) {
+      const double ca = std::cos(ang), sa = std::sin(ang);
+      QuiltGrid g;
+      g.cell = c;
+      g.x0 = (ilo - 0.5) * c;
+      g.y0 = (jlo - 0.5) * c;
+      g.nx = ihi - ilo + 1;
+      g.ny = jhi - jlo + 1;
+      const std::size_t ncell = static_cast<std::size_t>(g.nx) * g.ny;
+      g.processed.assign(ncell, 0);
+      g.subpatch.assign(ncell, 0);
+      // P_out: cells within r of the seed cell whose centre lies on the patch.
+      for (int j = sj - r; j <= sj + r; ++j)
+        for (int i = si - r; i <= si + r; ++i) {
+          if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) continue;
+          const double x = g.x0 + (i + 0.5) * c, y = g.y0 + (j + 0.5) * c;
+          std::array<double, 3> w;
+          if (locator0.locate({ca * x + sa * y, -sa * x + ca * y}, w) >= 0) g.subpatch[j * g.nx + i] = 1;
+        }
+      g.subpatch[sj * g.nx + si] = 1;
+      // Processed cells: the earlier footprints' points on the patch, in the frame.
+      for (std::size_t k = 0; k < flat.faces.size(); ++k) {
+        const auto& t = ftris[k];
+        for (const auto& bb : cover[static_cast<std::size_t>(flat.faces[k])]) {
+          const double b0 = 1 - bb[0] - bb[1];
+          const double x = b0 * t[0][0] + bb[0] * t[1][0] + bb[1] * t[2][0];
+          const double y = b0 * t[0][1] + bb[0] * t[1][1] + bb[1] * t[2][1];
+          const int cc = g.cell_of(ca * x - sa * y, sa * x + ca * y);
+          if (cc >= 0) g.processed[static_cast<std::size_t>(cc)] = 1;
+        }
+      }
+      return g;
+    };
     res.seconds_patch += tp.seconds();
 
     // 6. Output elements touching the patch, in the frame.
@@ -725,8 +733,80 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       frame.push_back(std::move(m));
     }
     const std::size_t n_in = frame.size();
-    std::vector<ElementMesh> before = frame;
     std::vector<char> alive(n_in, 1);
+    // 5b. Rotation of the placement (see SurfaceQuiltOptions::rotation_max_deg):
+    // the frame turned about the seed centroid, the translation matched in
+    // each turned frame (eq. 3 over at most rotation_match_vertices output
+    // vertices of P_out; the field's frame searches every grid translation,
+    // turned frames refine around its best one), the turn of lowest mean cost
+    // per vertex kept. The turns are searched by steps away from the field's
+    // direction, on the side that improves, while the cost decreases (ties:
+    // the smaller turn).
+    Timer tr;
+    double turn = 0;
+    const int nturn = static_cast<int>(std::floor(opt.rotation_max_deg / opt.rotation_step_deg + 1e-9));
+    if (nturn > 0 && n_in > 0) {
+      QuiltStepOptions so = opt.step;
+      so.max_match_vertices = opt.rotation_match_vertices;
+      std::vector<ElementMesh> turned = frame;
+      QuiltPlacement at0;
+      // Mean cost per vertex of turn k * step (infinity: no vertex in P_out).
+      auto mean_cost = [&](int k) {
+        const double ang = k * opt.rotation_step_deg * kPi / 180.0;
+        const double ca = std::cos(ang), sa = std::sin(ang);
+        for (std::size_t e = 0; e < n_in; ++e)
+          for (std::size_t v = 0; v < frame[e].points.size(); ++v) {
+            const P3& p = frame[e].points[v];
+            turned[e].points[v] = {ca * p[0] - sa * p[1], sa * p[0] + ca * p[1], p[2]};
+          }
+        const QuiltGrid g = make_grid(ang);
+        const QuiltMatch m = match_swatch_placement(swatch, tree, g, turned, alive, rng, so, k == 0 ? nullptr : &at0);
+        res.stats.candidates += m.candidates;
+        if (k == 0) at0 = m.placement;
+        return m.vertices ? m.cost / static_cast<double>(m.vertices) : std::numeric_limits<double>::infinity();
+      };
+      const double c0 = mean_cost(0);
+      if (std::isfinite(c0)) {
+        const double cm = mean_cost(-1), cp = mean_cost(1);
+        int best_k = 0;
+        double best_c = c0;
+        if (cm < best_c) best_c = cm, best_k = -1;
+        if (cp < best_c) best_c = cp, best_k = 1;
+        for (int k = 2 * best_k; best_k != 0 && std::abs(k) <= nturn; k += best_k > 0 ? 1 : -1) {
+          const double ck = mean_cost(k);
+          if (!(ck < best_c)) break;
+          best_c = ck;
+          best_k = k;
+        }
+        turn = best_k * opt.rotation_step_deg * kPi / 180.0;
+      }
+    }
+    QuiltGrid grid = make_grid(turn);
+    if (turn != 0) {
+      ++res.patches_turned;
+      const double ca = std::cos(turn), sa = std::sin(turn);
+      auto rot = [&](double& x, double& y) {
+        const double x2 = ca * x - sa * y;
+        y = sa * x + ca * y;
+        x = x2;
+      };
+      for (auto& p : flat.uv) rot(p[0], p[1]);
+      for (auto& t : ftris)
+        for (auto& p : t) rot(p[0], p[1]);
+      for (ElementMesh& m : frame)
+        for (P3& p : m.points) rot(p[0], p[1]);
+      std::map<P3, SurfaceQuiltVertex> turned_loc;
+      for (const auto& [p, l] : keep_loc) {
+        P3 q = p;
+        rot(q[0], q[1]);
+        turned_loc.emplace(q, l);
+      }
+      keep_loc.swap(turned_loc);
+    }
+    res.turn_deg_sum += std::abs(turn) * 180.0 / kPi;
+    res.seconds_turn += tr.seconds();
+    const PatchLocator locator = turn != 0 ? PatchLocator(ftris, c) : locator0;
+    std::vector<ElementMesh> before = frame;
     QuiltStepStats stats;
     const QuiltPlacement placed = quilt_step(swatch, tree, grid, frame, alive, rng, opt.step, stats);
     res.stats.add(stats);

@@ -28,10 +28,14 @@
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
-//    seed centroid at the origin; a grid of cells (as in mesh_quilting.h)
-//    over it; a cell is processed when the base triangle under its centre is.
-//    P_out = cells within subpatch_radius (Chebyshev) of the seed cell whose
-//    centre lies on the patch.
+//    seed centroid at the origin (a cell centre); a grid of cells (as in
+//    mesh_quilting.h) over it; processed cells as in step 6. P_out = cells
+//    within subpatch_radius (Chebyshev) of the seed cell whose centre lies on
+//    the patch. Then the frame is turned about the seed centroid by the angle
+//    (within +-rotation_max_deg of the field's direction, our choice: the
+//    paper searches translations only) whose best translation matches the
+//    texture already placed best (eq. 3, mean per vertex of P_out); the grid
+//    and P_out turn with the frame (SurfaceQuiltOptions::rotation_max_deg).
 // 6. Output elements with a vertex on a patch triangle are expressed in the
 //    frame (vertices on other triangles: projected onto the plane of the
 //    patch triangle with the nearest centroid, barycentric coordinates
@@ -96,6 +100,25 @@ struct SurfaceQuiltOptions {
   /// Default 0: on the open cylinder of the tests, 0.1 kept 2 more elements
   /// and 303 more intersecting face pairs within elements (their tips).
   double max_past_border = 0;
+  /// Rotation of each placement (issue #8; our choice, the paper's section 2.4
+  /// searches translations only and section 3.1 takes the patch's frame from
+  /// the guidance field): besides the field's direction (step 4) the frame is
+  /// tried turned by +-rotation_step_deg, +-2 rotation_step_deg, ... up to
+  /// +-rotation_max_deg about the seed centroid, the best translation found
+  /// for each (section 2.4, eq. 3, over at most rotation_match_vertices
+  /// output vertices), and the turn whose mean cost per vertex is lowest is
+  /// kept (ties: the smaller turn). The field's direction at the seed and the
+  /// direction the neighbouring texture actually runs in differ on curved
+  /// surfaces (each earlier patch was aligned at its own seed, and the LSCM
+  /// flattening turns the field by the surface's holonomy in between), so
+  /// translated threads meet the old ones at an angle and cannot be stitched.
+  /// Defaults: 15 degrees in steps of 5 (7 turns). rotation_max_deg in [0, 90],
+  /// 0 = translations only (the state before); rotation_step_deg in (0, 90].
+  double rotation_max_deg = 15.0;
+  double rotation_step_deg = 5.0;
+  /// Output vertices of P_out used to compare the turns (evenly subsampled;
+  /// the chosen turn's translation is then matched with step.max_match_vertices); >= 1.
+  int rotation_match_vertices = 150;
   /// Patch radius in swatch diagonals (scaled); > 0.
   double patch_radius = 1.0;
   /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
@@ -157,8 +180,14 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Placements turned away from the field's direction by the rotation
+  /// search (SurfaceQuiltOptions::rotation_max_deg), and the sum of |turn|
+  /// over all placements (degrees).
+  int patches_turned = 0;
+  double turn_deg_sum = 0;
   QuiltStepStats stats;
-  double seconds = 0, seconds_patch = 0, seconds_step = 0;
+  /// seconds_turn: the rotation search (part of seconds_step).
+  double seconds = 0, seconds_patch = 0, seconds_step = 0, seconds_turn = 0;
 };
 
 /// Quilts `swatch` over `base`; writes `out`. See the header comment.
