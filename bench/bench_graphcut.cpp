@@ -10,9 +10,11 @@
 // completeness, mean squared difference per value (lower is better).
 // Alpha is kept: both outputs are compared with the exemplar's channels.
 //
-// Usage: bench_graphcut [TEXTURE_DIR] [WORK_DIR] [NAME,NAME,...|-] [GMIC_RUNS] [TILE_SIZE]
+// Usage: bench_graphcut [TEXTURE_DIR] [WORK_DIR] [NAME,NAME,...|-] [GMIC_RUNS] [TILE_SIZE] [MODE]
 // The optional list keeps only the textures whose file stem is listed ("-" =
-// all). G'MIC (from PATH; if it is missing the G'MIC fields are null) is
+// all). MODE: all (default), synthesis (no tile) or tile (no 256 synthesis,
+// no G'MIC). G'MIC (from PATH; if it is missing or GMIC_RUNS is 0 the G'MIC
+// fields are absent) is
 // unseeded, so it runs GMIC_RUNS times (default 3) per texture and ours is
 // compared with the median of its similarity scores and the median of its
 // wall and CPU times (each run includes G'MIC's process start and PNG IO,
@@ -140,10 +142,16 @@ int main(int argc, char** argv) {
 
   // G'MIC's syntexturize_matchpatch is unseeded: its output (and score) moves
   // between runs, so it runs `gmic_runs` times and we compare with the median.
-  const int gmic_runs = argc > 4 ? std::max(1, std::atoi(argv[4])) : 3;
+  const int gmic_runs = argc > 4 ? std::max(0, std::atoi(argv[4])) : 3;
   const int tile_size = argc > 5 ? std::max(8, std::atoi(argv[5])) : 128;
+  const std::string mode = argc > 6 ? argv[6] : "all";
+  if (mode != "all" && mode != "synthesis" && mode != "tile") {
+    std::fprintf(stderr, "bench_graphcut: MODE must be all, synthesis or tile, got '%s'\n", mode.c_str());
+    return 2;
+  }
+  const bool run_synthesis = mode != "tile", run_tile = mode != "synthesis";
 
-  int compared = 0, no_worse = 0, faster = 0, tiles_ok = 0;
+  int compared = 0, no_worse = 0, faster = 0, tiles_ok = 0, tiles_ok_synthesis_cut = 0;
   double t_ours = 0, t_gmic = 0, cpu_ours = 0, cpu_gmic = 0;
   for (const auto& f : files) {
     const std::string name = fs::path(f).stem().string();
@@ -152,6 +160,7 @@ int main(int argc, char** argv) {
     j["texture"] = name;
     j["exemplar"] = std::to_string(ex.width) + "x" + std::to_string(ex.height) + "x" + std::to_string(ex.channels);
 
+    if (run_synthesis) {
     GraphcutOptions o;
     o.seed = 1;
     double c0 = self_cpu_seconds();
@@ -169,7 +178,7 @@ int main(int argc, char** argv) {
     j["surftex_seam_cost"] = {r.seam_cost_after_fill, r.seam_cost_final};
     j["surftex_patches"] = {r.fill_patches, r.refinement_tried, r.refinement_accepted};
 
-    if (have_gmic) {
+    if (have_gmic && gmic_runs > 0) {
       std::vector<double> walls, cpus, scores;
       int failed_rc = 0;
       for (int run = 0; run < gmic_runs; ++run) {
@@ -212,26 +221,32 @@ int main(int argc, char** argv) {
       }
       if (failed_rc != 0) j["gmic_error"] = failed_rc;
     }
+    }  // run_synthesis
 
+    if (run_tile) {
     TileOptions to;
-    c0 = self_cpu_seconds();
-    tm.reset();
+    double c0 = self_cpu_seconds();
+    Timer tm;
     TileResult t = make_tileable_detailed(ex, tile_size, to);
     j["tile_size"] = tile_size;
     j["tile_seconds"] = tm.seconds();
     j["tile_cpu_seconds"] = self_cpu_seconds() - c0;
     j["tile_wrap_seam_ratio"] = t.wrap_seam_ratio;
+    j["tile_wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
+    j["tile_cut_shift"] = {t.shift_x, t.shift_y};
     j["tile_seam_cost"] = t.seam_cost;
     const WrapSeamStats ws = wrap_seam_stats(t.tile);
     j["tile_wrap_mean_jump"] = ws.wrap_mean;
     j["tile_inside_mean_jump"] = ws.inside_mean;
     j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
     if (t.wrap_seam_ratio <= 1.3) ++tiles_ok;
+    if (t.wrap_seam_ratio_at_synthesis_cut <= 1.3) ++tiles_ok_synthesis_cut;
     Image rep(2 * tile_size, 2 * tile_size, t.tile.channels);
     for (int y = 0; y < rep.height; ++y)
       for (int x = 0; x < rep.width; ++x)
         for (int c = 0; c < rep.channels; ++c) rep.at(x, y, c) = t.tile.at(x % tile_size, y % tile_size, c);
     write_image(work + "/" + name + "_tile2x2.png", rep);
+    }  // run_tile
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);
   }
@@ -250,6 +265,7 @@ int main(int argc, char** argv) {
   s["gmic_total_seconds"] = t_gmic;
   s["tile_size"] = tile_size;
   s["tiles_wrap_seam_ratio_le_1_3"] = tiles_ok;
+  s["tiles_wrap_seam_ratio_at_synthesis_cut_le_1_3"] = tiles_ok_synthesis_cut;
   std::printf("%s\n", s.dump().c_str());
   return 0;
 }
