@@ -64,6 +64,7 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
                             ") must be smaller than the patch size (" + std::to_string(g.patch_size) + ")");
   g.refinement_passes = o.refinement_passes;
   g.k = o.k;
+  g.repetition_penalty = o.repetition_penalty;
   g.periodic_output = true;
   g.seed = o.seed;
   g.progress = o.progress;

@@ -52,6 +52,12 @@ struct TileOptions {
   /// Placement temperature (GraphcutOptions::k). Range > 0.
   double k = 0.002;
   PlacementMode placement = PlacementMode::SubPatch;
+  /// GraphcutOptions::repetition_penalty. Default 0 here (0.3 for graph-cut
+  /// synthesis): a tile is judged by its seams more than by how much of the
+  /// exemplar it shows. Measured at 128 px (seed 1, the 29 shared
+  /// textures): summed tile seam cost 2145 with 0, 2178 with 0.3
+  /// (red_checked_384 13 -> 23, ink_b_400 16 -> 28). Range >= 0.
+  double repetition_penalty = 0.0;
   /// Roll the finished tile so that its border (wrap row and column) lies on
   /// the smoothest row and column pair of the torus (choose_torus_cut).
   /// Default true. The tiling is unchanged: the result is a cyclic shift of
