@@ -121,6 +121,7 @@ TEST(TileableTile, At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines) {
       GraphcutOptions g;  // what make_tileable runs for a 32-px tile of a 32-px exemplar
       g.patch_size = 24;
       g.refinement_passes = 4;
+      g.repetition_penalty = TileOptions{}.repetition_penalty;
       g.periodic_output = true;
       g.seed = static_cast<std::uint64_t>(seed);
       GraphcutResult r = graphcut_synthesize_detailed(ex, s, s, g);
