@@ -105,6 +105,19 @@
 // water_caustics_300         0.16  0.00104    0.00100   0.00110      ok     -9.5%   1.739 -> 0.259 (40.5)
 // wood_512                   0.42  0.00031    0.00031   0.00034      ok     -7.9%   0.656 -> 0.515 (23.9)
 // woven_tissue_512           0.24  0.00290    0.00290   0.00282      LOSS   +2.7%   0.514 -> 0.424 (23.1)
+// Fresh G'MIC sampling on the 7 textures closest to the line (this benchmark,
+// GMIC_RUNS 3, 10:09-10:21, load average 7-9): ours / G'MIC median [its 3 runs]
+//   drawn_dots_512    0.006253 / 0.006150 [0.00627 0.00591 0.00615]  LOSS +1.7%
+//   gravel_gray_512   0.004170 / 0.004337 [0.00403 0.00435 0.00434]  ok
+//   ink_a_400         0.002869 / 0.003177 [0.00602 0.00318 0.00308]  ok
+//   red_checked_384   0.000383 / 0.000382 [0.00041 0.00038 0.00038]  LOSS +0.3%
+//   reptile_skin_512  0.001389 / 0.001401 [0.00144 0.00140 0.00135]  ok
+//   rock_512          0.002186 / 0.002142 [0.00214 0.00223 0.00210]  LOSS +2.1%
+//   woven_tissue_512  0.002897 / 0.002961 [0.00296 0.00297 0.00289]  ok
+// 4/7 here (gravel and woven flip to ok, rock and red_checked to loss): with
+// the other 22 at their margins above (all >= 5% except bricks_with_hole
+// -1.1%), 26/29 again; at this distance the verdict follows G'MIC's draw.
+// CPU ours/G'MIC over the 7: 0.30 (each G'MIC run includes its process start).
 
 #include <sys/resource.h>
 
@@ -206,91 +219,91 @@ int main(int argc, char** argv) {
     j["exemplar"] = std::to_string(ex.width) + "x" + std::to_string(ex.height) + "x" + std::to_string(ex.channels);
 
     if (run_synthesis) {
-    GraphcutOptions o;
-    o.seed = 1;
-    double c0 = self_cpu_seconds();
-    Timer tm;
-    GraphcutResult r = graphcut_synthesize_detailed(ex, 256, 256, o);
-    const double ours_s = tm.seconds(), ours_cpu = self_cpu_seconds() - c0;
-    const std::string ours_png = work + "/" + name + "_graphcut.png";
-    write_image(ours_png, r.image);
-    BidirectionalResult bo = bidirectional(r.image, ex);
-    j["surftex_seconds"] = ours_s;
-    j["surftex_cpu_seconds"] = ours_cpu;
-    j["surftex_bds"] = bo.total;
-    j["surftex_coherence"] = bo.coherence;
-    j["surftex_completeness"] = bo.completeness;
-    j["surftex_seam_cost"] = {r.seam_cost_after_fill, r.seam_cost_final};
-    j["surftex_patches"] = {r.fill_patches, r.refinement_tried, r.refinement_accepted};
+      GraphcutOptions o;
+      o.seed = 1;
+      double c0 = self_cpu_seconds();
+      Timer tm;
+      GraphcutResult r = graphcut_synthesize_detailed(ex, 256, 256, o);
+      const double ours_s = tm.seconds(), ours_cpu = self_cpu_seconds() - c0;
+      const std::string ours_png = work + "/" + name + "_graphcut.png";
+      write_image(ours_png, r.image);
+      BidirectionalResult bo = bidirectional(r.image, ex);
+      j["surftex_seconds"] = ours_s;
+      j["surftex_cpu_seconds"] = ours_cpu;
+      j["surftex_bds"] = bo.total;
+      j["surftex_coherence"] = bo.coherence;
+      j["surftex_completeness"] = bo.completeness;
+      j["surftex_seam_cost"] = {r.seam_cost_after_fill, r.seam_cost_final};
+      j["surftex_patches"] = {r.fill_patches, r.refinement_tried, r.refinement_accepted};
 
-    if (have_gmic && gmic_runs > 0) {
-      std::vector<double> walls, cpus, scores;
-      int failed_rc = 0;
-      for (int run = 0; run < gmic_runs; ++run) {
-        const std::string gm_png = work + "/" + name + "_gmic" + std::to_string(run) + ".png";
-        fs::remove(gm_png);
-        const std::string cmd = "gmic -v -1 input '" + f + "' syntexturize_matchpatch 256,256 output '" +
-                                gm_png + "' >/dev/null 2>&1";
-        double g0 = children_cpu_seconds();
-        tm.reset();
-        int rc = std::system(cmd.c_str());
-        const double gm_s = tm.seconds(), gm_cpu = children_cpu_seconds() - g0;
-        if (rc != 0 || !fs::exists(gm_png)) {
-          failed_rc = rc != 0 ? rc : -1;
-          continue;
+      if (have_gmic && gmic_runs > 0) {
+        std::vector<double> walls, cpus, scores;
+        int failed_rc = 0;
+        for (int run = 0; run < gmic_runs; ++run) {
+          const std::string gm_png = work + "/" + name + "_gmic" + std::to_string(run) + ".png";
+          fs::remove(gm_png);
+          const std::string cmd = "gmic -v -1 input '" + f + "' syntexturize_matchpatch 256,256 output '" +
+                                  gm_png + "' >/dev/null 2>&1";
+          double g0 = children_cpu_seconds();
+          tm.reset();
+          int rc = std::system(cmd.c_str());
+          const double gm_s = tm.seconds(), gm_cpu = children_cpu_seconds() - g0;
+          if (rc != 0 || !fs::exists(gm_png)) {
+            failed_rc = rc != 0 ? rc : -1;
+            continue;
+          }
+          Image g = match_channels(read_image(gm_png), ex.channels);
+          walls.push_back(gm_s);
+          cpus.push_back(gm_cpu);
+          scores.push_back(bidirectional(g, ex).total);
         }
-        Image g = match_channels(read_image(gm_png), ex.channels);
-        walls.push_back(gm_s);
-        cpus.push_back(gm_cpu);
-        scores.push_back(bidirectional(g, ex).total);
+        if (!scores.empty()) {
+          const double gm_bds = median(scores), gm_s = median(walls), gm_cpu = median(cpus);
+          j["gmic_runs"] = scores.size();
+          j["gmic_seconds_all"] = walls;
+          j["gmic_cpu_seconds_all"] = cpus;
+          j["gmic_bds_all"] = scores;
+          j["gmic_seconds"] = gm_s;
+          j["gmic_cpu_seconds"] = gm_cpu;
+          j["gmic_bds"] = gm_bds;
+          j["surftex_no_worse"] = bo.total <= gm_bds;
+          j["surftex_faster_wall"] = ours_s <= gm_s;
+          j["surftex_faster_cpu"] = ours_cpu <= gm_cpu;
+          ++compared;
+          if (bo.total <= gm_bds) ++no_worse;
+          if (ours_cpu <= gm_cpu) ++faster;
+          t_ours += ours_s;
+          t_gmic += gm_s;
+          cpu_ours += ours_cpu;
+          cpu_gmic += gm_cpu;
+        }
+        if (failed_rc != 0) j["gmic_error"] = failed_rc;
       }
-      if (!scores.empty()) {
-        const double gm_bds = median(scores), gm_s = median(walls), gm_cpu = median(cpus);
-        j["gmic_runs"] = scores.size();
-        j["gmic_seconds_all"] = walls;
-        j["gmic_cpu_seconds_all"] = cpus;
-        j["gmic_bds_all"] = scores;
-        j["gmic_seconds"] = gm_s;
-        j["gmic_cpu_seconds"] = gm_cpu;
-        j["gmic_bds"] = gm_bds;
-        j["surftex_no_worse"] = bo.total <= gm_bds;
-        j["surftex_faster_wall"] = ours_s <= gm_s;
-        j["surftex_faster_cpu"] = ours_cpu <= gm_cpu;
-        ++compared;
-        if (bo.total <= gm_bds) ++no_worse;
-        if (ours_cpu <= gm_cpu) ++faster;
-        t_ours += ours_s;
-        t_gmic += gm_s;
-        cpu_ours += ours_cpu;
-        cpu_gmic += gm_cpu;
-      }
-      if (failed_rc != 0) j["gmic_error"] = failed_rc;
-    }
     }  // run_synthesis
 
     if (run_tile) {
-    TileOptions to;
-    double c0 = self_cpu_seconds();
-    Timer tm;
-    TileResult t = make_tileable_detailed(ex, tile_size, to);
-    j["tile_size"] = tile_size;
-    j["tile_seconds"] = tm.seconds();
-    j["tile_cpu_seconds"] = self_cpu_seconds() - c0;
-    j["tile_wrap_seam_ratio"] = t.wrap_seam_ratio;
-    j["tile_wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
-    j["tile_cut_shift"] = {t.shift_x, t.shift_y};
-    j["tile_seam_cost"] = t.seam_cost;
-    const WrapSeamStats ws = wrap_seam_stats(t.tile);
-    j["tile_wrap_mean_jump"] = ws.wrap_mean;
-    j["tile_inside_mean_jump"] = ws.inside_mean;
-    j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
-    if (t.wrap_seam_ratio <= 1.3) ++tiles_ok;
-    if (t.wrap_seam_ratio_at_synthesis_cut <= 1.3) ++tiles_ok_synthesis_cut;
-    Image rep(2 * tile_size, 2 * tile_size, t.tile.channels);
-    for (int y = 0; y < rep.height; ++y)
-      for (int x = 0; x < rep.width; ++x)
-        for (int c = 0; c < rep.channels; ++c) rep.at(x, y, c) = t.tile.at(x % tile_size, y % tile_size, c);
-    write_image(work + "/" + name + "_tile2x2.png", rep);
+      TileOptions to;
+      double c0 = self_cpu_seconds();
+      Timer tm;
+      TileResult t = make_tileable_detailed(ex, tile_size, to);
+      j["tile_size"] = tile_size;
+      j["tile_seconds"] = tm.seconds();
+      j["tile_cpu_seconds"] = self_cpu_seconds() - c0;
+      j["tile_wrap_seam_ratio"] = t.wrap_seam_ratio;
+      j["tile_wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
+      j["tile_cut_shift"] = {t.shift_x, t.shift_y};
+      j["tile_seam_cost"] = t.seam_cost;
+      const WrapSeamStats ws = wrap_seam_stats(t.tile);
+      j["tile_wrap_mean_jump"] = ws.wrap_mean;
+      j["tile_inside_mean_jump"] = ws.inside_mean;
+      j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
+      if (t.wrap_seam_ratio <= 1.3) ++tiles_ok;
+      if (t.wrap_seam_ratio_at_synthesis_cut <= 1.3) ++tiles_ok_synthesis_cut;
+      Image rep(2 * tile_size, 2 * tile_size, t.tile.channels);
+      for (int y = 0; y < rep.height; ++y)
+        for (int x = 0; x < rep.width; ++x)
+          for (int c = 0; c < rep.channels; ++c) rep.at(x, y, c) = t.tile.at(x % tile_size, y % tile_size, c);
+      write_image(work + "/" + name + "_tile2x2.png", rep);
     }  // run_tile
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);
