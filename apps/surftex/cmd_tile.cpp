@@ -19,6 +19,7 @@ struct TileArgs {
   int patch = 0;
   int overlap = 0;
   int passes = TileOptions{}.refinement_passes;
+  bool synthesis_cut = false;
   CommonOptions common;
 };
 
@@ -32,6 +33,7 @@ int run_tile(const TileArgs& a) {
   o.patch_size = a.patch;
   o.overlap = a.overlap;
   o.refinement_passes = a.passes;
+  o.choose_cut = !a.synthesis_cut;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
   Timer timer;
@@ -57,13 +59,19 @@ int run_tile(const TileArgs& a) {
   report["passes"] = a.passes;
   report["seconds"] = seconds;
   report["wrap_seam_ratio"] = t.wrap_seam_ratio;
+  report["wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
+  report["choose_cut"] = o.choose_cut;
+  report["cut_shift"] = {t.shift_x, t.shift_y};
   report["exemplar_wrap_seam_ratio"] =
       ex.width >= 2 && ex.height >= 2 ? wrap_seam_ratio(ex) : 0.0;
   report["seam_cost"] = t.seam_cost;
   write_report(a.common, "tile", report);
   if (!a.common.quiet)
-    std::fprintf(stderr, "tile %dx%d written to %s in %.2f s, wrap-seam ratio %.3f\n", a.size,
-                 a.size, a.output.c_str(), seconds, t.wrap_seam_ratio);
+    std::fprintf(stderr,
+                 "tile %dx%d written to %s in %.2f s, wrap-seam ratio %.3f (%.3f at the synthesis "
+                 "cut, rolled by %d,%d)\n",
+                 a.size, a.size, a.output.c_str(), seconds, t.wrap_seam_ratio,
+                 t.wrap_seam_ratio_at_synthesis_cut, t.shift_x, t.shift_y);
   return 0;
 }
 
@@ -90,6 +98,10 @@ SubcommandRegistrar reg{
                       "Seam-repair passes after the tile is filled (0..100, default " +
                           std::to_string(TileOptions{}.refinement_passes) + ", as the library)")
            ->check(CLI::Range(0, 100));
+       app.add_flag("--synthesis-cut", a->synthesis_cut,
+                    "Keep the tile's border where the synthesis left it instead of rolling the "
+                    "tile so that its border lies on the smoothest row and column (the tiling is "
+                    "the same either way; default off: the border is moved)");
        app.add_option("--preview", a->preview,
                       "Also write the tile repeated 2x2 to this image (to check the seams)");
        add_common_options(app, a->common);

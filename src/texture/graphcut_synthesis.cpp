@@ -283,6 +283,50 @@ double GraphcutCanvas::pixel_seam_error(int x, int y) const {
   return e;
 }
 
+std::vector<double> GraphcutCanvas::seam_error_map() const {
+  std::vector<double> e(static_cast<std::size_t>(w_) * h_, 0.0);
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < w_; ++x) e[idx(x, y)] = pixel_seam_error(x, y);
+  return e;
+}
+
+GraphcutCanvas::ErrorRegion GraphcutCanvas::worst_error_region(const std::vector<double>& err, int side,
+                                                               const std::vector<char>& skip) const {
+  if (side < 1) throw InvalidInputError("worst_error_region: side must be >= 1, got " + std::to_string(side));
+  const std::size_t n = static_cast<std::size_t>(w_) * h_;
+  if (err.size() != n || (!skip.empty() && skip.size() != n))
+    throw InvalidInputError("worst_error_region: the error map (" + std::to_string(err.size()) +
+                            ") and skip mask (" + std::to_string(skip.size()) + ") must have " +
+                            std::to_string(n) + " entries");
+  side = std::min({side, w_, h_});
+  const int sx = side, sy = side;
+  // Window origins: every pixel on the torus, else those keeping the window inside.
+  const int nx = periodic_ ? w_ : w_ - sx + 1, ny = periodic_ ? h_ : h_ - sy + 1;
+  // Row sums of sx consecutive pixels, then column sums of sy rows.
+  std::vector<double> rows(static_cast<std::size_t>(nx) * h_, 0.0);
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < nx; ++x) {
+      double t = 0.0;
+      for (int i = 0; i < sx; ++i) t += err[idx((x + i) % w_, y)];
+      rows[static_cast<std::size_t>(y) * nx + x] = t;
+    }
+  ErrorRegion best;
+  best.side = side;
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x) {
+      const int cx = (x + sx / 2) % w_, cy = (y + sy / 2) % h_;
+      if (!skip.empty() && skip[idx(cx, cy)]) continue;
+      double t = 0.0;
+      for (int j = 0; j < sy; ++j) t += rows[static_cast<std::size_t>((y + j) % h_) * nx + x];
+      if (t > best.cost) {
+        best.cost = t;
+        best.x = x;
+        best.y = y;
+      }
+    }
+  return best;
+}
+
 double GraphcutCanvas::footprint_cost(const PatchPlacement& placement) const {
   PatchPlacement p = placement;
   if (!periodic_ && !clip_placement(p, w_, h_)) return 0.0;
@@ -344,6 +388,8 @@ class GraphcutSynthesizer {
     }
     int ov = o.overlap > 0 ? o.overlap : std::max(2, std::min(pw_, ph_) / 3);
     ov_ = std::min(ov, std::min(pw_, ph_) - 1);
+    error_side_ = std::min({o.error_region > 0 ? o.error_region : std::max(3, ov_ / 4), pw_, ph_});
+    match_side_ = std::min({3 * error_side_, pw_, ph_});
     // sigma^2: summed per-channel variance of the exemplar.
     const std::size_t np = static_cast<std::size_t>(ex.width) * ex.height;
     for (int c = 0; c < ex.channels; ++c) {
@@ -436,25 +482,36 @@ class GraphcutSynthesizer {
       }
   }
 
-  // Exemplar offset for a pw_ x ph_ patch at output (x0, y0).
+  // Exemplar offset for a tw x th template (an output window) at output
+  // (x0, y0): the exemplar position whose content matches the covered part
+  // of the window best (sub-patch matching).
   // `fill`: skip offsets that merely continue a patch already in the window
   // (within overlap/2 pixels of its translation) when any other offset
   // exists; otherwise a large exemplar is copied verbatim.
-  std::pair<int, int> choose_offset(int x0, int y0, bool fill) {
-    const int mx = ex_.width - pw_, my = ex_.height - ph_;
+  // `hole` (window coordinates x, y, side): pixels left out of the match
+  // (weight 0), e.g. the error region a refinement patch must replace.
+  std::pair<int, int> choose_offset(int x0, int y0, bool fill, const int* hole = nullptr) {
+    return choose_offset(x0, y0, pw_, ph_, fill, hole);
+  }
+  std::pair<int, int> choose_offset(int x0, int y0, int tw, int th, bool fill, const int* hole) {
+    const int mx = ex_.width - tw, my = ex_.height - th;
     if (opt_.placement == PlacementMode::Random) return {uniform_int(0, mx), uniform_int(0, my)};
     Image win;
     std::vector<float> mask;
-    window(x0, y0, pw_, ph_, win, mask);
+    window(x0, y0, tw, th, win, mask);
+    if (hole)
+      for (int j = std::max(0, hole[1]); j < std::min(th, hole[1] + hole[2]); ++j)
+        for (int i = std::max(0, hole[0]); i < std::min(tw, hole[0] + hole[2]); ++i)
+          mask[static_cast<std::size_t>(j) * tw + i] = 0.f;
     double area = std::accumulate(mask.begin(), mask.end(), 0.0);
     if (area <= 0.0) return {uniform_int(0, mx), uniform_int(0, my)};
     if (!matcher_) matcher_ = std::make_unique<MaskedSsdMatcher>(ex_, std::vector<float>{}, false);
     SsdMap m = matcher_->match(win, mask);
     std::vector<std::pair<int, int>> continued;  // exemplar offsets of patches in the window
     if (fill) {
-      for (int j = 0; j < ph_; ++j)
-        for (int i = 0; i < pw_; ++i) {
-          if (mask[static_cast<std::size_t>(j) * pw_ + i] == 0.f) continue;
+      for (int j = 0; j < th; ++j)
+        for (int i = 0; i < tw; ++i) {
+          if (mask[static_cast<std::size_t>(j) * tw + i] == 0.f) continue;
           int x = x0 + i, y = y0 + j;
           if (canvas_.periodic_) {
             x = (x % canvas_.w_ + canvas_.w_) % canvas_.w_;
@@ -465,6 +522,7 @@ class GraphcutSynthesizer {
         }
     }
     const int r = std::max(1, ov_ / 2);
+    const std::vector<double> rep = repetition(x0, y0, tw, th, m.nx, m.ny);
     std::vector<std::pair<int, double>> cand, excluded;
     cand.reserve(m.ssd.size());
     for (std::size_t i = 0; i < m.ssd.size(); ++i) {
@@ -472,10 +530,49 @@ class GraphcutSynthesizer {
       bool cont = false;
       for (const auto& e : continued)
         if (std::abs(ex - e.first) <= r && std::abs(ey - e.second) <= r) cont = true;
-      (cont ? excluded : cand).emplace_back(static_cast<int>(i), m.ssd[i] / area);
+      const double c = m.ssd[i] / area + (rep.empty() ? 0.0 : opt_.repetition_penalty * sigma2_ * rep[i]);
+      (cont ? excluded : cand).emplace_back(static_cast<int>(i), c);
     }
     int best = draw(cand.empty() ? excluded : cand);
     return {best % m.nx, best / m.nx};
+  }
+
+  // Repetition term of every offset (nx x ny, row-major; empty when the
+  // penalty is off): the mean over the exemplar window [u, u + patch) of the
+  // number of output pixels outside the target window at (x0, y0) that show
+  // each exemplar pixel, divided by max(1, output area / exemplar area).
+  std::vector<double> repetition(int x0, int y0, int tw, int th, int nx, int ny) const {
+    if (!(opt_.repetition_penalty > 0.0)) return {};
+    const int W = canvas_.w_, H = canvas_.h_, EW = ex_.width, EH = ex_.height;
+    std::vector<double> occ(static_cast<std::size_t>(EW + 1) * (EH + 1), 0.0);  // integral image
+    auto inside_window = [&](int x, int y) {
+      int i = x - x0, j = y - y0;
+      if (canvas_.periodic_) {
+        i = (i % W + W) % W;
+        j = (j % H + H) % H;
+      }
+      return i >= 0 && j >= 0 && i < tw && j < th;
+    };
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        if (!canvas_.covered(x, y) || inside_window(x, y)) continue;
+        occ[static_cast<std::size_t>(canvas_.source_y(x, y) + 1) * (EW + 1) + canvas_.source_x(x, y) + 1] += 1.0;
+      }
+    for (int y = 1; y <= EH; ++y)
+      for (int x = 1; x <= EW; ++x) {
+        const std::size_t k = static_cast<std::size_t>(y) * (EW + 1) + x;
+        occ[k] += occ[k - 1] + occ[k - EW - 1] - occ[k - EW - 2];
+      }
+    const double expected = std::max(1.0, static_cast<double>(W) * H / (static_cast<double>(EW) * EH));
+    const double norm = 1.0 / (expected * tw * th);
+    std::vector<double> rep(static_cast<std::size_t>(nx) * ny);
+    for (int v = 0; v < ny; ++v)
+      for (int u = 0; u < nx; ++u) {
+        auto at = [&](int x, int y) { return occ[static_cast<std::size_t>(y) * (EW + 1) + x]; };
+        const double sum = at(u + tw, v + th) - at(u, v + th) - at(u + tw, v) + at(u, v);
+        rep[static_cast<std::size_t>(v) * nx + u] = sum * norm;
+      }
+    return rep;
   }
 
   std::vector<int> grid(int size, int patch) const {
@@ -564,77 +661,126 @@ class GraphcutSynthesizer {
     }
   }
 
+  // Refinement (Kwatra et al. 2003 section 4: once the output is full,
+  // "we then iterate over regions of high seam cost"). Each step takes the
+  // error region -- the error_side_ x error_side_ window with the highest
+  // summed pixel seam error, recomputed after every accepted patch -- and
+  // centres a patch on it; its offset comes from sub-patch matching of the
+  // output window around the region, the region itself left out of the
+  // match (its pixels are what is replaced); the region is forced to take the
+  // new patch and the cut keeps old seams (section 3.3). The patch is kept if
+  // the total seam cost does not increase. Within a pass, regions centred in
+  // the central half of an earlier refinement patch of that pass are skipped,
+  // so a pass spreads over the worst seams instead of retrying one.
+  // The refinement patch for `region`: sub-patch matching of a tm x tm
+  // output window centred on it (the region itself left out of the match);
+  // the patch pasted is the exemplar around the match, up to pw_ x ph_ (the
+  // cut decides how much of it is used).
+  PatchPlacement refinement_placement(const GraphcutCanvas::ErrorRegion& region, int tm) {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const int cx = (region.x + region.side / 2) % W, cy = (region.y + region.side / 2) % H;
+    PatchPlacement p;
+    if (opt_.placement == PlacementMode::EntirePatch) {
+      p = entire_patch_placement(cx, cy);
+    } else {
+      tm = std::min({tm, pw_, ph_});
+      int x0 = cx - tm / 2, y0 = cy - tm / 2;
+      if (!canvas_.periodic_) {
+        x0 = std::clamp(x0, 0, W - tm);
+        y0 = std::clamp(y0, 0, H - tm);
+      }
+      // The region in window coordinates (x0 may have wrapped below 0).
+      int hx = region.x - x0, hy = region.y - y0;
+      if (canvas_.periodic_) {
+        hx = (hx % W + W) % W;
+        hy = (hy % H + H) % H;
+      }
+      const int hole[3] = {hx, hy, region.side};
+      auto [ux, uy] = choose_offset(x0, y0, tm, tm, false, hole);
+      const int left = std::min((pw_ - tm) / 2, ux), top = std::min((ph_ - tm) / 2, uy);
+      const int right = std::min(pw_ - tm - (pw_ - tm) / 2, ex_.width - ux - tm);
+      const int bottom = std::min(ph_ - tm - (ph_ - tm) / 2, ex_.height - uy - tm);
+      p = {x0 - left, y0 - top, ux - left, uy - top, left + tm + right, top + tm + bottom};
+    }
+    if (canvas_.periodic_) {
+      p.out_x = (p.out_x % W + W) % W;
+      p.out_y = (p.out_y % H + H) % H;
+    }
+    return p;
+  }
+
   void refine(GraphcutResult& res) {
     const int W = canvas_.w_, H = canvas_.h_;
     const int per_pass = std::max(1, fill_patches_);
+    if (opt_.refinement_passes == 0) return;
+    std::vector<double> err = canvas_.seam_error_map();
+    // Template sides: the sub-patch around the region, then the whole patch.
+    std::vector<int> templates = {match_side_};
+    if (opt_.placement != PlacementMode::EntirePatch && match_side_ < std::max(pw_, ph_))
+      templates.push_back(std::max(pw_, ph_));
+    auto wrap_mark = [&](std::vector<char>& m, int x, int y) {
+      if (canvas_.periodic_) {
+        x = (x % W + W) % W;
+        y = (y % H + H) % H;
+      }
+      if (x >= 0 && y >= 0 && x < W && y < H) m[static_cast<std::size_t>(y) * W + x] = 1;
+    };
     for (int pass = 0; pass < opt_.refinement_passes; ++pass) {
-      std::vector<std::pair<double, int>> err;
-      for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-          double e = canvas_.pixel_seam_error(x, y);
-          if (e > 0.0) err.emplace_back(-e, y * W + x);
-        }
-      std::sort(err.begin(), err.end());
       std::vector<char> visited(static_cast<std::size_t>(W) * H, 0);
-      int placed = 0;
-      for (const auto& e : err) {
-        if (placed >= per_pass) break;
-        const int tx = e.second % W, ty = e.second / W;
-        if (visited[static_cast<std::size_t>(e.second)]) continue;
-        PatchPlacement p;
-        if (opt_.placement == PlacementMode::EntirePatch) {
-          p = entire_patch_placement(tx, ty);
-        } else {
-          int x0 = tx - pw_ / 2, y0 = ty - ph_ / 2;
-          if (!canvas_.periodic_) {
-            x0 = std::clamp(x0, 0, W - pw_);
-            y0 = std::clamp(y0, 0, H - ph_);
+      for (int placed = 0; placed < per_pass; ++placed) {
+        const GraphcutCanvas::ErrorRegion region = canvas_.worst_error_region(err, error_side_, visited);
+        if (!(region.cost > 0.0)) break;
+        for (int j = 0; j < region.side; ++j)
+          for (int i = 0; i < region.side; ++i) wrap_mark(visited, region.x + i, region.y + j);
+        for (int tm : templates) {
+          const PatchPlacement p = refinement_placement(region, tm);
+          // Mark the central half of the footprint as handled for this pass.
+          for (int j = p.height / 4; j < p.height - p.height / 4; ++j)
+            for (int i = p.width / 4; i < p.width - p.width / 4; ++i) wrap_mark(visited, p.out_x + i, p.out_y + j);
+          const std::vector<int> keep_x = canvas_.sx_, keep_y = canvas_.sy_;
+          const double before = canvas_.footprint_cost(p);
+          const int changed = canvas_.place_graphcut(p);
+          ++res.refinement_tried;
+          if (changed == 0) continue;  // the cut kept every old pixel: try the next template
+          if (canvas_.footprint_cost(p) > before) {  // rounding only: the free cut cannot lose
+            canvas_.sx_ = keep_x;
+            canvas_.sy_ = keep_y;
+            continue;
           }
-          auto [ex, ey] = choose_offset(x0, y0, false);
-          p = {x0, y0, ex, ey, pw_, ph_};
-        }
-        if (canvas_.periodic_) {
-          p.out_x = (p.out_x % W + W) % W;
-          p.out_y = (p.out_y % H + H) % H;
-        }
-        // Mark the central half of the footprint as handled for this pass.
-        for (int j = ph_ / 4; j < ph_ - ph_ / 4; ++j)
-          for (int i = pw_ / 4; i < pw_ - pw_ / 4; ++i) {
-            int x = p.out_x + i, y = p.out_y + j;
-            if (canvas_.periodic_) { x %= W; y %= H; }
-            if (x >= 0 && y >= 0 && x < W && y < H) visited[static_cast<std::size_t>(y) * W + x] = 1;
-          }
-        visited[static_cast<std::size_t>(e.second)] = 1;
-        std::vector<std::pair<int, int>> forced;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            int x = tx + dx, y = ty + dy;
-            if (canvas_.periodic_) { x = (x % W + W) % W; y = (y % H + H) % H; }
-            forced.emplace_back(x, y);
-          }
-        const std::vector<int> keep_x = canvas_.sx_, keep_y = canvas_.sy_;
-        const double before = canvas_.footprint_cost(p);
-        canvas_.place_graphcut(p, forced);
-        const double after = canvas_.footprint_cost(p);
-        ++res.refinement_tried;
-        if (after > before) {
-          canvas_.sx_ = keep_x;
-          canvas_.sy_ = keep_y;
-        } else {
           ++res.refinement_accepted;
+          update_error(err, p);
+          break;
         }
-        ++placed;
         report_progress(opt_.progress, "graphcut refine",
-                        (pass + static_cast<double>(placed) / per_pass) / opt_.refinement_passes);
+                        (pass + static_cast<double>(placed + 1) / per_pass) / opt_.refinement_passes);
       }
     }
+  }
+
+  // Recomputes the pixel seam error of the footprint of `p` and the ring of
+  // pixels around it (the only pixels whose pairs a placement can change).
+  void update_error(std::vector<double>& err, const PatchPlacement& p) const {
+    const int W = canvas_.w_, H = canvas_.h_;
+    PatchPlacement q = p;
+    if (!canvas_.periodic_ && !clip_placement(q, W, H)) return;
+    for (int j = -1; j <= q.height; ++j)
+      for (int i = -1; i <= q.width; ++i) {
+        int x = q.out_x + i, y = q.out_y + j;
+        if (canvas_.periodic_) {
+          x = (x % W + W) % W;
+          y = (y % H + H) % H;
+        } else if (x < 0 || y < 0 || x >= W || y >= H) {
+          continue;
+        }
+        err[static_cast<std::size_t>(y) * W + x] = canvas_.pixel_seam_error(x, y);
+      }
   }
 
   const Image& ex_;
   const GraphcutOptions& opt_;
   GraphcutCanvas canvas_;
   std::mt19937_64 rng_;
-  int pw_ = 0, ph_ = 0, ov_ = 0;
+  int pw_ = 0, ph_ = 0, ov_ = 0, error_side_ = 0, match_side_ = 0;
   double sigma2_ = 0.0;
   int fill_patches_ = 0;
   std::unique_ptr<MaskedSsdMatcher> matcher_;
@@ -659,9 +805,15 @@ void validate(const Image& exemplar, int width, int height, const GraphcutOption
   if (o.patch_size > 0 && o.overlap >= o.patch_size)
     throw InvalidInputError("graphcut_synthesize: overlap (" + std::to_string(o.overlap) +
                             ") must be smaller than patch_size (" + std::to_string(o.patch_size) + ")");
+  if (o.error_region < 0)
+    throw InvalidInputError("graphcut_synthesize: error_region must be >= 0, got " +
+                            std::to_string(o.error_region));
   if (o.refinement_passes < 0)
     throw InvalidInputError("graphcut_synthesize: refinement_passes must be >= 0, got " +
                             std::to_string(o.refinement_passes));
+  if (!(o.repetition_penalty >= 0.0) || !std::isfinite(o.repetition_penalty))
+    throw InvalidInputError("graphcut_synthesize: repetition_penalty must be >= 0, got " +
+                            std::to_string(o.repetition_penalty));
   if (!(o.k > 0.0) || !std::isfinite(o.k))
     throw InvalidInputError("graphcut_synthesize: k (temperature) must be > 0, got " + std::to_string(o.k));
 }

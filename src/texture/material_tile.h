@@ -43,7 +43,9 @@ struct MaterialTileOptions {
   /// resampled (bilinear) to size x size. If `keys_are_tileable` is false
   /// (default) the square is then made tileable: without a painted mask by
   /// graph-cut textures on the torus (texture/tileable_tile.h, the paper's
-  /// [KdE*03]); with a painted mask by unconstrained toroidal synthesis from
+  /// [KdE*03]; its border rolled onto the smoothest row and column, before
+  /// the key's automatic feature mask is computed from it, so tile and mask
+  /// share the cut and the later layers inherit it); with a painted mask by unconstrained toroidal synthesis from
   /// itself (the constrained synthesis with mask weight 0 and a random start),
   /// which carries the mask along its indirection. If true, the square is used
   /// as is (it must already tile).

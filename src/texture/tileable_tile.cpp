@@ -2,12 +2,50 @@
 #include "texture/tileable_tile.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
+#include "texture/image_ops.h"
 #include "texture/wrap_seam_ratio.h"
 
 namespace surftex {
+
+namespace {
+double jump(const Image& img, int x0, int y0, int x1, int y1) {
+  const float* a = img.pixel(x0, y0);
+  const float* b = img.pixel(x1, y1);
+  double s = 0.0;
+  for (int c = 0; c < img.channels; ++c) {
+    const double d = static_cast<double>(a[c]) - b[c];
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+}  // namespace
+
+TorusCut choose_torus_cut(const Image& img) {
+  if (img.empty() || img.width < 2 || img.height < 2)
+    throw InvalidInputError("choose_torus_cut: the image must be at least 2x2, got " +
+                            std::to_string(img.width) + "x" + std::to_string(img.height));
+  const int W = img.width, H = img.height;
+  // col[x]: summed jump between columns x-1 and x (mod W); row[y] likewise.
+  std::vector<double> col(static_cast<std::size_t>(W), 0.0), row(static_cast<std::size_t>(H), 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      col[static_cast<std::size_t>(x)] += jump(img, (x + W - 1) % W, y, x, y);
+      row[static_cast<std::size_t>(y)] += jump(img, x, (y + H - 1) % H, x, y);
+    }
+  TorusCut c;
+  for (int x = 1; x < W; ++x)
+    if (col[static_cast<std::size_t>(x)] < col[static_cast<std::size_t>(c.shift_x)]) c.shift_x = x;
+  for (int y = 1; y < H; ++y)
+    if (row[static_cast<std::size_t>(y)] < row[static_cast<std::size_t>(c.shift_y)]) c.shift_y = y;
+  c.column_jump = col[static_cast<std::size_t>(c.shift_x)] / H;
+  c.row_jump = row[static_cast<std::size_t>(c.shift_y)] / W;
+  return c;
+}
 
 TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOptions& o) {
   if (size < 8) throw InvalidInputError("make_tileable: size must be >= 8, got " + std::to_string(size));
@@ -26,12 +64,20 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
                             ") must be smaller than the patch size (" + std::to_string(g.patch_size) + ")");
   g.refinement_passes = o.refinement_passes;
   g.k = o.k;
+  g.repetition_penalty = o.repetition_penalty;
   g.periodic_output = true;
   g.seed = o.seed;
   g.progress = o.progress;
   GraphcutResult r = graphcut_synthesize_detailed(exemplar, size, size, g);
   TileResult t;
   t.tile = std::move(r.image);
+  t.wrap_seam_ratio_at_synthesis_cut = wrap_seam_ratio(t.tile);
+  if (o.choose_cut) {
+    const TorusCut c = choose_torus_cut(t.tile);
+    t.shift_x = c.shift_x;
+    t.shift_y = c.shift_y;
+    if (c.shift_x != 0 || c.shift_y != 0) t.tile = crop(t.tile, c.shift_x, c.shift_y, size, size, true);
+  }
   t.wrap_seam_ratio = wrap_seam_ratio(t.tile);
   t.seam_cost = r.seam_cost_final;
   return t;

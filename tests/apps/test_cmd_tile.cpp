@@ -23,6 +23,19 @@ TEST(CmdTile, WritesTilePreviewAndReportAndRefusesOverwrite) {
   EXPECT_EQ(j["command"], "tile");
   EXPECT_LE(j["wrap_seam_ratio"].get<double>(), 1.3);
   EXPECT_GE(j["seconds"].get<double>(), 0.0);
+  // The border is rolled onto the smoothest line: the ratio there is no
+  // higher than at the synthesis cut (both reported).
+  EXPECT_EQ(j["choose_cut"], true);
+  EXPECT_LE(j["wrap_seam_ratio"].get<double>(), j["wrap_seam_ratio_at_synthesis_cut"].get<double>());
+  // --synthesis-cut keeps the synthesis cut: no roll, the two ratios agree.
+  test::RunResult keep = test::run_surftex("tile '" + ex + "' -o '" + dir + "/k.png' --size 40 --synthesis-cut --report '" +
+                                           dir + "/k.json' --quiet");
+  ASSERT_EQ(keep.exit_code, 0) << keep.err;
+  std::ifstream kin(dir + "/k.json");
+  nlohmann::json k = nlohmann::json::parse(kin);
+  EXPECT_EQ(k["cut_shift"], nlohmann::json::array({0, 0}));
+  EXPECT_EQ(k["wrap_seam_ratio"].get<double>(), k["wrap_seam_ratio_at_synthesis_cut"].get<double>());
+  EXPECT_EQ(k["wrap_seam_ratio_at_synthesis_cut"].get<double>(), j["wrap_seam_ratio_at_synthesis_cut"].get<double>());
   // Existing output without --force: error, exit 2.
   test::RunResult again = test::run_surftex(args);
   EXPECT_EQ(again.exit_code, 2);

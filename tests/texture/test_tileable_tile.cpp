@@ -3,12 +3,14 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <string>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "test_support.h"
 #include "texture/graphcut_synthesis.h"
+#include "texture/image_ops.h"
 #include "texture/material_tile.h"
 #include "texture/tileable_tile.h"
 #include "texture/wrap_seam_ratio.h"
@@ -119,11 +121,13 @@ TEST(TileableTile, At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines) {
       GraphcutOptions g;  // what make_tileable runs for a 32-px tile of a 32-px exemplar
       g.patch_size = 24;
       g.refinement_passes = 4;
+      g.repetition_penalty = TileOptions{}.repetition_penalty;
       g.periodic_output = true;
       g.seed = static_cast<std::uint64_t>(seed);
       GraphcutResult r = graphcut_synthesize_detailed(ex, s, s, g);
       TileOptions to;
       to.seed = g.seed;
+      to.choose_cut = false;  // the wrap lines where the synthesis put them
       ASSERT_EQ(make_tileable(ex, s, to).data, r.image.data) << "the test mirrors make_tileable";
       // Seam cost of one line: each neighbour pair across it pasted into a
       // 2x1 (column line) or 1x2 (row line) canvas from its two sources.
@@ -149,4 +153,64 @@ TEST(TileableTile, At32PxTheWrapLinesCarryNoMoreSeamThanOtherLines) {
   }
   EXPECT_GT(line_cost, 0.0);  // guard: these tiles do have seams
   EXPECT_LE(wrap_cost, 1.5 * line_cost) << "wrap " << wrap_cost << " mean line " << line_cost;
+}
+
+TEST(TileableTile, TorusCutFindsTheSmoothestRowAndColumn) {
+  // Noise with one pair of equal columns (5, 6) and one pair of equal rows
+  // (13, 14): the only zero-jump lines of the torus.
+  Image img(24, 20, 3);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (float& v : img.data) v = u(rng);
+  for (int y = 0; y < img.height; ++y)
+    for (int c = 0; c < 3; ++c) img.at(6, y, c) = img.at(5, y, c);
+  for (int x = 0; x < img.width; ++x)
+    for (int c = 0; c < 3; ++c) img.at(x, 14, c) = img.at(x, 13, c);
+  TorusCut cut = choose_torus_cut(img);
+  EXPECT_EQ(cut.shift_x, 6);
+  EXPECT_EQ(cut.shift_y, 14);
+  EXPECT_EQ(cut.column_jump, 0.0);
+  EXPECT_EQ(cut.row_jump, 0.0);
+  EXPECT_GT(wrap_seam_ratio(img), 0.5);  // guard: the noise's own wrap is not smooth
+  EXPECT_EQ(wrap_seam_stats(crop(img, cut.shift_x, cut.shift_y, 24, 20, true)).wrap_mean, 0.0);
+  // Ties keep the current cut.
+  TorusCut flat = choose_torus_cut(Image(8, 8, 1, 0.5f));
+  EXPECT_EQ(flat.shift_x, 0);
+  EXPECT_EQ(flat.shift_y, 0);
+  EXPECT_THROW(choose_torus_cut(Image(1, 8, 1)), InvalidInputError);
+}
+
+// Issue #3 (G2): the two textures whose 128-px tiles had a wrap-seam ratio
+// above 1.3 at the synthesis cut (dots_large 1.60 with seam cost 0,
+// water_caustics 1.71): the wrap line ran along texture features. The chosen
+// cut is the same tiling (a roll, bit for bit), its wrap lines are the
+// smoothest of the torus, and its ratio is at most the one at the synthesis
+// cut.
+TEST(TileableTile, ChosenCutIsARollOfTheSynthesisedTileOnItsSmoothestLines) {
+  const int size = sanitized() ? 64 : 128;
+  for (const char* name : {"dots_large_208x168.png", "water_caustics_300.png"}) {
+    Image ex = read_image(test::shared_data(std::string("textures/") + name));
+    TileOptions keep;
+    keep.choose_cut = false;
+    const TileResult a = make_tileable_detailed(ex, size, keep);
+    const TileResult b = make_tileable_detailed(ex, size, TileOptions{});
+    EXPECT_EQ(a.shift_x, 0);
+    EXPECT_EQ(a.shift_y, 0);
+    EXPECT_DOUBLE_EQ(a.wrap_seam_ratio, a.wrap_seam_ratio_at_synthesis_cut);
+    EXPECT_DOUBLE_EQ(b.wrap_seam_ratio_at_synthesis_cut, a.wrap_seam_ratio);
+    EXPECT_EQ(b.seam_cost, a.seam_cost) << name;
+    ASSERT_EQ(b.tile.data, crop(a.tile, b.shift_x, b.shift_y, size, size, true).data) << name;
+    EXPECT_LE(b.wrap_seam_ratio, a.wrap_seam_ratio) << name;
+    EXPECT_NEAR(b.wrap_seam_ratio, wrap_seam_ratio(b.tile), 1e-12);
+    if (!sanitized()) {
+      EXPECT_GT(a.wrap_seam_ratio, 1.3) << name << ": the case this test is about";
+      EXPECT_LE(b.wrap_seam_ratio, 1.3) << name;
+    }
+    // No other roll gives smoother wrap lines: vary one shift, keep the other.
+    const double best = wrap_seam_stats(b.tile).wrap_mean;
+    for (int s = 0; s < size; ++s) {
+      EXPECT_GE(wrap_seam_stats(crop(a.tile, s, b.shift_y, size, size, true)).wrap_mean, best - 1e-12) << s;
+      EXPECT_GE(wrap_seam_stats(crop(a.tile, b.shift_x, s, size, size, true)).wrap_mean, best - 1e-12) << s;
+    }
+  }
 }
