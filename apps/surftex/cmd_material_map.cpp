@@ -64,6 +64,8 @@ struct Args {
 
 // Version 2: z_s, z_t are stored in per-vertex frames (s/t coupled across
 // field cuts); version-1 states (independent s and t) are refused.
+// "swap_coordinates": false when solved with --no-swap (the paper's
+// simplified PGP: no frames, every corner turn 0); absent = true.
 const char* const kStateFormat = "surftex material-map state v2";
 
 void save_state(const std::string& path, const Mesh& mesh, const PeriodicGlobalParameterization& pgp,
