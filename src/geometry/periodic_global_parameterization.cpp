@@ -460,6 +460,9 @@ struct PgpPattern {
   /// per live edge: parity of the turns between its two vertex frames (0: s
   /// couples to s and t to t; 1: s to t), which decides the block's nonzeros
   std::vector<std::uint8_t> parity;
+  /// unknown numbering (see unknown_index): false = 4 per vertex together
+  /// (coupled), true = all s pairs then all t pairs (paper's simplified PGP)
+  bool split_st = false;
   /// per live edge: positions of the 4x4 block (row-major) below the diagonal,
   /// -1 for the entries that are structurally zero (or no block)
   std::vector<std::array<std::ptrdiff_t, 16>> off;
@@ -469,11 +472,22 @@ struct PgpPattern {
 /// and c (s = 0, t = 1) match up to the parity of the frames' turns.
 bool block_entry(int r, int c, int parity) { return ((r / 2) ^ (c / 2)) == parity; }
 
-PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::vector<std::uint8_t> parity) {
+/// Index of real unknown r (0..3 = Re z_s, Im z_s, Re z_t, Im z_t) of free
+/// vertex `var` among the 4n: coupled, a vertex's 4 together (4 var + r);
+/// split (swap_coordinates false: s and t never meet, the matrix is block
+/// diagonal), the 2n s unknowns first and the 2n t unknowns after, each half
+/// in the same vertex order, so that CHOLMOD factors two independent trees.
+inline int unknown_index(int var, int r, int n, bool split_st) {
+  return split_st ? (r / 2) * 2 * n + 2 * var + (r % 2) : 4 * var + r;
+}
+
+PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::vector<std::uint8_t> parity,
+                        bool split_st) {
   PgpPattern p;
   p.var = std::move(var);
   p.n = n;
   p.parity = std::move(parity);
+  p.split_st = split_st;
   // Visits every stored off-diagonal entry of every edge block:
   // f(edge k, index 4r+c in the 4x4 block, row, column) in the lower triangle.
   auto for_each_block_entry = [&](auto&& f) {
@@ -482,7 +496,8 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
       if (a < 0 || b < 0 || a == b) continue;
       for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c)
-          if (block_entry(r, c, p.parity[k])) f(k, 4 * r + c, 4 * std::max(a, b) + r, 4 * std::min(a, b) + c);
+          if (block_entry(r, c, p.parity[k]))
+            f(k, 4 * r + c, unknown_index(std::max(a, b), r, n, split_st), unknown_index(std::min(a, b), c, n, split_st));
     }
   };
   std::vector<Eigen::Triplet<double>> trip;
@@ -593,6 +608,18 @@ struct PeriodicGlobalParameterization::Impl {
   std::vector<std::array<double, 2>> edge_energy;  // per live edge
   bool cache_valid = false;
   std::unique_ptr<PgpCurlCorrector> curl;  // keeps its factorisation (opt.curl_correction)
+  /// The face -> vertex frame turns: the accumulated matchings (coupled
+  /// form), or none at all in the paper's simplified PGP (swap_coordinates
+  /// false: each vertex's s is the s of every face around it, so across a
+  /// cut of the combed field s meets t's direction; the faces there become
+  /// singular, handled at rendering time, Ray et al. 2009 section 2.3).
+  void vertex_matchings(const std::vector<char>* vertex_mask) {
+    if (!opt.swap_coordinates) {
+      corner.assign(mesh.num_halfedges(), 0);
+      return;
+    }
+    corner_matchings_into(mesh, quarter, vertex_mask, corner);
+  }
   PgpCurlCorrector* corrector() {
     if (!curl) curl = std::make_unique<PgpCurlCorrector>(curl_options(opt));
     return curl.get();
@@ -628,7 +655,9 @@ struct PeriodicGlobalParameterization::Impl {
   St face_alpha(HalfedgeIndex h) const {
     const HalfedgeIndex h0 = mesh.halfedge(mesh.edge(h), 0);
     const bool reference = h == h0 ? true : mesh.is_border(h0);
-    return reference ? St{alpha[h.idx()][0], alpha[h.idx()][1]}
+    // Without swapping (the paper's form) every face reads the edge's alpha
+    // as the solve did, in the edge's reference frame.
+    return reference || !opt.swap_coordinates ? St{alpha[h.idx()][0], alpha[h.idx()][1]}
                      : turn_st({alpha[h.idx()][0], alpha[h.idx()][1]}, quarter[h.idx()]);
   }
   /// Turns from the reference face of live edge k to its (source, target) frames.
@@ -746,6 +775,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   auto state = [&](std::size_t v) -> Vec4 { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; };
   const int n = count;
   const int n4 = 4 * n;
+  const bool split_st = !opt.swap_coordinates;
+  auto unknown = [n, split_st](int v, int r) { return unknown_index(v, r, n, split_st); };
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
   std::vector<Mat4> maps(t.ends.size());
@@ -773,8 +804,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       const double w = t.weight[k];
       const Mat4& M = maps[k];
       for (int r = 0; r < 4; ++r) {
-        if (vi >= 0) val[P.diag[4 * vi + r]] += w;
-        if (vj >= 0) val[P.diag[4 * vj + r]] += w;
+        if (vi >= 0) val[P.diag[unknown(vi, r)]] += w;
+        if (vj >= 0) val[P.diag[unknown(vj, r)]] += w;
       }
       if (vi >= 0 && vj >= 0) {
         // Only the parity's entries: the others of M are exact zeros (signed
@@ -787,15 +818,15 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       } else if (vj >= 0) {
         const Vec4 xi = state(i);
         for (int r = 0; r < 4; ++r)
-          for (int c = 0; c < 4; ++c) b[4 * vj + r] += w * M[r][c] * xi[c];
+          for (int c = 0; c < 4; ++c) b[unknown(vj, r)] += w * M[r][c] * xi[c];
       } else {
         const Vec4 xj = state(j);
         for (int r = 0; r < 4; ++r)
-          for (int c = 0; c < 4; ++c) b[4 * vi + r] += w * M[c][r] * xj[c];
+          for (int c = 0; c < 4; ++c) b[unknown(vi, r)] += w * M[c][r] * xj[c];
       }
     }
     for (int v = 0; v < n; ++v)
-      for (int r = 0; r < 4; ++r) val[P.diag[4 * v + r]] += shift * mass[v];
+      for (int r = 0; r < 4; ++r) val[P.diag[unknown(v, r)]] += shift * mass[v];
   };
 
   // Reference scale of the shift: mean diagonal of F_PGP over mean mass.
@@ -881,9 +912,9 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
           std::vector<char> vertex_mask(t.nv, 0);
           for (std::size_t k = 0; k < t.ends.size(); ++k)
             if (edge_mask[t.edges[k]]) vertex_mask[t.ends[k][0]] = vertex_mask[t.ends[k][1]] = 1;
-          corner_matchings_into(mesh, quarter, &vertex_mask, corner);
+          vertex_matchings(&vertex_mask);
         } else {
-          corner = corner_matchings(mesh, quarter);
+          vertex_matchings(nullptr);
         }
         ealpha = edge_alphas(alpha);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
@@ -906,7 +937,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
 
   std::vector<std::uint8_t> parity(t.ends.size());
   for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
-  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity;
+  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity || pattern->split_st != split_st;
   const bool same_pattern = analyzed && !rebuild;
   res.reused_analysis = same_pattern;
   analyzed = same_pattern;
@@ -922,7 +953,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       [&] {
         Timer tt;
         if (rebuild) {
-          pattern = std::make_unique<PgpPattern>(make_pattern(t, var, count, parity));
+          pattern = std::make_unique<PgpPattern>(make_pattern(t, var, count, parity, split_st));
           pattern->natural = natural;
         }
         bd.pattern = tt.seconds();
@@ -959,7 +990,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     for (std::size_t v = 0; v < t.nv; ++v)
       if (P.var[v] >= 0) {
         const Vec4 xv = state(v);
-        for (int r = 0; r < 4; ++r) x[4 * P.var[v] + r] = xv[r];
+        for (int r = 0; r < 4; ++r) x[unknown(P.var[v], r)] = xv[r];
       }
     // Ginzburg-Landau relaxation with one factorisation of F_PGP + mu M:
     // min F + mu sum_i M_i |z_i - u_i|^2, u = z/|z| of the previous iterate
@@ -977,11 +1008,12 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     for (int it = 0; it < iterations && failure.empty(); ++it) {
       for (int v = 0; v < n; ++v)
         for (int p = 0; p < 2; ++p) {
-          const double re = x[4 * v + 2 * p], im = x[4 * v + 2 * p + 1];
+          const int ire = unknown(v, 2 * p), iim = unknown(v, 2 * p + 1);
+          const double re = x[ire], im = x[iim];
           const double a = std::hypot(re, im);
           const bool ok = a > 1e-300 && std::isfinite(a);
-          rhs[4 * v + 2 * p] = b[4 * v + 2 * p] + shift * mass[v] * (ok ? re / a : 1.0);
-          rhs[4 * v + 2 * p + 1] = b[4 * v + 2 * p + 1] + shift * mass[v] * (ok ? im / a : 0.0);
+          rhs[ire] = b[ire] + shift * mass[v] * (ok ? re / a : 1.0);
+          rhs[iim] = b[iim] + shift * mass[v] * (ok ? im / a : 0.0);
         }
       x = solver.solve(rhs);
       if (solver.info() != Eigen::Success) failure = "solve failed";
@@ -990,8 +1022,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     if (failure.empty())
       for (std::size_t v = 0; v < t.nv; ++v) {
         if (P.var[v] < 0) continue;
-        const int o = 4 * P.var[v];
-        const Cplx a(x[o], x[o + 1]), c(x[o + 2], x[o + 3]);
+        const int o = P.var[v];
+        const Cplx a(x[unknown(o, 0)], x[unknown(o, 1)]), c(x[unknown(o, 2)], x[unknown(o, 3)]);
         const double la = std::abs(a), lc = std::abs(c);
         zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
         zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
@@ -999,7 +1031,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     split(bd.solves);
   }
   if (!failure.empty())
-    throw SolverError("periodic_global_parameterization: coupled (s,t) system " + failure + " (" +
+    throw SolverError(std::string("periodic_global_parameterization: ") + (split_st ? "s and t systems " : "coupled (s,t) system ") + failure + " (" +
                       std::to_string(n) + " free vertices)");
   analyzed = n > 0;
   // The reference vertices were locked at (1, 1) at initialisation: s = t = 0 there.
@@ -1151,7 +1183,8 @@ std::array<double, 2> PeriodicGlobalParameterization::energies() {
   std::vector<std::uint8_t> quarter;
   face_gradients_into(im.mesh, im.opt, t.frames, nullptr, g, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, g, t.frames, nullptr, alpha, &quarter);
-  const std::vector<std::uint8_t> corner = corner_matchings(im.mesh, quarter);
+  const std::vector<std::uint8_t> corner =
+      im.opt.swap_coordinates ? corner_matchings(im.mesh, quarter) : std::vector<std::uint8_t>(im.mesh.num_halfedges(), 0);
   std::array<double, 2> out{0, 0};
   for (std::size_t k = 0; k < t.ends.size(); ++k) {
     const HalfedgeIndex h = im.mesh.halfedge(EdgeIndex(t.edges[k]), 0), o = im.mesh.opposite(h);
@@ -1177,7 +1210,7 @@ void PeriodicGlobalParameterization::write_corners() {
   const PgpTopology& t = im.topology();
   face_gradients_into(im.mesh, im.opt, t.frames, nullptr, im.grad, im.corrector());
   halfedge_alphas_into(im.mesh, im.opt, im.grad, t.frames, nullptr, im.alpha, &im.quarter);
-  im.corner = corner_matchings(im.mesh, im.quarter);
+  im.vertex_matchings(nullptr);
   im.edge_energy.clear();
   im.cache_valid = false;  // energies not computed
   im.write_corners(im.alpha, nullptr);

@@ -131,6 +131,21 @@ struct PgpOptions {
   /// budget of an interactive edit. Ray et al. 2009 section 2.3 uses the
   /// target d/S as given.
   bool curl_correction = false;
+  /// Swap s and t across the quarter-turn cuts of the combed N-field (Ray et
+  /// al. 2006's coupling; the default). false = the paper's simplified PGP
+  /// (Ray et al. 2009 section 2.3: "singularities can be handled at rendering
+  /// time and there is no swapping of texture coordinates"): every corner's
+  /// and edge's turns are taken as 0, s couples only with s and t only with t
+  /// (each vertex's (s,t) is that of every face around it, the edges' alphas
+  /// read in their reference face's frame by both faces), so the system is
+  /// two independent real systems, numbered s first then t, each in the same
+  /// nested-dissection order: about a quarter of the factorisation's flops,
+  /// half of each triangular solve. The faces along the field's cuts then
+  /// become singular (distorted faces), which section 3's blending hides.
+  /// Measured (bench_pgp --no-swap, load ~3): armadillo_52k first init
+  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8; singular
+  /// faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
+  bool swap_coordinates = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";

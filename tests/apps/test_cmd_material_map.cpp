@@ -142,3 +142,28 @@ TEST(CmdMaterialMap, CurlCorrectionIsOptInAndTheStateKeepsIt) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir + "/update/report.json"))["curl_correction"], true);
 }
+
+// --no-swap (the paper's simplified PGP, PgpOptions::swap_coordinates false)
+// is off by default, is stored in the state, and an update keeps the state's
+// form even without the flag (its z are in that form's frames).
+TEST(CmdMaterialMap, NoSwapIsOptInAndTheStateKeepsIt) {
+  const std::string dir = make_inputs(test::temp_dir("cmd-matmap-noswap"));
+  const std::string base =
+      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 -q ";
+  ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/swap'").exit_code, 0);
+  test::RunResult r =
+      test::run_surftex(base + "--constraints '" + dir + "/c1.json' --no-swap -o '" + dir + "/noswap'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto json = [&](const std::string& f) { return nlohmann::json::parse(std::ifstream(dir + f)); };
+  EXPECT_EQ(json("/swap/report.json")["swap_coordinates"], true);
+  EXPECT_EQ(json("/noswap/report.json")["swap_coordinates"], false);
+  EXPECT_EQ(json("/swap/state.json")["swap_coordinates"], true);
+  EXPECT_EQ(json("/noswap/state.json")["swap_coordinates"], false);
+  r = test::run_surftex(base + "--update '" + dir + "/c2.json' --state '" + dir + "/noswap/state.json' -o '" + dir +
+                        "/update'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(json("/update/report.json")["swap_coordinates"], false);
+  EXPECT_EQ(json("/update/state.json")["swap_coordinates"], false);
+  r = test::run_surftex("material-map --help");
+  EXPECT_NE(r.out.find("--no-swap"), std::string::npos) << r.out;
+}
