@@ -236,39 +236,49 @@ TEST(PeriodicGlobalParameterization, SameBytesWithOneOrManyThreads) {
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
 
+namespace {
+void fandisk_with_cuts(Mesh& m) {
+  read_mesh(test::shared_data("meshes/fandisk.off"), m);
+  interpolate_direction_field(m, constraints_from_constant_vector(m, {0.3, 0.1, 1.0}), {});
+  interpolate_scalar_field(m, {{0, pgp_default_scale(m, 8.0)}}, scale_field_options());
+}
+
+// Energies, z and corners after an initialisation and a local update of
+// fandisk (a real mesh with quarter-turn cuts) on `threads` threads.
+std::vector<double> fandisk_init_and_update_bytes(int threads, const PgpOptions& o) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  Mesh m;
+  fandisk_with_cuts(m);
+  PeriodicGlobalParameterization pgp(m, o);
+  const PgpResult r = pgp.initialize();
+  EXPECT_FALSE(r.reused_analysis);
+  std::vector<double> out{r.energy_s, r.energy_t};
+  EffectAreaOptions eo;
+  eo.max_faces = m.number_of_faces() / 4;
+  const auto c = static_cast<std::uint32_t>(m.number_of_vertices() / 3);
+  const EffectArea area = compute_effect_area(m, {c}, eo);
+  DirectionFieldOptions dopt;
+  dopt.area = &area;
+  const auto cf = static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(c))).idx());
+  interpolate_direction_field(m, {{cf, {0.0, 1.0, 1.0}}}, dopt);
+  const PgpResult u = pgp.update(area);
+  out.insert(out.end(), {u.energy_s, u.energy_t});
+  for (const auto* z : {&pgp.z_s(), &pgp.z_t()})
+    for (const auto& z1 : *z) out.insert(out.end(), {z1.real(), z1.imag()});
+  auto stm = find(m, kCornerSTM).first;
+  for (HalfedgeIndex h : m.halfedges())
+    if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
+  return out;
+}
+}  // namespace
+
 // The solver overlaps its connectivity-only work (METIS order, pattern,
 // symbolic analysis) with the field's (gradients, alphas, edge maps, start):
 // on a real mesh with quarter-turn cuts, an initialisation and a local update
 // give the same bytes on one thread and on two (where the overlaps run side
 // by side).
 TEST(PeriodicGlobalParameterization, SameBytesWithOneOrTwoThreadsOnFandiskInitAndUpdate) {
-  auto run = [](int threads) {
-    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    Mesh m;
-    read_mesh(test::shared_data("meshes/fandisk.off"), m);
-    interpolate_direction_field(m, constraints_from_constant_vector(m, {0.3, 0.1, 1.0}), {});
-    interpolate_scalar_field(m, {{0, pgp_default_scale(m, 8.0)}}, scale_field_options());
-    PeriodicGlobalParameterization pgp(m);
-    const PgpResult r = pgp.initialize();
-    EXPECT_FALSE(r.reused_analysis);
-    std::vector<double> out{r.energy_s, r.energy_t};
-    EffectAreaOptions eo;
-    eo.max_faces = m.number_of_faces() / 4;
-    const EffectArea area = compute_effect_area(m, {static_cast<std::uint32_t>(m.number_of_vertices() / 3)}, eo);
-    DirectionFieldOptions dopt;
-    dopt.area = &area;
-    const auto cf = static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(m.number_of_vertices() / 3))).idx());
-    interpolate_direction_field(m, {{cf, {0.0, 1.0, 1.0}}}, dopt);
-    const PgpResult u = pgp.update(area);
-    out.insert(out.end(), {u.energy_s, u.energy_t});
-    for (const auto* z : {&pgp.z_s(), &pgp.z_t()})
-      for (const auto& c : *z) out.insert(out.end(), {c.real(), c.imag()});
-    auto stm = find(m, kCornerSTM).first;
-    for (HalfedgeIndex h : m.halfedges())
-      if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
-    return out;
-  };
-  const auto a = run(1), b = run(2);
+  const auto a = fandisk_init_and_update_bytes(1, {}), b = fandisk_init_and_update_bytes(2, {});
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
@@ -304,14 +314,6 @@ TEST(PeriodicGlobalParameterization, NoSwapFlatGridConstantFieldIsAffine) {
     }
   }
 }
-
-namespace {
-void fandisk_with_cuts(Mesh& m) {
-  read_mesh(test::shared_data("meshes/fandisk.off"), m);
-  interpolate_direction_field(m, constraints_from_constant_vector(m, {0.3, 0.1, 1.0}), {});
-  interpolate_scalar_field(m, {{0, pgp_default_scale(m, 8.0)}}, scale_field_options());
-}
-}  // namespace
 
 // Without swapping the 4n system is block diagonal (s with s, t with t),
 // numbered as two halves in the same order: CHOLMOD factors two independent
@@ -387,33 +389,9 @@ TEST(PeriodicGlobalParameterization, NoSwapLocalUpdateLeavesTheOutsideBitForBit)
 }
 
 TEST(PeriodicGlobalParameterization, NoSwapSameBytesWithOneOrTwoThreadsOnFandiskInitAndUpdate) {
-  auto run = [](int threads) {
-    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    Mesh m;
-    fandisk_with_cuts(m);
-    PgpOptions o;
-    o.swap_coordinates = false;
-    PeriodicGlobalParameterization pgp(m, o);
-    const PgpResult r = pgp.initialize();
-    std::vector<double> out{r.energy_s, r.energy_t};
-    EffectAreaOptions eo;
-    eo.max_faces = m.number_of_faces() / 4;
-    const auto c = static_cast<std::uint32_t>(m.number_of_vertices() / 3);
-    const EffectArea area = compute_effect_area(m, {c}, eo);
-    DirectionFieldOptions dopt;
-    dopt.area = &area;
-    interpolate_direction_field(m, {{static_cast<std::uint32_t>(m.face(m.halfedge(VertexIndex(c))).idx()), {0.0, 1.0, 1.0}}},
-                                dopt);
-    const PgpResult u = pgp.update(area);
-    out.insert(out.end(), {u.energy_s, u.energy_t});
-    for (const auto* z : {&pgp.z_s(), &pgp.z_t()})
-      for (const auto& z1 : *z) out.insert(out.end(), {z1.real(), z1.imag()});
-    auto stm = find(m, kCornerSTM).first;
-    for (HalfedgeIndex h : m.halfedges())
-      if (!m.is_border(h)) out.insert(out.end(), {stm[h][0], stm[h][1]});
-    return out;
-  };
-  const auto a = run(1), b = run(2);
+  PgpOptions o;
+  o.swap_coordinates = false;
+  const auto a = fandisk_init_and_update_bytes(1, o), b = fandisk_init_and_update_bytes(2, o);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
