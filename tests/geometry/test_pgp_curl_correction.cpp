@@ -253,8 +253,8 @@ TEST(PgpCurlCorrection, LocalUpdateKeepsTheOutside) {
 
 // Without the correction a local update recomputes gradients and alphas only
 // next to the free faces (cache elsewhere): its corners inside the area must
-// still equal a full rewrite from the same state (the default now refreshes
-// everything; this keeps the cached path covered).
+// still equal a full rewrite from the same state (the cached path; with the
+// correction on, an update refreshes everything).
 TEST(PgpCurlCorrection, WithoutItTheUpdateCacheMatchesAFullRewrite) {
   Mesh m;
   make_torus(m, 3.0, 1.0, 48, 24);
