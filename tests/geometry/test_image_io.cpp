@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
@@ -86,13 +87,46 @@ TEST(ImageIO, TruncatedPngIsRefused) {
   write_image(dir + "/a.png", ramp(64, 64, 3));
   auto size = fs::file_size(dir + "/a.png");
   fs::resize_file(dir + "/a.png", size / 2);
+  // The refusal is ours alone: libpng, left to find the damage, prints its
+  // own "libpng error: ..." line on stderr before our error.
+  testing::internal::CaptureStderr();
   try {
     read_image(dir + "/a.png");
-    FAIL() << "truncated file accepted";
+    ADD_FAILURE() << "truncated file accepted";
   } catch (const IOError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated or corrupt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("past the end of the file"), std::string::npos) << e.what();
     EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
   }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
+TEST(ImageIO, PngWithADamagedChunkIsRefusedNamingTheChunk) {
+  std::string dir = test::temp_dir("img");
+  write_image(dir + "/a.png", ramp(64, 64, 3));
+  std::string bytes;
+  {
+    std::ifstream f(dir + "/a.png", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(f), {});
+  }
+  const auto idat = bytes.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  bytes[idat + 10] = static_cast<char>(bytes[idat + 10] ^ 0x5A);  // one byte of compressed data
+  {
+    std::ofstream f(dir + "/b.png", std::ios::binary);
+    f << bytes;
+  }
+  testing::internal::CaptureStderr();
+  try {
+    read_image(dir + "/b.png");
+    ADD_FAILURE() << "damaged file accepted";
+  } catch (const IOError& e) {
+    EXPECT_NE(std::string(e.what()).find("PNG chunk 'IDAT'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CRC"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  // The intact file still reads (the check accepts what libpng writes).
+  EXPECT_EQ(read_image(dir + "/a.png").width, 64);
 }
 
 TEST(ImageIO, EmptyImageIsNotWrittenAndLeavesNoFile) {
