@@ -189,6 +189,20 @@ Format sniff(std::string_view data) {
   return obj_like ? Format::Obj : Format::Unknown;
 }
 
+// The image format whose signature starts `data`, or empty: a user may hand
+// an image where a mesh is expected (argument order); say so rather than
+// report the parse of binary bytes as text.
+std::string image_signature(std::string_view d) {
+  if (d.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8)) return "PNG";
+  if (d.substr(0, 3) == std::string_view("\xff\xd8\xff", 3)) return "JPEG";
+  if (d.substr(0, 4) == std::string_view("II*\0", 4) || d.substr(0, 4) == std::string_view("MM\0*", 4))
+    return "TIFF";
+  if (d.substr(0, 4) == std::string_view("\x76\x2f\x31\x01", 4)) return "OpenEXR";
+  if (d.substr(0, 6) == "GIF87a" || d.substr(0, 6) == "GIF89a") return "GIF";
+  if (d.substr(0, 4) == "RIFF" && d.substr(8, 4) == "WEBP") return "WebP";
+  return {};
+}
+
 std::string read_whole_file(const std::string& path) {
   std::error_code ec;
   if (path.empty()) throw IOError("mesh path is empty");
@@ -217,6 +231,11 @@ PolygonSoup read_polygon_soup(const std::string& path) {
                : ext == ".ply" ? Format::Ply
                : ext == ".stl" ? Format::Stl
                                : sniff(bytes);
+  if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl") {
+    const std::string image = image_signature(bytes);
+    if (!image.empty())
+      throw IOError("'" + path + "' is a " + image + " image, not a mesh (mesh formats: OFF, OBJ, PLY, STL)");
+  }
   PolygonSoup soup;
   switch (fmt) {
     case Format::Off: soup = read_off(path, bytes); break;

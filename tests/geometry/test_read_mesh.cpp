@@ -567,6 +567,19 @@ TEST(ReadMeshHostile, TruncatedFilesThrowOrLoadFewerFaces) {
   }
 }
 
+TEST(ReadMeshHostile, AnImageGivenAsAMeshIsNamedAsSuch) {
+  auto d = test::temp_dir("rm");
+  // A PNG signature followed by bytes that, read as text, hold OBJ-like lines:
+  // the sniffer alone would parse them and complain about a "line".
+  std::string png("\x89PNG\r\n\x1a\n", 8);
+  png += "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  auto msg = expect_throw<IOError>([&] { read_polygon_soup(write_file(d, "texture.png", png)); });
+  EXPECT_NE(msg.find("is a PNG image, not a mesh"), std::string::npos) << msg;
+  std::string jpeg("\xff\xd8\xff\xe0", 4);
+  msg = expect_throw<IOError>([&] { read_polygon_soup(write_file(d, "photo", jpeg + "\nf 1 2 3\n")); });
+  EXPECT_NE(msg.find("is a JPEG image"), std::string::npos) << msg;
+}
+
 TEST(ReadMeshHostile, NanAndInfCoordinatesAreInvalidInput) {
   auto d = test::temp_dir("rm");
   for (std::string bad : {"nan", "inf", "-inf", "1e999"}) {
