@@ -99,7 +99,24 @@ struct TileResult {
   /// choose_cut): tile(x, y) = synthesised((x + shift_x) mod size, (y + shift_y) mod size).
   int shift_x = 0, shift_y = 0;
   double seam_cost = 0;        ///< final total seam cost (graph-cut units, unchanged by the roll)
+  /// texture/wrap_seam_ratio.h worst_line_ratio of the tile: the highest
+  /// line jump of the torus over the mean of its orientation, the same for
+  /// every roll (the check that no straight seam lies anywhere).
+  double worst_line_ratio = 0;
+  /// Where the synthesis cut (column line 0, row line 0 of the synthesised
+  /// tile) ranks among the lines of the torus: the fraction of the W column
+  /// lines (H row lines) whose jump is below it, 0 = smoothest, 1 = roughest.
+  /// Measured to be uniform (no line of the fill grid is special, see
+  /// texture/tileable_tile.h).
+  double synthesis_column_percentile = 0, synthesis_row_percentile = 0;
 };
+
+/// The graph-cut options make_tileable_detailed runs for `exemplar`, `size`
+/// and `options` (automatic patch side resolved, periodic_output = true), so
+/// that a caller can run graphcut_synthesize_detailed itself (e.g. for the
+/// source maps) without copying the defaults. Throws InvalidInputError as
+/// make_tileable_detailed for invalid options.
+GraphcutOptions tileable_graphcut_options(const Image& exemplar, int size, const TileOptions& options = {});
 
 /// A size x size periodic tile grown from `exemplar`. Throws InvalidInputError
 /// naming the option for size < 8, an empty exemplar or an invalid option.

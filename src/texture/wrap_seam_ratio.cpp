@@ -45,4 +45,75 @@ WrapSeamStats wrap_seam_stats(const Image& img) {
 
 double wrap_seam_ratio(const Image& img) { return wrap_seam_stats(img).ratio; }
 
+LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
+  const int min_side = periodic ? 2 : 3;
+  if (img.empty() || img.width < min_side || img.height < min_side)
+    throw InvalidInputError(std::string("line_jump_profile: the image must be at least ") +
+                            (periodic ? "2x2" : "3x3") + ", got " + std::to_string(img.width) + "x" +
+                            std::to_string(img.height));
+  const int W = img.width, H = img.height;
+  LineJumpProfile p;
+  p.periodic = periodic;
+  p.column.assign(static_cast<std::size_t>(W), 0.0);
+  p.row.assign(static_cast<std::size_t>(H), 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (periodic || x > 0) p.column[static_cast<std::size_t>(x)] += jump(img, (x + W - 1) % W, y, x, y);
+      if (periodic || y > 0) p.row[static_cast<std::size_t>(y)] += jump(img, x, (y + H - 1) % H, x, y);
+    }
+  const int first = periodic ? 0 : 1;
+  for (double& c : p.column) c /= H;
+  for (double& r : p.row) r /= W;
+  for (int x = first; x < W; ++x) p.column_mean += p.column[static_cast<std::size_t>(x)];
+  for (int y = first; y < H; ++y) p.row_mean += p.row[static_cast<std::size_t>(y)];
+  p.column_mean /= W - first;
+  p.row_mean /= H - first;
+  auto ratio = [](double v, double mean) {
+    if (mean > 0.0) return v / mean;
+    return v > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+  };
+  p.worst_ratio = -1.0;
+  for (int x = first; x < W; ++x) {
+    const double r = ratio(p.column[static_cast<std::size_t>(x)], p.column_mean);
+    if (r > p.worst_ratio) {
+      p.worst_ratio = r;
+      p.worst_is_column = true;
+      p.worst_index = x;
+    }
+  }
+  for (int y = first; y < H; ++y) {
+    const double r = ratio(p.row[static_cast<std::size_t>(y)], p.row_mean);
+    if (r > p.worst_ratio) {
+      p.worst_ratio = r;
+      p.worst_is_column = false;
+      p.worst_index = y;
+    }
+  }
+  if (periodic) {
+    p.wrap_column_ratio = ratio(p.column[0], p.column_mean);
+    p.wrap_row_ratio = ratio(p.row[0], p.row_mean);
+  }
+  return p;
+}
+
+double worst_line_ratio(const Image& img) { return line_jump_profile(img, true).worst_ratio; }
+
+double rolled_wrap_seam_ratio(const LineJumpProfile& p, int x, int y) {
+  const int W = static_cast<int>(p.column.size()), H = static_cast<int>(p.row.size());
+  if (!p.periodic || W < 2 || H < 2)
+    throw InvalidInputError("rolled_wrap_seam_ratio: needs the profile of a periodic image (line_jump_profile(img, true))");
+  if (x < 0 || x >= W || y < 0 || y >= H)
+    throw InvalidInputError("rolled_wrap_seam_ratio: line (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") outside the " + std::to_string(W) + "x" + std::to_string(H) + " torus");
+  // Summed jumps: every horizontal pair lies on one column line (H per line),
+  // every vertical pair on one row line (W per line).
+  const double h_all = p.column_mean * W * H, v_all = p.row_mean * W * H;
+  const double h_wrap = p.column[static_cast<std::size_t>(x)] * H, v_wrap = p.row[static_cast<std::size_t>(y)] * W;
+  const double wrap_mean = (h_wrap + v_wrap) / (W + H);
+  const double inside_mean =
+      (h_all - h_wrap + v_all - v_wrap) / (static_cast<double>(W - 1) * H + static_cast<double>(W) * (H - 1));
+  if (inside_mean > 0.0) return wrap_mean / inside_mean;
+  return wrap_mean > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+}
+
 }  // namespace surftex

@@ -42,6 +42,8 @@
 // the ratio at the synthesis cut beside it (1.60 and 1.74 for these two
 // with the error-region refinement of session 4).
 
+#include <vector>
+
 #include "geometry/image.h"
 
 namespace surftex {
@@ -57,5 +59,56 @@ WrapSeamStats wrap_seam_stats(const Image& img);
 
 /// wrap_seam_stats(img).ratio.
 double wrap_seam_ratio(const Image& img);
+
+// Worst-line ratio: the roll-independent check that a periodic image holds no
+// straight seam anywhere. The wrap-seam ratio looks at one row and one column
+// (where the image happens to start); any cyclic shift of a periodic tile is
+// the same tiling, so a straight seam may as well lie inside. Here every line
+// of the torus is measured: column line x is the H pairs between columns x-1
+// and x (mod W), row line y the W pairs between rows y-1 and y (mod H). Each
+// line's mean jump is divided by the mean jump of all pairs of the same
+// orientation on the torus (horizontal pairs for column lines, vertical pairs
+// for row lines; both include the wrap pairs, so the figure does not change
+// when the image is rolled). Per orientation, because an anisotropic texture
+// (horizontal wood grain, stripes) has different jumps across rows and
+// across columns without any seam. Seamless: about 1 on the mean line, and
+// the maximum over the W + H lines is above 1 by the spread of one line's
+// sample (a sparse texture whose features are aligned in rows, e.g. a dot
+// lattice, reaches 1.5 or more on the rows grazing its features; compare
+// with the same figure of the exemplar: line_jump_profile(ex, false)).
+struct LineJumpProfile {
+  std::vector<double> column;  ///< W entries: mean jump across column line x (pairs (x-1, x))
+  std::vector<double> row;     ///< H entries: mean jump across row line y (pairs (y-1, y))
+  double column_mean = 0.0;    ///< mean of `column` (mean horizontal-pair jump)
+  double row_mean = 0.0;       ///< mean of `row` (mean vertical-pair jump)
+  /// max over lines of line jump / mean of its orientation (0/0 counts as 1,
+  /// x/0 as +inf).
+  double worst_ratio = 1.0;
+  bool worst_is_column = true;  ///< orientation of the worst line
+  int worst_index = 0;          ///< its x (column line) or y (row line)
+  /// Ratio of the lines of the image's own wrap (column line 0, row line 0),
+  /// each against its orientation's mean (periodic only; 1 when not periodic).
+  double wrap_column_ratio = 1.0, wrap_row_ratio = 1.0;
+  bool periodic = true;  ///< as passed to line_jump_profile
+};
+
+/// The jump profile of every column and row line. `periodic` true: the
+/// image is a torus (W column lines including x = 0, the wrap; H row lines).
+/// false: only interior lines (column lines 1..W-1, row lines 1..H-1; entry 0
+/// of each vector is 0 and left out of the means), e.g. for an exemplar as a
+/// reference of how uneven its own lines are. Throws InvalidInputError if the
+/// image is smaller than 2x2 (3x3 when not periodic).
+LineJumpProfile line_jump_profile(const Image& img, bool periodic = true);
+
+/// line_jump_profile(img, true).worst_ratio.
+double worst_line_ratio(const Image& img);
+
+/// The wrap_seam_ratio the periodic image of profile `p` (line_jump_profile
+/// with periodic = true) has when rolled so that its wrap lies on column line
+/// `x` and row line `y` (i.e. of crop(img, x, y, W, H, true)), exactly, in
+/// O(1): over all W x H rolls this is the distribution a wrap-seam ratio
+/// taken at an arbitrary cut is drawn from. Throws InvalidInputError for a
+/// non-periodic profile or a line index out of range.
+double rolled_wrap_seam_ratio(const LineJumpProfile& p, int x, int y);
 
 }  // namespace surftex
