@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/wrap_seam_ratio.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -73,8 +74,10 @@ LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
     return v > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
   };
   p.worst_ratio = -1.0;
+  p.worst_column_ratio = p.worst_row_ratio = -1.0;
   for (int x = first; x < W; ++x) {
     const double r = ratio(p.column[static_cast<std::size_t>(x)], p.column_mean);
+    p.worst_column_ratio = std::max(p.worst_column_ratio, r);
     if (r > p.worst_ratio) {
       p.worst_ratio = r;
       p.worst_is_column = true;
@@ -83,6 +86,7 @@ LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
   }
   for (int y = first; y < H; ++y) {
     const double r = ratio(p.row[static_cast<std::size_t>(y)], p.row_mean);
+    p.worst_row_ratio = std::max(p.worst_row_ratio, r);
     if (r > p.worst_ratio) {
       p.worst_ratio = r;
       p.worst_is_column = false;

@@ -41,6 +41,20 @@
 // over the lines of the torus, biased low by construction; TileResult keeps
 // the ratio at the synthesis cut beside it (1.60 and 1.74 for these two
 // with the error-region refinement of session 4).
+// Is the synthesis cut a special line? No (session 5, 128-px tiles of the 28
+// non-constant shared textures, seeds 1-6, line_jump_profile): line 0's jump
+// ranks at percentile 0.48 +- 0.02 among the 128 lines of its orientation
+// (uniform: 0.5; columns 0.480, rows 0.480), its mean ratio to the mean line
+// is 0.97, 9.5% of line-0 samples exceed 1.3 against 13% of all lines, and
+// the patch-edge lines of the 2x2 fill grid (0, 48, 64, 112) sit at
+// percentiles 0.48-0.54 (they carry 1.5x the seam pairs of other lines, at
+// no higher jump). Over the 29 seed-1 tiles, the expected number of ratios
+// above 1.3 at a cut drawn uniformly among the 128 x 128 rolls
+// (rolled_wrap_seam_ratio) is 2.68; 3 are observed at the synthesis cut.
+// The three (dots_large, ink_a, water_caustics) have their wrap row at
+// percentile 0.98, 0.92, 0.98 of their rows: a draw from their own line
+// spread (seeds 2-6 give 0.72-1.16, 0.90-1.31, 0.74-1.45), not a seam (their
+// wrap rows hold 0, 16 and 3 seam pairs of 128).
 
 #include <vector>
 
@@ -86,6 +100,10 @@ struct LineJumpProfile {
   double worst_ratio = 1.0;
   bool worst_is_column = true;  ///< orientation of the worst line
   int worst_index = 0;          ///< its x (column line) or y (row line)
+  /// The worst column line's and the worst row line's ratio (worst_ratio is
+  /// their maximum): compare each with the same figure of the exemplar, as a
+  /// texture's two orientations can differ (wood grain: rough rows, even columns).
+  double worst_column_ratio = 1.0, worst_row_ratio = 1.0;
   /// Ratio of the lines of the image's own wrap (column line 0, row line 0),
   /// each against its orientation's mean (periodic only; 1 when not periodic).
   double wrap_column_ratio = 1.0, wrap_row_ratio = 1.0;

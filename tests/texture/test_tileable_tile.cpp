@@ -236,6 +236,8 @@ TEST(WrapSeamRatio, WorstLineFindsAStraightSeamAnywhereForEveryRoll) {
   EXPECT_TRUE(p.worst_is_column);
   EXPECT_EQ(p.worst_index, 17);
   EXPECT_GT(p.worst_ratio, 2.5);
+  EXPECT_EQ(p.worst_column_ratio, p.worst_ratio);
+  EXPECT_LT(p.worst_row_ratio, 1.5);  // no seam across rows
   EXPECT_LT(wrap_seam_ratio(img), 1.2);  // the seam is not at the wrap
   EXPECT_LT(p.wrap_column_ratio, 1.2);
   for (const auto& roll : {std::pair<int, int>{5, 9}, {17, 0}, {30, 33}}) {
