@@ -382,6 +382,8 @@ int main(int argc, char** argv) {
       j["tile_worst_line_ratio"] = t.worst_line_ratio;
       j["tile_worst_line"] = {prof.worst_is_column ? "column" : "row", prof.worst_index};  // in the rolled tile
       j["tile_worst_column_row_ratio"] = {prof.worst_column_ratio, prof.worst_row_ratio};
+      j["tile_source_matched_wrap_ratio_at_synthesis_cut"] = t.source_matched_wrap_ratio_at_synthesis_cut;
+      j["tile_source_matched_worst_line_ratio"] = t.source_matched_worst_line_ratio;
       j["tile_synthesis_cut_percentile"] = {t.synthesis_column_percentile, t.synthesis_row_percentile};
       j["tile_roll_wrap_ratio_median"] = median(rolls);
       j["tile_roll_wrap_ratio_fraction_above_1_3"] = above;

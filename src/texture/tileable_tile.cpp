@@ -85,6 +85,9 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
   };
   t.synthesis_column_percentile = below(prof.column, prof.column[0]);
   t.synthesis_row_percentile = below(prof.row, prof.row[0]);
+  const SourceMatchedLineProfile sm = source_matched_line_profile(t.tile, exemplar, r.source_x, r.source_y);
+  t.source_matched_wrap_ratio_at_synthesis_cut = sm.wrap_ratio;
+  t.source_matched_worst_line_ratio = sm.worst_ratio;
   if (o.choose_cut) {
     const TorusCut c = choose_torus_cut(t.tile);
     t.shift_x = c.shift_x;

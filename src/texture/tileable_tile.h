@@ -118,6 +118,14 @@ struct TileResult {
   /// Measured to be uniform (no line of the fill grid is special, see
   /// texture/tileable_tile.h).
   double synthesis_column_percentile = 0, synthesis_row_percentile = 0;
+  /// texture/wrap_seam_ratio.h source_matched_line_profile of the tile as
+  /// synthesised (the sources are known): the wrap lines' jump over the
+  /// exemplar's own jump at the same sources (1 = copied verbatim or as
+  /// smooth as the exemplar there), and the worst line of the torus (the same
+  /// for every roll). Phase-robust: a line along texture features is not
+  /// penalised, a line along which the sources change with a step is.
+  double source_matched_wrap_ratio_at_synthesis_cut = 0;
+  double source_matched_worst_line_ratio = 0;
 };
 
 /// The graph-cut options make_tileable_detailed runs for `exemplar`, `size`

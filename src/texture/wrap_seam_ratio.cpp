@@ -120,4 +120,76 @@ double rolled_wrap_seam_ratio(const LineJumpProfile& p, int x, int y) {
   return wrap_mean > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
 }
 
+SourceMatchedLineProfile source_matched_line_profile(const Image& img, const Image& ex,
+                                                     const std::vector<int>& sx, const std::vector<int>& sy) {
+  if (img.empty() || img.width < 2 || img.height < 2)
+    throw InvalidInputError("source_matched_line_profile: the image must be at least 2x2, got " +
+                            std::to_string(img.width) + "x" + std::to_string(img.height));
+  const int W = img.width, H = img.height;
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  if (sx.size() != n || sy.size() != n)
+    throw InvalidInputError("source_matched_line_profile: source maps have " + std::to_string(sx.size()) + " and " +
+                            std::to_string(sy.size()) + " entries, the image " + std::to_string(n));
+  if (ex.channels != img.channels)
+    throw InvalidInputError("source_matched_line_profile: exemplar has " + std::to_string(ex.channels) +
+                            " channels, the image " + std::to_string(img.channels));
+  for (std::size_t i = 0; i < n; ++i)
+    if (sx[i] < 0 || sy[i] < 0 || sx[i] >= ex.width || sy[i] >= ex.height)
+      throw InvalidInputError("source_matched_line_profile: source (" + std::to_string(sx[i]) + ", " +
+                              std::to_string(sy[i]) + ") of pixel " + std::to_string(i) + " is outside the " +
+                              std::to_string(ex.width) + "x" + std::to_string(ex.height) + " exemplar");
+  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < ex.width && y < ex.height; };
+  SourceMatchedLineProfile p;
+  std::vector<double> cj(static_cast<std::size_t>(W), 0.0), cn(cj), rj(static_cast<std::size_t>(H), 0.0), rn(rj);
+  // One pair: s = (x0, y0), t = s + (dx, dy) on the torus (t = (x1, y1)).
+  auto pair = [&](int x0, int y0, int x1, int y1, int dx, int dy, double& sum_jump, double& sum_natural) {
+    const std::size_t a = static_cast<std::size_t>(y0) * W + x0, b = static_cast<std::size_t>(y1) * W + x1;
+    const double j = jump(img, x0, y0, x1, y1);
+    const int ax = sx[a], ay = sy[a], bx = sx[b], by = sy[b];
+    if (!(bx == ax + dx && by == ay + dy)) ++p.seam_pairs;
+    double nat = 0.0;
+    int terms = 0;
+    if (inside(ax + dx, ay + dy)) {
+      nat += jump(ex, ax, ay, ax + dx, ay + dy);
+      ++terms;
+    }
+    if (inside(bx - dx, by - dy)) {
+      nat += jump(ex, bx - dx, by - dy, bx, by);
+      ++terms;
+    }
+    sum_jump += j;
+    sum_natural += terms > 0 ? nat / terms : j;
+  };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      pair((x + W - 1) % W, y, x, y, 1, 0, cj[static_cast<std::size_t>(x)], cn[static_cast<std::size_t>(x)]);
+      pair(x, (y + H - 1) % H, x, y, 0, 1, rj[static_cast<std::size_t>(y)], rn[static_cast<std::size_t>(y)]);
+    }
+  auto ratio = [](double j, double nat) {
+    if (nat > 0.0) return j / nat;
+    return j > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+  };
+  p.column.resize(cj.size());
+  p.row.resize(rj.size());
+  p.worst_ratio = -1.0;
+  for (int x = 0; x < W; ++x) {
+    p.column[static_cast<std::size_t>(x)] = ratio(cj[static_cast<std::size_t>(x)], cn[static_cast<std::size_t>(x)]);
+    if (p.column[static_cast<std::size_t>(x)] > p.worst_ratio) {
+      p.worst_ratio = p.column[static_cast<std::size_t>(x)];
+      p.worst_is_column = true;
+      p.worst_index = x;
+    }
+  }
+  for (int y = 0; y < H; ++y) {
+    p.row[static_cast<std::size_t>(y)] = ratio(rj[static_cast<std::size_t>(y)], rn[static_cast<std::size_t>(y)]);
+    if (p.row[static_cast<std::size_t>(y)] > p.worst_ratio) {
+      p.worst_ratio = p.row[static_cast<std::size_t>(y)];
+      p.worst_is_column = false;
+      p.worst_index = y;
+    }
+  }
+  p.wrap_ratio = ratio(cj[0] + rj[0], cn[0] + rn[0]);
+  return p;
+}
+
 }  // namespace surftex

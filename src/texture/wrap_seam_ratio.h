@@ -121,6 +121,38 @@ LineJumpProfile line_jump_profile(const Image& img, bool periodic = true);
 /// line_jump_profile(img, true).worst_ratio.
 double worst_line_ratio(const Image& img);
 
+// Source-matched line ratio: a phase-robust line check for a periodic image
+// made of exemplar pixels (graph-cut synthesis: the source of every pixel is
+// known). For each neighbour pair (s, t) of the torus, its jump |I(s)-I(t)|
+// is compared with the jump the exemplar itself has there: the mean of
+// |E(a) - E(a + d)| and |E(b - d) - E(b)| (a, b the exemplar sources of s, t,
+// d the pair's direction; the terms whose pixel falls outside the exemplar
+// are left out, the pair's own jump used when both do). A pair copied
+// verbatim (b = a + d) has ratio exactly 1, whatever the content: a line
+// running along dot edges or caustics is not penalised, a line along which
+// the sources change with a colour step is. Per line: summed jump over
+// summed exemplar jump (1 when both are 0, +inf when only the latter is).
+struct SourceMatchedLineProfile {
+  std::vector<double> column;  ///< W entries: ratio of column line x (pairs (x-1, x) mod W)
+  std::vector<double> row;     ///< H entries: ratio of row line y
+  /// The two wrap lines (column line 0, row line 0) pooled: summed jump over
+  /// summed exemplar jump of their W + H pairs.
+  double wrap_ratio = 1.0;
+  double worst_ratio = 1.0;     ///< max over the W + H lines
+  bool worst_is_column = true;  ///< orientation of the worst line
+  int worst_index = 0;          ///< its x or y
+  int seam_pairs = 0;           ///< pairs whose sources are not exemplar neighbours
+};
+
+/// The source-matched line profile of `img` (periodic, W x H) whose pixel
+/// (x, y) was copied from exemplar pixel (source_x[i], source_y[i]),
+/// i = y W + x. Throws InvalidInputError if the image is smaller than 2x2,
+/// the source vectors do not have W H entries, a source lies outside the
+/// exemplar, or the channel counts differ.
+SourceMatchedLineProfile source_matched_line_profile(const Image& img, const Image& exemplar,
+                                                     const std::vector<int>& source_x,
+                                                     const std::vector<int>& source_y);
+
 /// The wrap_seam_ratio the periodic image of profile `p` (line_jump_profile
 /// with periodic = true) has when rolled so that its wrap lies on column line
 /// `x` and row line `y` (i.e. of crop(img, x, y, W, H, true)), exactly, in

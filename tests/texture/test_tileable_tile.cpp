@@ -202,7 +202,11 @@ TEST(TileableTile, ChosenCutIsARollOfTheSynthesisedTileOnItsSmoothestLines) {
     if (!sanitized()) {
       EXPECT_GT(a.wrap_seam_ratio, 1.3) << name << ": the case this test is about";
       EXPECT_LE(b.wrap_seam_ratio, 1.3) << name;
+      // ... yet the synthesis cut carries no seam: its jumps are those of the
+      // exemplar at the same sources (measured 1.000 and 1.029).
+      EXPECT_LE(a.source_matched_wrap_ratio_at_synthesis_cut, 1.1) << name;
     }
+    EXPECT_EQ(b.source_matched_worst_line_ratio, a.source_matched_worst_line_ratio) << name;
     // No other roll gives smoother wrap lines: vary one shift, keep the other.
     const double best = wrap_seam_stats(b.tile).wrap_mean;
     for (int s = 0; s < size; ++s) {
@@ -312,4 +316,52 @@ TEST(TileableTile, SynthesisCutIsAnOrdinaryLineOfTheTorus) {
   // outputs 0.997 (sanitized 0.91).
   EXPECT_LT(tile_pct, 0.7) << "plain outputs " << plain_pct;
   EXPECT_GT(plain_pct, 0.85) << "guard: a non-periodic output's wrap is a seam";
+}
+
+// The source-matched line profile on a hand-made torus: a smooth exemplar
+// with one sharp vertical edge (exemplar column 12 vs 13). The 16x16 tile
+// copies the exemplar verbatim except at column line 10 (sources jump by 15
+// columns) and the two wrap lines (the torus must close somewhere). The
+// exemplar's edge lands on tile column line 7: a big jump, copied verbatim.
+TEST(WrapSeamRatio, SourceMatchedLinesSeeSeamsNotContent) {
+  const double pi = std::acos(-1.0);
+  Image ex(48, 40, 3);
+  for (int y = 0; y < ex.height; ++y)
+    for (int x = 0; x < ex.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        ex.at(x, y, c) = static_cast<float>(0.4 + 0.2 * std::sin(2 * pi * (x / 23.0 + y / 31.0 + 0.2 * c)) +
+                                            (x > 12 ? 0.3 : 0.0));
+  const int S = 16;
+  std::vector<int> sx(S * S), sy(S * S);
+  Image tile(S, S, 3);
+  for (int y = 0; y < S; ++y)
+    for (int x = 0; x < S; ++x) {
+      const int i = y * S + x;
+      sx[i] = x < 10 ? x + 6 : x + 21;  // pixel 6 <- exemplar 12, pixel 7 <- 13: the edge
+      sy[i] = y + 5;
+      for (int c = 0; c < 3; ++c) tile.at(x, y, c) = ex.at(sx[i], sy[i], c);
+    }
+  const SourceMatchedLineProfile p = source_matched_line_profile(tile, ex, sx, sy);
+  ASSERT_EQ(p.column.size(), static_cast<std::size_t>(S));
+  for (int k = 1; k < S; ++k) {
+    EXPECT_DOUBLE_EQ(p.row[static_cast<std::size_t>(k)], 1.0) << k;
+    if (k != 10) {
+      EXPECT_DOUBLE_EQ(p.column[static_cast<std::size_t>(k)], 1.0) << k;
+    }
+  }
+  EXPECT_GT(p.column[10], 2.0);
+  EXPECT_TRUE(p.worst_is_column);
+  EXPECT_EQ(p.seam_pairs, 3 * S);  // column lines 10 and 0, row line 0
+  EXPECT_GT(p.wrap_ratio, 1.5);
+  // The jump profile, blind to sources, sees the verbatim edge as a line
+  // well above the mean.
+  const LineJumpProfile j = line_jump_profile(tile, true);
+  EXPECT_GT(j.column[7] / j.column_mean, 2.0);
+  EXPECT_DOUBLE_EQ(p.column[7], 1.0);
+  // Validation.
+  EXPECT_THROW(source_matched_line_profile(tile, ex, std::vector<int>(5, 0), sy), InvalidInputError);
+  std::vector<int> bad = sx;
+  bad[3] = ex.width;
+  EXPECT_THROW(source_matched_line_profile(tile, ex, bad, sy), InvalidInputError);
+  EXPECT_THROW(source_matched_line_profile(tile, Image(48, 40, 1), sx, sy), InvalidInputError);
 }
