@@ -67,6 +67,8 @@ int run_tile(const TileArgs& a) {
   report["seam_cost"] = t.seam_cost;
   report["worst_line_ratio"] = t.worst_line_ratio;
   report["synthesis_cut_percentile"] = {t.synthesis_column_percentile, t.synthesis_row_percentile};
+  report["source_matched_wrap_ratio_at_synthesis_cut"] = t.source_matched_wrap_ratio_at_synthesis_cut;
+  report["source_matched_worst_line_ratio"] = t.source_matched_worst_line_ratio;
   write_report(a.common, "tile", report);
   if (!a.common.quiet)
     std::fprintf(stderr,
