@@ -65,13 +65,17 @@ int run_tile(const TileArgs& a) {
   report["exemplar_wrap_seam_ratio"] =
       ex.width >= 2 && ex.height >= 2 ? wrap_seam_ratio(ex) : 0.0;
   report["seam_cost"] = t.seam_cost;
+  report["worst_line_ratio"] = t.worst_line_ratio;
+  report["synthesis_cut_percentile"] = {t.synthesis_column_percentile, t.synthesis_row_percentile};
+  report["source_matched_wrap_ratio_at_synthesis_cut"] = t.source_matched_wrap_ratio_at_synthesis_cut;
+  report["source_matched_worst_line_ratio"] = t.source_matched_worst_line_ratio;
   write_report(a.common, "tile", report);
   if (!a.common.quiet)
     std::fprintf(stderr,
                  "tile %dx%d written to %s in %.2f s, wrap-seam ratio %.3f (%.3f at the synthesis "
-                 "cut, rolled by %d,%d)\n",
+                 "cut, rolled by %d,%d), worst line of the torus %.3f\n",
                  a.size, a.size, a.output.c_str(), seconds, t.wrap_seam_ratio,
-                 t.wrap_seam_ratio_at_synthesis_cut, t.shift_x, t.shift_y);
+                 t.wrap_seam_ratio_at_synthesis_cut, t.shift_x, t.shift_y, t.worst_line_ratio);
   return 0;
 }
 

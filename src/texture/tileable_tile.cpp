@@ -47,7 +47,7 @@ TorusCut choose_torus_cut(const Image& img) {
   return c;
 }
 
-TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOptions& o) {
+GraphcutOptions tileable_graphcut_options(const Image& exemplar, int size, const TileOptions& o) {
   if (size < 8) throw InvalidInputError("make_tileable: size must be >= 8, got " + std::to_string(size));
   if (exemplar.empty()) throw InvalidInputError("make_tileable: the exemplar is empty");
   GraphcutOptions g;
@@ -68,10 +68,26 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
   g.periodic_output = true;
   g.seed = o.seed;
   g.progress = o.progress;
+  return g;
+}
+
+TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOptions& o) {
+  const GraphcutOptions g = tileable_graphcut_options(exemplar, size, o);
   GraphcutResult r = graphcut_synthesize_detailed(exemplar, size, size, g);
   TileResult t;
   t.tile = std::move(r.image);
   t.wrap_seam_ratio_at_synthesis_cut = wrap_seam_ratio(t.tile);
+  const LineJumpProfile prof = line_jump_profile(t.tile, true);
+  t.worst_line_ratio = prof.worst_ratio;
+  auto below = [](const std::vector<double>& v, double x) {
+    return static_cast<double>(std::count_if(v.begin(), v.end(), [x](double e) { return e < x; })) /
+           static_cast<double>(v.size() - 1);
+  };
+  t.synthesis_column_percentile = below(prof.column, prof.column[0]);
+  t.synthesis_row_percentile = below(prof.row, prof.row[0]);
+  const SourceMatchedLineProfile sm = source_matched_line_profile(t.tile, exemplar, r.source_x, r.source_y);
+  t.source_matched_wrap_ratio_at_synthesis_cut = sm.wrap_ratio;
+  t.source_matched_worst_line_ratio = sm.worst_ratio;
   if (o.choose_cut) {
     const TorusCut c = choose_torus_cut(t.tile);
     t.shift_x = c.shift_x;

@@ -20,6 +20,15 @@
 // border is not wrapped: mip-mapping or bilinear filtering with clamped
 // borders, and the material-space T_0 / T_M key tiles (Ray et al. 2009
 // section 1), whose feature masks are computed after the roll.
+// The synthesis cut itself is not a worse line than any other (measured:
+// its jump ranks at percentile 0.48 among the torus lines over 29 textures x
+// 6 seeds; texture/wrap_seam_ratio.h), so the roll does not hide a seam the
+// synthesis puts at the start of its fill grid; it only moves the border off
+// lines that happen to run along texture features. Because the roll picks
+// the minimum over lines, neither wrap-seam ratio proves that no straight
+// seam lies inside: TileResult::worst_line_ratio (every line of the torus,
+// roll-independent) is the figure for that, to be read against the same
+// figure of tile-sized windows of the exemplar (bench/bench_graphcut.cpp).
 
 #include <cstdint>
 
@@ -99,7 +108,32 @@ struct TileResult {
   /// choose_cut): tile(x, y) = synthesised((x + shift_x) mod size, (y + shift_y) mod size).
   int shift_x = 0, shift_y = 0;
   double seam_cost = 0;        ///< final total seam cost (graph-cut units, unchanged by the roll)
+  /// texture/wrap_seam_ratio.h worst_line_ratio of the tile: the highest
+  /// line jump of the torus over the mean of its orientation, the same for
+  /// every roll (the check that no straight seam lies anywhere).
+  double worst_line_ratio = 0;
+  /// Where the synthesis cut (column line 0, row line 0 of the synthesised
+  /// tile) ranks among the lines of the torus: the fraction of the W column
+  /// lines (H row lines) whose jump is below it, 0 = smoothest, 1 = roughest.
+  /// Measured to be uniform (no line of the fill grid is special, see
+  /// texture/tileable_tile.h).
+  double synthesis_column_percentile = 0, synthesis_row_percentile = 0;
+  /// texture/wrap_seam_ratio.h source_matched_line_profile of the tile as
+  /// synthesised (the sources are known): the wrap lines' jump over the
+  /// exemplar's own jump at the same sources (1 = copied verbatim or as
+  /// smooth as the exemplar there), and the worst line of the torus (the same
+  /// for every roll). Phase-robust: a line along texture features is not
+  /// penalised, a line along which the sources change with a step is.
+  double source_matched_wrap_ratio_at_synthesis_cut = 0;
+  double source_matched_worst_line_ratio = 0;
 };
+
+/// The graph-cut options make_tileable_detailed runs for `exemplar`, `size`
+/// and `options` (automatic patch side resolved, periodic_output = true), so
+/// that a caller can run graphcut_synthesize_detailed itself (e.g. for the
+/// source maps) without copying the defaults. Throws InvalidInputError as
+/// make_tileable_detailed for invalid options.
+GraphcutOptions tileable_graphcut_options(const Image& exemplar, int size, const TileOptions& options = {});
 
 /// A size x size periodic tile grown from `exemplar`. Throws InvalidInputError
 /// naming the option for size < 8, an empty exemplar or an invalid option.

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/wrap_seam_ratio.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -44,5 +45,151 @@ WrapSeamStats wrap_seam_stats(const Image& img) {
 }
 
 double wrap_seam_ratio(const Image& img) { return wrap_seam_stats(img).ratio; }
+
+LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
+  const int min_side = periodic ? 2 : 3;
+  if (img.empty() || img.width < min_side || img.height < min_side)
+    throw InvalidInputError(std::string("line_jump_profile: the image must be at least ") +
+                            (periodic ? "2x2" : "3x3") + ", got " + std::to_string(img.width) + "x" +
+                            std::to_string(img.height));
+  const int W = img.width, H = img.height;
+  LineJumpProfile p;
+  p.periodic = periodic;
+  p.column.assign(static_cast<std::size_t>(W), 0.0);
+  p.row.assign(static_cast<std::size_t>(H), 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (periodic || x > 0) p.column[static_cast<std::size_t>(x)] += jump(img, (x + W - 1) % W, y, x, y);
+      if (periodic || y > 0) p.row[static_cast<std::size_t>(y)] += jump(img, x, (y + H - 1) % H, x, y);
+    }
+  const int first = periodic ? 0 : 1;
+  for (double& c : p.column) c /= H;
+  for (double& r : p.row) r /= W;
+  for (int x = first; x < W; ++x) p.column_mean += p.column[static_cast<std::size_t>(x)];
+  for (int y = first; y < H; ++y) p.row_mean += p.row[static_cast<std::size_t>(y)];
+  p.column_mean /= W - first;
+  p.row_mean /= H - first;
+  auto ratio = [](double v, double mean) {
+    if (mean > 0.0) return v / mean;
+    return v > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+  };
+  p.worst_ratio = -1.0;
+  p.worst_column_ratio = p.worst_row_ratio = -1.0;
+  for (int x = first; x < W; ++x) {
+    const double r = ratio(p.column[static_cast<std::size_t>(x)], p.column_mean);
+    p.worst_column_ratio = std::max(p.worst_column_ratio, r);
+    if (r > p.worst_ratio) {
+      p.worst_ratio = r;
+      p.worst_is_column = true;
+      p.worst_index = x;
+    }
+  }
+  for (int y = first; y < H; ++y) {
+    const double r = ratio(p.row[static_cast<std::size_t>(y)], p.row_mean);
+    p.worst_row_ratio = std::max(p.worst_row_ratio, r);
+    if (r > p.worst_ratio) {
+      p.worst_ratio = r;
+      p.worst_is_column = false;
+      p.worst_index = y;
+    }
+  }
+  if (periodic) {
+    p.wrap_column_ratio = ratio(p.column[0], p.column_mean);
+    p.wrap_row_ratio = ratio(p.row[0], p.row_mean);
+  }
+  return p;
+}
+
+double worst_line_ratio(const Image& img) { return line_jump_profile(img, true).worst_ratio; }
+
+double rolled_wrap_seam_ratio(const LineJumpProfile& p, int x, int y) {
+  const int W = static_cast<int>(p.column.size()), H = static_cast<int>(p.row.size());
+  if (!p.periodic || W < 2 || H < 2)
+    throw InvalidInputError("rolled_wrap_seam_ratio: needs the profile of a periodic image (line_jump_profile(img, true))");
+  if (x < 0 || x >= W || y < 0 || y >= H)
+    throw InvalidInputError("rolled_wrap_seam_ratio: line (" + std::to_string(x) + ", " + std::to_string(y) +
+                            ") outside the " + std::to_string(W) + "x" + std::to_string(H) + " torus");
+  // Summed jumps: every horizontal pair lies on one column line (H per line),
+  // every vertical pair on one row line (W per line).
+  const double h_all = p.column_mean * W * H, v_all = p.row_mean * W * H;
+  const double h_wrap = p.column[static_cast<std::size_t>(x)] * H, v_wrap = p.row[static_cast<std::size_t>(y)] * W;
+  const double wrap_mean = (h_wrap + v_wrap) / (W + H);
+  const double inside_mean =
+      (h_all - h_wrap + v_all - v_wrap) / (static_cast<double>(W - 1) * H + static_cast<double>(W) * (H - 1));
+  if (inside_mean > 0.0) return wrap_mean / inside_mean;
+  return wrap_mean > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+}
+
+SourceMatchedLineProfile source_matched_line_profile(const Image& img, const Image& ex,
+                                                     const std::vector<int>& sx, const std::vector<int>& sy) {
+  if (img.empty() || img.width < 2 || img.height < 2)
+    throw InvalidInputError("source_matched_line_profile: the image must be at least 2x2, got " +
+                            std::to_string(img.width) + "x" + std::to_string(img.height));
+  const int W = img.width, H = img.height;
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  if (sx.size() != n || sy.size() != n)
+    throw InvalidInputError("source_matched_line_profile: source maps have " + std::to_string(sx.size()) + " and " +
+                            std::to_string(sy.size()) + " entries, the image " + std::to_string(n));
+  if (ex.channels != img.channels)
+    throw InvalidInputError("source_matched_line_profile: exemplar has " + std::to_string(ex.channels) +
+                            " channels, the image " + std::to_string(img.channels));
+  for (std::size_t i = 0; i < n; ++i)
+    if (sx[i] < 0 || sy[i] < 0 || sx[i] >= ex.width || sy[i] >= ex.height)
+      throw InvalidInputError("source_matched_line_profile: source (" + std::to_string(sx[i]) + ", " +
+                              std::to_string(sy[i]) + ") of pixel " + std::to_string(i) + " is outside the " +
+                              std::to_string(ex.width) + "x" + std::to_string(ex.height) + " exemplar");
+  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < ex.width && y < ex.height; };
+  SourceMatchedLineProfile p;
+  std::vector<double> cj(static_cast<std::size_t>(W), 0.0), cn(cj), rj(static_cast<std::size_t>(H), 0.0), rn(rj);
+  // One pair: s = (x0, y0), t = s + (dx, dy) on the torus (t = (x1, y1)).
+  auto pair = [&](int x0, int y0, int x1, int y1, int dx, int dy, double& sum_jump, double& sum_natural) {
+    const std::size_t a = static_cast<std::size_t>(y0) * W + x0, b = static_cast<std::size_t>(y1) * W + x1;
+    const double j = jump(img, x0, y0, x1, y1);
+    const int ax = sx[a], ay = sy[a], bx = sx[b], by = sy[b];
+    if (!(bx == ax + dx && by == ay + dy)) ++p.seam_pairs;
+    double nat = 0.0;
+    int terms = 0;
+    if (inside(ax + dx, ay + dy)) {
+      nat += jump(ex, ax, ay, ax + dx, ay + dy);
+      ++terms;
+    }
+    if (inside(bx - dx, by - dy)) {
+      nat += jump(ex, bx - dx, by - dy, bx, by);
+      ++terms;
+    }
+    sum_jump += j;
+    sum_natural += terms > 0 ? nat / terms : j;
+  };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      pair((x + W - 1) % W, y, x, y, 1, 0, cj[static_cast<std::size_t>(x)], cn[static_cast<std::size_t>(x)]);
+      pair(x, (y + H - 1) % H, x, y, 0, 1, rj[static_cast<std::size_t>(y)], rn[static_cast<std::size_t>(y)]);
+    }
+  auto ratio = [](double j, double nat) {
+    if (nat > 0.0) return j / nat;
+    return j > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+  };
+  p.column.resize(cj.size());
+  p.row.resize(rj.size());
+  p.worst_ratio = -1.0;
+  for (int x = 0; x < W; ++x) {
+    p.column[static_cast<std::size_t>(x)] = ratio(cj[static_cast<std::size_t>(x)], cn[static_cast<std::size_t>(x)]);
+    if (p.column[static_cast<std::size_t>(x)] > p.worst_ratio) {
+      p.worst_ratio = p.column[static_cast<std::size_t>(x)];
+      p.worst_is_column = true;
+      p.worst_index = x;
+    }
+  }
+  for (int y = 0; y < H; ++y) {
+    p.row[static_cast<std::size_t>(y)] = ratio(rj[static_cast<std::size_t>(y)], rn[static_cast<std::size_t>(y)]);
+    if (p.row[static_cast<std::size_t>(y)] > p.worst_ratio) {
+      p.worst_ratio = p.row[static_cast<std::size_t>(y)];
+      p.worst_is_column = false;
+      p.worst_index = y;
+    }
+  }
+  p.wrap_ratio = ratio(cj[0] + rj[0], cn[0] + rn[0]);
+  return p;
+}
 
 }  // namespace surftex

@@ -36,6 +36,12 @@ TEST(CmdTile, WritesTilePreviewAndReportAndRefusesOverwrite) {
   EXPECT_EQ(k["cut_shift"], nlohmann::json::array({0, 0}));
   EXPECT_EQ(k["wrap_seam_ratio"].get<double>(), k["wrap_seam_ratio_at_synthesis_cut"].get<double>());
   EXPECT_EQ(k["wrap_seam_ratio_at_synthesis_cut"].get<double>(), j["wrap_seam_ratio_at_synthesis_cut"].get<double>());
+  // The worst line of the torus does not depend on the roll.
+  EXPECT_NEAR(k["worst_line_ratio"].get<double>(), j["worst_line_ratio"].get<double>(), 1e-9);
+  EXPECT_EQ(k["synthesis_cut_percentile"], j["synthesis_cut_percentile"]);
+  EXPECT_EQ(k["source_matched_worst_line_ratio"], j["source_matched_worst_line_ratio"]);
+  EXPECT_GE(k["source_matched_worst_line_ratio"].get<double>(),
+            k["source_matched_wrap_ratio_at_synthesis_cut"].get<double>() - 1e-12);
   // Existing output without --force: error, exit 2.
   test::RunResult again = test::run_surftex(args);
   EXPECT_EQ(again.exit_code, 2);
