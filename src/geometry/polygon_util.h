@@ -9,21 +9,17 @@
 #include <vector>
 
 #include "geometry/mesh.h"
+#include "geometry/newell.h"
 
 namespace surftex {
 
 /// Newell vector area of polygon f: half the sum of cross products of
 /// consecutive corners; its length is the area of a planar polygon.
 inline Vector3 polygon_vector_area(const Mesh& mesh, FaceIndex f) {
-  double x = 0, y = 0, z = 0;
-  for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
-    const Point3& a = mesh.point(mesh.source(h));
-    const Point3& b = mesh.point(mesh.target(h));
-    x += (a.y() - b.y()) * (a.z() + b.z());
-    y += (a.z() - b.z()) * (a.x() + b.x());
-    z += (a.x() - b.x()) * (a.y() + b.y());
-  }
-  return Vector3(0.5 * x, 0.5 * y, 0.5 * z);
+  std::vector<const Point3*> corners;
+  for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) corners.push_back(&mesh.point(v));
+  const auto n = newell_normal(corners.size(), [&](std::size_t k) -> const Point3& { return *corners[k]; });
+  return Vector3(0.5 * n[0], 0.5 * n[1], 0.5 * n[2]);
 }
 
 inline double polygon_area(const Mesh& mesh, FaceIndex f) {

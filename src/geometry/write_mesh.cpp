@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "geometry/errors.h"
+#include "geometry/newell.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
@@ -112,14 +113,8 @@ Gathered gather(const std::string& path, const Mesh& mesh, const WriteMeshOption
       // vector area, so larger faces weigh more).
       std::vector<std::array<double, 3>> acc(g.pos.size(), {0.0, 0.0, 0.0});
       for (const auto& f : g.faces) {
-        std::array<double, 3> n{0, 0, 0};
-        for (std::size_t k = 0; k < f.size(); ++k) {
-          const auto& a = g.pos[f[k]];
-          const auto& b = g.pos[f[(k + 1) % f.size()]];
-          n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-          n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-          n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-        }
+        const std::array<double, 3> n =
+            newell_normal(f.size(), [&](std::size_t k) -> const std::array<double, 3>& { return g.pos[f[k]]; });
         for (std::size_t v : f)
           for (int c = 0; c < 3; ++c) acc[v][c] += n[c];
       }
