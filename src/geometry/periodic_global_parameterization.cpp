@@ -466,7 +466,35 @@ struct PgpPattern {
   /// per live edge: positions of the 4x4 block (row-major) below the diagonal,
   /// -1 for the entries that are structurally zero (or no block)
   std::vector<std::array<std::ptrdiff_t, 16>> off;
+  /// split_st only: the two diagonal blocks of A (s: unknowns 0..2n-1, t:
+  /// 2n..4n-1; A has nothing outside them) as two matrices of their own,
+  /// whose values are A's first `nnz_s` values and the rest, in order.
+  std::array<SpMat, 2> half;
+  std::ptrdiff_t nnz_s = 0;
 };
+
+/// The two diagonal 2n x 2n blocks of a block-diagonal lower triangle (split
+/// numbering), same entry order as in A (column-major, rows sorted).
+void split_halves(PgpPattern& p) {
+  const int m = 2 * p.n;
+  const SpMat& A = p.A;
+  p.nnz_s = A.outerIndexPtr()[m];
+  for (int h = 0; h < 2; ++h) {
+    SpMat& B = p.half[static_cast<std::size_t>(h)];
+    const std::ptrdiff_t begin = h == 0 ? 0 : p.nnz_s, end = h == 0 ? p.nnz_s : A.nonZeros();
+    B.resize(m, m);
+    B.resizeNonZeros(end - begin);
+    for (int c = 0; c <= m; ++c) B.outerIndexPtr()[c] = static_cast<int>(A.outerIndexPtr()[h * m + c] - begin);
+    for (std::ptrdiff_t q = begin; q < end; ++q) {
+      const int row = A.innerIndexPtr()[q] - h * m;
+      if (row < 0 || row >= m)
+        throw SolverError("periodic_global_parameterization: s and t systems not independent (entry row " +
+                          std::to_string(row + h * m) + ")");
+      B.innerIndexPtr()[q - begin] = row;
+      B.valuePtr()[q - begin] = 0.0;
+    }
+  }
+}
 
 /// Entry (r, c) of an edge block is structurally nonzero iff the pairs of r
 /// and c (s = 0, t = 1) match up to the parity of the frames' turns.
@@ -519,6 +547,7 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
   none.fill(-1);
   p.off.assign(t.ends.size(), none);
   for_each_block_entry([&](std::size_t k, int rc, int row, int col) { p.off[k][rc] = position(row, col); });
+  if (split_st) split_halves(p);
   return p;
 }
 
@@ -595,6 +624,9 @@ struct PeriodicGlobalParameterization::Impl {
   /// Order of the initial free set computed ahead by prepare(): (natural, var).
   std::unique_ptr<std::pair<std::vector<int>, std::vector<int>>> prepared;
   Cholesky solver;
+  /// The s and t systems' own factors (swap_coordinates false with
+  /// separate_halves; each with its own cholmod_common).
+  std::array<Cholesky, 2> halves;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
   std::string blas_core;  // OpenBLAS kernel set behind CHOLMOD ("" = another BLAS)
@@ -627,11 +659,13 @@ struct PeriodicGlobalParameterization::Impl {
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
     blas_core = configure_blas();
-    solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
-    // The unknowns come in nested-dissection order (nested_dissection_order):
-    // CHOLMOD keeps it (then postorders the elimination tree).
-    solver.cholmod().nmethods = 1;
-    solver.cholmod().method[0].ordering = CHOLMOD_NATURAL;
+    for (Cholesky* S : {&solver, &halves[0], &halves[1]}) {
+      S->cholmod().print = 0;  // failures are thrown as SolverError, not printed
+      // The unknowns come in nested-dissection order (nested_dissection_order):
+      // CHOLMOD keeps it (then postorders the elimination tree).
+      S->cholmod().nmethods = 1;
+      S->cholmod().method[0].ordering = CHOLMOD_NATURAL;
+    }
   }
 
   const PgpTopology& topology() {
@@ -776,6 +810,13 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   const int n = count;
   const int n4 = 4 * n;
   const bool split_st = !opt.swap_coordinates;
+  // The two halves as two systems on two tasks (see PgpOptions::separate_halves).
+  const bool separate = split_st && opt.separate_halves;
+  auto analyze_half = [&](int h) -> std::string {
+    Cholesky& S = halves[static_cast<std::size_t>(h)];
+    S.analyzePattern(pattern->half[static_cast<std::size_t>(h)]);
+    return S.info() == Eigen::Success ? std::string() : std::string("symbolic analysis failed");
+  };
   auto unknown = [n, split_st](int v, int r) { return unknown_index(v, r, n, split_st); };
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
@@ -967,7 +1008,15 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   tbb::parallel_invoke(
       [&] {
         Timer tt;
-        if (n > 0 && !same_pattern) {
+        if (n > 0 && !same_pattern && separate) {
+          // The s and t halves analysed side by side (each its own
+          // cholmod_common: nothing shared).
+          std::array<std::string, 2> why;
+          tbb::parallel_invoke([&] { why[0] = analyze_half(0); }, [&] { why[1] = analyze_half(1); });
+          failure = !why[0].empty() ? why[0] : why[1];
+          factor_size = {halves[0].cholmod().fl + halves[1].cholmod().fl,
+                         halves[0].cholmod().lnz + halves[1].cholmod().lnz};
+        } else if (n > 0 && !same_pattern) {
           // Symbolic analysis of the pattern alone (the values come beside).
           solver.analyzePattern(pattern->A);
           if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
@@ -1000,12 +1049,57 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
     // fandisk), and F's smallest eigenvector localises where the field's curl
     // is low, its tail not following the field (80% distorted faces on a torus).
-    solver.factorize(A);
-    if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
-    split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
+    if (separate) {
+      // The paper's simplified PGP: the s and t systems are independent, and
+      // so are their relaxations (each step normalises s pairs and t pairs
+      // separately), so each half is factored and relaxed on its own task
+      // with its own factor: the same operations on the same values as one
+      // block-diagonal system, whichever thread runs a half.
+      std::array<std::string, 2> why;
+      std::array<double, 2> factor_seconds{0, 0}, solve_seconds{0, 0};
+      std::array<int, 2> steps{0, 0};
+      auto run_half = [&](int h) {
+        Timer th;
+        Cholesky& S = halves[static_cast<std::size_t>(h)];
+        SpMat& B = pattern->half[static_cast<std::size_t>(h)];
+        const std::ptrdiff_t begin = h == 0 ? 0 : P.nnz_s;
+        std::copy(A.valuePtr() + begin, A.valuePtr() + begin + B.nonZeros(), B.valuePtr());
+        S.factorize(B);
+        if (S.info() != Eigen::Success) why[h] = "factorisation failed (not positive definite?)";
+        factor_seconds[h] = th.seconds();
+        th.reset();
+        const int m = 2 * n, off = h * m;
+        Eigen::VectorXd xh = x.segment(off, m), rh(m);
+        for (int it = 0; it < iterations && why[h].empty(); ++it) {
+          for (int v = 0; v < n; ++v) {
+            const double re = xh[2 * v], im = xh[2 * v + 1];
+            const double a = std::hypot(re, im);
+            const bool ok = a > 1e-300 && std::isfinite(a);
+            rh[2 * v] = b[off + 2 * v] + shift * mass[v] * (ok ? re / a : 1.0);
+            rh[2 * v + 1] = b[off + 2 * v + 1] + shift * mass[v] * (ok ? im / a : 0.0);
+          }
+          xh = S.solve(rh);
+          if (S.info() != Eigen::Success) why[h] = "solve failed";
+          ++steps[h];
+        }
+        x.segment(off, m) = xh;
+        solve_seconds[h] = th.seconds();
+      };
+      tbb::parallel_invoke([&] { run_half(0); }, [&] { run_half(1); });
+      failure = !why[0].empty() ? why[0] : why[1];
+      // Each half's own wall time; the two run side by side.
+      bd.factorization = std::max(factor_seconds[0], factor_seconds[1]);
+      bd.solves = std::max(solve_seconds[0], solve_seconds[1]);
+      bd.steps = std::min(steps[0], steps[1]);
+      lap.reset();
+    } else {
+      solver.factorize(A);
+      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
+      split(bd.factorization);
+    }
     Eigen::VectorXd rhs(n4);
-    for (int it = 0; it < iterations && failure.empty(); ++it) {
+    for (int it = 0; it < iterations && failure.empty() && !separate; ++it) {
       for (int v = 0; v < n; ++v)
         for (int p = 0; p < 2; ++p) {
           const int ire = unknown(v, 2 * p), iim = unknown(v, 2 * p + 1);
@@ -1028,7 +1122,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
         zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
       }
-    split(bd.solves);
+    split(bd.solves);  // (the halves' own times were set above; this adds the write-back)
   }
   if (!failure.empty())
     throw SolverError(std::string("periodic_global_parameterization: ") + (split_st ? "s and t systems " : "coupled (s,t) system ") + failure + " (" +

@@ -146,6 +146,14 @@ struct PgpOptions {
   /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8; singular
   /// faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
   bool swap_coordinates = true;
+  /// With swap_coordinates false only: factor and relax the s and t systems
+  /// as two CHOLMOD systems (own factor and workspace each) on two TBB tasks
+  /// instead of one block-diagonal system. Same bytes either way and on any
+  /// thread count (the same operations on the same values; CHOLMOD's dense
+  /// kernels run on the serial OpenBLAS, which Debian builds with its
+  /// USE_LOCKING option for calls from several threads: see the BLAS note
+  /// above). false is kept for comparison (tests, bench_pgp --one-system).
+  bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";

@@ -396,6 +396,50 @@ TEST(PeriodicGlobalParameterization, NoSwapSameBytesWithOneOrTwoThreadsOnFandisk
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
 
+// The no-swap s and t systems factored and relaxed as two CHOLMOD systems on
+// two tasks (PgpOptions::separate_halves, the default) must give exactly what
+// the single block-diagonal system gives (separate_halves false, one thread):
+// an exchanged, misplaced or half-copied value, a wrong offset of the t half
+// or a shared workspace would change the bytes of z, the energies or the
+// corners. Run on two threads, so that the halves' BLAS calls overlap.
+TEST(PeriodicGlobalParameterization, NoSwapTwoSystemsGiveTheBytesOfOneSystem) {
+  PgpOptions two;
+  two.swap_coordinates = false;
+  PgpOptions one = two;
+  one.separate_halves = false;
+  const auto a = fandisk_init_and_update_bytes(1, one), b = fandisk_init_and_update_bytes(2, two);
+  ASSERT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  EXPECT_EQ(0.0, worst);
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
+  // And the halves really are different systems (not one solved twice).
+  Mesh m;
+  fandisk_with_cuts(m);
+  PeriodicGlobalParameterization pgp(m, two);
+  const PgpResult r = pgp.initialize();
+  EXPECT_GT(r.energy_s, 0.0);
+  EXPECT_NE(r.energy_s, r.energy_t);
+  std::size_t differ = 0;
+  for (std::size_t v = 0; v < pgp.z_s().size(); ++v) differ += pgp.z_s()[v] != pgp.z_t()[v];
+  EXPECT_GT(differ, pgp.z_s().size() / 2);
+}
+
+// Repeated two-thread no-swap runs (the halves' CHOLMOD/OpenBLAS calls side
+// by side) give the same bytes every time: a race in the BLAS's buffers would
+// show up as a differing run.
+TEST(PeriodicGlobalParameterization, NoSwapTwoSystemsRepeatBitForBit) {
+  PgpOptions o;
+  o.swap_coordinates = false;
+  const auto ref = fandisk_init_and_update_bytes(2, o);
+  const int runs = std::getenv("SURFTEX_SANITIZED") ? 1 : 3;
+  for (int i = 0; i < runs; ++i) {
+    const auto again = fandisk_init_and_update_bytes(2, o);
+    ASSERT_EQ(ref.size(), again.size());
+    EXPECT_EQ(0, std::memcmp(ref.data(), again.data(), ref.size() * sizeof(double))) << "run " << i;
+  }
+}
+
 // prepare() and prepare(area) (connectivity-only work, run here while the
 // direction field is interpolated, as the material-map pipeline does) change
 // no byte of the initialisation and of a local update, which then skip the
