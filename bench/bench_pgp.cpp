@@ -4,7 +4,7 @@
 // over ~25% of the triangles, on real meshes of ~11K, ~24K and ~50K triangles.
 // Best of 3 runs (wall "seconds", and "cpu_seconds" of all threads of that
 // run); one JSON line per mesh and step.
-// Usage: bench_pgp [--no-sweep] [--no-swap] [mesh ...]   (default: shared data fandisk,
+// Usage: bench_pgp [--no-sweep] [--no-swap [--one-system]] [mesh ...]   (default: shared data fandisk,
 // dragon_25k, armadillo_52k; --no-sweep skips the singular fraction against
 // the period). The PGP steps carry the solver's own wall-time breakdown.
 //
@@ -203,10 +203,11 @@ void emit(const std::string& mesh, std::size_t faces, const std::string& step, d
 
 // The PGP's own breakdown of one run (wall seconds per step).
 bool g_swap_coordinates = true;  // PgpOptions::swap_coordinates of the run (--no-swap)
+bool g_separate_halves = false;  // no-swap solved as two systems on two tasks (not --one-system)
 
 nlohmann::json breakdown(const PgpResult& r) {
   const PgpResult::Breakdown& b = r.breakdown;
-  return {{"pgp_seconds", r.seconds},         {"swap_coordinates", g_swap_coordinates},         {"topology", b.topology},
+  return {{"pgp_seconds", r.seconds},         {"swap_coordinates", g_swap_coordinates}, {"separate_halves", g_separate_halves}, {"concurrent_halves", r.concurrent_halves},         {"topology", b.topology},
           {"field", b.field},                 {"ordering", b.ordering},
           {"pattern", b.pattern},
           {"start", b.start},                 {"assembly", b.assembly},
@@ -389,12 +390,15 @@ int main(int argc, char** argv) {
       pgp_options.curl_correction = true;
     else if (std::string(argv[i]) == "--no-swap")
       pgp_options.swap_coordinates = false;  // the paper's simplified PGP (section 2.3)
+    else if (std::string(argv[i]) == "--one-system")
+      pgp_options.separate_halves = false;  // with --no-swap: one block-diagonal CHOLMOD system
     else if (std::string(argv[i]) == "--field-sweep")
       field_sweep = true;
     else
       meshes.push_back(argv[i]);
   }
   g_swap_coordinates = pgp_options.swap_coordinates;
+  g_separate_halves = !pgp_options.swap_coordinates && pgp_options.separate_halves;
   if (meshes.empty()) {
     const std::string d = std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/";
     meshes = {d + "fandisk.off", d + "dragon_25k.off", d + "armadillo_52k.off"};

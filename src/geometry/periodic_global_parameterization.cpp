@@ -16,6 +16,7 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <type_traits>
 
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
@@ -114,46 +115,213 @@ std::vector<int> nested_dissection_order(const std::vector<int>& var, int n,
 ///    OPENBLAS_CORETYPE variable, set for the call only). The kernels change
 ///    the rounding of the factor (as on any other machine model), not the
 ///    determinism: same machine, same bytes.
-const std::string& configure_blas() {
-  static const std::string core = [] {
-    using SetThreads = void (*)(int);
-    for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
-      if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
-    using CoreName = char* (*)();
-    using Hook = void (*)();
-    void* name_fn = dlsym(RTLD_DEFAULT, "openblas_get_corename");
-    if (!name_fn) return std::string();
-    auto corename = [&] {
-      const char* c = reinterpret_cast<CoreName>(name_fn)();
-      return std::string(c ? c : "");
-    };
-    std::string current = corename();
-    std::string lower = current;
-    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    void* quit = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit");
-    void* init = dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init");
-    if (lower != "prescott" || std::getenv("OPENBLAS_CORETYPE") || !quit || !init) return current;
-    const char* target = nullptr;
+/// configure_blas for one loaded copy of OpenBLAS (`handle` for dlsym:
+/// RTLD_DEFAULT for the process's own), through that copy's own C library.
+std::string configure_blas_in(void* handle) {
+  auto sym = [handle](const char* name) { return dlsym(handle, name); };
+  using SetThreads = void (*)(int);
+  for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
+    if (void* f = sym(name)) reinterpret_cast<SetThreads>(f)(1);
+  using CoreName = char* (*)();
+  using Hook = void (*)();
+  void* name_fn = sym("openblas_get_corename");
+  if (!name_fn) return std::string();
+  auto corename = [&] {
+    const char* c = reinterpret_cast<CoreName>(name_fn)();
+    return std::string(c ? c : "");
+  };
+  std::string current = corename();
+  std::string lower = current;
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  void* quit = sym("gotoblas_dynamic_quit");
+  void* init = sym("gotoblas_dynamic_init");
+  // The environment of that copy's C library (a private copy has its own).
+  using SetEnv = int (*)(const char*, const char*, int);
+  using UnsetEnv = int (*)(const char*);
+  using GetEnv = char* (*)(const char*);
+  void* set_env = sym("setenv");
+  void* unset_env = sym("unsetenv");
+  void* get_env = sym("getenv");
+  if (lower != "prescott" || !quit || !init || !set_env || !unset_env || !get_env ||
+      reinterpret_cast<GetEnv>(get_env)("OPENBLAS_CORETYPE"))
+    return current;
+  const char* target = nullptr;
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
-      target = "SkylakeX";
-    else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-      target = "Haswell";
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+    target = "SkylakeX";
+  else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    target = "Haswell";
 #endif
-    if (!target) return current;
-    setenv("OPENBLAS_CORETYPE", target, 1);
-    reinterpret_cast<Hook>(quit)();
-    reinterpret_cast<Hook>(init)();
-    unsetenv("OPENBLAS_CORETYPE");
-    // re-pin (the thread count is kept by the re-initialisation, but cheaply sure)
-    for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
-      if (void* f = dlsym(RTLD_DEFAULT, name)) reinterpret_cast<SetThreads>(f)(1);
-    return corename();
-  }();
+  if (!target) return current;
+  reinterpret_cast<SetEnv>(set_env)("OPENBLAS_CORETYPE", target, 1);
+  reinterpret_cast<Hook>(quit)();
+  reinterpret_cast<Hook>(init)();
+  reinterpret_cast<UnsetEnv>(unset_env)("OPENBLAS_CORETYPE");
+  // re-pin (the thread count is kept by the re-initialisation, but cheaply sure)
+  for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"})
+    if (void* f = sym(name)) reinterpret_cast<SetThreads>(f)(1);
+  return corename();
+}
+
+const std::string& configure_blas() {
+  static const std::string core = configure_blas_in(RTLD_DEFAULT);
   return core;
 }
+
+/// The CHOLMOD entry points the split (no-swap) solve uses, from one loaded
+/// copy of libcholmod.
+struct CholmodApi {
+  int (*start)(cholmod_common*) = nullptr;
+  int (*finish)(cholmod_common*) = nullptr;
+  cholmod_factor* (*analyze)(cholmod_sparse*, cholmod_common*) = nullptr;
+  int (*factorize)(cholmod_sparse*, cholmod_factor*, cholmod_common*) = nullptr;
+  cholmod_dense* (*solve)(int, cholmod_factor*, cholmod_dense*, cholmod_common*) = nullptr;
+  int (*free_factor)(cholmod_factor**, cholmod_common*) = nullptr;
+  int (*free_dense)(cholmod_dense**, cholmod_common*) = nullptr;
+  std::string blas_core;
+};
+
+/// The process's own CHOLMOD (the one Eigen's wrappers call).
+const CholmodApi& process_cholmod() {
+  static const CholmodApi api = [] {
+    CholmodApi a;
+    a.start = &cholmod_start;
+    a.finish = &cholmod_finish;
+    a.analyze = &cholmod_analyze;
+    a.factorize = &cholmod_factorize;
+    a.solve = &cholmod_solve;
+    a.free_factor = &cholmod_free_factor;
+    a.free_dense = &cholmod_free_dense;
+    a.blas_core = configure_blas();
+    return a;
+  }();
+  return api;
+}
+
+/// A second, private copy of libcholmod with its own BLAS, LAPACK and C
+/// library (dlmopen into a new link namespace), or nullptr where that is
+/// not possible. Why: Debian's serial OpenBLAS 0.3.21 (libopenblas0-serial,
+/// the libblas.so.3 here) is not safe for concurrent calls from several
+/// threads: it is built without USE_LOCKING (openblas_get_config():
+/// "... SINGLE_THREADED"; blas_memory_free takes no lock, and
+/// blas_memory_alloc releases its lock after the initialisation check and
+/// claims a buffer slot with an unlocked test-and-set), so two level-3 calls
+/// at once can get the same work buffer. Measured: the two no-swap halves
+/// factored side by side through the one process copy failed on
+/// armadillo_52k ("not positive definite") in 3 of 4 two-thread runs. A
+/// private copy has its own buffer table (and its own OpenBLAS kernel
+/// choice, set up the same way), so the two halves share no BLAS state.
+const CholmodApi* private_cholmod() {
+  static const std::unique_ptr<CholmodApi> api = []() -> std::unique_ptr<CholmodApi> {
+#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+    Dl_info info{};
+    if (!dladdr(reinterpret_cast<void*>(&cholmod_start), &info) || !info.dli_fname) return nullptr;
+    void* h = dlmopen(LM_ID_NEWLM, info.dli_fname, RTLD_NOW | RTLD_LOCAL);
+    if (!h) return nullptr;  // kept loaded for the process's lifetime
+    auto a = std::make_unique<CholmodApi>();
+    auto get = [h](auto& fn, const char* name) {
+      fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(h, name));
+      return fn != nullptr;
+    };
+    if (!get(a->start, "cholmod_start") || !get(a->finish, "cholmod_finish") ||
+        !get(a->analyze, "cholmod_analyze") || !get(a->factorize, "cholmod_factorize") ||
+        !get(a->solve, "cholmod_solve") || !get(a->free_factor, "cholmod_free_factor") ||
+        !get(a->free_dense, "cholmod_free_dense"))
+      return nullptr;
+    a->blas_core = configure_blas_in(h);
+    // Same kernels as the process copy, or the two halves would round
+    // differently from one system (then use the process copy for both).
+    if (a->blas_core != configure_blas()) return nullptr;
+    return a;
+#else
+    return nullptr;
+#endif
+  }();
+  return api.get();
+}
+
+/// Supernodal LL' of one real symmetric matrix (lower triangle given, the
+/// order kept) through the given CHOLMOD copy; the settings of Eigen's
+/// CholmodSupernodalLLT as used below (natural order, final_asis), so it
+/// computes exactly what that does on the same matrix.
+class SupernodalHalf {
+ public:
+  SupernodalHalf() = default;
+  SupernodalHalf(const SupernodalHalf&) = delete;
+  SupernodalHalf& operator=(const SupernodalHalf&) = delete;
+  ~SupernodalHalf() { reset(nullptr); }
+  /// Binds to a CHOLMOD copy (drops any factor).
+  void reset(const CholmodApi* api) {
+    if (api_) {
+      if (factor_) api_->free_factor(&factor_, &common_);
+      api_->finish(&common_);
+    }
+    api_ = api;
+    factor_ = nullptr;
+    if (!api_) return;
+    api_->start(&common_);
+    common_.print = 0;
+    common_.nmethods = 1;
+    common_.method[0].ordering = CHOLMOD_NATURAL;
+    common_.postorder = 1;
+    common_.final_asis = 1;
+    common_.supernodal = CHOLMOD_SUPERNODAL;
+  }
+  const CholmodApi* api() const { return api_; }
+  bool analyze(const SpMat& A) {
+    if (factor_) api_->free_factor(&factor_, &common_);
+    cholmod_sparse a = view(A);
+    factor_ = api_->analyze(&a, &common_);
+    return factor_ && common_.status == CHOLMOD_OK;
+  }
+  bool factorize(const SpMat& A) {
+    if (!factor_) return false;
+    cholmod_sparse a = view(A);
+    api_->factorize(&a, factor_, &common_);
+    return common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
+  }
+  bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    cholmod_dense d{};
+    d.nrow = static_cast<std::size_t>(b.size());
+    d.ncol = 1;
+    d.nzmax = d.nrow;
+    d.d = d.nrow;
+    d.x = const_cast<double*>(b.data());
+    d.xtype = CHOLMOD_REAL;
+    d.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* r = api_->solve(CHOLMOD_A, factor_, &d, &common_);
+    if (!r) return false;
+    x = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(r->x), b.size());
+    api_->free_dense(&r, &common_);
+    return true;
+  }
+  double flops() const { return common_.fl; }
+  double nonzeros() const { return common_.lnz; }
+
+ private:
+  static cholmod_sparse view(const SpMat& A) {
+    cholmod_sparse a{};
+    a.nrow = static_cast<std::size_t>(A.rows());
+    a.ncol = static_cast<std::size_t>(A.cols());
+    a.nzmax = static_cast<std::size_t>(A.nonZeros());
+    a.p = const_cast<int*>(A.outerIndexPtr());
+    a.i = const_cast<int*>(A.innerIndexPtr());
+    a.x = const_cast<double*>(A.valuePtr());
+    a.stype = -1;  // lower triangle stored
+    a.itype = CHOLMOD_INT;
+    a.xtype = CHOLMOD_REAL;
+    a.dtype = CHOLMOD_DOUBLE;
+    a.sorted = 1;
+    a.packed = 1;
+    return a;
+  }
+  const CholmodApi* api_ = nullptr;
+  cholmod_common common_{};
+  cholmod_factor* factor_ = nullptr;
+};
+
 using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
 using Mat4 = std::array<Vec4, 4>;    // [row][col]
 using St = std::array<double, 2>;
@@ -626,7 +794,10 @@ struct PeriodicGlobalParameterization::Impl {
   Cholesky solver;
   /// The s and t systems' own factors (swap_coordinates false with
   /// separate_halves; each with its own cholmod_common).
-  std::array<Cholesky, 2> halves;
+  std::array<SupernodalHalf, 2> halves;
+  /// Whether the halves run side by side (the second on a private CHOLMOD
+  /// copy; else both on the process's, one after the other).
+  bool halves_concurrent = false;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
   std::string blas_core;  // OpenBLAS kernel set behind CHOLMOD ("" = another BLAS)
@@ -659,13 +830,17 @@ struct PeriodicGlobalParameterization::Impl {
 
   Impl(Mesh& m, PgpOptions o) : mesh(m), opt(std::move(o)) {
     blas_core = configure_blas();
-    for (Cholesky* S : {&solver, &halves[0], &halves[1]}) {
-      S->cholmod().print = 0;  // failures are thrown as SolverError, not printed
-      // The unknowns come in nested-dissection order (nested_dissection_order):
-      // CHOLMOD keeps it (then postorders the elimination tree).
-      S->cholmod().nmethods = 1;
-      S->cholmod().method[0].ordering = CHOLMOD_NATURAL;
+    if (!opt.swap_coordinates && opt.separate_halves) {
+      const CholmodApi* second = private_cholmod();
+      halves_concurrent = second != nullptr;
+      halves[0].reset(&process_cholmod());
+      halves[1].reset(second ? second : &process_cholmod());
     }
+    solver.cholmod().print = 0;  // failures are thrown as SolverError, not printed
+    // The unknowns come in nested-dissection order (nested_dissection_order):
+    // CHOLMOD keeps it (then postorders the elimination tree).
+    solver.cholmod().nmethods = 1;
+    solver.cholmod().method[0].ordering = CHOLMOD_NATURAL;
   }
 
   const PgpTopology& topology() {
@@ -813,9 +988,16 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   // The two halves as two systems on two tasks (see PgpOptions::separate_halves).
   const bool separate = split_st && opt.separate_halves;
   auto analyze_half = [&](int h) -> std::string {
-    Cholesky& S = halves[static_cast<std::size_t>(h)];
-    S.analyzePattern(pattern->half[static_cast<std::size_t>(h)]);
-    return S.info() == Eigen::Success ? std::string() : std::string("symbolic analysis failed");
+    return halves[static_cast<std::size_t>(h)].analyze(pattern->half[static_cast<std::size_t>(h)])
+               ? std::string()
+               : std::string("symbolic analysis failed");
+  };
+  // Side by side when each half has its own CHOLMOD copy, else in turn.
+  auto both_halves = [&](auto&& f) {
+    if (halves_concurrent)
+      tbb::parallel_invoke([&] { f(0); }, [&] { f(1); });
+    else
+      for (int h = 0; h < 2; ++h) f(h);
   };
   auto unknown = [n, split_st](int v, int r) { return unknown_index(v, r, n, split_st); };
   // Edge maps where they are read: edges touching a free vertex, and the
@@ -1012,10 +1194,9 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
           // The s and t halves analysed side by side (each its own
           // cholmod_common: nothing shared).
           std::array<std::string, 2> why;
-          tbb::parallel_invoke([&] { why[0] = analyze_half(0); }, [&] { why[1] = analyze_half(1); });
+          both_halves([&](int h) { why[static_cast<std::size_t>(h)] = analyze_half(h); });
           failure = !why[0].empty() ? why[0] : why[1];
-          factor_size = {halves[0].cholmod().fl + halves[1].cholmod().fl,
-                         halves[0].cholmod().lnz + halves[1].cholmod().lnz};
+          factor_size = {halves[0].flops() + halves[1].flops(), halves[0].nonzeros() + halves[1].nonzeros()};
         } else if (n > 0 && !same_pattern) {
           // Symbolic analysis of the pattern alone (the values come beside).
           solver.analyzePattern(pattern->A);
@@ -1061,12 +1242,11 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       std::array<int, 2> steps{0, 0};
       auto run_half = [&](int h) {
         Timer th;
-        Cholesky& S = halves[static_cast<std::size_t>(h)];
+        SupernodalHalf& S = halves[static_cast<std::size_t>(h)];
         SpMat& B = pattern->half[static_cast<std::size_t>(h)];
         const std::ptrdiff_t begin = h == 0 ? 0 : P.nnz_s;
         std::copy(A.valuePtr() + begin, A.valuePtr() + begin + B.nonZeros(), B.valuePtr());
-        S.factorize(B);
-        if (S.info() != Eigen::Success) why[h] = "factorisation failed (not positive definite?)";
+        if (!S.factorize(B)) why[h] = "factorisation failed (not positive definite?)";
         factor_seconds[h] = th.seconds();
         th.reset();
         const int m = 2 * n, off = h * m;
@@ -1079,14 +1259,14 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
             rh[2 * v] = b[off + 2 * v] + shift * mass[v] * (ok ? re / a : 1.0);
             rh[2 * v + 1] = b[off + 2 * v + 1] + shift * mass[v] * (ok ? im / a : 0.0);
           }
-          xh = S.solve(rh);
-          if (S.info() != Eigen::Success) why[h] = "solve failed";
+          if (!S.solve(rh, xh)) why[h] = "solve failed";
           ++steps[h];
         }
         x.segment(off, m) = xh;
         solve_seconds[h] = th.seconds();
       };
-      tbb::parallel_invoke([&] { run_half(0); }, [&] { run_half(1); });
+      both_halves(run_half);
+      res.concurrent_halves = halves_concurrent;
       failure = !why[0].empty() ? why[0] : why[1];
       // Each half's own wall time; the two run side by side.
       bd.factorization = std::max(factor_seconds[0], factor_seconds[1]);

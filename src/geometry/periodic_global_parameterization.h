@@ -167,6 +167,10 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
+  /// No-swap with separate_halves: the s and t halves were factored and
+  /// relaxed side by side (each on its own CHOLMOD/OpenBLAS copy); false
+  /// when they ran in turn (no private copy could be loaded) or not split.
+  bool concurrent_halves = false;
   /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
   /// BLAS; see the BLAS note above).
   std::string blas_core;
