@@ -215,7 +215,11 @@ const CholmodApi& process_cholmod() {
 /// choice, set up the same way), so the two halves share no BLAS state.
 const CholmodApi* private_cholmod() {
   static const std::unique_ptr<CholmodApi> api = []() -> std::unique_ptr<CholmodApi> {
-#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+#if defined(__SANITIZE_ADDRESS__)
+    // A second C library in the process, unseen by AddressSanitizer's
+    // interceptors: not under the sanitizers (the halves then run in turn).
+    return nullptr;
+#elif defined(__GLIBC__) && defined(_GNU_SOURCE)
     Dl_info info{};
     if (!dladdr(reinterpret_cast<void*>(&cholmod_start), &info) || !info.dli_fname) return nullptr;
     void* h = dlmopen(LM_ID_NEWLM, info.dli_fname, RTLD_NOW | RTLD_LOCAL);

@@ -44,6 +44,12 @@
 // bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
 // and falls back to its generic SSE3 kernels, it is switched to its AVX-512
 // (or AVX2) kernels once per process (PgpResult::blas_core names the set).
+// Debian 12's serial OpenBLAS (libopenblas0-serial 0.3.21) is not safe for
+// concurrent calls (built without USE_LOCKING: its work-buffer table is
+// claimed without a lock), so CHOLMOD is never entered from two threads
+// at once through it: with swap_coordinates false the t half runs on a
+// private copy of libcholmod and its OpenBLAS (dlmopen, own buffers, same
+// kernels) beside the s half on the process's copy (separate_halves).
 // The paper writes R with the opposite rotation sign and a 2 pi missing in
 // the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -147,12 +153,19 @@ struct PgpOptions {
   /// faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
   bool swap_coordinates = true;
   /// With swap_coordinates false only: factor and relax the s and t systems
-  /// as two CHOLMOD systems (own factor and workspace each) on two TBB tasks
-  /// instead of one block-diagonal system. Same bytes either way and on any
-  /// thread count (the same operations on the same values; CHOLMOD's dense
-  /// kernels run on the serial OpenBLAS, which Debian builds with its
-  /// USE_LOCKING option for calls from several threads: see the BLAS note
-  /// above). false is kept for comparison (tests, bench_pgp --one-system).
+  /// (each relaxation step normalises s pairs and t pairs separately, so the
+  /// two chains of 16 steps are independent) as two CHOLMOD systems on two
+  /// TBB tasks instead of one block-diagonal system: the s half on the
+  /// process's CHOLMOD, the t half on a private copy of libcholmod and its
+  /// OpenBLAS (see the BLAS note above; where no private copy loads, e.g.
+  /// under the sanitizers, the halves run in turn: PgpResult::
+  /// concurrent_halves). Same bytes as one system and on any thread count
+  /// (the same supernodal operations on the same values, same kernels).
+  /// false (one system) is kept for comparison (tests, bench_pgp
+  /// --one-system). Measured 2026-11-22 (armadillo_52k, shared machine at
+  /// load 6-9: the second core is rarely free, wall figures are for the lead
+  /// to re-measure): each half's factorisation 0.07-0.08 s thread CPU
+  /// (CHOLMOD analysis flops 2.83e8 each).
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
@@ -188,10 +201,10 @@ struct PgpResult {
     double start = 0;        ///< spanning-tree integration (initialisation only)
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
     double analysis = 0;     ///< symbolic factorisation (0 when reused)
-    double factorization = 0;  ///< numeric factorisation
+    double factorization = 0;  ///< numeric factorisation (concurrent halves: the slower half's)
     double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count)
     double factor_nonzeros = 0;  ///< in the Cholesky factor L
-    double solves = 0;       ///< all relaxation steps (right-hand side + solve)
+    double solves = 0;       ///< all relaxation steps (right-hand side + solve; concurrent halves: the slower half's)
     int steps = 0;           ///< relaxation steps run
     double energy = 0;       ///< energies at the solution
     double corners = 0;      ///< corner write-back (equation 4)
