@@ -274,30 +274,33 @@ class SupernodalHalf {
     common_.supernodal = CHOLMOD_SUPERNODAL;
   }
   const CholmodApi* api() const { return api_; }
-  bool analyze(const SpMat& A) {
+  /// Symbolic analysis of `a` (its pattern), then numeric factorisation of
+  /// a matrix with that pattern.
+  bool analyze(cholmod_sparse a) {
     if (factor_) api_->free_factor(&factor_, &common_);
-    cholmod_sparse a = view(A);
     factor_ = api_->analyze(&a, &common_);
     return factor_ && common_.status == CHOLMOD_OK;
   }
-  bool factorize(const SpMat& A) {
+  bool factorize(cholmod_sparse a) {
     if (!factor_) return false;
-    cholmod_sparse a = view(A);
     api_->factorize(&a, factor_, &common_);
     return common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
   }
-  bool solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  /// x = A^-1 b for one column of `rows` entries of type `xtype`
+  /// (interleaved (re, im) for CHOLMOD_COMPLEX); x must have room.
+  bool solve(const double* b, std::size_t rows, int xtype, double* x) {
     cholmod_dense d{};
-    d.nrow = static_cast<std::size_t>(b.size());
+    d.nrow = rows;
     d.ncol = 1;
-    d.nzmax = d.nrow;
-    d.d = d.nrow;
-    d.x = const_cast<double*>(b.data());
-    d.xtype = CHOLMOD_REAL;
+    d.nzmax = rows;
+    d.d = rows;
+    d.x = const_cast<double*>(b);
+    d.xtype = xtype;
     d.dtype = CHOLMOD_DOUBLE;
     cholmod_dense* r = api_->solve(CHOLMOD_A, factor_, &d, &common_);
     if (!r) return false;
-    x = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(r->x), b.size());
+    const std::size_t count = xtype == CHOLMOD_COMPLEX ? 2 * rows : rows;
+    std::copy(static_cast<const double*>(r->x), static_cast<const double*>(r->x) + count, x);
     api_->free_dense(&r, &common_);
     return true;
   }
@@ -305,22 +308,6 @@ class SupernodalHalf {
   double nonzeros() const { return common_.lnz; }
 
  private:
-  static cholmod_sparse view(const SpMat& A) {
-    cholmod_sparse a{};
-    a.nrow = static_cast<std::size_t>(A.rows());
-    a.ncol = static_cast<std::size_t>(A.cols());
-    a.nzmax = static_cast<std::size_t>(A.nonZeros());
-    a.p = const_cast<int*>(A.outerIndexPtr());
-    a.i = const_cast<int*>(A.innerIndexPtr());
-    a.x = const_cast<double*>(A.valuePtr());
-    a.stype = -1;  // lower triangle stored
-    a.itype = CHOLMOD_INT;
-    a.xtype = CHOLMOD_REAL;
-    a.dtype = CHOLMOD_DOUBLE;
-    a.sorted = 1;
-    a.packed = 1;
-    return a;
-  }
   const CholmodApi* api_ = nullptr;
   cholmod_common common_{};
   cholmod_factor* factor_ = nullptr;
@@ -639,32 +626,58 @@ struct PgpPattern {
   /// -1 for the entries that are structurally zero (or no block)
   std::vector<std::array<std::ptrdiff_t, 16>> off;
   /// split_st only: the two diagonal blocks of A (s: unknowns 0..2n-1, t:
-  /// 2n..4n-1; A has nothing outside them) as two matrices of their own,
-  /// whose values are A's first `nnz_s` values and the rest, in order.
-  std::array<SpMat, 2> half;
-  std::ptrdiff_t nnz_s = 0;
+  /// 2n..4n-1; A has nothing outside them) as two complex Hermitian n x n
+  /// matrices (lower triangle, CHOLMOD's interleaved complex values): each
+  /// 2x2 block of a half is a scaled rotation [[c, -s], [s, c]] (vertex
+  /// blocks c I), i.e. multiplication by c + i s, so the half is the real
+  /// form of the complex system of z_s (z_t) itself.
+  struct ComplexHalf {
+    std::vector<int> col, row;  ///< CSC pattern (n + 1 column starts, row indices)
+    std::vector<double> x;      ///< (re, im) per entry
+    /// per entry: positions in A's values of its real part (entry (2r, 2c)
+    /// of the half) and imaginary part ((2r+1, 2c); -1 on the diagonal)
+    std::vector<std::ptrdiff_t> re, im;
+  };
+  std::array<ComplexHalf, 2> half;
 };
 
-/// The two diagonal 2n x 2n blocks of a block-diagonal lower triangle (split
-/// numbering), same entry order as in A (column-major, rows sorted).
+/// The two complex halves of a block-diagonal lower triangle (split
+/// numbering): per vertex column c of half h, the even real column 2c (its
+/// odd column holds the same numbers by the rotation structure).
 void split_halves(PgpPattern& p) {
-  const int m = 2 * p.n;
+  const int n = p.n, m = 2 * n;
   const SpMat& A = p.A;
-  p.nnz_s = A.outerIndexPtr()[m];
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
   for (int h = 0; h < 2; ++h) {
-    SpMat& B = p.half[static_cast<std::size_t>(h)];
-    const std::ptrdiff_t begin = h == 0 ? 0 : p.nnz_s, end = h == 0 ? p.nnz_s : A.nonZeros();
-    B.resize(m, m);
-    B.resizeNonZeros(end - begin);
-    for (int c = 0; c <= m; ++c) B.outerIndexPtr()[c] = static_cast<int>(A.outerIndexPtr()[h * m + c] - begin);
-    for (std::ptrdiff_t q = begin; q < end; ++q) {
-      const int row = A.innerIndexPtr()[q] - h * m;
-      if (row < 0 || row >= m)
-        throw SolverError("periodic_global_parameterization: s and t systems not independent (entry row " +
-                          std::to_string(row + h * m) + ")");
-      B.innerIndexPtr()[q - begin] = row;
-      B.valuePtr()[q - begin] = 0.0;
+    PgpPattern::ComplexHalf& C = p.half[static_cast<std::size_t>(h)];
+    C.col.assign(static_cast<std::size_t>(n) + 1, 0);
+    C.row.clear();
+    C.re.clear();
+    C.im.clear();
+    for (int c = 0; c < n; ++c) {
+      const int real_col = h * m + 2 * c;
+      for (int q = outer[real_col]; q < outer[real_col + 1]; ++q) {
+        const int r = inner[q] - h * m;  // real row within the half
+        if (r < 0 || r >= m)
+          throw SolverError("periodic_global_parameterization: s and t systems not independent (entry row " +
+                            std::to_string(inner[q]) + ")");
+        if (r % 2 != 0) continue;  // an imaginary part, taken with its real part
+        C.row.push_back(r / 2);
+        C.re.push_back(q);
+        std::ptrdiff_t im = -1;
+        if (r / 2 != c) {
+          // the next stored row of this column is r + 1 (rows sorted)
+          if (q + 1 >= outer[real_col + 1] || inner[q + 1] - h * m != r + 1)
+            throw SolverError("periodic_global_parameterization: s and t blocks not rotations at row " +
+                              std::to_string(inner[q]));
+          im = q + 1;
+        }
+        C.im.push_back(im);
+      }
+      C.col[static_cast<std::size_t>(c) + 1] = static_cast<int>(C.row.size());
     }
+    C.x.assign(2 * C.row.size(), 0.0);
   }
 }
 
@@ -991,10 +1004,26 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   const bool split_st = !opt.swap_coordinates;
   // The two halves as two systems on two tasks (see PgpOptions::separate_halves).
   const bool separate = split_st && opt.separate_halves;
+  // Half h as a complex Hermitian CHOLMOD matrix (lower triangle given).
+  auto half_matrix = [&](int h) {
+    PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+    cholmod_sparse a{};
+    a.nrow = a.ncol = static_cast<std::size_t>(pattern->n);
+    a.nzmax = C.row.size();
+    a.p = C.col.data();
+    a.i = C.row.data();
+    a.x = C.x.data();
+    a.stype = -1;
+    a.itype = CHOLMOD_INT;
+    a.xtype = CHOLMOD_COMPLEX;
+    a.dtype = CHOLMOD_DOUBLE;
+    a.sorted = 1;
+    a.packed = 1;
+    return a;
+  };
   auto analyze_half = [&](int h) -> std::string {
-    return halves[static_cast<std::size_t>(h)].analyze(pattern->half[static_cast<std::size_t>(h)])
-               ? std::string()
-               : std::string("symbolic analysis failed");
+    return halves[static_cast<std::size_t>(h)].analyze(half_matrix(h)) ? std::string()
+                                                                          : std::string("symbolic analysis failed");
   };
   // Side by side when each half has its own CHOLMOD copy, else in turn.
   auto both_halves = [&](auto&& f) {
@@ -1247,10 +1276,13 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
       auto run_half = [&](int h) {
         Timer th;
         SupernodalHalf& S = halves[static_cast<std::size_t>(h)];
-        SpMat& B = pattern->half[static_cast<std::size_t>(h)];
-        const std::ptrdiff_t begin = h == 0 ? 0 : P.nnz_s;
-        std::copy(A.valuePtr() + begin, A.valuePtr() + begin + B.nonZeros(), B.valuePtr());
-        if (!S.factorize(B)) why[h] = "factorisation failed (not positive definite?)";
+        PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+        const double* val = A.valuePtr();
+        for (std::size_t q = 0; q < C.re.size(); ++q) {
+          C.x[2 * q] = val[C.re[q]];
+          C.x[2 * q + 1] = C.im[q] >= 0 ? val[C.im[q]] : 0.0;
+        }
+        if (!S.factorize(half_matrix(h))) why[h] = "factorisation failed (not positive definite?)";
         factor_seconds[h] = th.seconds();
         th.reset();
         const int m = 2 * n, off = h * m;
@@ -1263,7 +1295,8 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
             rh[2 * v] = b[off + 2 * v] + shift * mass[v] * (ok ? re / a : 1.0);
             rh[2 * v + 1] = b[off + 2 * v + 1] + shift * mass[v] * (ok ? im / a : 0.0);
           }
-          if (!S.solve(rh, xh)) why[h] = "solve failed";
+          // (re, im) pairs: the complex right-hand side and solution as they are
+          if (!S.solve(rh.data(), static_cast<std::size_t>(n), CHOLMOD_COMPLEX, xh.data())) why[h] = "solve failed";
           ++steps[h];
         }
         x.segment(off, m) = xh;

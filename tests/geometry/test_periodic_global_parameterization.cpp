@@ -396,13 +396,14 @@ TEST(PeriodicGlobalParameterization, NoSwapSameBytesWithOneOrTwoThreadsOnFandisk
   EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
 }
 
-// The no-swap s and t systems factored and relaxed as two CHOLMOD systems on
-// two tasks (PgpOptions::separate_halves, the default) must give exactly what
-// the single block-diagonal system gives (separate_halves false, one thread):
-// an exchanged, misplaced or half-copied value, a wrong offset of the t half
-// or a shared workspace would change the bytes of z, the energies or the
-// corners. Run on two threads, so that the halves' BLAS calls overlap.
-TEST(PeriodicGlobalParameterization, NoSwapTwoSystemsGiveTheBytesOfOneSystem) {
+// The no-swap s and t systems factored and relaxed as two complex Hermitian
+// CHOLMOD systems on two tasks (PgpOptions::separate_halves, the default)
+// must give what the single real block-diagonal system gives (separate_halves
+// false, one thread) up to rounding: an exchanged, misplaced or conjugated
+// entry, a wrong offset of the t half or a shared workspace would change z,
+// the energies or the corners by far more than 1e-9 (measured: 7e-14). Run
+// on two threads, so that the halves' BLAS calls overlap.
+TEST(PeriodicGlobalParameterization, NoSwapTwoComplexSystemsMatchOneRealSystem) {
   PgpOptions two;
   two.swap_coordinates = false;
   PgpOptions one = two;
@@ -411,8 +412,7 @@ TEST(PeriodicGlobalParameterization, NoSwapTwoSystemsGiveTheBytesOfOneSystem) {
   ASSERT_EQ(a.size(), b.size());
   double worst = 0;
   for (std::size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
-  EXPECT_EQ(0.0, worst);
-  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(double)));
+  EXPECT_LT(worst, 1e-9);
   // And the halves really are different systems (not one solved twice).
   Mesh m;
   fandisk_with_cuts(m);
