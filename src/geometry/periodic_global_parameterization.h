@@ -46,10 +46,10 @@
 // (or AVX2) kernels once per process (PgpResult::blas_core names the set).
 // Debian 12's serial OpenBLAS (libopenblas0-serial 0.3.21) is not safe for
 // concurrent calls (built without USE_LOCKING: its work-buffer table is
-// claimed without a lock), so CHOLMOD is never entered from two threads
-// at once through it: with swap_coordinates false the t half runs on a
-// private copy of libcholmod and its OpenBLAS (dlmopen, own buffers, same
-// kernels) beside the s half on the process's copy (separate_halves).
+// claimed without a lock), so the BLAS-reaching CHOLMOD calls (numeric
+// factorisation, solves) of all solvers of the process take turns behind
+// one lock: the no-swap s and t halves run one after the other, and two
+// solvers on two threads give the bytes each gives alone.
 // The paper writes R with the opposite rotation sign and a 2 pi missing in
 // the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -149,23 +149,29 @@ struct PgpOptions {
   /// half of each triangular solve. The faces along the field's cuts then
   /// become singular (distorted faces), which section 3's blending hides.
   /// Measured (bench_pgp --no-swap, load ~3): armadillo_52k first init
-  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8; singular
-  /// faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
+  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8 (one real
+  /// system; see separate_halves for the complex halves: 0.44 s CPU);
+  /// singular faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
   bool swap_coordinates = true;
   /// With swap_coordinates false only: factor and relax the s and t systems
   /// (each relaxation step normalises s pairs and t pairs separately, so the
-  /// two chains of 16 steps are independent) as two CHOLMOD systems on two
-  /// TBB tasks instead of one block-diagonal system: the s half on the
-  /// process's CHOLMOD, the t half on a private copy of libcholmod and its
-  /// OpenBLAS (see the BLAS note above; where no private copy loads, e.g.
-  /// under the sanitizers, the halves run in turn: PgpResult::
-  /// concurrent_halves). Same bytes as one system and on any thread count
-  /// (the same supernodal operations on the same values, same kernels).
-  /// false (one system) is kept for comparison (tests, bench_pgp
-  /// --one-system). Measured 2026-11-22 (armadillo_52k, shared machine at
-  /// load 6-9: the second core is rarely free, wall figures are for the lead
-  /// to re-measure): each half's factorisation 0.07-0.08 s thread CPU
-  /// (CHOLMOD analysis flops 2.83e8 each).
+  /// two chains of steps are independent) one after the other, each as the
+  /// complex Hermitian n x n system of z_s (z_t) that its real 2n x 2n form
+  /// stands for (the 2x2 blocks are scaled rotations: multiplication by
+  /// c + i s), instead of one real block-diagonal 4n system: about half the
+  /// real flops of the factorisation and half the factor's bytes read per
+  /// solve. Same bytes on any thread count; equal to the one-system result
+  /// up to rounding (fandisk init + update: 7e-14). false (one real system)
+  /// is kept for comparison (tests, bench_pgp --one-system). The two halves
+  /// could run side by side (independent), but not on this BLAS (see the
+  /// BLAS note above). The coupled form (the default) has no complex form:
+  /// its quarter and half turns conjugate z (antilinear maps).
+  /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 7-8
+  /// (wall figures for the lead to re-measure), one real system -> two
+  /// complex halves, CPU seconds: init (analysis reused) 0.37 -> 0.24,
+  /// first call 0.59 -> 0.44, local update 0.065 -> 0.035; factorisation
+  /// 0.17-0.26 -> 0.08-0.12 s wall, 16 solves 0.14-0.23 -> 0.13-0.15;
+  /// singular fractions unchanged.
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
@@ -180,10 +186,6 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
-  /// No-swap with separate_halves: the s and t halves were factored and
-  /// relaxed side by side (each on its own CHOLMOD/OpenBLAS copy); false
-  /// when they ran in turn (no private copy could be loaded) or not split.
-  bool concurrent_halves = false;
   /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
   /// BLAS; see the BLAS note above).
   std::string blas_core;
@@ -201,10 +203,10 @@ struct PgpResult {
     double start = 0;        ///< spanning-tree integration (initialisation only)
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
     double analysis = 0;     ///< symbolic factorisation (0 when reused)
-    double factorization = 0;  ///< numeric factorisation (concurrent halves: the slower half's)
-    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count)
+    double factorization = 0;  ///< numeric factorisation
+    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count from the pattern; for the complex halves of the n x n patterns, each a complex operation, ~4 real flops)
     double factor_nonzeros = 0;  ///< in the Cholesky factor L
-    double solves = 0;       ///< all relaxation steps (right-hand side + solve; concurrent halves: the slower half's)
+    double solves = 0;       ///< all relaxation steps (right-hand side + solve)
     int steps = 0;           ///< relaxation steps run
     double energy = 0;       ///< energies at the solution
     double corners = 0;      ///< corner write-back (equation 4)
