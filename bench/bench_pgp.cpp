@@ -142,8 +142,8 @@
 // the solves are memory-bound), ordering 0.13-0.14 s (unchanged, beside the
 // field). The 0.5 s first-call goal at 52K is still missed by ~0.07 s at
 // this load, at the price of the coupling's gain on fandisk.
-// Issue #5 session 5 (2026-11-22 13:00-13:25 UTC, shared 2-core machine at
-// load 6-9 throughout: the process mostly gets one core (CPU ~ wall); CPU
+// Issue #5 session 5 (2026-11-22 12:38-13:21 UTC, shared 2-core machine at
+// load 6-10 throughout: the process mostly gets one core (CPU ~ wall); CPU
 // seconds are the reliable figure, wall for the lead to re-measure
 // quietly). --no-swap: the s and t halves now run as two complex Hermitian
 // n x n systems (each 2x2 block of a half is a scaled rotation), one after
@@ -161,25 +161,29 @@
 // (dlmopen): same bytes and safe BLAS, but the second libgomp/libc share the
 // threads' pthread-key slots with the first, and a std::thread that ran both
 // aborted at exit (libgomp goacc_destroy_thread assertion). Best of 3 per
-// bench run, wall / CPU
-// seconds, one real system (--one-system) -> two complex halves:
+// bench run, wall / CPU seconds, one real system (--one-system) -> two
+// complex halves, final version (halves in turn), 13:19-13:21 UTC, load
+// 7.9-10.1 (wall ~2x CPU):
 //                          fandisk (12.9K)     dragon_25k (25.0K)  armadillo_52k (52.0K)
-//   init, first call       0.14/0.14 ->        0.32-0.37/0.25-0.27 0.58-1.07/0.58-0.69 ->
-//                          0.21/0.11           -> 0.25/0.19        0.61-0.66/0.44-0.45
-//   init, analysis reused  0.09/0.09 ->        0.16-0.24/0.17 ->   0.37-0.57/0.37-0.43 ->
-//                          0.07/0.06           0.11/0.11           0.30-0.36/0.23-0.25
-//   local update PGP       0.011-0.013 ->      0.024-0.031/0.023   0.054-0.16/0.056-0.105 ->
-//                          0.007/0.011         -> 0.021/0.016      0.035-0.052/0.035-0.036
-//   armadillo breakdown (reused, wall): factorisation 0.17-0.26 -> 0.08-0.12,
-//   16 solves 0.14-0.23 -> 0.13-0.15; CHOLMOD's pattern
+//   init, first call       0.25/0.14 ->        0.49/0.26 ->        1.16-1.30/0.64 ->
+//                          0.18/0.09           0.41/0.20           0.65-0.84/0.40-0.43
+//   init, analysis reused  0.18/0.09 ->        0.33/0.16 ->        0.48-0.81/0.38-0.41 ->
+//                          0.09/0.05           0.20/0.10           0.26-0.47/0.23-0.24
+//   local update PGP       0.021/0.013 ->      0.052/0.025 ->      0.067-0.14/0.059-0.069 ->
+//                          0.013/0.007         0.032/0.016         0.048-0.075/0.034-0.042
+//   armadillo breakdown (analysis reused, wall): factorisation 0.19-0.37 ->
+//   0.08-0.16, 16 solves 0.19-0.32 -> 0.11-0.19; CHOLMOD's pattern
 //   flop count 5.66e8 (real 4n) -> 7.14e7 (two n x n complex patterns, ~4
-//   real flops per complex operation: about half the real work).
+//   real flops per complex operation: about half the real work). Earlier
+//   runs (13:00-13:06, load 6-8, the halves then side by side on the
+//   dlmopen'ed copy, effectively one core): armadillo reused 0.30-0.36 /
+//   0.23-0.25, first call 0.61-0.66 / 0.44-0.45, update 0.035-0.052 / 0.035.
 // Results equal the one-system ones to 7e-14 (fandisk init + update);
 // singular fraction unchanged: fandisk 22.90%, dragon_25k 57.96%,
 // armadillo_52k 33.08% (--no-swap). The coupled default is unchanged (same
-// bytes; this session: armadillo init first call 0.67-0.81 / 0.66-0.68,
-// reused 0.44-0.62 / 0.44-0.52, update 0.087-0.10 / 0.078-0.095; fandisk
-// 9.58%, dragon 58.43%, armadillo 29.59%). CHOLMOD nrelax/zrelax for the
+// bytes; this session at load 6-10: armadillo init first call 0.67-1.11 /
+// 0.66-0.68, reused 0.44-0.82 / 0.44-0.52, update 0.087-0.15 / 0.077-0.095;
+// fandisk 9.58%, dragon 58.43%, armadillo 29.59%). CHOLMOD nrelax/zrelax for the
 // no-swap halves ({16,64,256}/{.8,.4,.2}, {8,32,128}/{.8,.2,.1} against the
 // default {4,16,48}/{.8,.1,.05}): 0.073-0.079 s thread CPU per half either
 // way, within the noise, kept at the defaults.

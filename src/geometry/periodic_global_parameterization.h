@@ -166,12 +166,11 @@ struct PgpOptions {
   /// could run side by side (independent), but not on this BLAS (see the
   /// BLAS note above). The coupled form (the default) has no complex form:
   /// its quarter and half turns conjugate z (antilinear maps).
-  /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 7-8
+  /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 8-10
   /// (wall figures for the lead to re-measure), one real system -> two
-  /// complex halves, CPU seconds: init (analysis reused) 0.37 -> 0.24,
-  /// first call 0.59 -> 0.44, local update 0.065 -> 0.035; factorisation
-  /// 0.17-0.26 -> 0.08-0.12 s wall, 16 solves 0.14-0.23 -> 0.13-0.15;
-  /// singular fractions unchanged.
+  /// complex halves, CPU seconds: init (analysis reused) 0.38-0.41 ->
+  /// 0.23-0.24, first call 0.64 -> 0.40-0.43, local update 0.059-0.069 ->
+  /// 0.034-0.042; singular fractions unchanged (bench_pgp header).
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
