@@ -4,7 +4,7 @@
 // over ~25% of the triangles, on real meshes of ~11K, ~24K and ~50K triangles.
 // Best of 3 runs (wall "seconds", and "cpu_seconds" of all threads of that
 // run); one JSON line per mesh and step.
-// Usage: bench_pgp [--no-sweep] [--no-swap] [mesh ...]   (default: shared data fandisk,
+// Usage: bench_pgp [--no-sweep] [--no-swap [--one-system]] [mesh ...]   (default: shared data fandisk,
 // dragon_25k, armadillo_52k; --no-sweep skips the singular fraction against
 // the period). The PGP steps carry the solver's own wall-time breakdown.
 //
@@ -142,6 +142,51 @@
 // the solves are memory-bound), ordering 0.13-0.14 s (unchanged, beside the
 // field). The 0.5 s first-call goal at 52K is still missed by ~0.07 s at
 // this load, at the price of the coupling's gain on fandisk.
+// Issue #5 session 5 (2026-11-22 12:38-13:21 UTC, shared 2-core machine at
+// load 6-10 throughout: the process mostly gets one core (CPU ~ wall); CPU
+// seconds are the reliable figure, wall for the lead to re-measure
+// quietly). --no-swap: the s and t halves now run as two complex Hermitian
+// n x n systems (each 2x2 block of a half is a scaled rotation), one after
+// the other (PgpOptions::separate_halves; --one-system = the previous
+// single real block-diagonal system). Side by side on two TBB tasks they
+// would be independent, but Debian's libopenblas0-serial 0.3.21 is not
+// safe for concurrent calls (config "OpenBLAS 0.3.21 NO_LAPACKE
+// DYNAMIC_ARCH NO_AFFINITY SkylakeX SINGLE_THREADED"; no pthread import;
+// blas_memory_alloc claims buffer slots with an unlocked test-and-set,
+// blas_memory_free takes no lock: built without USE_LOCKING): the two
+// halves factored side by side failed with "not positive definite" in 3 of
+// 4 two-thread armadillo runs. Tried and dropped: CHOLMOD's simplicial LL'
+// (no BLAS) for one half, 0.16-0.19 s thread CPU against 0.07-0.08 for a
+// supernodal half (no gain); a private libcholmod + OpenBLAS copy per half
+// (dlmopen): same bytes and safe BLAS, but the second libgomp/libc share the
+// threads' pthread-key slots with the first, and a std::thread that ran both
+// aborted at exit (libgomp goacc_destroy_thread assertion). Best of 3 per
+// bench run, wall / CPU seconds, one real system (--one-system) -> two
+// complex halves, final version (halves in turn), 13:19-13:21 UTC, load
+// 7.9-10.1 (wall ~2x CPU):
+//                          fandisk (12.9K)     dragon_25k (25.0K)  armadillo_52k (52.0K)
+//   init, first call       0.25/0.14 ->        0.49/0.26 ->        1.16-1.30/0.64 ->
+//                          0.18/0.09           0.41/0.20           0.65-0.84/0.40-0.43
+//   init, analysis reused  0.18/0.09 ->        0.33/0.16 ->        0.48-0.81/0.38-0.41 ->
+//                          0.09/0.05           0.20/0.10           0.26-0.47/0.23-0.24
+//   local update PGP       0.021/0.013 ->      0.052/0.025 ->      0.067-0.14/0.059-0.069 ->
+//                          0.013/0.007         0.032/0.016         0.048-0.075/0.034-0.042
+//   armadillo breakdown (analysis reused, wall): factorisation 0.19-0.37 ->
+//   0.08-0.16, 16 solves 0.19-0.32 -> 0.11-0.19; CHOLMOD's pattern
+//   flop count 5.66e8 (real 4n) -> 7.14e7 (two n x n complex patterns, ~4
+//   real flops per complex operation: about half the real work). Earlier
+//   runs (13:00-13:06, load 6-8, the halves then side by side on the
+//   dlmopen'ed copy, effectively one core): armadillo reused 0.30-0.36 /
+//   0.23-0.25, first call 0.61-0.66 / 0.44-0.45, update 0.035-0.052 / 0.035.
+// Results equal the one-system ones to 7e-14 (fandisk init + update);
+// singular fraction unchanged: fandisk 22.90%, dragon_25k 57.96%,
+// armadillo_52k 33.08% (--no-swap). The coupled default is unchanged (same
+// bytes; this session at load 6-10: armadillo init first call 0.67-1.11 /
+// 0.66-0.68, reused 0.44-0.82 / 0.44-0.52, update 0.087-0.15 / 0.077-0.095;
+// fandisk 9.58%, dragon 58.43%, armadillo 29.59%). CHOLMOD nrelax/zrelax for the
+// no-swap halves ({16,64,256}/{.8,.4,.2}, {8,32,128}/{.8,.2,.1} against the
+// default {4,16,48}/{.8,.1,.05}): 0.073-0.079 s thread CPU per half either
+// way, within the noise, kept at the defaults.
 #include <nlohmann/json.hpp>
 #include <tbb/parallel_invoke.h>
 
@@ -203,10 +248,11 @@ void emit(const std::string& mesh, std::size_t faces, const std::string& step, d
 
 // The PGP's own breakdown of one run (wall seconds per step).
 bool g_swap_coordinates = true;  // PgpOptions::swap_coordinates of the run (--no-swap)
+bool g_separate_halves = false;  // no-swap solved as two complex systems (not --one-system)
 
 nlohmann::json breakdown(const PgpResult& r) {
   const PgpResult::Breakdown& b = r.breakdown;
-  return {{"pgp_seconds", r.seconds},         {"swap_coordinates", g_swap_coordinates},         {"topology", b.topology},
+  return {{"pgp_seconds", r.seconds},         {"swap_coordinates", g_swap_coordinates}, {"separate_halves", g_separate_halves},         {"topology", b.topology},
           {"field", b.field},                 {"ordering", b.ordering},
           {"pattern", b.pattern},
           {"start", b.start},                 {"assembly", b.assembly},
@@ -389,12 +435,15 @@ int main(int argc, char** argv) {
       pgp_options.curl_correction = true;
     else if (std::string(argv[i]) == "--no-swap")
       pgp_options.swap_coordinates = false;  // the paper's simplified PGP (section 2.3)
+    else if (std::string(argv[i]) == "--one-system")
+      pgp_options.separate_halves = false;  // with --no-swap: one block-diagonal CHOLMOD system
     else if (std::string(argv[i]) == "--field-sweep")
       field_sweep = true;
     else
       meshes.push_back(argv[i]);
   }
   g_swap_coordinates = pgp_options.swap_coordinates;
+  g_separate_halves = !pgp_options.swap_coordinates && pgp_options.separate_halves;
   if (meshes.empty()) {
     const std::string d = std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/";
     meshes = {d + "fandisk.off", d + "dragon_25k.off", d + "armadillo_52k.off"};

@@ -44,6 +44,11 @@ bool metis_order(std::vector<idx_t>& xadj, std::vector<idx_t>& adjncy, std::vect
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_NUMBERING] = 0;
+  // METIS draws from libc's one rand() state (srand(seed) per call, see
+  // nested_dissection_order): two solvers ordering at once on two threads
+  // would interleave their draws. One at a time.
+  static std::mutex metis_mutex;
+  std::lock_guard<std::mutex> lock(metis_mutex);
   return METIS_NodeND(&nv, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data()) == METIS_OK;
 }
 
@@ -154,6 +159,89 @@ const std::string& configure_blas() {
   }();
   return core;
 }
+
+/// Held around every call into CHOLMOD that reaches the BLAS (numeric
+/// factorisation, solve). Debian 12's serial OpenBLAS (libopenblas0-serial
+/// 0.3.21) is not safe for concurrent calls from several threads: it is
+/// built without USE_LOCKING (openblas_get_config(): "OpenBLAS 0.3.21
+/// NO_LAPACKE DYNAMIC_ARCH NO_AFFINITY SkylakeX SINGLE_THREADED"; no pthread
+/// import; blas_memory_free takes no lock and blas_memory_alloc releases its
+/// lock after the initialisation check, then claims a work-buffer slot with
+/// an unlocked test-and-set), so two level-3 calls at once can share a work
+/// buffer. Measured: the no-swap s and t halves factored side by side on two
+/// TBB tasks failed with "not positive definite" in 3 of 4 two-thread
+/// armadillo_52k runs (and passed with this lock). So the halves run in turn,
+/// and two solvers on two threads take turns here (same bytes as alone).
+/// (A private copy of libcholmod + OpenBLAS loaded with dlmopen did run the
+/// halves side by side with the same bytes, but its second libgomp and C
+/// library share the threads' pthread-key slots with the first: a thread
+/// that had run OpenMP code of both and then exited aborted in libgomp's
+/// goacc_destroy_thread. Dropped.)
+std::mutex& cholmod_blas_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+/// Supernodal LL' (LL^H) of one real symmetric (complex Hermitian) matrix,
+/// lower triangle given, the order kept (natural, postordered): the settings
+/// of Eigen's CholmodSupernodalLLT as used for the one-system path.
+class SupernodalHalf {
+ public:
+  SupernodalHalf() {
+    cholmod_start(&common_);
+    common_.print = 0;  // failures are thrown as SolverError, not printed
+    common_.nmethods = 1;
+    common_.method[0].ordering = CHOLMOD_NATURAL;  // the nested-dissection order given
+    common_.postorder = 1;
+    common_.final_asis = 1;
+    common_.supernodal = CHOLMOD_SUPERNODAL;
+  }
+  SupernodalHalf(const SupernodalHalf&) = delete;
+  SupernodalHalf& operator=(const SupernodalHalf&) = delete;
+  ~SupernodalHalf() {
+    if (factor_) cholmod_free_factor(&factor_, &common_);
+    cholmod_finish(&common_);
+  }
+  /// Symbolic analysis of `a` (its pattern), then numeric factorisation of
+  /// a matrix with that pattern.
+  bool analyze(cholmod_sparse a) {
+    if (factor_) cholmod_free_factor(&factor_, &common_);
+    factor_ = cholmod_analyze(&a, &common_);
+    return factor_ && common_.status == CHOLMOD_OK;
+  }
+  bool factorize(cholmod_sparse a) {
+    if (!factor_) return false;
+    std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+    cholmod_factorize(&a, factor_, &common_);
+    return common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
+  }
+  /// x = A^-1 b for one column of `rows` entries of type `xtype`
+  /// (interleaved (re, im) for CHOLMOD_COMPLEX); x must have room.
+  bool solve(const double* b, std::size_t rows, int xtype, double* x) {
+    cholmod_dense d{};
+    d.nrow = rows;
+    d.ncol = 1;
+    d.nzmax = rows;
+    d.d = rows;
+    d.x = const_cast<double*>(b);
+    d.xtype = xtype;
+    d.dtype = CHOLMOD_DOUBLE;
+    std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+    cholmod_dense* r = cholmod_solve(CHOLMOD_A, factor_, &d, &common_);
+    if (!r) return false;
+    const std::size_t count = xtype == CHOLMOD_COMPLEX ? 2 * rows : rows;
+    std::copy(static_cast<const double*>(r->x), static_cast<const double*>(r->x) + count, x);
+    cholmod_free_dense(&r, &common_);
+    return true;
+  }
+  double flops() const { return common_.fl; }
+  double nonzeros() const { return common_.lnz; }
+
+ private:
+  cholmod_common common_{};
+  cholmod_factor* factor_ = nullptr;
+};
+
 using Vec4 = std::array<double, 4>;  // (Re z_s, Im z_s, Re z_t, Im z_t) of one vertex
 using Mat4 = std::array<Vec4, 4>;    // [row][col]
 using St = std::array<double, 2>;
@@ -466,7 +554,61 @@ struct PgpPattern {
   /// per live edge: positions of the 4x4 block (row-major) below the diagonal,
   /// -1 for the entries that are structurally zero (or no block)
   std::vector<std::array<std::ptrdiff_t, 16>> off;
+  /// split_st only: the two diagonal blocks of A (s: unknowns 0..2n-1, t:
+  /// 2n..4n-1; A has nothing outside them) as two complex Hermitian n x n
+  /// matrices (lower triangle, CHOLMOD's interleaved complex values): each
+  /// 2x2 block of a half is a scaled rotation [[c, -s], [s, c]] (vertex
+  /// blocks c I), i.e. multiplication by c + i s, so the half is the real
+  /// form of the complex system of z_s (z_t) itself.
+  struct ComplexHalf {
+    std::vector<int> col, row;  ///< CSC pattern (n + 1 column starts, row indices)
+    std::vector<double> x;      ///< (re, im) per entry
+    /// per entry: positions in A's values of its real part (entry (2r, 2c)
+    /// of the half) and imaginary part ((2r+1, 2c); -1 on the diagonal)
+    std::vector<std::ptrdiff_t> re, im;
+  };
+  std::array<ComplexHalf, 2> half;
 };
+
+/// The two complex halves of a block-diagonal lower triangle (split
+/// numbering): per vertex column c of half h, the even real column 2c (its
+/// odd column holds the same numbers by the rotation structure).
+void split_halves(PgpPattern& p) {
+  const int n = p.n, m = 2 * n;
+  const SpMat& A = p.A;
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  for (int h = 0; h < 2; ++h) {
+    PgpPattern::ComplexHalf& C = p.half[static_cast<std::size_t>(h)];
+    C.col.assign(static_cast<std::size_t>(n) + 1, 0);
+    C.row.clear();
+    C.re.clear();
+    C.im.clear();
+    for (int c = 0; c < n; ++c) {
+      const int real_col = h * m + 2 * c;
+      for (int q = outer[real_col]; q < outer[real_col + 1]; ++q) {
+        const int r = inner[q] - h * m;  // real row within the half
+        if (r < 0 || r >= m)
+          throw SolverError("periodic_global_parameterization: s and t systems not independent (entry row " +
+                            std::to_string(inner[q]) + ")");
+        if (r % 2 != 0) continue;  // an imaginary part, taken with its real part
+        C.row.push_back(r / 2);
+        C.re.push_back(q);
+        std::ptrdiff_t im = -1;
+        if (r / 2 != c) {
+          // the next stored row of this column is r + 1 (rows sorted)
+          if (q + 1 >= outer[real_col + 1] || inner[q + 1] - h * m != r + 1)
+            throw SolverError("periodic_global_parameterization: s and t blocks not rotations at row " +
+                              std::to_string(inner[q]));
+          im = q + 1;
+        }
+        C.im.push_back(im);
+      }
+      C.col[static_cast<std::size_t>(c) + 1] = static_cast<int>(C.row.size());
+    }
+    C.x.assign(2 * C.row.size(), 0.0);
+  }
+}
 
 /// Entry (r, c) of an edge block is structurally nonzero iff the pairs of r
 /// and c (s = 0, t = 1) match up to the parity of the frames' turns.
@@ -519,6 +661,7 @@ PgpPattern make_pattern(const PgpTopology& t, std::vector<int> var, int n, std::
   none.fill(-1);
   p.off.assign(t.ends.size(), none);
   for_each_block_entry([&](std::size_t k, int rc, int row, int col) { p.off[k][rc] = position(row, col); });
+  if (split_st) split_halves(p);
   return p;
 }
 
@@ -595,6 +738,9 @@ struct PeriodicGlobalParameterization::Impl {
   /// Order of the initial free set computed ahead by prepare(): (natural, var).
   std::unique_ptr<std::pair<std::vector<int>, std::vector<int>>> prepared;
   Cholesky solver;
+  /// The s and t systems' own factors (swap_coordinates false with
+  /// separate_halves; each with its own cholmod_common).
+  std::array<SupernodalHalf, 2> halves;
   std::array<double, 2> factor_size{0, 0};  // flops and nonzeros of the analysed factor
   bool analyzed = false;
   std::string blas_core;  // OpenBLAS kernel set behind CHOLMOD ("" = another BLAS)
@@ -776,6 +922,29 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   const int n = count;
   const int n4 = 4 * n;
   const bool split_st = !opt.swap_coordinates;
+  // The two halves as two systems on two tasks (see PgpOptions::separate_halves).
+  const bool separate = split_st && opt.separate_halves;
+  // Half h as a complex Hermitian CHOLMOD matrix (lower triangle given).
+  auto half_matrix = [&](int h) {
+    PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+    cholmod_sparse a{};
+    a.nrow = a.ncol = static_cast<std::size_t>(pattern->n);
+    a.nzmax = C.row.size();
+    a.p = C.col.data();
+    a.i = C.row.data();
+    a.x = C.x.data();
+    a.stype = -1;
+    a.itype = CHOLMOD_INT;
+    a.xtype = CHOLMOD_COMPLEX;
+    a.dtype = CHOLMOD_DOUBLE;
+    a.sorted = 1;
+    a.packed = 1;
+    return a;
+  };
+  auto analyze_half = [&](int h) -> std::string {
+    return halves[static_cast<std::size_t>(h)].analyze(half_matrix(h)) ? std::string()
+                                                                          : std::string("symbolic analysis failed");
+  };
   auto unknown = [n, split_st](int v, int r) { return unknown_index(v, r, n, split_st); };
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
@@ -967,7 +1136,13 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   tbb::parallel_invoke(
       [&] {
         Timer tt;
-        if (n > 0 && !same_pattern) {
+        if (n > 0 && !same_pattern && separate) {
+          // The s and t halves' own analyses (no BLAS: beside the assembly).
+          std::array<std::string, 2> why;
+          for (int h = 0; h < 2; ++h) why[static_cast<std::size_t>(h)] = analyze_half(h);
+          failure = !why[0].empty() ? why[0] : why[1];
+          factor_size = {halves[0].flops() + halves[1].flops(), halves[0].nonzeros() + halves[1].nonzeros()};
+        } else if (n > 0 && !same_pattern) {
           // Symbolic analysis of the pattern alone (the values come beside).
           solver.analyzePattern(pattern->A);
           if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
@@ -1000,12 +1175,64 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
     // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
     // fandisk), and F's smallest eigenvector localises where the field's curl
     // is low, its tail not following the field (80% distorted faces on a torus).
-    solver.factorize(A);
-    if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
-    split(bd.factorization);
     const int iterations = global ? opt.init_iterations : opt.update_iterations;
+    if (separate) {
+      // The paper's simplified PGP: the s and t systems are independent, and
+      // so are their relaxations (each step normalises s pairs and t pairs
+      // separately), so each half is factored and relaxed on its own, as the
+      // complex Hermitian system its real form stands for (half the real
+      // flops of the 2x2 blocks, half the factor's bytes per solve).
+      std::array<std::string, 2> why;
+      std::array<double, 2> factor_seconds{0, 0}, solve_seconds{0, 0};
+      std::array<int, 2> steps{0, 0};
+      auto run_half = [&](int h) {
+        Timer th;
+        SupernodalHalf& S = halves[static_cast<std::size_t>(h)];
+        PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+        const double* val = A.valuePtr();
+        for (std::size_t q = 0; q < C.re.size(); ++q) {
+          C.x[2 * q] = val[C.re[q]];
+          C.x[2 * q + 1] = C.im[q] >= 0 ? val[C.im[q]] : 0.0;
+        }
+        if (!S.factorize(half_matrix(h))) why[h] = "factorisation failed (not positive definite?)";
+        factor_seconds[h] = th.seconds();
+        th.reset();
+        const int m = 2 * n, off = h * m;
+        Eigen::VectorXd xh = x.segment(off, m), rh(m);
+        for (int it = 0; it < iterations && why[h].empty(); ++it) {
+          for (int v = 0; v < n; ++v) {
+            const double re = xh[2 * v], im = xh[2 * v + 1];
+            const double a = std::hypot(re, im);
+            const bool ok = a > 1e-300 && std::isfinite(a);
+            rh[2 * v] = b[off + 2 * v] + shift * mass[v] * (ok ? re / a : 1.0);
+            rh[2 * v + 1] = b[off + 2 * v + 1] + shift * mass[v] * (ok ? im / a : 0.0);
+          }
+          // (re, im) pairs: the complex right-hand side and solution as they are
+          if (!S.solve(rh.data(), static_cast<std::size_t>(n), CHOLMOD_COMPLEX, xh.data())) why[h] = "solve failed";
+          ++steps[h];
+        }
+        x.segment(off, m) = xh;
+        solve_seconds[h] = th.seconds();
+      };
+      // In turn: the halves would run side by side on two tasks (independent,
+      // same bytes), but the BLAS behind CHOLMOD is not safe for concurrent
+      // calls (cholmod_blas_mutex).
+      for (int h = 0; h < 2 && why[0].empty(); ++h) run_half(h);
+      failure = !why[0].empty() ? why[0] : why[1];
+      bd.factorization = factor_seconds[0] + factor_seconds[1];
+      bd.solves = solve_seconds[0] + solve_seconds[1];
+      bd.steps = std::min(steps[0], steps[1]);
+      lap.reset();
+    } else {
+      {
+        std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+        solver.factorize(A);
+      }
+      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
+      split(bd.factorization);
+    }
     Eigen::VectorXd rhs(n4);
-    for (int it = 0; it < iterations && failure.empty(); ++it) {
+    for (int it = 0; it < iterations && failure.empty() && !separate; ++it) {
       for (int v = 0; v < n; ++v)
         for (int p = 0; p < 2; ++p) {
           const int ire = unknown(v, 2 * p), iim = unknown(v, 2 * p + 1);
@@ -1015,7 +1242,10 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
           rhs[ire] = b[ire] + shift * mass[v] * (ok ? re / a : 1.0);
           rhs[iim] = b[iim] + shift * mass[v] * (ok ? im / a : 0.0);
         }
-      x = solver.solve(rhs);
+      {
+        std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+        x = solver.solve(rhs);
+      }
       if (solver.info() != Eigen::Success) failure = "solve failed";
       ++bd.steps;
     }
@@ -1028,7 +1258,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
         zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
       }
-    split(bd.solves);
+    split(bd.solves);  // (the halves' own times were set above; this adds the write-back)
   }
   if (!failure.empty())
     throw SolverError(std::string("periodic_global_parameterization: ") + (split_st ? "s and t systems " : "coupled (s,t) system ") + failure + " (" +

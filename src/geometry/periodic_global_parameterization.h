@@ -44,6 +44,12 @@
 // bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
 // and falls back to its generic SSE3 kernels, it is switched to its AVX-512
 // (or AVX2) kernels once per process (PgpResult::blas_core names the set).
+// Debian 12's serial OpenBLAS (libopenblas0-serial 0.3.21) is not safe for
+// concurrent calls (built without USE_LOCKING: its work-buffer table is
+// claimed without a lock), so the BLAS-reaching CHOLMOD calls (numeric
+// factorisation, solves) of all solvers of the process take turns behind
+// one lock: the no-swap s and t halves run one after the other, and two
+// solvers on two threads give the bytes each gives alone.
 // The paper writes R with the opposite rotation sign and a 2 pi missing in
 // the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -143,9 +149,29 @@ struct PgpOptions {
   /// half of each triangular solve. The faces along the field's cuts then
   /// become singular (distorted faces), which section 3's blending hides.
   /// Measured (bench_pgp --no-swap, load ~3): armadillo_52k first init
-  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8; singular
-  /// faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
+  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8 (one real
+  /// system; see separate_halves for the complex halves: 0.44 s CPU);
+  /// singular faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
   bool swap_coordinates = true;
+  /// With swap_coordinates false only: factor and relax the s and t systems
+  /// (each relaxation step normalises s pairs and t pairs separately, so the
+  /// two chains of steps are independent) one after the other, each as the
+  /// complex Hermitian n x n system of z_s (z_t) that its real 2n x 2n form
+  /// stands for (the 2x2 blocks are scaled rotations: multiplication by
+  /// c + i s), instead of one real block-diagonal 4n system: about half the
+  /// real flops of the factorisation and half the factor's bytes read per
+  /// solve. Same bytes on any thread count; equal to the one-system result
+  /// up to rounding (fandisk init + update: 7e-14). false (one real system)
+  /// is kept for comparison (tests, bench_pgp --one-system). The two halves
+  /// could run side by side (independent), but not on this BLAS (see the
+  /// BLAS note above). The coupled form (the default) has no complex form:
+  /// its quarter and half turns conjugate z (antilinear maps).
+  /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 8-10
+  /// (wall figures for the lead to re-measure), one real system -> two
+  /// complex halves, CPU seconds: init (analysis reused) 0.38-0.41 ->
+  /// 0.23-0.24, first call 0.64 -> 0.40-0.43, local update 0.059-0.069 ->
+  /// 0.034-0.042; singular fractions unchanged (bench_pgp header).
+  bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
   std::string direction_map = "f:dir";
@@ -177,7 +203,7 @@ struct PgpResult {
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
     double analysis = 0;     ///< symbolic factorisation (0 when reused)
     double factorization = 0;  ///< numeric factorisation
-    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count)
+    double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count from the pattern; for the complex halves of the n x n patterns, each a complex operation, ~4 real flops)
     double factor_nonzeros = 0;  ///< in the Cholesky factor L
     double solves = 0;       ///< all relaxation steps (right-hand side + solve)
     int steps = 0;           ///< relaxation steps run
