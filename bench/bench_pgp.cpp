@@ -261,7 +261,7 @@ nlohmann::json breakdown(const PgpResult& r) {
           {"solves", b.solves},               {"steps", b.steps},
           {"energy", b.energy},               {"corners", b.corners},
           {"reused_analysis", r.reused_analysis}, {"free_vertices", r.free_vertices},
-          {"blas_core", r.blas_core}};
+          {"blas_core", r.blas_core}, {"concurrent_blas", r.concurrent_blas}};
 }
 
 /// Keeps the result of the fastest run (for its breakdown).

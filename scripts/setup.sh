@@ -13,15 +13,17 @@ PKGS=(
   libgtest-dev libgmock-dev
   libnanoflann-dev libtbb-dev libcli11-dev nlohmann-json3-dev libtinygltf-dev libstb-dev
   libsuitesparse-dev libmetis-dev
-  # An optimised single-threaded BLAS/LAPACK behind CHOLMOD (PGP): takes over
-  # libblas.so.3 through Debian's alternatives; serial, so results do not
-  # depend on a BLAS thread count (the pthread build gives different bytes
-  # per thread count: measured). OpenBLAS 0.3.21 does not know recent Xeons
-  # (AVX-512) and falls back to its generic "Prescott" kernels (5x slower
-  # dgemm); the PGP switches it to its SkylakeX/Haswell kernels at run time
+  # An optimised BLAS/LAPACK behind CHOLMOD (PGP): takes over libblas.so.3
+  # through Debian's alternatives. The pthread build, pinned to one BLAS
+  # thread at run time (its thread count changes the bytes: measured), gives
+  # the serial build's bytes and, unlike Debian's serial build (no
+  # USE_LOCKING), may be called from two threads at once, so the PGP runs
+  # the paper's s and t systems side by side. OpenBLAS 0.3.21 does not know
+  # recent Xeons (AVX-512) and falls back to its generic "Prescott" kernels
+  # (5x slower dgemm); the PGP switches it to its SkylakeX/Haswell kernels
   # unless OPENBLAS_CORETYPE is set (periodic_global_parameterization.cpp,
-  # configure_blas).
-  libopenblas0-serial
+  # configure_blas, blas_allows_concurrent_calls).
+  libopenblas0-pthread
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi

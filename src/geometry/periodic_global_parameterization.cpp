@@ -160,27 +160,52 @@ const std::string& configure_blas() {
   return core;
 }
 
-/// Held around every call into CHOLMOD that reaches the BLAS (numeric
-/// factorisation, solve). Debian 12's serial OpenBLAS (libopenblas0-serial
-/// 0.3.21) is not safe for concurrent calls from several threads: it is
-/// built without USE_LOCKING (openblas_get_config(): "OpenBLAS 0.3.21
-/// NO_LAPACKE DYNAMIC_ARCH NO_AFFINITY SkylakeX SINGLE_THREADED"; no pthread
-/// import; blas_memory_free takes no lock and blas_memory_alloc releases its
-/// lock after the initialisation check, then claims a work-buffer slot with
-/// an unlocked test-and-set), so two level-3 calls at once can share a work
-/// buffer. Measured: the no-swap s and t halves factored side by side on two
-/// TBB tasks failed with "not positive definite" in 3 of 4 two-thread
-/// armadillo_52k runs (and passed with this lock). So the halves run in turn,
-/// and two solvers on two threads take turns here (same bytes as alone).
-/// (A private copy of libcholmod + OpenBLAS loaded with dlmopen did run the
-/// halves side by side with the same bytes, but its second libgomp and C
-/// library share the threads' pthread-key slots with the first: a thread
-/// that had run OpenMP code of both and then exited aborted in libgomp's
-/// goacc_destroy_thread. Dropped.)
-std::mutex& cholmod_blas_mutex() {
-  static std::mutex m;
-  return m;
+/// Whether the BLAS behind CHOLMOD may be entered from two threads at once.
+/// OpenBLAS says how it was built: openblas_get_parallel() is 0 for the
+/// single-threaded build (USE_THREAD=0), which Debian 12 ships as
+/// libopenblas0-serial 0.3.21 without USE_LOCKING: not safe for concurrent
+/// calls (openblas_get_config(): "... SkylakeX SINGLE_THREADED"; in the
+/// disassembly blas_memory_free takes no lock and blas_memory_alloc claims
+/// a work-buffer slot with an unlocked test-and-set, so two level-3 calls at
+/// once can share a work buffer; measured: the no-swap s and t halves
+/// factored side by side failed with "not positive definite" in 3 of 4
+/// two-thread armadillo_52k runs). The pthread build (libopenblas0-pthread,
+/// what scripts/setup.sh installs; 1 for pthreads, 2 for OpenMP) locks its
+/// buffers and, pinned to one thread by configure_blas, gives the serial
+/// build's bytes (material-map on armadillo_52k: same mesh.obj). Any other
+/// BLAS is not known here and is treated as unsafe.
+bool blas_allows_concurrent_calls() {
+  static const bool safe = [] {
+    configure_blas();
+    using Parallel = int (*)();
+    void* f = dlsym(RTLD_DEFAULT, "openblas_get_parallel");
+    return f && reinterpret_cast<Parallel>(f)() > 0;
+  }();
+  return safe;
 }
+
+/// Held around every call into CHOLMOD that reaches the BLAS (numeric
+/// factorisation, solve) unless the BLAS allows concurrent calls
+/// (blas_allows_concurrent_calls): then two solvers on two threads, and the
+/// no-swap s and t halves, run side by side; otherwise they take turns (same
+/// bytes either way). (A private copy of libcholmod + OpenBLAS loaded with
+/// dlmopen was tried for the serial build: same bytes, but its second
+/// libgomp and C library share the threads' pthread-key slots with the
+/// first, and a thread that had run OpenMP code of both aborted at exit in
+/// libgomp's goacc_destroy_thread. Dropped.)
+class BlasGuard {
+ public:
+  BlasGuard() : lock_(mutex(), std::defer_lock) {
+    if (!blas_allows_concurrent_calls()) lock_.lock();
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::unique_lock<std::mutex> lock_;
+};
 
 /// Supernodal LL' (LL^H) of one real symmetric (complex Hermitian) matrix,
 /// lower triangle given, the order kept (natural, postordered): the settings
@@ -211,7 +236,7 @@ class SupernodalHalf {
   }
   bool factorize(cholmod_sparse a) {
     if (!factor_) return false;
-    std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+    BlasGuard blas_guard;
     cholmod_factorize(&a, factor_, &common_);
     return common_.status == CHOLMOD_OK && factor_->minor == factor_->n;
   }
@@ -226,7 +251,7 @@ class SupernodalHalf {
     d.x = const_cast<double*>(b);
     d.xtype = xtype;
     d.dtype = CHOLMOD_DOUBLE;
-    std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+    BlasGuard blas_guard;
     cholmod_dense* r = cholmod_solve(CHOLMOD_A, factor_, &d, &common_);
     if (!r) return false;
     const std::size_t count = xtype == CHOLMOD_COMPLEX ? 2 * rows : rows;
@@ -884,6 +909,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
   Timer timer, lap;
   PgpResult res;
   res.blas_core = blas_core;
+  res.concurrent_blas = blas_allows_concurrent_calls();
   PgpResult::Breakdown& bd = res.breakdown;
   auto split = [&lap](double& into) {
     into += lap.seconds();
@@ -1214,18 +1240,25 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
         x.segment(off, m) = xh;
         solve_seconds[h] = th.seconds();
       };
-      // In turn: the halves would run side by side on two tasks (independent,
-      // same bytes), but the BLAS behind CHOLMOD is not safe for concurrent
-      // calls (cholmod_blas_mutex).
-      for (int h = 0; h < 2 && why[0].empty(); ++h) run_half(h);
+      // Side by side on two tasks where the BLAS allows concurrent calls, in
+      // turn otherwise (BlasGuard); independent, so the same bytes either way.
+      if (blas_allows_concurrent_calls())
+        tbb::parallel_invoke([&] { run_half(0); }, [&] { run_half(1); });
+      else
+        for (int h = 0; h < 2 && why[0].empty(); ++h) run_half(h);
       failure = !why[0].empty() ? why[0] : why[1];
-      bd.factorization = factor_seconds[0] + factor_seconds[1];
-      bd.solves = solve_seconds[0] + solve_seconds[1];
+      if (blas_allows_concurrent_calls()) {
+        bd.factorization = std::max(factor_seconds[0], factor_seconds[1]);
+        bd.solves = std::max(solve_seconds[0], solve_seconds[1]);
+      } else {
+        bd.factorization = factor_seconds[0] + factor_seconds[1];
+        bd.solves = solve_seconds[0] + solve_seconds[1];
+      }
       bd.steps = std::min(steps[0], steps[1]);
       lap.reset();
     } else {
       {
-        std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+        BlasGuard blas_guard;
         solver.factorize(A);
       }
       if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
@@ -1243,7 +1276,7 @@ PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& f
           rhs[iim] = b[iim] + shift * mass[v] * (ok ? im / a : 0.0);
         }
       {
-        std::lock_guard<std::mutex> lock(cholmod_blas_mutex());
+        BlasGuard blas_guard;
         x = solver.solve(rhs);
       }
       if (solver.info() != Eigen::Success) failure = "solve failed";

@@ -188,6 +188,10 @@ struct PgpResult {
   /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
   /// BLAS; see the BLAS note above).
   std::string blas_core;
+  /// The BLAS allows concurrent calls (OpenBLAS's pthread build), so two
+  /// solvers on two threads, and the no-swap s and t halves, run side by
+  /// side instead of taking turns (same bytes either way).
+  bool concurrent_blas = false;
   /// Wall-time breakdown of `seconds` (each step's own wall time, seconds).
   /// Three pairs of steps run side by side (tbb::parallel_invoke), so the
   /// sum exceeds `seconds` on several threads: `ordering` beside `field`
@@ -202,10 +206,10 @@ struct PgpResult {
     double start = 0;        ///< spanning-tree integration (initialisation only)
     double assembly = 0;     ///< matrix values and locked-vertex right-hand side
     double analysis = 0;     ///< symbolic factorisation (0 when reused)
-    double factorization = 0;  ///< numeric factorisation
+    double factorization = 0;  ///< numeric factorisation (no-swap halves side by side: the slower half's)
     double factor_flops = 0;     ///< of the numeric factorisation (CHOLMOD's count from the pattern; for the complex halves of the n x n patterns, each a complex operation, ~4 real flops)
     double factor_nonzeros = 0;  ///< in the Cholesky factor L
-    double solves = 0;       ///< all relaxation steps (right-hand side + solve)
+    double solves = 0;       ///< all relaxation steps (right-hand side + solve; halves side by side: the slower half's)
     int steps = 0;           ///< relaxation steps run
     double energy = 0;       ///< energies at the solution
     double corners = 0;      ///< corner write-back (equation 4)
