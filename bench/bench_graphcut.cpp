@@ -11,9 +11,11 @@
 // Alpha is kept: both outputs are compared with the exemplar's channels.
 //
 // Usage: bench_graphcut [TEXTURE_DIR] [WORK_DIR] [NAME,NAME,...|-] [GMIC_RUNS] [TILE_SIZE] [MODE]
+//                       [STRAIGHT_SEAM_STEPS] [STRAIGHT_SEAM_COST_TOLERANCE]
 // The optional list keeps only the textures whose file stem is listed ("-" =
 // all). MODE: all (default), synthesis (no tile) or tile (no 256 synthesis,
-// no G'MIC). G'MIC (from PATH; if it is missing or GMIC_RUNS is 0 the G'MIC
+// no G'MIC). The last two override TileOptions::straight_seam_steps (0 = the
+// tiles without the straight-seam repair) and straight_seam_cost_tolerance. G'MIC (from PATH; if it is missing or GMIC_RUNS is 0 the G'MIC
 // fields are absent) is
 // unseeded, so it runs GMIC_RUNS times (default 3) per texture and ours is
 // compared with the median of its similarity scores and the median of its
@@ -297,6 +299,9 @@ int main(int argc, char** argv) {
   const int gmic_runs = argc > 4 ? std::max(0, std::atoi(argv[4])) : 3;
   const int tile_size = argc > 5 ? std::max(8, std::atoi(argv[5])) : 128;
   const std::string mode = argc > 6 ? argv[6] : "all";
+  TileOptions tile_options;
+  if (argc > 7) tile_options.straight_seam_steps = std::max(0, std::atoi(argv[7]));
+  if (argc > 8) tile_options.straight_seam_cost_tolerance = std::max(0.0, std::atof(argv[8]));
   if (mode != "all" && mode != "synthesis" && mode != "tile") {
     std::fprintf(stderr, "bench_graphcut: MODE must be all, synthesis or tile, got '%s'\n", mode.c_str());
     return 2;
@@ -377,7 +382,7 @@ int main(int argc, char** argv) {
     }  // run_synthesis
 
     if (run_tile) {
-      TileOptions to;
+      const TileOptions& to = tile_options;
       double c0 = self_cpu_seconds();
       Timer tm;
       TileResult t = make_tileable_detailed(ex, tile_size, to);
