@@ -887,8 +887,9 @@ class GraphcutSynthesizer {
       const int s0 = side / 2 - seg / 2, s1 = s0 + seg;             // along it
       // Lens-shaped band: `band` pixels each side at the middle of the
       // stretch, 1 at its ends, so that its own border is not a straight
-      // line parallel to the one being repaired (measured: a rectangular
-      // band gave 5/7 instead of 6/7 of the seam tiles fixed, at a higher cost).
+      // line parallel to the one being repaired (measured on the 7 tiles with
+      // straight seams: a rectangular band fixed as many, 6/7, at a higher
+      // eq.-1 cost, 482.7 vs 468.2, with higher worst lines).
       for (int a = s0; a < s1; ++a)
         for (int c = b0; c < b1; ++c) {
           const double t = std::abs((a - s0) + 0.5 - seg / 2.0) / (seg / 2.0);

@@ -29,6 +29,13 @@
 // seam lies inside: TileResult::worst_line_ratio (every line of the torus,
 // roll-independent) is the figure for that, to be read against the same
 // figure of tile-sized windows of the exemplar (bench/bench_graphcut.cpp).
+// Straight seams inside (TileOptions::straight_seam_steps): the eq.-1 cut
+// can leave two large patches meeting along a straight overlap edge
+// (wood_512, 128 px, seed 1: column line 86, source-matched ratio 3.18);
+// the graph-cut synthesis then repairs the lines of the torus whose
+// source-matched ratio exceeds 1.3 with small targeted patches
+// (GraphcutOptions::straight_seam_steps), measured 22/29 -> 28/29 tiles with
+// every line <= 1.3 at +6% summed seam cost.
 
 #include <cstdint>
 

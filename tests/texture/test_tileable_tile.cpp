@@ -375,23 +375,25 @@ TEST(WrapSeamRatio, SourceMatchedLinesSeeSeamsNotContent) {
 // must bring the worst line of the torus to <= 1.3 against the exemplar's own
 // jumps, at a bounded eq.-1 cost, without a seam across the wrap.
 TEST(TileableTile, StraightSeamRepairBreaksTheStraightSeamInsideTheWoodTile) {
+  // Sanitized: a 64-px tile of the exemplar's 256-px corner (FFT matching
+  // over the whole 512-px exemplar dominates the run time).
   const int size = sanitized() ? 64 : 128;
-  const Image ex = read_image(test::shared_data("textures/wood_512.png"));
+  Image ex = read_image(test::shared_data("textures/wood_512.png"));
+  if (sanitized()) ex = crop_corner(ex, 0, 0, 256, 256);
   TileOptions off;
   off.straight_seam_steps = 0;
   const TileResult a = make_tileable_detailed(ex, size, off);
-  const TileResult b = make_tileable_detailed(ex, size, TileOptions{});
   EXPECT_GT(a.source_matched_worst_line_ratio, 1.3) << "the case this test is about";
-  EXPECT_LE(b.source_matched_worst_line_ratio, 1.3);
-  EXPECT_LE(b.seam_cost, a.seam_cost * (1.0 + TileOptions{}.straight_seam_cost_tolerance) + 1e-9);
-  EXPECT_LE(b.source_matched_wrap_ratio_at_synthesis_cut, 1.1);
-  // The figure is recomputed independently from the result's own sources.
-  const GraphcutResult g = graphcut_synthesize_detailed(ex, size, size, tileable_graphcut_options(ex, size));
-  EXPECT_EQ(g.seam_cost_final, b.seam_cost);
+  const TileOptions on;
+  const GraphcutResult g = graphcut_synthesize_detailed(ex, size, size, tileable_graphcut_options(ex, size, on));
+  EXPECT_EQ(g.seam_cost_before_straight, a.seam_cost);  // the repair starts from the unrepaired tile
   EXPECT_GE(g.straight_seam_accepted, 1);
-  EXPECT_LE(g.seam_cost_final, g.seam_cost_before_straight * 1.1 + 1e-9);
+  EXPECT_LE(g.seam_cost_final, g.seam_cost_before_straight * (1.0 + on.straight_seam_cost_tolerance) + 1e-9);
+  // Recomputed from the result's own sources: no line of the torus is a seam
+  // any more, and the wrap still carries none.
   const SourceMatchedLineProfile p = source_matched_line_profile(g.image, ex, g.source_x, g.source_y);
   EXPECT_LE(p.worst_ratio, 1.3);
+  EXPECT_LE(p.wrap_ratio, 1.1);
 }
 
 // The repair is deterministic for any thread count (the FFT matching runs
