@@ -144,9 +144,9 @@ struct GraphcutOptions {
   /// the line's pairs there become exemplar neighbours), the rest is cut
   /// freely with the gradient-normalised cost of eq. 5 (new seams along
   /// texture edges). The offsets tried are the 8 best sub-patch matches of
-  /// the footprint (band left out) not within patch/8 px of a translation
-  /// already in the footprint (continuing one side only moves the straight
-  /// seam). Of those that lower the penalty (summed squared excess of the
+  /// the footprint (band left out) not within max(2, repair patch/8) px of a
+  /// translation already in the footprint (continuing one side only moves
+  /// the straight seam). Of those that lower the penalty (summed squared excess of the
   /// lines above straight_seam_ratio), do not raise the worst line, keep the
   /// total eq.-1 seam cost within (1 + straight_seam_cost_tolerance) times
   /// its value before this stage and do not make the output's own wrap lines
