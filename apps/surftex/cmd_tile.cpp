@@ -19,6 +19,7 @@ struct TileArgs {
   int patch = 0;
   int overlap = 0;
   int passes = TileOptions{}.refinement_passes;
+  int straight_seam_steps = TileOptions{}.straight_seam_steps;
   bool synthesis_cut = false;
   CommonOptions common;
 };
@@ -33,6 +34,7 @@ int run_tile(const TileArgs& a) {
   o.patch_size = a.patch;
   o.overlap = a.overlap;
   o.refinement_passes = a.passes;
+  o.straight_seam_steps = a.straight_seam_steps;
   o.choose_cut = !a.synthesis_cut;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
@@ -57,6 +59,7 @@ int run_tile(const TileArgs& a) {
   report["patch"] = a.patch;
   report["overlap"] = a.overlap;
   report["passes"] = a.passes;
+  report["straight_seam_steps"] = a.straight_seam_steps;
   report["seconds"] = seconds;
   report["wrap_seam_ratio"] = t.wrap_seam_ratio;
   report["wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
@@ -102,6 +105,12 @@ SubcommandRegistrar reg{
                       "Seam-repair passes after the tile is filled (0..100, default " +
                           std::to_string(TileOptions{}.refinement_passes) + ", as the library)")
            ->check(CLI::Range(0, 100));
+       app.add_option("--straight-seam-steps", a->straight_seam_steps,
+                      "Targeted repairs of straight seams inside the tile: lines whose jump is "
+                      "above 1.3x the exemplar's own jump at the same sources get a small patch "
+                      "across them, the tile's seam cost may at most double; 0 = off (0..1000, "
+                      "default " + std::to_string(TileOptions{}.straight_seam_steps) + ")")
+           ->check(CLI::Range(0, 1000));
        app.add_flag("--synthesis-cut", a->synthesis_cut,
                     "Keep the tile's border where the synthesis left it instead of rolling the "
                     "tile so that its border lies on the smoothest row and column (the tiling is "

@@ -127,6 +127,39 @@ struct GraphcutOptions {
   bool gradient_normalized = false;
   /// Toroidal output: the result tiles seamlessly left-right and top-bottom.
   bool periodic_output = false;
+  /// Straight-seam repair of a periodic output (not in Kwatra et al.; only
+  /// with periodic_output, ignored otherwise): after the refinement passes,
+  /// up to this many targeted attempts at the lines of the torus whose
+  /// source-matched ratio (texture/wrap_seam_ratio.h
+  /// source_matched_line_profile: a line's jump over the exemplar's own jump
+  /// at the same sources) exceeds straight_seam_ratio. Eq.-1 cuts can leave
+  /// two large patches meeting along a straight overlap edge, a seam the eye
+  /// follows, and the refinement above never raises the eq.-1 cost, so it
+  /// keeps them (measured, bench/bench_graphcut.cpp session 5). An attempt
+  /// takes the worst such line with a stretch not tried yet, the stretch
+  /// (half the repair patch) with the largest excess jump (jump minus the
+  /// exemplar's jump), and pastes a repair patch (a quarter of the output
+  /// side, at least 16 px, at most the patch size) centred on it: a
+  /// lens-shaped band straddling the line there must take the new patch (so
+  /// the line's pairs there become exemplar neighbours), the rest is cut
+  /// freely with the gradient-normalised cost of eq. 5 (new seams along
+  /// texture edges). The offsets tried are the 8 best sub-patch matches of
+  /// the footprint (band left out) not within max(2, repair patch/8) px of a
+  /// translation already in the footprint (continuing one side only moves
+  /// the straight seam). Of those that lower the penalty (summed squared excess of the
+  /// lines above straight_seam_ratio), do not raise the worst line, keep the
+  /// total eq.-1 seam cost within (1 + straight_seam_cost_tolerance) times
+  /// its value before this stage and do not make the output's own wrap lines
+  /// rougher (wrap_seam_ratio above max(its value before, straight_seam_ratio)),
+  /// the one removing the most penalty per unit of eq.-1 cost added is kept.
+  /// Cost: one FFT match and up to 8 small cuts per attempt.
+  /// Range >= 0; 0 = off.
+  int straight_seam_steps = 0;
+  /// Source-matched line ratio above which a line is repaired. Range > 1.
+  double straight_seam_ratio = 1.3;
+  /// Allowed relative rise of the total eq.-1 seam cost over the whole
+  /// straight-seam stage (of the output's own cost). Range >= 0.
+  double straight_seam_cost_tolerance = 1.0;
   std::uint64_t seed = 1;
   ProgressCallback progress;
 };
@@ -217,6 +250,9 @@ struct GraphcutResult {
   int fill_patches = 0;              ///< patches placed by the fill pass
   int refinement_tried = 0;          ///< refinement patches tried (cuts made)
   int refinement_accepted = 0;       ///< ... that changed the output (never raising the seam cost)
+  double seam_cost_before_straight = 0;  ///< seam cost before the straight-seam stage
+  int straight_seam_tried = 0;       ///< straight-seam attempts (stretches of lines targeted)
+  int straight_seam_accepted = 0;    ///< ... whose paste was kept
 };
 
 /// Synthesizes a width x height image from `exemplar`. Throws

@@ -66,6 +66,9 @@ GraphcutOptions tileable_graphcut_options(const Image& exemplar, int size, const
   g.k = o.k;
   g.repetition_penalty = o.repetition_penalty;
   g.periodic_output = true;
+  g.straight_seam_steps = o.straight_seam_steps;
+  g.straight_seam_ratio = o.straight_seam_ratio;
+  g.straight_seam_cost_tolerance = o.straight_seam_cost_tolerance;
   g.seed = o.seed;
   g.progress = o.progress;
   return g;

@@ -61,7 +61,9 @@
 // inside some tiles (source-matched worst line: wood_512 3.18 on a column
 // that shows a visible straight seam, ink_b_400 6.0 on a row, ink_a 2.2,
 // water_caustics 1.7, brick_gray 1.7): the defect a roll to the smoothest
-// line could hide, and the figure to watch for it.
+// line could hide, and the figure to watch for it. Repaired since by
+// GraphcutOptions::straight_seam_steps (tiles: 28/29 with every line <= 1.3;
+// ink_b 1.62 left; bench/bench_graphcut.cpp).
 
 #include <vector>
 
