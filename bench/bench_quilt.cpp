@@ -105,19 +105,24 @@ int main(int argc, char** argv) {
       qo.step.check_stitch_geometry = false;
     }
     if (variant == "translation") qo.rotation_max_deg = 0;
+    if (variant == "drop") qo.step.keep_cut_refused_inputs = false;
+    if (variant == "grown_z") qo.max_z_growth = 0.5;
+    if (variant == "mean_scale") qo.seed_scale = false;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
           {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported},
           {"patches_turned", r.patches_turned}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
+          {"seed_scale", {r.seed_scale_min, r.seed_scale_max}},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
           {"coincident", r.stats.coincident}, {"stitched_trimmed", r.stats.stitched_trimmed},
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
           {"refused_border", r.stats.refused_border},
-          {"refused_geometry", r.stats.refused_geometry}, {"out_replaced", r.stats.out_replaced},
-          {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"dropped_new", r.dropped_new},
+          {"refused_geometry", r.stats.refused_geometry}, {"refused_reasons", r.stats.refused_reasons}, {"out_replaced", r.stats.out_replaced},
+          {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"in_cut_added", r.stats.in_cut_added}, {"in_cut_components", r.stats.in_cut_components}, {"dropped_new", r.dropped_new},
           {"elements_not_expressible", r.elements_not_expressible}, {"elements_partial", r.elements_partial},
           {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border},
+          {"z_clamped", r.z_clamped}, {"z_grown_below", r.z_grown_below}, {"z_grown_above", r.z_grown_above},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}, {"seconds_turn", r.seconds_turn}});
@@ -128,6 +133,7 @@ int main(int argc, char** argv) {
     line({{"stage", "embed"}, {"charts", er.atlas.num_charts}, {"tets", er.tets}, {"shell_height", er.shell_height}, {"clamped_vertices", er.clamped_vertices},
           {"stretch_before", er.stretch.stretch_before}, {"stretch_after", er.stretch.stretch_after},
           {"faces", out.number_of_faces()}, {"outside_vertices", er.embed.outside},
+          {"outside_below", er.outside_below}, {"outside_above", er.outside_above}, {"outside_uv", er.outside_uv},
           {"self_intersections", er.embed.self_intersecting_pairs},
           {"self_intersections_within", er.self_intersections_within},
           {"self_intersections_between", er.self_intersections_between}, {"seconds_atlas", er.seconds_atlas},
@@ -142,6 +148,8 @@ int main(int argc, char** argv) {
       get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
       scene.join(out);
       write_image(outdir + "/bunny_" + kind + ".png", render_preview(scene, 30.f, 20.f, 1000));
+      write_image(outdir + "/bunny_" + kind + "_back.png", render_preview(scene, 210.f, 20.f, 1000));
+      write_image(outdir + "/bunny_" + kind + "_top.png", render_preview(scene, 120.f, 60.f, 1000));
     }
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

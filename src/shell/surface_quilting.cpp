@@ -401,6 +401,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
   if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
+  if (!(o.max_z_growth >= 0 && o.max_z_growth <= 10)) bad("max_z_growth must be in [0, 10]", o.max_z_growth);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
   if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
@@ -553,8 +554,24 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       }
     }
     const V2 oc{(q0[0] + q1[0] + q2[0]) / 3, (q0[1] + q1[1] + q2[1]) / 3};
+    // The flattening's scale where the match is made (SurfaceQuiltOptions::seed_scale).
+    double sloc = 1;
+    if (opt.seed_scale) {
+      const double rad = (r + 0.5) * c * S * std::sqrt(2.0);
+      double a3 = 0, a2 = 0;
+      for (int f : flat.faces) {
+        const P3 d = sub3(b.centroid[f], b.centroid[seed]);
+        if (f != seed && dot3(d, d) > rad * rad) continue;
+        const auto& t = b.faces[f];
+        a3 += b.area[f];
+        a2 += std::abs(area2(flat.uv[flat.local[t[0]]], flat.uv[flat.local[t[1]]], flat.uv[flat.local[t[2]]]));
+      }
+      if (a3 > 0 && a2 > 0) sloc = std::sqrt(a3 / a2);
+    }
+    res.seed_scale_min = res.steps == 0 ? sloc : std::min(res.seed_scale_min, sloc);
+    res.seed_scale_max = res.steps == 0 ? sloc : std::max(res.seed_scale_max, sloc);
     for (auto& p : flat.uv) {
-      const double x = (p[0] - oc[0]) / S, y = (p[1] - oc[1]) / S;
+      const double x = (p[0] - oc[0]) * sloc / S, y = (p[1] - oc[1]) * sloc / S;
       p = {rot_c * x - rot_s * y, rot_s * x + rot_c * y};
     }
     std::vector<std::array<V2, 3>> ftris(flat.faces.size());
@@ -1012,6 +1029,25 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       out.tri_element.push_back(out.elements);
     }
     ++out.elements;
+  }
+  {
+    // The z range (SurfaceQuiltOptions::max_z_growth): widened to the
+    // vertices' heights, at most max_z_growth swatch heights each side.
+    const double h = out.z_max - out.z_min;
+    const double lim_lo = out.z_min - opt.max_z_growth * h, lim_hi = out.z_max + opt.max_z_growth * h;
+    double lo = out.z_min, hi = out.z_max;
+    for (SurfaceQuiltVertex& v : out.vertices) {
+      if (v.z < lim_lo || v.z > lim_hi) {
+        v.z = std::clamp(v.z, lim_lo, lim_hi);
+        ++res.z_clamped;
+      }
+      lo = std::min(lo, v.z);
+      hi = std::max(hi, v.z);
+    }
+    res.z_grown_below = out.z_min - lo;
+    res.z_grown_above = hi - out.z_max;
+    out.z_min = lo;
+    out.z_max = hi;
   }
   res.elements = out.elements;
   res.faces = out.tris.size();

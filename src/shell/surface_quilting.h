@@ -28,7 +28,8 @@
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
-//    seed centroid at the origin (a cell centre); a grid of cells (as in
+//    times the flattening's own scale around the seed (seed_scale), seed
+//    centroid at the origin (a cell centre); a grid of cells (as in
 //    mesh_quilting.h) over it; processed cells as in step 6. P_out = cells
 //    within subpatch_radius (Chebyshev) of the seed cell whose centre lies on
 //    the patch. Then the frame is turned about the seed centroid by the angle
@@ -119,6 +120,28 @@ struct SurfaceQuiltOptions {
   /// Output vertices of P_out used to compare the turns (evenly subsampled;
   /// the chosen turn's translation is then matched with step.max_match_vertices); >= 1.
   int rotation_match_vertices = 150;
+  /// The output's z range (SurfaceQuilt::z_min, z_max: the shell's w = 0
+  /// and 1) is the swatch's widened to the heights the quilt's vertices
+  /// reached (the element deformations and stitches of sections 2.6-2.7 move
+  /// vertices a little above or below the swatch), by at most this many
+  /// swatch heights on each side; vertices beyond are clamped to it (counted
+  /// in SurfaceQuiltResult::z_clamped). Issue #8: with the swatch's range, 8,240
+  /// of the bunny's vertices had w outside [0, 1] and were extrapolated out of
+  /// the shell. In [0, 10]; 0 = the swatch's range, every vertex clamped into
+  /// it. Default 0: the shell's thickness follows the range, and at 0.5 (the
+  /// range reached its limit) the bunny's shell stretch rose from 1.037 to
+  /// 1.129 (limit 1.05).
+  double max_z_growth = 0;
+  /// Scale of the patch frame (our choice; step 5): true = the flattening's
+  /// own scale around the seed (3D area over uv area of the patch faces whose
+  /// centroid lies within the P_out radius of the seed's), so that the
+  /// texture already placed keeps its size where the new swatch is matched
+  /// against it; false = the patch's mean (uv area = 3D area over the whole
+  /// patch, the state before). LSCM is conformal but not area-preserving: a
+  /// patch accepted at area distortion 4 is up to 2x longer or shorter
+  /// around its seed than on average, and the old threads, seen at that
+  /// scale, ran at other spacings than the swatch's.
+  bool seed_scale = true;
   /// Patch radius in swatch diagonals (scaled); > 0.
   double patch_radius = 1.0;
   /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
@@ -157,7 +180,10 @@ struct SurfaceQuilt {
   std::vector<int> tri_element;  ///< element id per triangle, 0..elements-1
   int elements = 0;
   double scale = 0;              ///< mesh units per swatch unit
-  double z_min = 0, z_max = 0;   ///< the swatch's z range (swatch units)
+  /// The output's z range (swatch units): the swatch's, widened to the
+  /// vertices' heights (SurfaceQuiltOptions::max_z_growth); every vertex's z
+  /// lies in it.
+  double z_min = 0, z_max = 0;
 };
 
 struct SurfaceQuiltResult {
@@ -167,6 +193,8 @@ struct SurfaceQuiltResult {
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
   int patches_transported = 0; ///< patches oriented by the transported direction (step 4)
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
+  /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
+  double seed_scale_min = 1, seed_scale_max = 1;
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
   /// Times an output element touching a patch had a vertex that cannot be
   /// expressed in the patch frame: off the patch, farther than 2R from (or at
@@ -180,6 +208,11 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Vertices whose z was clamped into the output's z range, and how far the
+  /// range was widened below / above the swatch's (swatch units; see
+  /// SurfaceQuiltOptions::max_z_growth).
+  std::size_t z_clamped = 0;
+  double z_grown_below = 0, z_grown_above = 0;
   /// Placements turned away from the field's direction by the rotation
   /// search (SurfaceQuiltOptions::rotation_max_deg), and the sum of |turn|
   /// over all placements (degrees).
