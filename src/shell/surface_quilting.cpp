@@ -1022,6 +1022,24 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       ++res.elements_past_border;
       continue;
     }
+    {
+      // Heights past the output's z range (SurfaceQuiltOptions::max_z_growth):
+      // the element is shifted in z into it, or squeezed if taller than it.
+      const double h = swatch.bbox_max[2] - swatch.bbox_min[2];
+      const double lim_lo = swatch.bbox_min[2] - opt.max_z_growth * h, lim_hi = swatch.bbox_max[2] + opt.max_z_growth * h;
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const SurfaceQuiltVertex& v : settled) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+      if (lo < lim_lo || hi > lim_hi) {
+        ++res.z_fitted_elements;
+        res.z_fitted_vertices += settled.size();
+        if (hi - lo <= lim_hi - lim_lo) {
+          const double shift = lo < lim_lo ? lim_lo - lo : lim_hi - hi;
+          for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(v.z + shift, lim_lo, lim_hi);
+        } else {
+          for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(lim_lo + (v.z - lo) * (lim_hi - lim_lo) / (hi - lo), lim_lo, lim_hi);
+        }
+      }
+    }
     const int base_index = static_cast<int>(out.vertices.size());
     for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
     for (const Tri& t : el.mesh.tris) {
@@ -1032,18 +1050,9 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   }
   {
     // The z range (SurfaceQuiltOptions::max_z_growth): widened to the
-    // vertices' heights, at most max_z_growth swatch heights each side.
-    const double h = out.z_max - out.z_min;
-    const double lim_lo = out.z_min - opt.max_z_growth * h, lim_hi = out.z_max + opt.max_z_growth * h;
+    // vertices' heights (each element was fitted within the limits above).
     double lo = out.z_min, hi = out.z_max;
-    for (SurfaceQuiltVertex& v : out.vertices) {
-      if (v.z < lim_lo || v.z > lim_hi) {
-        v.z = std::clamp(v.z, lim_lo, lim_hi);
-        ++res.z_clamped;
-      }
-      lo = std::min(lo, v.z);
-      hi = std::max(hi, v.z);
-    }
+    for (const SurfaceQuiltVertex& v : out.vertices) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
     res.z_grown_below = out.z_min - lo;
     res.z_grown_above = hi - out.z_max;
     out.z_min = lo;

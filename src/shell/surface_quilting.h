@@ -124,13 +124,16 @@ struct SurfaceQuiltOptions {
   /// and 1) is the swatch's widened to the heights the quilt's vertices
   /// reached (the element deformations and stitches of sections 2.6-2.7 move
   /// vertices a little above or below the swatch), by at most this many
-  /// swatch heights on each side; vertices beyond are clamped to it (counted
-  /// in SurfaceQuiltResult::z_clamped). Issue #8: with the swatch's range, 8,240
-  /// of the bunny's vertices had w outside [0, 1] and were extrapolated out of
-  /// the shell. In [0, 10]; 0 = the swatch's range, every vertex clamped into
-  /// it. Default 0: the shell's thickness follows the range, and at 0.5 (the
-  /// range reached its limit) the bunny's shell stretch rose from 1.037 to
-  /// 1.129 (limit 1.05).
+  /// swatch heights on each side; an element reaching beyond is shifted in z
+  /// into it (squeezed if taller than it; counted in
+  /// SurfaceQuiltResult::z_fitted_elements). Issue #8: with the swatch's
+  /// range and nothing fitted, 8,240 of the bunny's vertices had w outside
+  /// [0, 1] and were extrapolated out of the shell. In [0, 10]; 0 = the
+  /// swatch's range. Default 0: the shell's thickness follows the range, and
+  /// at 0.5 (the range reached its limit) the bunny's shell stretch rose from
+  /// 1.037 to 1.129 (limit 1.05). (Clamping each vertex instead, as first
+  /// tried, flattened whole threads lifted past the top into degenerate
+  /// ribbons: 35K -> 58K intersecting pairs within elements.)
   double max_z_growth = 0;
   /// Scale of the patch frame (our choice; step 5): true = the flattening's
   /// own scale around the seed (3D area over uv area of the patch faces whose
@@ -140,8 +143,10 @@ struct SurfaceQuiltOptions {
   /// patch, the state before). LSCM is conformal but not area-preserving: a
   /// patch accepted at area distortion 4 is up to 2x longer or shorter
   /// around its seed than on average, and the old threads, seen at that
-  /// scale, ran at other spacings than the swatch's.
-  bool seed_scale = true;
+  /// scale, ran at other spacings than the swatch's. Default false: on the
+  /// bunny (one run each, load 4-9) it did not stitch more (73 stitched with
+  /// it, 94 without; the frame scale around the seeds ranged 0.86 - 1.57).
+  bool seed_scale = false;
   /// Patch radius in swatch diagonals (scaled); > 0.
   double patch_radius = 1.0;
   /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
@@ -208,10 +213,10 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
-  /// Vertices whose z was clamped into the output's z range, and how far the
-  /// range was widened below / above the swatch's (swatch units; see
-  /// SurfaceQuiltOptions::max_z_growth).
-  std::size_t z_clamped = 0;
+  /// Elements shifted or squeezed in z into the output's z range and their
+  /// vertices, and how far the range was widened below / above the swatch's
+  /// (swatch units; see SurfaceQuiltOptions::max_z_growth).
+  std::size_t z_fitted_elements = 0, z_fitted_vertices = 0;
   double z_grown_below = 0, z_grown_above = 0;
   /// Placements turned away from the field's direction by the rotation
   /// search (SurfaceQuiltOptions::rotation_max_deg), and the sum of |turn|

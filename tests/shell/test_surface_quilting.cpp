@@ -3,6 +3,7 @@
 // sections 3.1 and 3.2): quilt_surface, surface_quilt_to_texture,
 // surface_quilt_displaced, embed_surface_quilt.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <array>
 #include <cmath>
@@ -224,7 +225,7 @@ TEST(SurfaceQuilting, TorusChainmailIntersectionsSplitByElementAndNoVertexLeaves
             << er.stretch.stretch_before << " -> " << er.stretch.stretch_after << ", pairs within "
             << er.self_intersections_within << " (swatch " << swatch_within << "), between "
             << er.self_intersections_between << ", outside " << er.embed.outside << " (below " << er.outside_below
-            << ", above " << er.outside_above << ", (u, v) " << er.outside_uv << "), z clamped " << qr.z_clamped << "\n";
+            << ", above " << er.outside_above << ", (u, v) " << er.outside_uv << "), z fitted " << qr.z_fitted_elements << "\n";
   // Every vertex lies in the shell: distance to the torus' core circle in [r - eps, r + shell height + eps].
   for (VertexIndex v : out.vertices()) {
     const Point3 p = out.point(v);
@@ -476,11 +477,11 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
     closed_ok[keep] = closed_fraction(displaced) >= 0.9;
     // Every height lies in the output's z range, which is the swatch's
     // (SurfaceQuiltOptions::max_z_growth 0): the deformations and stitches
-    // moved some vertices past it, and they are clamped (before issue #8's
-    // session 5 they were left there and mapped out of the shell).
+    // moved some elements past it, and they are shifted back into it (before
+    // issue #8's session 5 they were left there and mapped out of the shell).
     EXPECT_EQ(q.z_min, sw.bbox_min[2]);
     EXPECT_EQ(q.z_max, sw.bbox_max[2]);
-    EXPECT_GT(r.z_clamped, 0u);
+    EXPECT_GT(r.z_fitted_elements, 0u);
     for (const SurfaceQuiltVertex& v : q.vertices) {
       ASSERT_GE(v.z, q.z_min);
       ASSERT_LE(v.z, q.z_max);
@@ -502,6 +503,41 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
   // relative size 0.45: 16 x 16 swatch threads per turn).
   EXPECT_LT(bare[1], 0.5 * bare[0]);
   EXPECT_LT(bare[1], 0.08);
+}
+
+// The refused inputs' cut parts and the z fitting (issue #8, session 5) keep
+// the quilt deterministic: same seed, same output on 1 and 2 threads.
+TEST(SurfaceQuilting, WeaveCylinderWithCutPartsSameOutputOnOneAndTwoThreads) {
+  Mesh base;
+  make_cylinder(base, 1.0, 2.0, 16, 6);
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 4;
+  wo.sides = 5;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  const Swatch sw = make_swatch(wm);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.5;
+  o.up = {0.0, 0.6, 0.8};
+  o.rotation_max_deg = 0;  // (the turn search has its own determinism; keeps this test short)
+  SurfaceQuilt q[2];
+  SurfaceQuiltResult r[2];
+  for (int k = 0; k < 2; ++k) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(k + 1));
+    r[k] = quilt_surface(base, sw, q[k], o);
+  }
+  EXPECT_GT(r[0].stats.in_cut_added, 0u);  // the new path is taken
+  EXPECT_EQ(r[0].stats.in_cut_added, r[1].stats.in_cut_added);
+  EXPECT_EQ(r[0].z_fitted_elements, r[1].z_fitted_elements);
+  ASSERT_EQ(q[0].tris, q[1].tris);
+  ASSERT_EQ(q[0].vertices.size(), q[1].vertices.size());
+  for (std::size_t i = 0; i < q[0].vertices.size(); ++i) {
+    ASSERT_EQ(q[0].vertices[i].face, q[1].vertices[i].face);
+    ASSERT_EQ(q[0].vertices[i].b1, q[1].vertices[i].b1);
+    ASSERT_EQ(q[0].vertices[i].b2, q[1].vertices[i].b2);
+    ASSERT_EQ(q[0].vertices[i].z, q[1].vertices[i].z);
+  }
 }
 
 }  // namespace
