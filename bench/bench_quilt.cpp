@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
     if (variant == "drop") qo.step.keep_cut_refused_inputs = false;
     if (variant == "grown_z") qo.max_z_growth = 0.5;
     if (variant == "seed_scale") qo.seed_scale = true;
+    if (variant == "keep_stretched") qo.max_edge_stretch = 0;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
@@ -121,7 +122,7 @@ int main(int argc, char** argv) {
           {"refused_geometry", r.stats.refused_geometry}, {"refused_reasons", r.stats.refused_reasons}, {"out_replaced", r.stats.out_replaced},
           {"in_dropped", r.stats.in_dropped}, {"in_added", r.stats.in_added}, {"in_cut_added", r.stats.in_cut_added}, {"in_cut_components", r.stats.in_cut_components}, {"dropped_new", r.dropped_new},
           {"elements_not_expressible", r.elements_not_expressible}, {"elements_partial", r.elements_partial},
-          {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border},
+          {"seams_broken", r.seams_broken}, {"elements_past_border", r.elements_past_border}, {"elements_stretched", r.elements_stretched},
           {"z_fitted_elements", r.z_fitted_elements}, {"z_fitted_vertices", r.z_fitted_vertices}, {"z_grown_below", r.z_grown_below}, {"z_grown_above", r.z_grown_above},
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},

@@ -203,6 +203,7 @@ int run_quilt(QuiltArgs& a) {
     rep["max_turn_deg"] = o.rotation_max_deg;
     rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
+    rep["elements_stretched"] = r.elements_stretched;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["coincident"] = r.stats.coincident;

@@ -401,6 +401,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
   if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
+  if (!(o.max_edge_stretch >= 0) || !std::isfinite(o.max_edge_stretch)) bad("max_edge_stretch must be >= 0", o.max_edge_stretch);
   if (!(o.max_z_growth >= 0 && o.max_z_growth <= 10)) bad("max_z_growth must be in [0, 10]", o.max_z_growth);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
@@ -995,6 +996,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     ++step_id;
   }
   // Output.
+  double max_edge2 = 0;  // squared, mesh units (SurfaceQuiltOptions::max_edge_stretch)
+  for (const Tri& t : swatch.mesh.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 d = sub3(swatch.mesh.points[static_cast<std::size_t>(t[k])], swatch.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+      max_edge2 = std::max(max_edge2, dot3(d, d));
+    }
+  max_edge2 *= opt.max_edge_stretch * opt.max_edge_stretch * S * S;
   out = SurfaceQuilt{};
   out.scale = S;
   out.z_min = swatch.bbox_min[2];
@@ -1021,6 +1029,24 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     if (static_cast<double>(past) > opt.max_past_border * static_cast<double>(settled.size())) {
       ++res.elements_past_border;
       continue;
+    }
+    if (opt.max_edge_stretch > 0) {
+      // Stretched elements (SurfaceQuiltOptions::max_edge_stretch): an edge
+      // whose feet on the base mesh lie far apart.
+      bool stretched = false;
+      for (const Tri& t : el.mesh.tris) {
+        for (int k = 0; k < 3 && !stretched; ++k) {
+          const SurfaceQuiltVertex &v0 = settled[static_cast<std::size_t>(t[k])], &v1 = settled[static_cast<std::size_t>(t[(k + 1) % 3])];
+          const P3 d = sub3(base_point(b, v0), base_point(b, v1));
+          const double dz = (v0.z - v1.z) * S;
+          if (dot3(d, d) + dz * dz > max_edge2) stretched = true;
+        }
+        if (stretched) break;
+      }
+      if (stretched) {
+        ++res.elements_stretched;
+        continue;
+      }
     }
     {
       // Heights past the output's z range (SurfaceQuiltOptions::max_z_growth):

@@ -120,6 +120,13 @@ struct SurfaceQuiltOptions {
   /// Output vertices of P_out used to compare the turns (evenly subsampled;
   /// the chosen turn's translation is then matched with step.max_match_vertices); >= 1.
   int rotation_match_vertices = 150;
+  /// Elements with an edge longer than this many times the swatch's longest
+  /// edge (scaled; measured between the edge's feet on the base mesh, with
+  /// the height difference) are removed at the end (issue #8, our choice,
+  /// like the paper's removal of "visually-displeasing elements", section 4):
+  /// a vertex moved beyond its patch and walked onto a distant face (across
+  /// the gap between the bunny's ears) made long spikes. >= 0; 0 = keep all.
+  double max_edge_stretch = 6.0;
   /// The output's z range (SurfaceQuilt::z_min, z_max: the shell's w = 0
   /// and 1) is the swatch's widened to the heights the quilt's vertices
   /// reached (the element deformations and stitches of sections 2.6-2.7 move
@@ -213,6 +220,8 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Elements removed at the end for a stretched edge (SurfaceQuiltOptions::max_edge_stretch).
+  std::size_t elements_stretched = 0;
   /// Elements shifted or squeezed in z into the output's z range and their
   /// vertices, and how far the range was widened below / above the swatch's
   /// (swatch units; see SurfaceQuiltOptions::max_z_growth).
