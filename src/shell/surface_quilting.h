@@ -60,7 +60,13 @@
 // At the end every location is moved onto the base face that contains it
 // (walking across edges); elements with more than max_past_border of their
 // vertices past a border of the base mesh are removed (issue #8: our choice,
-// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border).
+// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border);
+// elements with a stretched edge are removed (max_edge_stretch), and elements
+// reaching above or below the output's z range are shifted into it
+// (max_z_growth), so that every vertex has w in [0, 1] in the shell (issue #8).
+// A refused stitch no longer drops the new patch's element whole: its end
+// beyond the overlap is kept, closed at the cut
+// (QuiltStepOptions::keep_cut_refused_inputs).
 // Finally surface_quilt_to_texture expresses every vertex in the base mesh
 // atlas's texture space (u, v, w), w = (z - z_min) / (z_max - z_min) of the
 // swatch, ready for embed_in_shell (section 3.2); surface_quilt_displaced is
