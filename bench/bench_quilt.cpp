@@ -12,7 +12,13 @@
 //                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
 //                    [variant: fixed (default) | baseline = issue #8's stitch checks and
 //                     transported orientation off, for before/after comparisons |
-//                     translation = placements not turned (rotation_max_deg 0)]
+//                     translation = placements not turned (rotation_max_deg 0) |
+//                     drop = refused input threads dropped whole (keep_cut_refused_inputs off) |
+//                     grown_z = z range widened up to 0.5 swatch heights (max_z_growth 0.5) |
+//                     seed_scale = frame scaled by the flattening around the seed |
+//                     keep_stretched = no removal of stretched elements (max_edge_stretch 0)]
+// Writes bunny_<swatch>.png (azimuth 30, elevation 20), _back.png (210, 20)
+// and _top.png (120, 60) with the PLY when an output folder is given.
 //
 // Issue #8, session 4 (turned placements, SurfaceQuiltOptions::rotation_max_deg;
 // measured under load 6.5-8.7, so CPU times matter, walls do not): default
@@ -24,6 +30,31 @@
 // cut ends (MergeOptions::trim_overlapping_ends) added, "fixed": 108 stitched,
 // 1281 refused, 11 coincident, 870K faces, 25,482 within / 111,282 between,
 // 8,240 vertices outside the shell (4,370 before), user CPU 92 s.
+//
+// Issue #8, session 5 (2026-11-22, load 4.5-10 from other engineers' builds:
+// walls are not comparable, user CPU is). Refusals of the run above by
+// QuiltStepStats::refused_reasons (1,281): misaligned loops 872 (centroids
+// apart 338, normals > 60 deg 278, radii ratio > 2 256: the new thread does
+// not lie on the old one, or a thread of the other direction is related at a
+// crossing), cuts opened different numbers of loops 229, self-intersecting
+// stitch 133, non-simple cut border 35, non-manifold 12. Of 2,316 placed
+// threads 1,364 were dropped whole (bare strips), 844 added, 108 stitched.
+// The 8,240 outside vertices were all w < 0 (4,349) or w > 1 (3,891), none
+// off the texture space in (u, v): deformed and stitched elements left the
+// swatch's z range. Fixes, one at a time (same run otherwise):
+//   z fitted (max_z_growth 0, elements shifted into the range; "drop"):
+//     outside 8,240 -> 0 (210 elements shifted), within 25,482 -> 25,430,
+//     between 111,282 -> 111,994, 870,454 faces, stretch 1.040 -> 1.037,
+//     user CPU 94 s. (Widened range instead, 0.5 heights: stretch 1.144 -> 1.129.)
+//   + refused threads keep their end beyond the overlap (keep_cut_refused_inputs):
+//     dropped 1,364 -> 660, 721 kept cut, 100 stitched, 1,320 refused,
+//     1,003,862 faces, within 30,239, between 149,988, user CPU 99 s.
+//   + stretched elements removed (max_edge_stretch 12; default "fixed"):
+//     53 removed, 946,255 faces, within 18,633, between 100,981, 0 outside,
+//     stretch 1.040 -> 1.037, quilt 153 s, total wall 2:50 at load 5.5-8.5,
+//     user CPU 93.6 s (max_edge_stretch 6: 122 removed, 882K faces, within
+//     10,544, between 75,752, but bare ears).
+//   seed_scale (not default): stitched 73 vs 94 without in the same setting.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
