@@ -358,6 +358,10 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) 
   SurfaceQuiltOptions o;
   o.relative_size = test::sanitized() ? 0.45 : 0.35;
   o.up = {0.0, 0.6, 0.8};
+  // The figures above were measured with refused inputs dropped whole; their
+  // kept cut parts (issue #8, session 5) do not change what this test is
+  // about and made it about 30% slower.
+  o.step.keep_cut_refused_inputs = false;
   std::size_t stitched = 0, tried = 0;
   int turned = 0, steps = 0;
   // (Under the sanitizers at relative size 0.45, seeds 1 and 2: turned 40 of
