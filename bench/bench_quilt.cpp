@@ -144,7 +144,9 @@ int main(int argc, char** argv) {
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
           {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported},
-          {"patches_turned", r.patches_turned}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
+          {"patches_turned", r.patches_turned}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0},
+          {"overlap_jump_deg", r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0},
+          {"overlap_over10_fraction", r.overlap_area > 0 ? r.overlap_area_over10 / r.overlap_area : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
           {"seed_scale", {r.seed_scale_min, r.seed_scale_max}},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
           {"coincident", r.stats.coincident}, {"stitched_trimmed", r.stats.stitched_trimmed},

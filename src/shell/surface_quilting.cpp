@@ -970,7 +970,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     for (std::size_t k = 0; k < flat.faces.size(); ++k) {
       const int f = flat.faces[k];
       P3& g = face_dir[static_cast<std::size_t>(f)];
-      if (!processed[f] || norm3(g) > 0) continue;
+      if (!processed[f]) continue;
+      const bool old_dir = norm3(g) > 0;
+      if (old_dir) {  // only faces under this footprint are compared (SurfaceQuiltResult::overlap_turn_deg)
+        const double cxp = (ftris[k][0][0] + ftris[k][1][0] + ftris[k][2][0]) / 3;
+        const double cyp = (ftris[k][0][1] + ftris[k][1][1] + ftris[k][2][1]) / 3;
+        if (!(cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1)) continue;
+      }
       // 3D = p0 + E M^-1 (uv - q0), E = [e1 e2], M = [q1 - q0, q2 - q0]; direction of (0, 1).
       const auto& tk = ftris[k];
       const double m11 = tk[1][0] - tk[0][0], m12 = tk[2][0] - tk[0][0], m21 = tk[1][1] - tk[0][1], m22 = tk[2][1] - tk[0][1];
@@ -981,7 +987,19 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       const P3 e1 = sub3(b.pts[tri[1]], b.pts[tri[0]]), e2 = sub3(b.pts[tri[2]], b.pts[tri[0]]);
       const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
       const double l = norm3(v);
-      if (l > 0) g = {v[0] / l, v[1] / l, v[2] / l};
+      if (!(l > 0)) continue;
+      if (old_dir) {
+        // Angle between this placement's threads and the earlier ones, folded
+        // by the weave's quarter-turn symmetry into [0, 45] degrees.
+        const double cosang = std::clamp(dot3(v, g) / l, -1.0, 1.0);
+        double a = std::fmod(std::acos(cosang) * 180.0 / kPi, 90.0);
+        a = std::min(a, 90.0 - a);
+        res.overlap_turn_sum += b.area[f] * a;
+        res.overlap_area += b.area[f];
+        if (a > 10) res.overlap_area_over10 += b.area[f];
+      } else {
+        g = {v[0] / l, v[1] / l, v[2] / l};
+      }
     }
     // The footprint's points (section 2.3's processed cells, kept on the surface).
     for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)

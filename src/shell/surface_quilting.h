@@ -242,6 +242,13 @@ struct SurfaceQuiltResult {
   /// over all placements (degrees).
   int patches_turned = 0;
   double turn_deg_sum = 0;
+  /// Orientation jumps (a diagnostic): over the base faces that a placement
+  /// covers and an earlier one had covered, the angle between the two
+  /// placements' +y directions on that face, folded by a quarter turn into
+  /// [0, 45] degrees (the weave's and chain mail's symmetry), area-weighted:
+  /// overlap_turn_sum / overlap_area is the mean jump; overlap_area_over10
+  /// the area (mesh units^2, counted once per placement) where it exceeds 10 degrees.
+  double overlap_turn_sum = 0, overlap_area = 0, overlap_area_over10 = 0;
   QuiltStepStats stats;
   /// seconds_turn: the rotation search (part of seconds_step).
   double seconds = 0, seconds_patch = 0, seconds_step = 0, seconds_turn = 0;
