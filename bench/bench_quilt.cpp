@@ -66,6 +66,10 @@
 // "fixed" again with "translation" beside it (load 3.5): wall 1:48, user CPU
 // 93.8 s; 0 vertices outside the shell ("translation": 51, all with w in
 // [0, 1] but (u, v) outside every texture-space tet: not investigated).
+// "transport" (every patch oriented by the earlier placements): jumps 12.1
+// deg, 42% over 10 deg, 94 stitched: no better. Quiet machine (load 0.7-1.1),
+// "fixed": quilt 64.0 s, total 68.0 s, wall 1:11.4, user CPU 97.5 s, 946,255
+// faces, stretch 1.040 -> 1.037, same output as under load.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
