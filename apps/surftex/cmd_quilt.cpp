@@ -203,6 +203,7 @@ int run_quilt(QuiltArgs& a) {
     rep["max_turn_deg"] = o.rotation_max_deg;
     rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
+    rep["elements_stretched"] = r.elements_stretched;
     rep["stitched"] = r.stats.stitched;
     rep["stitch_refused"] = r.stats.stitch_refused;
     rep["coincident"] = r.stats.coincident;
@@ -221,6 +222,13 @@ int run_quilt(QuiltArgs& a) {
     rep["stitch_refused_border"] = r.stats.refused_border;
     rep["stitch_refused_geometry"] = r.stats.refused_geometry;
     rep["stitch_refused_infeasible"] = r.stats.refused_infeasible;
+    rep["stitch_refused_reasons"] = r.stats.refused_reasons;
+    rep["inputs_dropped"] = r.stats.in_dropped;
+    rep["inputs_kept_cut"] = r.stats.in_cut_added;
+    rep["z_fitted_elements"] = r.z_fitted_elements;
+    rep["outside_below"] = er.outside_below;
+    rep["outside_above"] = er.outside_above;
+    rep["outside_uv"] = er.outside_uv;
     if (er.embed.checked) {
       rep["self_intersections"] = er.embed.self_intersecting_pairs;
       rep["self_intersections_within_elements"] = er.self_intersections_within;

@@ -624,6 +624,40 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
 }
 }  // namespace
 
+namespace {
+// The kept part of closed `m` split into components, each cut loop closed by
+// a fan around the loop's centroid (see MergeResult::capped_b).
+std::vector<ElementMesh> capped_kept_components(const ElementMesh& m, const std::vector<char>& keep) {
+  std::vector<ElementMesh> out;
+  std::size_t kept = 0;
+  for (char k : keep) kept += k ? 1 : 0;
+  if (kept == 0 || kept == m.tris.size() || count_border_edges(m) != 0) return out;
+  std::vector<int> tris;
+  for (std::size_t t = 0; t < m.tris.size(); ++t)
+    if (keep[t]) tris.push_back(static_cast<int>(t));
+  const ElementMesh part = extract_triangles(m, tris);
+  std::vector<int> comp;
+  const int nc = triangle_components(part, comp);
+  for (int c = 0; c < nc; ++c) {
+    std::vector<int> ct;
+    for (std::size_t t = 0; t < part.tris.size(); ++t)
+      if (comp[t] == c) ct.push_back(static_cast<int>(t));
+    if (10 * ct.size() < m.tris.size()) continue;
+    ElementMesh e = extract_triangles(part, ct);
+    std::vector<std::vector<int>> loops;
+    if (!boundary_loops(e, loops) || loops.size() != 1) continue;
+    for (const std::vector<int>& l : loops) {
+      if (l.size() < 3) continue;
+      const int cv = static_cast<int>(e.points.size());
+      e.points.push_back(loop_centroid(e, l));
+      for (std::size_t k = 0; k < l.size(); ++k) e.tris.push_back({l[(k + 1) % l.size()], l[k], cv});
+    }
+    if (is_closed_oriented(e)) out.push_back(std::move(e));
+  }
+  return out;
+}
+}  // namespace
+
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt) {
   MergeResult r;
@@ -654,6 +688,13 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
       again.trimmed = true;
       return again;
     }
+  }
+  if (!r.stitched && !r.coincident) {
+    // B's kept part on its own side only (see MergeResult::capped_b).
+    std::vector<char> own = trimmed.empty() ? cb.keep : trimmed;
+    for (std::size_t t = 0; t < b.tris.size(); ++t)
+      if (own[t] && region(centroid(b, b.tris[t])) != side_b) own[t] = 0;
+    r.capped_b = capped_kept_components(b, own);
   }
   return r;
 }

@@ -132,6 +132,20 @@ struct MergeResult {
   bool coincident = false;
   /// Stitched after trimming B's overlapping cut end (MergeOptions::trim_overlapping_ends).
   bool trimmed = false;
+  /// When refused (not coincident) with both cuts feasible and B closed:
+  /// B's kept part (trimmed back as in MergeOptions::trim_overlapping_ends
+  /// when the stitch crossed itself) restricted to the triangles whose
+  /// centroid lies in B's own outside region (side_b, e.g. kNew: not in the
+  /// overlap, where A and the other old elements stay), split into connected
+  /// components; the components with exactly one cut loop (an element's end,
+  /// e.g. a thread running on past the overlap; not an arc of a ring or a
+  /// middle piece) and at least a tenth of B's triangles are kept, the loop
+  /// closed by a fan around its centroid, so that each is closed again. Empty if nothing or everything of B is
+  /// kept. The caller may add these instead of dropping B (issue #8:
+  /// dropping a whole refused thread left bare strips; keeping B's whole
+  /// kept part, overlap included, put it on top of misaligned old threads:
+  /// see QuiltStepOptions::keep_cut_refused_inputs).
+  std::vector<ElementMesh> capped_b;
 };
 
 /// Cuts A and B and stitches them. Refuses (stitched = false, reason set,

@@ -128,7 +128,17 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   }
   mesh_from_elements(els, out);
   res.embed.vertices = nv;
-  for (char o : outside) res.embed.outside += static_cast<std::size_t>(o);
+  for (std::size_t i = 0; i < nv; ++i) {
+    if (!outside[i]) continue;
+    ++res.embed.outside;
+    const double w = (quilt.vertices[i].z - quilt.z_min) / dz;
+    if (w < 0)
+      ++res.outside_below;
+    else if (w > 1)
+      ++res.outside_above;
+    else
+      ++res.outside_uv;
+  }
   if (opt.check_self_intersections) {
     const std::vector<FacePair> pairs = self_intersecting_faces(out);
     auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;

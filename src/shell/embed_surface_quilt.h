@@ -50,6 +50,11 @@ struct EmbedSurfaceQuiltResult {
   std::size_t tets = 0, clamped_vertices = 0;
   double shell_height = 0;        ///< nominal absolute shell height (mesh units)
   EmbedInShellResult embed;       ///< outside vertices, self-intersecting pairs (all)
+  /// The outside vertices by cause: w below 0 / above 1 (the quilt's height
+  /// left the swatch's z range), or w in [0, 1] with (u, v) outside every tet
+  /// of the texture space (the stretch minimisation moved the offset
+  /// vertices' (u, v), so the prism's texture-space tets lean).
+  std::size_t outside_below = 0, outside_above = 0, outside_uv = 0;
   /// The self-intersecting pairs split by element: both faces in one element
   /// (what the swatch's elements may already have, and deformation adds) and
   /// faces of two different elements (overlapping elements: a quilting defect).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -40,9 +41,12 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   refused_border += o.refused_border;
   refused_geometry += o.refused_geometry;
   coincident += o.coincident;
+  for (const auto& [k, n] : o.refused_reasons) refused_reasons[k] += n;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
   in_added += o.in_added;
+  in_cut_added += o.in_cut_added;
+  in_cut_components += o.in_cut_components;
   seconds_match += o.seconds_match;
   seconds_correspond += o.seconds_correspond;
   seconds_deform += o.seconds_deform;
@@ -50,6 +54,29 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
 }
 
 namespace {
+// The kind of a refusal (QuiltStepStats::refused_reasons): the reason up to
+// the second ':' (first word group after a ':' kept, e.g. "misaligned loops:
+// normals"), digit runs and numbers replaced by N.
+std::string reason_kind(const std::string& reason) {
+  std::string head = reason;
+  const std::size_t c1 = reason.find(':');
+  if (c1 != std::string::npos) {
+    std::size_t end = reason.find_first_of("0123456789-", c1 + 2);
+    if (end == std::string::npos) end = reason.size();
+    head = reason.substr(0, end);
+    while (!head.empty() && head.back() == ' ') head.pop_back();
+  }
+  std::string out;
+  for (std::size_t i = 0; i < head.size(); ++i) {
+    if (std::isdigit(static_cast<unsigned char>(head[i]))) {
+      out += 'N';
+      while (i + 1 < head.size() && (std::isdigit(static_cast<unsigned char>(head[i + 1])) || head[i + 1] == '.')) ++i;
+    } else {
+      out += head[i];
+    }
+  }
+  return out;
+}
 int find_root(std::vector<int>& p, int x) {
   while (p[x] != x) x = p[x] = p[p[x]];
   return x;
@@ -296,6 +323,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
 
   std::vector<char> add_in(ni, 1);
   std::vector<std::pair<int, ElementMesh>> replacements;
+  std::vector<ElementMesh> cut_inputs;  // refused inputs' closed kept parts (keep_cut_refused_inputs)
   double t_deform = 0, t_merge = 0;
   for (auto& [root, g] : groups) {
     auto& [outs, ins] = g;
@@ -378,6 +406,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         }
       } else {
         ++stats.stitch_refused;
+        ++stats.refused_reasons[reason_kind(r.reason)];
         if (r.reason.find("infeasible") != std::string::npos)
           ++stats.refused_infeasible;
         else if (r.reason.rfind("misaligned", 0) == 0 || r.reason.rfind("self-intersecting", 0) == 0)
@@ -389,7 +418,14 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
           add_in[e] = 0;
-          ++stats.in_dropped;
+          if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
+            ++stats.in_cut_added;
+
+            stats.in_cut_components += r.capped_b.size();
+            for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
+          } else {
+            ++stats.in_dropped;
+          }
         }
       }
     }
@@ -403,6 +439,10 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
       alive.push_back(1);
       ++stats.in_added;
     }
+  for (ElementMesh& m : cut_inputs) {
+    elements.push_back(std::move(m));
+    alive.push_back(1);
+  }
   for (int j = std::max(0, oj); j < std::min(grid.ny, oj + sy); ++j)
     for (int i = std::max(0, oi); i < std::min(grid.nx, oi + sx); ++i) grid.processed[j * grid.nx + i] = 1;
   stats.seconds_deform += t_deform;

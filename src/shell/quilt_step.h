@@ -7,7 +7,9 @@
 // quilting on surfaces (surface_quilting.h), where it is the LSCM plane of a
 // surface patch. Seed finding (2.3) is the caller's.
 #include <cstdint>
+#include <map>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "shell/element_mesh.h"
@@ -42,6 +44,13 @@ struct QuiltStepOptions {
   /// on top of it: overlapping duplicates are worse than a small gap. The
   /// paper has no refusals (its merge always succeeds).
   bool drop_refused_inputs = true;
+  /// With drop_refused_inputs: add the refused input element's kept part
+  /// outside the overlap instead, closed at its cuts (MergeResult::capped_b),
+  /// so that the new patch is covered up to the overlap, where the old
+  /// elements stay (the two abut there instead of being stitched). Issue #8: on the 5K-face bunny 1,364 of 2,316
+  /// placed threads were dropped whole, leaving bare strips. false = drop the
+  /// whole input element (the state before).
+  bool keep_cut_refused_inputs = true;
   /// Geometric checks of each stitch (MergeOptions::max_loop_offset and the
   /// next three, at their defaults): zip only loop pairs that face each other
   /// and refuse stitches that cross themselves. false = off (the state before
@@ -94,7 +103,15 @@ struct QuiltStepStats {
   /// counted in stitch_refused (until issue #8's session 4 they were, as
   /// "loops": planar 3x3 chain mail, 38 of 43 refusals).
   std::size_t coincident = 0;
+  /// Refusals by the kind of MergeResult::reason (its text before the first
+  /// ':' with every number replaced by N, e.g. "misaligned loops: normals",
+  /// "cuts opened N and N loops"): the finer breakdown of the four counts above.
+  std::map<std::string, std::size_t> refused_reasons;
   std::size_t out_replaced = 0, in_dropped = 0, in_added = 0;
+  /// Refused input elements added as their closed kept parts
+  /// (QuiltStepOptions::keep_cut_refused_inputs; not counted in in_dropped),
+  /// and the elements (components) this added.
+  std::size_t in_cut_added = 0, in_cut_components = 0;
   double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
   void add(const QuiltStepStats& o);
 };

@@ -401,6 +401,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.cell_size >= 0) || !std::isfinite(o.cell_size)) bad("cell_size must be >= 0", o.cell_size);
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
   if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
+  if (!(o.max_edge_stretch >= 0) || !std::isfinite(o.max_edge_stretch)) bad("max_edge_stretch must be >= 0", o.max_edge_stretch);
+  if (!(o.max_z_growth >= 0 && o.max_z_growth <= 10)) bad("max_z_growth must be in [0, 10]", o.max_z_growth);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
   if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
@@ -553,8 +555,24 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       }
     }
     const V2 oc{(q0[0] + q1[0] + q2[0]) / 3, (q0[1] + q1[1] + q2[1]) / 3};
+    // The flattening's scale where the match is made (SurfaceQuiltOptions::seed_scale).
+    double sloc = 1;
+    if (opt.seed_scale) {
+      const double rad = (r + 0.5) * c * S * std::sqrt(2.0);
+      double a3 = 0, a2 = 0;
+      for (int f : flat.faces) {
+        const P3 d = sub3(b.centroid[f], b.centroid[seed]);
+        if (f != seed && dot3(d, d) > rad * rad) continue;
+        const auto& t = b.faces[f];
+        a3 += b.area[f];
+        a2 += std::abs(area2(flat.uv[flat.local[t[0]]], flat.uv[flat.local[t[1]]], flat.uv[flat.local[t[2]]]));
+      }
+      if (a3 > 0 && a2 > 0) sloc = std::sqrt(a3 / a2);
+    }
+    res.seed_scale_min = res.steps == 0 ? sloc : std::min(res.seed_scale_min, sloc);
+    res.seed_scale_max = res.steps == 0 ? sloc : std::max(res.seed_scale_max, sloc);
     for (auto& p : flat.uv) {
-      const double x = (p[0] - oc[0]) / S, y = (p[1] - oc[1]) / S;
+      const double x = (p[0] - oc[0]) * sloc / S, y = (p[1] - oc[1]) * sloc / S;
       p = {rot_c * x - rot_s * y, rot_s * x + rot_c * y};
     }
     std::vector<std::array<V2, 3>> ftris(flat.faces.size());
@@ -952,7 +970,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     for (std::size_t k = 0; k < flat.faces.size(); ++k) {
       const int f = flat.faces[k];
       P3& g = face_dir[static_cast<std::size_t>(f)];
-      if (!processed[f] || norm3(g) > 0) continue;
+      if (!processed[f]) continue;
+      const bool old_dir = norm3(g) > 0;
+      if (old_dir) {  // only faces under this footprint are compared (SurfaceQuiltResult::overlap_turn_deg)
+        const double cxp = (ftris[k][0][0] + ftris[k][1][0] + ftris[k][2][0]) / 3;
+        const double cyp = (ftris[k][0][1] + ftris[k][1][1] + ftris[k][2][1]) / 3;
+        if (!(cxp >= fx0 && cxp < fx1 && cyp >= fy0 && cyp < fy1)) continue;
+      }
       // 3D = p0 + E M^-1 (uv - q0), E = [e1 e2], M = [q1 - q0, q2 - q0]; direction of (0, 1).
       const auto& tk = ftris[k];
       const double m11 = tk[1][0] - tk[0][0], m12 = tk[2][0] - tk[0][0], m21 = tk[1][1] - tk[0][1], m22 = tk[2][1] - tk[0][1];
@@ -963,7 +987,19 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       const P3 e1 = sub3(b.pts[tri[1]], b.pts[tri[0]]), e2 = sub3(b.pts[tri[2]], b.pts[tri[0]]);
       const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
       const double l = norm3(v);
-      if (l > 0) g = {v[0] / l, v[1] / l, v[2] / l};
+      if (!(l > 0)) continue;
+      if (old_dir) {
+        // Angle between this placement's threads and the earlier ones, folded
+        // by the weave's quarter-turn symmetry into [0, 45] degrees.
+        const double cosang = std::clamp(dot3(v, g) / l, -1.0, 1.0);
+        double a = std::fmod(std::acos(cosang) * 180.0 / kPi, 90.0);
+        a = std::min(a, 90.0 - a);
+        res.overlap_turn_sum += b.area[f] * a;
+        res.overlap_area += b.area[f];
+        if (a > 10) res.overlap_area_over10 += b.area[f];
+      } else {
+        g = {v[0] / l, v[1] / l, v[2] / l};
+      }
     }
     // The footprint's points (section 2.3's processed cells, kept on the surface).
     for (double y = fy0 + 0.25 * c; y < fy1; y += 0.5 * c)
@@ -978,6 +1014,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     ++step_id;
   }
   // Output.
+  double max_edge2 = 0;  // squared, mesh units (SurfaceQuiltOptions::max_edge_stretch)
+  for (const Tri& t : swatch.mesh.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 d = sub3(swatch.mesh.points[static_cast<std::size_t>(t[k])], swatch.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+      max_edge2 = std::max(max_edge2, dot3(d, d));
+    }
+  max_edge2 *= opt.max_edge_stretch * opt.max_edge_stretch * S * S;
   out = SurfaceQuilt{};
   out.scale = S;
   out.z_min = swatch.bbox_min[2];
@@ -1005,6 +1048,42 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       ++res.elements_past_border;
       continue;
     }
+    if (opt.max_edge_stretch > 0) {
+      // Stretched elements (SurfaceQuiltOptions::max_edge_stretch): an edge
+      // whose feet on the base mesh lie far apart.
+      bool stretched = false;
+      for (const Tri& t : el.mesh.tris) {
+        for (int k = 0; k < 3 && !stretched; ++k) {
+          const SurfaceQuiltVertex &v0 = settled[static_cast<std::size_t>(t[k])], &v1 = settled[static_cast<std::size_t>(t[(k + 1) % 3])];
+          const P3 d = sub3(base_point(b, v0), base_point(b, v1));
+          const double dz = (v0.z - v1.z) * S;
+          if (dot3(d, d) + dz * dz > max_edge2) stretched = true;
+        }
+        if (stretched) break;
+      }
+      if (stretched) {
+        ++res.elements_stretched;
+        continue;
+      }
+    }
+    {
+      // Heights past the output's z range (SurfaceQuiltOptions::max_z_growth):
+      // the element is shifted in z into it, or squeezed if taller than it.
+      const double h = swatch.bbox_max[2] - swatch.bbox_min[2];
+      const double lim_lo = swatch.bbox_min[2] - opt.max_z_growth * h, lim_hi = swatch.bbox_max[2] + opt.max_z_growth * h;
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const SurfaceQuiltVertex& v : settled) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+      if (lo < lim_lo || hi > lim_hi) {
+        ++res.z_fitted_elements;
+        res.z_fitted_vertices += settled.size();
+        if (hi - lo <= lim_hi - lim_lo) {
+          const double shift = lo < lim_lo ? lim_lo - lo : lim_hi - hi;
+          for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(v.z + shift, lim_lo, lim_hi);
+        } else {
+          for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(lim_lo + (v.z - lo) * (lim_hi - lim_lo) / (hi - lo), lim_lo, lim_hi);
+        }
+      }
+    }
     const int base_index = static_cast<int>(out.vertices.size());
     for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
     for (const Tri& t : el.mesh.tris) {
@@ -1012,6 +1091,16 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       out.tri_element.push_back(out.elements);
     }
     ++out.elements;
+  }
+  {
+    // The z range (SurfaceQuiltOptions::max_z_growth): widened to the
+    // vertices' heights (each element was fitted within the limits above).
+    double lo = out.z_min, hi = out.z_max;
+    for (const SurfaceQuiltVertex& v : out.vertices) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+    res.z_grown_below = out.z_min - lo;
+    res.z_grown_above = hi - out.z_max;
+    out.z_min = lo;
+    out.z_max = hi;
   }
   res.elements = out.elements;
   res.faces = out.tris.size();

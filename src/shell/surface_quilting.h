@@ -28,7 +28,8 @@
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
-//    seed centroid at the origin (a cell centre); a grid of cells (as in
+//    times the flattening's own scale around the seed (seed_scale), seed
+//    centroid at the origin (a cell centre); a grid of cells (as in
 //    mesh_quilting.h) over it; processed cells as in step 6. P_out = cells
 //    within subpatch_radius (Chebyshev) of the seed cell whose centre lies on
 //    the patch. Then the frame is turned about the seed centroid by the angle
@@ -59,7 +60,13 @@
 // At the end every location is moved onto the base face that contains it
 // (walking across edges); elements with more than max_past_border of their
 // vertices past a border of the base mesh are removed (issue #8: our choice,
-// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border).
+// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border);
+// elements with a stretched edge are removed (max_edge_stretch), and elements
+// reaching above or below the output's z range are shifted into it
+// (max_z_growth), so that every vertex has w in [0, 1] in the shell (issue #8).
+// A refused stitch no longer drops the new patch's element whole: its end
+// beyond the overlap is kept, closed at the cut
+// (QuiltStepOptions::keep_cut_refused_inputs).
 // Finally surface_quilt_to_texture expresses every vertex in the base mesh
 // atlas's texture space (u, v, w), w = (z - z_min) / (z_max - z_min) of the
 // swatch, ready for embed_in_shell (section 3.2); surface_quilt_displaced is
@@ -119,6 +126,44 @@ struct SurfaceQuiltOptions {
   /// Output vertices of P_out used to compare the turns (evenly subsampled;
   /// the chosen turn's translation is then matched with step.max_match_vertices); >= 1.
   int rotation_match_vertices = 150;
+  /// Elements with an edge longer than this many times the swatch's longest
+  /// edge (scaled; measured between the edge's feet on the base mesh, with
+  /// the height difference) are removed at the end (issue #8, our choice,
+  /// like the paper's removal of "visually-displeasing elements", section 4):
+  /// a vertex moved beyond its patch and walked onto a distant face (across
+  /// the gap between the bunny's ears) made long spikes. >= 0; 0 = keep all.
+  /// Default 12: on the 5K-face bunny 53 elements go and the intersecting
+  /// pairs within / between elements drop 30.2K -> 18.6K / 150K -> 101K;
+  /// at 6, 122 went (10.5K / 76K) but so did threads on the ears, whose
+  /// patches stretch the flattening most (bare ears in the render).
+  double max_edge_stretch = 12.0;
+  /// The output's z range (SurfaceQuilt::z_min, z_max: the shell's w = 0
+  /// and 1) is the swatch's widened to the heights the quilt's vertices
+  /// reached (the element deformations and stitches of sections 2.6-2.7 move
+  /// vertices a little above or below the swatch), by at most this many
+  /// swatch heights on each side; an element reaching beyond is shifted in z
+  /// into it (squeezed if taller than it; counted in
+  /// SurfaceQuiltResult::z_fitted_elements). Issue #8: with the swatch's
+  /// range and nothing fitted, 8,240 of the bunny's vertices had w outside
+  /// [0, 1] and were extrapolated out of the shell. In [0, 10]; 0 = the
+  /// swatch's range. Default 0: the shell's thickness follows the range, and
+  /// at 0.5 (the range reached its limit) the bunny's shell stretch rose from
+  /// 1.037 to 1.129 (limit 1.05). (Clamping each vertex instead, as first
+  /// tried, flattened whole threads lifted past the top into degenerate
+  /// ribbons: 35K -> 58K intersecting pairs within elements.)
+  double max_z_growth = 0;
+  /// Scale of the patch frame (our choice; step 5): true = the flattening's
+  /// own scale around the seed (3D area over uv area of the patch faces whose
+  /// centroid lies within the P_out radius of the seed's), so that the
+  /// texture already placed keeps its size where the new swatch is matched
+  /// against it; false = the patch's mean (uv area = 3D area over the whole
+  /// patch, the state before). LSCM is conformal but not area-preserving: a
+  /// patch accepted at area distortion 4 is up to 2x longer or shorter
+  /// around its seed than on average, and the old threads, seen at that
+  /// scale, ran at other spacings than the swatch's. Default false: on the
+  /// bunny (one run each, load 4-9) it did not stitch more (73 stitched with
+  /// it, 94 without; the frame scale around the seeds ranged 0.86 - 1.57).
+  bool seed_scale = false;
   /// Patch radius in swatch diagonals (scaled); > 0.
   double patch_radius = 1.0;
   /// Largest angle between a patch triangle's normal and the seed's (degrees); in (0, 180].
@@ -157,7 +202,10 @@ struct SurfaceQuilt {
   std::vector<int> tri_element;  ///< element id per triangle, 0..elements-1
   int elements = 0;
   double scale = 0;              ///< mesh units per swatch unit
-  double z_min = 0, z_max = 0;   ///< the swatch's z range (swatch units)
+  /// The output's z range (swatch units): the swatch's, widened to the
+  /// vertices' heights (SurfaceQuiltOptions::max_z_growth); every vertex's z
+  /// lies in it.
+  double z_min = 0, z_max = 0;
 };
 
 struct SurfaceQuiltResult {
@@ -167,6 +215,8 @@ struct SurfaceQuiltResult {
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
   int patches_transported = 0; ///< patches oriented by the transported direction (step 4)
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
+  /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
+  double seed_scale_min = 1, seed_scale_max = 1;
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
   /// Times an output element touching a patch had a vertex that cannot be
   /// expressed in the patch frame: off the patch, farther than 2R from (or at
@@ -180,11 +230,25 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Elements removed at the end for a stretched edge (SurfaceQuiltOptions::max_edge_stretch).
+  std::size_t elements_stretched = 0;
+  /// Elements shifted or squeezed in z into the output's z range and their
+  /// vertices, and how far the range was widened below / above the swatch's
+  /// (swatch units; see SurfaceQuiltOptions::max_z_growth).
+  std::size_t z_fitted_elements = 0, z_fitted_vertices = 0;
+  double z_grown_below = 0, z_grown_above = 0;
   /// Placements turned away from the field's direction by the rotation
   /// search (SurfaceQuiltOptions::rotation_max_deg), and the sum of |turn|
   /// over all placements (degrees).
   int patches_turned = 0;
   double turn_deg_sum = 0;
+  /// Orientation jumps (a diagnostic): over the base faces that a placement
+  /// covers and an earlier one had covered, the angle between the two
+  /// placements' +y directions on that face, folded by a quarter turn into
+  /// [0, 45] degrees (the weave's and chain mail's symmetry), area-weighted:
+  /// overlap_turn_sum / overlap_area is the mean jump; overlap_area_over10
+  /// the area (mesh units^2, counted once per placement) where it exceeds 10 degrees.
+  double overlap_turn_sum = 0, overlap_area = 0, overlap_area_over10 = 0;
   QuiltStepStats stats;
   /// seconds_turn: the rotation search (part of seconds_step).
   double seconds = 0, seconds_patch = 0, seconds_step = 0, seconds_turn = 0;

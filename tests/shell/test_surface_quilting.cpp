@@ -3,7 +3,9 @@
 // sections 3.1 and 3.2): quilt_surface, surface_quilt_to_texture,
 // surface_quilt_displaced, embed_surface_quilt.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <vector>
@@ -222,7 +224,8 @@ TEST(SurfaceQuilting, TorusChainmailIntersectionsSplitByElementAndNoVertexLeaves
             << ", stitched " << qr.stats.stitched << ", refused " << qr.stats.stitch_refused << ", stretch "
             << er.stretch.stretch_before << " -> " << er.stretch.stretch_after << ", pairs within "
             << er.self_intersections_within << " (swatch " << swatch_within << "), between "
-            << er.self_intersections_between << "\n";
+            << er.self_intersections_between << ", outside " << er.embed.outside << " (below " << er.outside_below
+            << ", above " << er.outside_above << ", (u, v) " << er.outside_uv << "), z fitted " << qr.z_fitted_elements << "\n";
   // Every vertex lies in the shell: distance to the torus' core circle in [r - eps, r + shell height + eps].
   for (VertexIndex v : out.vertices()) {
     const Point3 p = out.point(v);
@@ -355,6 +358,10 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) 
   SurfaceQuiltOptions o;
   o.relative_size = test::sanitized() ? 0.45 : 0.35;
   o.up = {0.0, 0.6, 0.8};
+  // The figures above were measured with refused inputs dropped whole; their
+  // kept cut parts (issue #8, session 5) do not change what this test is
+  // about and made it about 30% slower.
+  o.step.keep_cut_refused_inputs = false;
   std::size_t stitched = 0, tried = 0;
   int turned = 0, steps = 0;
   // (Under the sanitizers at relative size 0.45, seeds 1 and 2: turned 40 of
@@ -400,6 +407,192 @@ TEST(SurfaceQuilting, RotationSearchOptionsAreChecked) {
   const SurfaceQuiltResult r = quilt_surface(base, sw, q, o);
   EXPECT_EQ(r.patches_turned, 0);
   EXPECT_EQ(r.turn_deg_sum, 0.0);
+}
+
+}  // namespace
+}  // namespace surftex
+
+namespace surftex {
+namespace {
+
+// Fraction of the base faces with no quilt vertex within `radius` (mesh
+// units) of their centroid, distances measured between the centroid and the
+// foot point of each quilt vertex on its base face (a bare spot of the base
+// surface, wider than the gaps between a weave's threads when radius is
+// about a thread spacing).
+double bare_fraction(const Mesh& base, const SurfaceQuilt& q, double radius) {
+  std::vector<std::array<Point3, 3>> fp(base.number_of_faces());
+  for (FaceIndex f : base.faces()) {
+    int k = 0;
+    for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) fp[f.idx()][static_cast<std::size_t>(k++)] = base.point(v);
+  }
+  std::vector<Point3> foot;
+  foot.reserve(q.vertices.size());
+  for (const SurfaceQuiltVertex& v : q.vertices) {
+    const auto& t = fp[static_cast<std::size_t>(v.face)];
+    const double b0 = 1 - v.b1 - v.b2;
+    foot.emplace_back(b0 * t[0].x() + v.b1 * t[1].x() + v.b2 * t[2].x(), b0 * t[0].y() + v.b1 * t[1].y() + v.b2 * t[2].y(),
+                      b0 * t[0].z() + v.b1 * t[1].z() + v.b2 * t[2].z());
+  }
+  std::size_t bare = 0;
+  for (const auto& t : fp) {
+    const Point3 c((t[0].x() + t[1].x() + t[2].x()) / 3, (t[0].y() + t[1].y() + t[2].y()) / 3,
+                   (t[0].z() + t[1].z() + t[2].z()) / 3);
+    bool covered = false;
+    for (const Point3& p : foot)
+      if (CGAL::squared_distance(c, p) <= radius * radius) {
+        covered = true;
+        break;
+      }
+    bare += covered ? 0 : 1;
+  }
+  return fp.empty() ? 0.0 : static_cast<double>(bare) / static_cast<double>(fp.size());
+}
+
+// Issue #8, session 5: an input thread whose stitch to the old thread was
+// refused was dropped whole (on the 5K-face bunny 1,364 of 2,316 placed
+// threads), and its patch was marked processed: bare strips of base surface
+// where the old thread ended and the new one was missing. Now the refused
+// input keeps its part beyond the cut, closed at the cut
+// (QuiltStepOptions::keep_cut_refused_inputs), so that the two abut.
+TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
+  Mesh base;
+  make_cylinder(base, 1.0, 2.0, 20, 8);
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 6;
+  wo.sides = 6;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  const Swatch sw = make_swatch(wm);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.45;
+  o.up = {0.0, 0.6, 0.8};  // a helix field: many refused stitches
+  double bare[2] = {0, 0};
+  int closed_ok[2] = {0, 0};
+  for (int keep = 0; keep < 2; ++keep) {
+    o.step.keep_cut_refused_inputs = keep == 1;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, sw, q, o);
+    // One thread spacing (swatch units) in mesh units: wider than any gap of an intact weave.
+    bare[keep] = bare_fraction(base, q, wo.spacing * q.scale);
+    Mesh displaced;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, displaced);
+    closed_ok[keep] = closed_fraction(displaced) >= 0.9;
+    // Every height lies in the output's z range, which is the swatch's
+    // (SurfaceQuiltOptions::max_z_growth 0): the deformations and stitches
+    // moved some elements past it, and they are shifted back into it (before
+    // issue #8's session 5 they were left there and mapped out of the shell).
+    EXPECT_EQ(q.z_min, sw.bbox_min[2]);
+    EXPECT_EQ(q.z_max, sw.bbox_max[2]);
+    EXPECT_GT(r.z_fitted_elements, 0u);
+    for (const SurfaceQuiltVertex& v : q.vertices) {
+      ASSERT_GE(v.z, q.z_min);
+      ASSERT_LE(v.z, q.z_max);
+    }
+    std::cout << "[ refused inputs ] keep cut " << keep << ": stitched " << r.stats.stitched << ", refused "
+              << r.stats.stitch_refused << ", dropped " << r.stats.in_dropped << ", kept cut " << r.stats.in_cut_added
+              << " (" << r.stats.in_cut_components << " parts), faces " << r.faces << ", bare faces " << bare[keep]
+              << "\n";
+    if (keep == 1) {
+      EXPECT_GT(r.stats.in_cut_added, 0u);
+    } else {
+      EXPECT_EQ(r.stats.in_cut_added, 0u);
+    }
+  }
+  EXPECT_TRUE(closed_ok[0]);
+  EXPECT_TRUE(closed_ok[1]);  // the kept parts are closed at their cuts
+  // Measured (Release): 16.3% of the faces bare with the whole refused
+  // threads dropped, 5.6% with their cut parts kept (20 x 8 cylinder,
+  // relative size 0.45; 30 x 12 at 0.35: 12.9% -> 4.2%).
+  EXPECT_LT(bare[1], 0.5 * bare[0]);
+  EXPECT_LT(bare[1], 0.08);
+}
+
+// The refused inputs' cut parts and the z fitting (issue #8, session 5) keep
+// the quilt deterministic: same seed, same output on 1 and 2 threads.
+TEST(SurfaceQuilting, WeaveCylinderWithCutPartsSameOutputOnOneAndTwoThreads) {
+  Mesh base;
+  make_cylinder(base, 1.0, 2.0, 16, 6);
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 4;
+  wo.sides = 5;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  const Swatch sw = make_swatch(wm);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.5;
+  o.up = {0.0, 0.6, 0.8};
+  o.rotation_max_deg = 0;  // (the turn search has its own determinism; keeps this test short)
+  SurfaceQuilt q[2];
+  SurfaceQuiltResult r[2];
+  for (int k = 0; k < 2; ++k) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(k + 1));
+    r[k] = quilt_surface(base, sw, q[k], o);
+  }
+  EXPECT_GT(r[0].stats.in_cut_added, 0u);  // the new path is taken
+  EXPECT_EQ(r[0].stats.in_cut_added, r[1].stats.in_cut_added);
+  EXPECT_EQ(r[0].z_fitted_elements, r[1].z_fitted_elements);
+  ASSERT_EQ(q[0].tris, q[1].tris);
+  ASSERT_EQ(q[0].vertices.size(), q[1].vertices.size());
+  for (std::size_t i = 0; i < q[0].vertices.size(); ++i) {
+    ASSERT_EQ(q[0].vertices[i].face, q[1].vertices[i].face);
+    ASSERT_EQ(q[0].vertices[i].b1, q[1].vertices[i].b1);
+    ASSERT_EQ(q[0].vertices[i].b2, q[1].vertices[i].b2);
+    ASSERT_EQ(q[0].vertices[i].z, q[1].vertices[i].z);
+  }
+}
+
+// The final removal of stretched elements (SurfaceQuiltOptions::max_edge_stretch):
+// at 0 nothing is removed for it; at a fraction of the swatch's longest edge
+// every element goes; with the default every remaining edge is within the
+// limit (measured as the option states: feet on the base mesh and height).
+TEST(SurfaceQuilting, StretchedElementsAreRemovedAtTheEnd) {
+  Mesh base;
+  make_icosphere(base, 2);
+  const Swatch sw = tiny_scatter();
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.5;
+  SurfaceQuilt q;
+  o.max_edge_stretch = 0;
+  const SurfaceQuiltResult keep = quilt_surface(base, sw, q, o);
+  EXPECT_EQ(keep.elements_stretched, 0u);
+  ASSERT_GT(keep.elements, 0);
+  o.max_edge_stretch = 0.5;
+  const SurfaceQuiltResult none = quilt_surface(base, sw, q, o);
+  EXPECT_EQ(none.elements, 0);
+  EXPECT_EQ(static_cast<int>(none.elements_stretched), keep.elements);
+  o.max_edge_stretch = -1;
+  EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+  o = {};
+  o.relative_size = 0.5;
+  const SurfaceQuiltResult def = quilt_surface(base, sw, q, o);
+  double sw_edge = 0;
+  for (const Tri& t : sw.mesh.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 &a = sw.mesh.points[static_cast<std::size_t>(t[k])], &c = sw.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])];
+      sw_edge = std::max(sw_edge, std::sqrt((a[0] - c[0]) * (a[0] - c[0]) + (a[1] - c[1]) * (a[1] - c[1]) + (a[2] - c[2]) * (a[2] - c[2])));
+    }
+  std::vector<std::array<Point3, 3>> fp(base.number_of_faces());
+  for (FaceIndex f : base.faces()) {
+    int k = 0;
+    for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) fp[f.idx()][static_cast<std::size_t>(k++)] = base.point(v);
+  }
+  auto foot = [&](const SurfaceQuiltVertex& v) {
+    const auto& t = fp[static_cast<std::size_t>(v.face)];
+    const double b0 = 1 - v.b1 - v.b2;
+    return Point3(b0 * t[0].x() + v.b1 * t[1].x() + v.b2 * t[2].x(), b0 * t[0].y() + v.b1 * t[1].y() + v.b2 * t[2].y(),
+                  b0 * t[0].z() + v.b1 * t[1].z() + v.b2 * t[2].z());
+  };
+  const double lim = o.max_edge_stretch * sw_edge * q.scale;
+  for (const Tri& t : q.tris)
+    for (int k = 0; k < 3; ++k) {
+      const SurfaceQuiltVertex &a = q.vertices[static_cast<std::size_t>(t[k])], &c = q.vertices[static_cast<std::size_t>(t[(k + 1) % 3])];
+      const double dz = (a.z - c.z) * q.scale;
+      ASSERT_LE(CGAL::squared_distance(foot(a), foot(c)) + dz * dz, lim * lim * (1 + 1e-9));
+    }
+  EXPECT_EQ(def.elements + static_cast<int>(def.elements_stretched), keep.elements);
 }
 
 }  // namespace
