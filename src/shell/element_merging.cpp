@@ -10,6 +10,7 @@
 #include "geometry/errors.h"
 #include "geometry/graph_cut.h"
 #include "geometry/mesh.h"
+#include "geometry/newell.h"
 #include "geometry/self_intersections.h"
 #include "shell/element_deformation.h"
 #include "shell/triangle_distance.h"
@@ -394,17 +395,10 @@ double loop_radius(const ElementMesh& m, const std::vector<int>& l, const P3& c)
   for (int v : l) r += dist(m.points[v], c);
   return l.empty() ? 0 : r / static_cast<double>(l.size());
 }
-// Newell area vector of a loop (right-hand rule along the loop's order).
+// Newell area vector of a loop (twice its vector area; right-hand rule along
+// the loop's order).
 P3 loop_area_vector(const ElementMesh& m, const std::vector<int>& l) {
-  P3 n{0, 0, 0};
-  for (std::size_t k = 0; k < l.size(); ++k) {
-    const P3& p = m.points[l[k]];
-    const P3& q = m.points[l[(k + 1) % l.size()]];
-    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-  }
-  return n;
+  return newell_normal(l.size(), [&](std::size_t k) -> const P3& { return m.points[l[k]]; });
 }
 // Why loop i of A and loop j of B (as cut, before B is reversed) cannot be
 // zipped, or "" if they can (see MergeOptions::max_loop_offset). A's loop runs
