@@ -17,7 +17,11 @@ Image render_view(const Mesh& mesh, const ViewOptions& o) {
   RenderMeshOptions rmo;
   rmo.corner_uvs = colors == Colors::Texture;
   rmo.vertex_colors = colors == Colors::VertexColors;
-  const RenderMesh rm = make_render_mesh(mesh, rmo);
+  RenderMesh rm = make_render_mesh(mesh, rmo);
+  if (o.up == ViewOptions::Up::Z) {
+    for (auto& p : rm.positions) p = {p[0], p[2], -p[1]};
+    for (auto& n : rm.vertex_normals) n = {n[0], n[2], -n[1]};
+  }
   RenderOptions ro;
   ro.width = ro.height = o.size;
   ro.color_source = colors == Colors::Texture        ? RenderOptions::ColorSource::Texture

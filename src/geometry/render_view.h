@@ -29,6 +29,11 @@ struct ViewOptions {
   /// Texture lookups past [0,1]: Clamp suits atlases (charts next to empty
   /// texels), Repeat suits periodic tiles.
   RenderOptions::Wrap wrap = RenderOptions::Wrap::Clamp;
+  /// The mesh's up axis. fit_camera orbits about +Y; a Z-up scene (the
+  /// quilting outputs: swatch height along z) is turned (x, y, z) -> (x, z, -y)
+  /// for the render, so the camera looks at it from above-front.
+  enum class Up { Y, Z };
+  Up up = Up::Y;
 };
 
 /// The rendered colour image (size x size x 3, linear RGB, white background).

@@ -6,8 +6,7 @@
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
-#include "geometry/rasterizer.h"
-#include "geometry/render_mesh.h"
+#include "geometry/render_view.h"
 
 namespace surftex {
 
@@ -32,18 +31,13 @@ void color_by_element(Mesh& mesh, std::uint64_t seed) {
 }
 
 Image render_preview(const Mesh& mesh, float azimuth, float elevation, int size) {
-  RenderMeshOptions ro;
-  ro.vertex_colors = find(mesh, kVertexColor).second;
-  const RenderMesh rm = make_render_mesh(mesh, ro);
-  RenderOptions o;
-  o.width = o.height = size;
-  o.color_source = ro.vertex_colors ? RenderOptions::ColorSource::VertexColors : RenderOptions::ColorSource::Constant;
-  // Scenes here are z-up; the camera helper orbits about +Y: look from above-front.
-  RenderMesh zup = rm;
-  for (auto& p : zup.positions) p = {p[0], p[2], -p[1]};
-  for (auto& n : zup.vertex_normals) n = {n[0], n[2], -n[1]};
-  const Camera cam = fit_camera(bounding_box(zup), azimuth, elevation);
-  return render(zup, cam, o).color;
+  ViewOptions v;
+  v.size = size;
+  v.azimuth_deg = azimuth;
+  v.elevation_deg = elevation;
+  v.colors = find(mesh, kVertexColor).second ? ViewOptions::Colors::VertexColors : ViewOptions::Colors::Constant;
+  v.up = ViewOptions::Up::Z;
+  return render_view(mesh, v);
 }
 
 }  // namespace surftex

@@ -15,9 +15,10 @@ namespace surftex {
 /// Throws InvalidInputError if the mesh has no kFaceElement map.
 void color_by_element(Mesh& mesh, std::uint64_t seed = 1);
 
-/// Shaded render (vertex colours if present, else a constant), camera fitted
+/// Shaded render of a z-up scene (vertex colours if present, else a
+/// constant): geometry/render_view.h with ViewOptions::Up::Z, camera fitted
 /// to the bounding box at the given azimuth / elevation (degrees), size x size
-/// pixels, supersampled 2x2. Throws as render()/make_render_mesh().
+/// pixels. Throws as render_view().
 Image render_preview(const Mesh& mesh, float azimuth_deg = 30.f, float elevation_deg = 35.f, int size = 800);
 
 }  // namespace surftex

@@ -67,3 +67,31 @@ TEST(RenderView, MissingColoursAreRefused) {
   v.texture = &tex;
   EXPECT_THROW(render_view(grid, v), InvalidInputError);  // no h:uv
 }
+
+TEST(RenderView, ZUpSceneIsSeenAsItsYUpTurnWould) {
+  // A cylinder along z (the quilting scenes' height axis), tilted a little so
+  // no view is symmetric.
+  Mesh zup;
+  make_cylinder(zup, 0.3, 2.0, 24, 6);
+  for (VertexIndex v : zup.vertices()) {
+    const Point3 p = zup.point(v);
+    zup.point(v) = Point3(p.x() + 0.2 * p.z(), p.y(), p.z());
+  }
+  Mesh yup = zup;
+  for (VertexIndex v : yup.vertices()) {
+    const Point3 p = yup.point(v);
+    yup.point(v) = Point3(p.x(), p.z(), -p.y());
+  }
+  ViewOptions v;
+  v.size = 96;
+  v.azimuth_deg = 30.f;
+  v.elevation_deg = 35.f;
+  v.up = ViewOptions::Up::Z;
+  const Image a = render_view(zup, v);
+  v.up = ViewOptions::Up::Y;
+  const Image b = render_view(yup, v);
+  EXPECT_EQ(a.data, b.data);
+  // ... and differs from the z-up mesh taken as y-up (lying on its side).
+  const Image c = render_view(zup, v);
+  EXPECT_NE(a.data, c.data);
+}
