@@ -44,12 +44,16 @@
 // bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
 // and falls back to its generic SSE3 kernels, it is switched to its AVX-512
 // (or AVX2) kernels once per process (PgpResult::blas_core names the set).
-// Debian 12's serial OpenBLAS (libopenblas0-serial 0.3.21) is not safe for
-// concurrent calls (built without USE_LOCKING: its work-buffer table is
-// claimed without a lock), so the BLAS-reaching CHOLMOD calls (numeric
+// Concurrent calls: Debian 12's serial OpenBLAS (libopenblas0-serial
+// 0.3.21) is not safe for them (built without USE_LOCKING: its work-buffer
+// table is claimed without a lock); its pthread build
+// (libopenblas0-pthread, which scripts/setup.sh installs) is, and pinned to
+// one thread it gives the serial build's bytes. Where the BLAS is not known
+// to allow concurrent calls, the BLAS-reaching CHOLMOD calls (numeric
 // factorisation, solves) of all solvers of the process take turns behind
-// one lock: the no-swap s and t halves run one after the other, and two
-// solvers on two threads give the bytes each gives alone.
+// one lock: the no-swap s and t halves then run one after the other instead
+// of side by side, and two solvers on two threads give the bytes each gives
+// alone either way (PgpResult::concurrent_blas).
 // The paper writes R with the opposite rotation sign and a 2 pi missing in
 // the rounding of (4); we use the self-consistent signs.
 //   - initialisation: the paper locks one vertex and minimises F. That
@@ -163,14 +167,16 @@ struct PgpOptions {
   /// solve. Same bytes on any thread count; equal to the one-system result
   /// up to rounding (fandisk init + update: 7e-14). false (one real system)
   /// is kept for comparison (tests, bench_pgp --one-system). The two halves
-  /// could run side by side (independent), but not on this BLAS (see the
-  /// BLAS note above). The coupled form (the default) has no complex form:
+  /// run side by side on two tasks where the BLAS allows concurrent calls
+  /// (see the BLAS note above), in turn otherwise. The coupled form (the default) has no complex form:
   /// its quarter and half turns conjugate z (antilinear maps).
   /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 8-10
   /// (wall figures for the lead to re-measure), one real system -> two
   /// complex halves, CPU seconds: init (analysis reused) 0.38-0.41 ->
   /// 0.23-0.24, first call 0.64 -> 0.40-0.43, local update 0.059-0.069 ->
-  /// 0.034-0.042; singular fractions unchanged (bench_pgp header).
+  /// 0.034-0.042; singular fractions unchanged (bench_pgp header). Quiet,
+  /// halves side by side (pthread OpenBLAS): first call 0.39 s wall, local
+  /// update 0.068 s (orientation + scale + PGP).
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
