@@ -407,6 +407,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
   if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
   if (o.rotation_match_vertices < 1) bad("rotation_match_vertices must be >= 1", o.rotation_match_vertices);
+  if (!(o.align_min_overlap >= 0 && o.align_min_overlap <= 1)) bad("align_min_overlap must be in [0, 1]", o.align_min_overlap);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -574,6 +575,47 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     for (auto& p : flat.uv) {
       const double x = (p[0] - oc[0]) * sloc / S, y = (p[1] - oc[1]) * sloc / S;
       p = {rot_c * x - rot_s * y, rot_s * x + rot_c * y};
+    }
+    // 4b. Orientation matched over the whole overlap (SurfaceQuiltOptions::
+    // align_to_overlap): every patch face an earlier placement covered maps
+    // that placement's +y (a 3D tangent) through this patch's flattening; the
+    // frame is turned by the area- and distance-weighted circular mean of the
+    // angles between those directions and +y, taken modulo a quarter turn
+    // (mean of 4 * angle), so that the new threads run along the old ones
+    // wherever the two overlap, not only at the seed.
+    if (opt.align_to_overlap) {
+      const double sigma = 0.5 * std::hypot(swatch.length(), swatch.width());
+      double sc = 0, ss = 0, wsum = 0, wall = 0;
+      for (int f : flat.faces) {
+        const auto& t = b.faces[f];
+        const V2 u0 = flat.uv[flat.local[t[0]]], u1 = flat.uv[flat.local[t[1]]], u2 = flat.uv[flat.local[t[2]]];
+        const double cx = (u0[0] + u1[0] + u2[0]) / 3, cy = (u0[1] + u1[1] + u2[1]) / 3;
+        const double w = b.area[f] * std::exp(-(cx * cx + cy * cy) / (2 * sigma * sigma));
+        wall += w;
+        const P3& g = face_dir[static_cast<std::size_t>(f)];
+        if (!(norm3(g) > 0)) continue;
+        // g = al e1 + be e2 (least squares in the face's plane) -> uv = al (u1 - u0) + be (u2 - u0).
+        const P3 e1 = sub3(b.pts[t[1]], b.pts[t[0]]), e2 = sub3(b.pts[t[2]], b.pts[t[0]]);
+        const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2), det = g11 * g22 - g12 * g12;
+        if (!(det > 0)) continue;
+        const double r1 = dot3(g, e1), r2 = dot3(g, e2);
+        const double al = (r1 * g22 - r2 * g12) / det, be = (g11 * r2 - g12 * r1) / det;
+        const double dx = al * (u1[0] - u0[0]) + be * (u2[0] - u0[0]), dy = al * (u1[1] - u0[1]) + be * (u2[1] - u0[1]);
+        if (!(std::hypot(dx, dy) > 0)) continue;
+        const double a = 4 * (kPi / 2 - std::atan2(dy, dx));  // turn taking the old +y onto +y, times 4
+        sc += w * std::cos(a);
+        ss += w * std::sin(a);
+        wsum += w;
+      }
+      // Only with enough overlap near the seed, and old directions that agree
+      // among themselves (resultant length of the quarter-turn mean).
+      if (wall > 0 && wsum >= opt.align_min_overlap * wall && std::hypot(sc, ss) >= 0.3 * wsum) {
+        const double turn0 = std::atan2(ss, sc) / 4;
+        const double ca = std::cos(turn0), sa = std::sin(turn0);
+        for (auto& p : flat.uv) p = {ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]};
+        ++res.patches_aligned;
+        res.align_deg_sum += std::abs(turn0) * 180.0 / kPi;
+      }
     }
     std::vector<std::array<V2, 3>> ftris(flat.faces.size());
     for (std::size_t k = 0; k < flat.faces.size(); ++k) {

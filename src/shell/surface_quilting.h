@@ -122,6 +122,19 @@ struct SurfaceQuiltOptions {
   /// Defaults: 15 degrees in steps of 5 (7 turns). rotation_max_deg in [0, 90],
   /// 0 = translations only (the state before); rotation_step_deg in (0, 90].
   double rotation_max_deg = 15.0;
+  /// Orientation matched over the whole overlap (issue #8, session 5; our
+  /// choice): before the turn search, the frame is turned so that the
+  /// earlier placements' +y directions on the patch's faces (each mapped
+  /// through this patch's flattening; weighted by area and by a Gaussian of
+  /// the distance to the seed, sigma half a swatch diagonal) agree with +y
+  /// modulo a quarter turn (the weave's and chain mail's symmetry), when the
+  /// covered faces hold at least align_min_overlap of that weight and the old
+  /// directions agree (quarter-turn resultant >= 0.3). The field then only
+  /// orients patches without earlier texture around them; the turn search
+  /// (rotation_max_deg) runs around the aligned frame. Default true.
+  bool align_to_overlap = true;
+  /// In [0, 1]; see align_to_overlap. Default 0.1.
+  double align_min_overlap = 0.1;
   double rotation_step_deg = 5.0;
   /// Output vertices of P_out used to compare the turns (evenly subsampled;
   /// the chosen turn's translation is then matched with step.max_match_vertices); >= 1.
@@ -214,6 +227,10 @@ struct SurfaceQuiltResult {
   std::size_t faces = 0, vertices = 0;
   int patches_shrunk = 0;      ///< patches regrown smaller for distortion (step 3)
   int patches_transported = 0; ///< patches oriented by the transported direction (step 4)
+  /// Patches turned by the whole-overlap alignment (SurfaceQuiltOptions::align_to_overlap)
+  /// and the sum of |turn| (degrees).
+  int patches_aligned = 0;
+  double align_deg_sum = 0;
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
   double seed_scale_min = 1, seed_scale_max = 1;

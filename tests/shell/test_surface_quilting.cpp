@@ -597,3 +597,63 @@ TEST(SurfaceQuilting, StretchedElementsAreRemovedAtTheEnd) {
 
 }  // namespace
 }  // namespace surftex
+
+namespace surftex {
+namespace {
+
+// Issue #8, session 5: each patch's frame was aligned with the field at its
+// own seed (and turned by at most +-15 degrees to match P_out), so on a
+// curved surface a placement's threads met the earlier ones at an angle over
+// most of the overlap (on the 5K-face bunny: mean 11.9 degrees, 40% of the
+// overlap area over 10). The frame is now turned, before the turn search, by
+// the quarter-turn circular mean of the angles between the earlier
+// placements' +y (mapped through this patch's flattening) and +y over the
+// whole overlap (SurfaceQuiltOptions::align_to_overlap).
+TEST(SurfaceQuilting, HelixFieldCylinderWeaveOverlapAlignedPlacementsJumpLess) {
+  Mesh base;
+  make_cylinder(base, 1.0, 2.0, test::sanitized() ? 20 : 30, test::sanitized() ? 8 : 12);
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 6;
+  wo.sides = 6;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  const Swatch sw = make_swatch(wm);
+  SurfaceQuiltOptions o;
+  o.relative_size = test::sanitized() ? 0.45 : 0.35;
+  o.up = {0.0, 0.6, 0.8};  // a helix field
+  o.step.keep_cut_refused_inputs = false;
+  auto run = [&](bool align, SurfaceQuiltResult& r) {
+    o.align_to_overlap = align;
+    SurfaceQuilt q;
+    r = quilt_surface(base, sw, q, o);
+    const double jump = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
+    const double over10 = r.overlap_area > 0 ? r.overlap_area_over10 / r.overlap_area : 0.0;
+    std::cout << "[ helix align ] align " << align << ": steps " << r.steps << ", aligned " << r.patches_aligned
+              << ", turned " << r.patches_turned << ", jump " << jump << " deg, over 10 deg " << over10
+              << ", stitched " << r.stats.stitched << ", refused " << r.stats.stitch_refused << "\n";
+    return jump;
+  };
+  SurfaceQuiltResult on, off;
+  const double j_on = run(true, on), j_off = run(false, off);
+  ASSERT_GT(on.overlap_area, 0.0);
+  EXPECT_GT(on.patches_aligned, on.steps / 2);
+  EXPECT_EQ(off.patches_aligned, 0);
+  EXPECT_LT(j_on, 0.7 * j_off);
+  EXPECT_LT(j_on, 5.0);
+}
+
+TEST(SurfaceQuilting, AlignMinOverlapIsChecked) {
+  Mesh base;
+  make_icosphere(base, 1);
+  const Swatch sw = tiny_scatter();
+  SurfaceQuilt q;
+  SurfaceQuiltOptions o;
+  o.align_min_overlap = 1.5;
+  EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+  o.align_min_overlap = -0.1;
+  EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+}
+
+}  // namespace
+}  // namespace surftex
