@@ -18,6 +18,7 @@
 //                     seed_scale = frame scaled by the flattening around the seed |
 //                     keep_stretched = no removal of stretched elements (max_edge_stretch 0) |
 //                     transport = every patch oriented by the earlier placements where there are any (transport_below 1) |
+//                     aligned_translation = aligned to the overlap, no turn search (rotation_max_deg 0) |
 //                     unaligned = no whole-overlap orientation (align_to_overlap off, the state before session 5's issue #8 fix)]
 // Writes bunny_<swatch>.png (azimuth 30, elevation 20), _back.png (210, 20)
 // and _top.png (120, 60) with the PLY when an output folder is given.
@@ -158,17 +159,19 @@ int main(int argc, char** argv) {
     if (variant == "keep_stretched") qo.max_edge_stretch = 0;
     if (variant == "transport") qo.transport_below = 1.0;
     if (variant == "unaligned") qo.align_to_overlap = false;
+    if (variant == "aligned_translation") qo.rotation_max_deg = 0;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
           {"patches_shrunk", r.patches_shrunk}, {"patches_transported", r.patches_transported},
           {"patches_turned", r.patches_turned}, {"patches_aligned", r.patches_aligned},
-          {"mean_align_deg", r.patches_aligned ? r.align_deg_sum / r.patches_aligned : 0.0}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0},
+          {"mean_align_deg", r.patches_aligned ? r.align_deg_sum / r.patches_aligned : 0.0},
+          {"align_residual_deg", r.align_residual_weight > 0 ? r.align_residual_sum / r.align_residual_weight : 0.0}, {"mean_turn_deg", r.steps ? r.turn_deg_sum / r.steps : 0.0},
           {"overlap_jump_deg", r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0},
           {"overlap_over10_fraction", r.overlap_area > 0 ? r.overlap_area_over10 / r.overlap_area : 0.0}, {"max_patch_distortion", r.max_patch_distortion},
           {"seed_scale", {r.seed_scale_min, r.seed_scale_max}},
           {"stitched", r.stats.stitched}, {"stitch_refused", r.stats.stitch_refused},
-          {"coincident", r.stats.coincident}, {"stitched_trimmed", r.stats.stitched_trimmed},
+          {"coincident", r.stats.coincident}, {"coincident_cut_added", r.stats.coincident_cut_added}, {"stitched_trimmed", r.stats.stitched_trimmed},
           {"refused_infeasible", r.stats.refused_infeasible}, {"refused_loops", r.stats.refused_loops},
           {"refused_border", r.stats.refused_border},
           {"refused_geometry", r.stats.refused_geometry}, {"refused_reasons", r.stats.refused_reasons}, {"out_replaced", r.stats.out_replaced},

@@ -37,7 +37,7 @@ std::string render_path_for(const std::string& out) {
 
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up";
-  bool no_render = false, no_check = false;
+  bool no_render = false, no_check = false, no_align = false;
   double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0;
   std::vector<double> up{0, 0, 1};
   int subpatch = 0, stretch_iterations = 20;
@@ -176,6 +176,7 @@ int run_quilt(QuiltArgs& a) {
     o.cell_size = a.cell;
     o.subpatch_radius = a.subpatch;
     o.rotation_max_deg = a.max_turn;
+    o.align_to_overlap = !a.no_align;
     o.seed = a.common.seed;
     o.progress = terminal_progress(a.common.quiet);
     SurfaceQuilt q;
@@ -200,6 +201,8 @@ int run_quilt(QuiltArgs& a) {
     rep["steps"] = r.steps;
     rep["patches_shrunk"] = r.patches_shrunk;
     rep["patches_transported"] = r.patches_transported;
+    rep["patches_aligned"] = r.patches_aligned;
+    rep["overlap_jump_deg"] = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
     rep["max_turn_deg"] = o.rotation_max_deg;
     rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
@@ -328,6 +331,9 @@ SubcommandRegistrar reg_quilt{
                       "searched in steps of 5 so that the swatch lines up with the texture already placed; "
                       "0 = translations only (0..90, default 15)")
            ->check(CLI::Range(0.0, 90.0));
+       app.add_flag("--no-align", a->no_align,
+                    "On a mesh: orient each patch by the guidance field at its seed only, not by the threads "
+                    "already placed over the whole overlap (default: aligned to the overlap where there is one)");
        add_common_options(app, a->common);
        return [a] { return run_quilt(*a); };
      }}};

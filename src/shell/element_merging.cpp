@@ -683,12 +683,26 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
       return again;
     }
   }
-  if (!r.stitched && !r.coincident) {
+  if (!r.stitched) {
     // B's kept part on its own side only (see MergeResult::capped_b).
     std::vector<char> own = trimmed.empty() ? cb.keep : trimmed;
     for (std::size_t t = 0; t < b.tris.size(); ++t)
       if (own[t] && region(centroid(b, b.tris[t])) != side_b) own[t] = 0;
     r.capped_b = capped_kept_components(b, own);
+    if (r.coincident) {
+      // Only parts that run on past A (at most a quarter of their vertices
+      // within the match distance of A): not a second copy of a ring A
+      // already completes.
+      const double d = auto_match(a, b, opt);
+      std::vector<ElementMesh> away;
+      for (ElementMesh& e : r.capped_b) {
+        std::size_t near = 0;
+        for (const P3& p : e.points)
+          if (ta.closest(p).distance <= d) ++near;
+        if (4 * near <= e.points.size()) away.push_back(std::move(e));
+      }
+      r.capped_b = std::move(away);
+    }
   }
   return r;
 }

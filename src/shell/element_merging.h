@@ -132,7 +132,9 @@ struct MergeResult {
   bool coincident = false;
   /// Stitched after trimming B's overlapping cut end (MergeOptions::trim_overlapping_ends).
   bool trimmed = false;
-  /// When refused (not coincident) with both cuts feasible and B closed:
+  /// When refused with both cuts feasible and B closed (coincident too, then
+  /// only the components with at most a quarter of their vertices within
+  /// the match distance of A, i.e. an end running on past A):
   /// B's kept part (trimmed back as in MergeOptions::trim_overlapping_ends
   /// when the stitch crossed itself) restricted to the triangles whose
   /// centroid lies in B's own outside region (side_b, e.g. kNew: not in the

@@ -41,6 +41,7 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   refused_border += o.refused_border;
   refused_geometry += o.refused_geometry;
   coincident += o.coincident;
+  coincident_cut_added += o.coincident_cut_added;
   for (const auto& [k, n] : o.refused_reasons) refused_reasons[k] += n;
   out_replaced += o.out_replaced;
   in_dropped += o.in_dropped;
@@ -402,7 +403,13 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && add_in[e]) {
           add_in[e] = 0;
-          ++stats.in_dropped;
+          if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
+            ++stats.coincident_cut_added;
+            stats.in_cut_components += r.capped_b.size();
+            for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
+          } else {
+            ++stats.in_dropped;
+          }
         }
       } else {
         ++stats.stitch_refused;

@@ -103,6 +103,13 @@ struct QuiltStepStats {
   /// counted in stitch_refused (until issue #8's session 4 they were, as
   /// "loops": planar 3x3 chain mail, 38 of 43 refusals).
   std::size_t coincident = 0;
+  /// Of those, the inputs whose end beyond the overlap, away from the output
+  /// element, was kept closed at the overlap instead of dropped with the rest
+  /// (MergeResult::capped_b of a coincident merge, with
+  /// keep_cut_refused_inputs; issue #8 session 5: once a patch's threads lie
+  /// on the old ones, a thread continuing an old one past the overlap is a
+  /// coincident merge, and dropping it whole left bare strips).
+  std::size_t coincident_cut_added = 0;
   /// Refusals by the kind of MergeResult::reason (its text before the first
   /// ':' with every number replaced by N, e.g. "misaligned loops: normals",
   /// "cuts opened N and N loops"): the finer breakdown of the four counts above.

@@ -586,6 +586,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     if (opt.align_to_overlap) {
       const double sigma = 0.5 * std::hypot(swatch.length(), swatch.width());
       double sc = 0, ss = 0, wsum = 0, wall = 0;
+      std::vector<std::pair<double, double>> angles;  // (4 * turn, weight) per covered face
       for (int f : flat.faces) {
         const auto& t = b.faces[f];
         const V2 u0 = flat.uv[flat.local[t[0]]], u1 = flat.uv[flat.local[t[1]]], u2 = flat.uv[flat.local[t[2]]];
@@ -606,6 +607,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         sc += w * std::cos(a);
         ss += w * std::sin(a);
         wsum += w;
+        angles.emplace_back(a, w);
       }
       // Only with enough overlap near the seed, and old directions that agree
       // among themselves (resultant length of the quarter-turn mean).
@@ -615,6 +617,12 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         for (auto& p : flat.uv) p = {ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]};
         ++res.patches_aligned;
         res.align_deg_sum += std::abs(turn0) * 180.0 / kPi;
+        // What no rigid turn removes: the spread of the old directions in this flattening.
+        for (const auto& [a, w] : angles) {
+          const double d = std::remainder(a - 4 * turn0, 2 * kPi) / 4;
+          res.align_residual_sum += w * std::abs(d) * 180.0 / kPi;
+          res.align_residual_weight += w;
+        }
       }
     }
     std::vector<std::array<V2, 3>> ftris(flat.faces.size());

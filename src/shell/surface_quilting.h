@@ -27,6 +27,15 @@
 //    discrete parallel transport from the neighbouring texture, our choice
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
+//    Then, where earlier placements cover enough of the patch around the
+//    seed, the frame is turned so that their +y directions, each mapped
+//    through this patch's own flattening face by face, agree with +y modulo
+//    a quarter turn over the whole overlap (area- and distance-weighted
+//    circular mean; SurfaceQuiltOptions::align_to_overlap, issue #8 session
+//    5, our choice): the field then orients only patches with no texture
+//    around them, and the threads of neighbouring patches run along each
+//    other instead of meeting at the angle by which the field and the
+//    flattenings turn between two seeds.
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
 //    times the flattening's own scale around the seed (seed_scale), seed
 //    centroid at the origin (a cell centre); a grid of cells (as in
@@ -231,6 +240,11 @@ struct SurfaceQuiltResult {
   /// and the sum of |turn| (degrees).
   int patches_aligned = 0;
   double align_deg_sum = 0;
+  /// Over the aligned patches' covered faces (same weights): the angle left
+  /// between the old directions and +y after the turn, folded into [0, 45]
+  /// degrees; align_residual_sum / align_residual_weight is the mean, what
+  /// the surface's curvature between two flattenings leaves to a rigid frame.
+  double align_residual_sum = 0, align_residual_weight = 0;
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
   double seed_scale_min = 1, seed_scale_max = 1;
