@@ -12,13 +12,14 @@
 //                    [edges kept by the decimation (7500)] [swatch: weave (default) | chainmail]
 //                    [variant: fixed (default) | baseline = issue #8's stitch checks and
 //                     transported orientation off, for before/after comparisons |
-//                     translation = placements not turned (rotation_max_deg 0) |
+//                     translation = placements not turned (rotation_max_deg 0; since session 5
+//                       the aligned patches are not turned by default either) |
 //                     drop = refused input threads dropped whole (keep_cut_refused_inputs off) |
 //                     grown_z = z range widened up to 0.5 swatch heights (max_z_growth 0.5) |
 //                     seed_scale = frame scaled by the flattening around the seed |
 //                     keep_stretched = no removal of stretched elements (max_edge_stretch 0) |
 //                     transport = every patch oriented by the earlier placements where there are any (transport_below 1) |
-//                     aligned_translation = aligned to the overlap, no turn search (rotation_max_deg 0) |
+//                     aligned_turned = aligned patches turn-searched too (aligned_rotation_max_deg 15) |
 //                     unaligned = no whole-overlap orientation (align_to_overlap off, the state before session 5's issue #8 fix)]
 // Writes bunny_<swatch>.png (azimuth 30, elevation 20), _back.png (210, 20)
 // and _top.png (120, 60) with the PLY when an output folder is given.
@@ -159,7 +160,7 @@ int main(int argc, char** argv) {
     if (variant == "keep_stretched") qo.max_edge_stretch = 0;
     if (variant == "transport") qo.transport_below = 1.0;
     if (variant == "unaligned") qo.align_to_overlap = false;
-    if (variant == "aligned_translation") qo.rotation_max_deg = 0;
+    if (variant == "aligned_turned") qo.aligned_rotation_max_deg = 15;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},

@@ -329,7 +329,8 @@ SubcommandRegistrar reg_quilt{
        app.add_option("--max-turn", a->max_turn,
                       "On a mesh: largest turn of a placement away from the field's direction, in degrees, "
                       "searched in steps of 5 so that the swatch lines up with the texture already placed; "
-                      "0 = translations only (0..90, default 15)")
+                      "0 = translations only; patches aligned to the threads already placed (see --no-align) "
+                      "are not turned (0..90, default 15)")
            ->check(CLI::Range(0.0, 90.0));
        app.add_flag("--no-align", a->no_align,
                     "On a mesh: orient each patch by the guidance field at its seed only, not by the threads "

@@ -408,6 +408,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
   if (o.rotation_match_vertices < 1) bad("rotation_match_vertices must be >= 1", o.rotation_match_vertices);
   if (!(o.align_min_overlap >= 0 && o.align_min_overlap <= 1)) bad("align_min_overlap must be in [0, 1]", o.align_min_overlap);
+  if (!(o.aligned_rotation_max_deg >= 0 && o.aligned_rotation_max_deg <= 90))
+    bad("aligned_rotation_max_deg must be in [0, 90]", o.aligned_rotation_max_deg);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -583,6 +585,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     // angles between those directions and +y, taken modulo a quarter turn
     // (mean of 4 * angle), so that the new threads run along the old ones
     // wherever the two overlap, not only at the seed.
+    bool aligned = false;
     if (opt.align_to_overlap) {
       const double sigma = 0.5 * std::hypot(swatch.length(), swatch.width());
       double sc = 0, ss = 0, wsum = 0, wall = 0;
@@ -616,6 +619,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         const double ca = std::cos(turn0), sa = std::sin(turn0);
         for (auto& p : flat.uv) p = {ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]};
         ++res.patches_aligned;
+        aligned = true;
         res.align_deg_sum += std::abs(turn0) * 180.0 / kPi;
         // What no rigid turn removes: the spread of the old directions in this flattening.
         for (const auto& [a, w] : angles) {
@@ -812,7 +816,8 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     // the smaller turn).
     Timer tr;
     double turn = 0;
-    const int nturn = static_cast<int>(std::floor(opt.rotation_max_deg / opt.rotation_step_deg + 1e-9));
+    const double turn_max = aligned ? std::min(opt.rotation_max_deg, opt.aligned_rotation_max_deg) : opt.rotation_max_deg;
+    const int nturn = static_cast<int>(std::floor(turn_max / opt.rotation_step_deg + 1e-9));
     if (nturn > 0 && n_in > 0) {
       QuiltStepOptions so = opt.step;
       so.max_match_vertices = opt.rotation_match_vertices;

@@ -475,6 +475,7 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
   o.up = {0.0, 0.6, 0.8};  // a helix field: many refused stitches
   double bare[2] = {0, 0};
   int closed_ok[2] = {0, 0};
+  std::size_t z_fitted = 0;
   for (int keep = 0; keep < 2; ++keep) {
     o.step.keep_cut_refused_inputs = keep == 1;
     SurfaceQuilt q;
@@ -490,7 +491,7 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
     // issue #8's session 5 they were left there and mapped out of the shell).
     EXPECT_EQ(q.z_min, sw.bbox_min[2]);
     EXPECT_EQ(q.z_max, sw.bbox_max[2]);
-    EXPECT_GT(r.z_fitted_elements, 0u);
+    z_fitted += r.z_fitted_elements;
     for (const SurfaceQuiltVertex& v : q.vertices) {
       ASSERT_GE(v.z, q.z_min);
       ASSERT_LE(v.z, q.z_max);
@@ -505,6 +506,9 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
       EXPECT_EQ(r.stats.in_cut_added, 0u);
     }
   }
+  // Some element was fitted (since the aligned patches are no longer turned,
+  // issue #8 session 5, none in the run without the cut parts).
+  EXPECT_GT(z_fitted, 0u);
   EXPECT_TRUE(closed_ok[0]);
   EXPECT_TRUE(closed_ok[1]);  // the kept parts are closed at their cuts
   // Measured (Release): 16.3% of the faces bare with the whole refused
@@ -514,7 +518,8 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
   // session 5) 29.1% -> 9.7% (30 x 12 at 0.35: 19.2% -> 8.1%): the threads
   // now lie on the old ones, but more of the base stays bare (fewer faces:
   // 4,714 vs 6,212) -- not yet understood; with the ends of coincident
-  // inputs kept (QuiltStepStats::coincident_cut_added) 8.75%, 4,884 faces.
+  // inputs kept (QuiltStepStats::coincident_cut_added) and the aligned
+  // patches not turned (aligned_rotation_max_deg 0): 24.4% -> 8.75%, 4,884 faces.
   EXPECT_LT(bare[1], 0.5 * bare[0]);
   EXPECT_LT(bare[1], 0.12);
 }
@@ -649,11 +654,29 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveOverlapAlignedPlacementsJumpLess) {
   ASSERT_GT(on.overlap_area, 0.0);
   EXPECT_GT(on.patches_aligned, on.steps / 2);
   EXPECT_EQ(off.patches_aligned, 0);
-  EXPECT_LT(j_on, 0.7 * j_off);
-  EXPECT_LT(j_on, 5.0);
+  // Measured (Release): 12.7 degrees unaligned (45% of the overlap over 10),
+  // under 0.01 aligned (the cylinder is developable: its flattenings differ
+  // by rigid motions only).
+  EXPECT_LT(j_on, 0.2 * j_off);
+  EXPECT_LT(j_on, 2.0);
+  // A sphere (not developable): what a rigid frame cannot remove stays
+  // (SurfaceQuiltResult::align_residual_sum: 12.0 degrees here), but the
+  // jump still drops. Measured (Release): 14.6 -> 11.5 degrees, 55% -> 40%
+  // of the overlap over 10 (at relative size 0.15 on the 1,280-face sphere:
+  // 12.4 -> 8.9; at 0.3 on 5,120 faces: 17.1 -> 16.8, residual 15.0: the
+  // patches are too large for the sphere's curvature). Skipped under the
+  // sanitizers (time).
+  if (test::sanitized()) return;
+  make_icosphere(base, 2);
+  o.up = {0.0, 0.0, 1.0};
+  o.relative_size = 0.2;
+  const double s_on = run(true, on), s_off = run(false, off);
+  std::cout << "[ sphere align ] residual " << on.align_residual_sum / std::max(1e-30, on.align_residual_weight) << " deg\n";
+  EXPECT_GT(on.patches_aligned, on.steps / 2);
+  EXPECT_LT(s_on, 0.85 * s_off);
 }
 
-TEST(SurfaceQuilting, AlignMinOverlapIsChecked) {
+TEST(SurfaceQuilting, AlignOptionsAreChecked) {
   Mesh base;
   make_icosphere(base, 1);
   const Swatch sw = tiny_scatter();
@@ -662,6 +685,9 @@ TEST(SurfaceQuilting, AlignMinOverlapIsChecked) {
   o.align_min_overlap = 1.5;
   EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
   o.align_min_overlap = -0.1;
+  EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+  o = {};
+  o.aligned_rotation_max_deg = 91;
   EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
 }
 
