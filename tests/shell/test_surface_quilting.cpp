@@ -664,16 +664,16 @@ TEST(SurfaceQuilting, HelixFieldCylinderWeaveOverlapAlignedPlacementsJumpLess) {
   // jump still drops. Measured (Release): 14.6 -> 11.5 degrees, 55% -> 40%
   // of the overlap over 10 (at relative size 0.15 on the 1,280-face sphere:
   // 12.4 -> 8.9; at 0.3 on 5,120 faces: 17.1 -> 16.8, residual 15.0: the
-  // patches are too large for the sphere's curvature). Skipped under the
-  // sanitizers (time).
+  // patches are too large for the sphere's curvature; translations only on
+  // both sides: 13.6 -> 11.4). Skipped under the sanitizers (time).
   if (test::sanitized()) return;
   make_icosphere(base, 2);
   o.up = {0.0, 0.0, 1.0};
   o.relative_size = 0.2;
-  const double s_on = run(true, on), s_off = run(false, off);
+  const double s_on = run(true, on);
   std::cout << "[ sphere align ] residual " << on.align_residual_sum / std::max(1e-30, on.align_residual_weight) << " deg\n";
   EXPECT_GT(on.patches_aligned, on.steps / 2);
-  EXPECT_LT(s_on, 0.85 * s_off);
+  EXPECT_LT(s_on, 13.0);  // unaligned: 14.6 (run only once here, for time)
 }
 
 TEST(SurfaceQuilting, AlignOptionsAreChecked) {
