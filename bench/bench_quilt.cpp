@@ -73,6 +73,38 @@
 // deg, 42% over 10 deg, 94 stitched: no better. Quiet machine (load 0.7-1.1),
 // "fixed": quilt 64.0 s, total 68.0 s, wall 1:11.4, user CPU 97.5 s, 946,255
 // faces, stretch 1.040 -> 1.037, same output as under load.
+//
+// Issue #8, session 5, orientation (2026-11-22 14:05-14:19 UTC, load 3.7-5,
+// other engineers building: walls not comparable, user CPU roughly). Each
+// patch is now turned, before the turn search, so that the earlier
+// placements' +y, mapped face by face through its own flattening, agree with
+// its +y over the whole overlap (quarter-turn circular mean,
+// SurfaceQuiltOptions::align_to_overlap), and aligned patches skip the turn
+// search (aligned_rotation_max_deg 0). One run each:
+//   "unaligned" (= the state before): jump 11.9 deg, 39.8% of the overlap
+//     over 10 deg; 188 steps, 128 turned; stitched 100, refused 1,320
+//     (misaligned 872: centroids 367, normals 236, radii 269; cuts opened
+//     N and N 289; self-intersecting 89); 946,255 faces; within 18,633,
+//     between 100,981; quilt 130 s, wall 2:19.6, user CPU 91.4 s.
+//   "aligned_turned" (aligned, then turned +-15 deg on P_out as before;
+//     the first version): jump 10.4 deg, 34.1%; 161 of 185 aligned (mean
+//     18.0 deg), 112 turned again (mean 4.0 deg); stitched 103, refused
+//     1,319 (misaligned 785); 926,822 faces; within 20,377, between 94,736;
+//     wall 2:34, user CPU 87.9 s (before the coincident ends were kept).
+//   "fixed" (default now): jump 7.5 deg, 23.5% over 10 deg; 179 steps, 169
+//     aligned (mean 16.6 deg), 6 turned; residual spread a rigid frame cannot
+//     remove (align_residual_deg) 7.9 deg; stitched 89, refused 1,228
+//     (misaligned 830: centroids 360, normals 213, radii 257; cuts opened N
+//     and N 206; self-intersecting 124; non-simple 51; non-manifold 17);
+//     coincident 9 (7 ends kept); 928,385 faces; within 17,685, between
+//     83,070; 0 outside; stretch 1.040 -> 1.037; quilt 59.3 s, total 65.1 s,
+//     wall 1:07.6, user CPU 62.0 s (the turn search was 33 s of the quilt).
+// The jump fell by a third, the misaligned refusals only by 5%: with the
+// threads parallel, the loops still miss each other by translation (centroids
+// apart) and by the bending the flattenings disagree on (normals, radii).
+// The renders (front, back, top) show larger areas of one thread direction;
+// the texture no longer follows the field (the back of the bunny is woven at
+// about 45 deg to it: the first patches' direction, carried over).
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
