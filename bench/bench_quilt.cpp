@@ -21,6 +21,7 @@
 //                     transport = every patch oriented by the earlier placements where there are any (transport_below 1) |
 //                     aligned_turned = aligned patches turn-searched too (aligned_rotation_max_deg 15) |
 //                     wide_pout = P_out half-size 3 cells instead of 2 (subpatch_radius 3) |
+//                     near_seed = alignment weighted near the seed (align_sigma 0.2 instead of 0.5) |
 //                     unaligned = no whole-overlap orientation (align_to_overlap off, the state before session 5's issue #8 fix)]
 // Writes bunny_<swatch>.png (azimuth 30, elevation 20), _back.png (210, 20)
 // and _top.png (120, 60) with the PLY when an output folder is given.
@@ -201,6 +202,7 @@ int main(int argc, char** argv) {
     if (variant == "unaligned") qo.align_to_overlap = false;
     if (variant == "aligned_turned") qo.aligned_rotation_max_deg = 15;
     if (variant == "wide_pout") qo.subpatch_radius = 3;
+    if (variant == "near_seed") qo.align_sigma = 0.2;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},

@@ -408,6 +408,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.rotation_step_deg > 0 && o.rotation_step_deg <= 90)) bad("rotation_step_deg must be in (0, 90]", o.rotation_step_deg);
   if (o.rotation_match_vertices < 1) bad("rotation_match_vertices must be >= 1", o.rotation_match_vertices);
   if (!(o.align_min_overlap >= 0 && o.align_min_overlap <= 1)) bad("align_min_overlap must be in [0, 1]", o.align_min_overlap);
+  if (!(o.align_sigma > 0) || !std::isfinite(o.align_sigma)) bad("align_sigma must be > 0", o.align_sigma);
   if (!(o.aligned_rotation_max_deg >= 0 && o.aligned_rotation_max_deg <= 90))
     bad("aligned_rotation_max_deg must be in [0, 90]", o.aligned_rotation_max_deg);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
@@ -587,7 +588,7 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     // wherever the two overlap, not only at the seed.
     bool aligned = false;
     if (opt.align_to_overlap) {
-      const double sigma = 0.5 * std::hypot(swatch.length(), swatch.width());
+      const double sigma = opt.align_sigma * std::hypot(swatch.length(), swatch.width());
       double sc = 0, ss = 0, wsum = 0, wall = 0;
       std::vector<std::pair<double, double>> angles;  // (4 * turn, weight) per covered face
       for (int f : flat.faces) {

@@ -135,7 +135,7 @@ struct SurfaceQuiltOptions {
   /// choice): before the turn search, the frame is turned so that the
   /// earlier placements' +y directions on the patch's faces (each mapped
   /// through this patch's flattening; weighted by area and by a Gaussian of
-  /// the distance to the seed, sigma half a swatch diagonal) agree with +y
+  /// the distance to the seed, sigma align_sigma swatch diagonals) agree with +y
   /// modulo a quarter turn (the weave's and chain mail's symmetry), when the
   /// covered faces hold at least align_min_overlap of that weight and the old
   /// directions agree (quarter-turn resultant >= 0.3). The field then only
@@ -144,6 +144,9 @@ struct SurfaceQuiltOptions {
   bool align_to_overlap = true;
   /// In [0, 1]; see align_to_overlap. Default 0.1.
   double align_min_overlap = 0.1;
+  /// Sigma of align_to_overlap's distance weight, in (scaled) swatch
+  /// diagonals; > 0. Default 0.5.
+  double align_sigma = 0.5;
   /// The turn search's range (as rotation_max_deg, which also bounds it) for
   /// patches aligned to the overlap; in [0, 90]. Default 0: on the 5K-face
   /// bunny the search (+-15 degrees, matched on P_out) turned 112 of 161

@@ -689,6 +689,9 @@ TEST(SurfaceQuilting, AlignOptionsAreChecked) {
   o = {};
   o.aligned_rotation_max_deg = 91;
   EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+  o = {};
+  o.align_sigma = 0;
+  EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
 }
 
 }  // namespace
