@@ -22,6 +22,7 @@
 //                     aligned_turned = aligned patches turn-searched too (aligned_rotation_max_deg 15) |
 //                     wide_pout = P_out half-size 3 cells instead of 2 (subpatch_radius 3) |
 //                     near_seed = alignment weighted near the seed (align_sigma 0.2 instead of 0.5) |
+//                     wide_align = alignment weighted over a wider area (align_sigma 1.0) |
 //                     unaligned = no whole-overlap orientation (align_to_overlap off, the state before session 5's issue #8 fix)]
 // Writes bunny_<swatch>.png (azimuth 30, elevation 20), _back.png (210, 20)
 // and _top.png (120, 60) with the PLY when an output folder is given.
@@ -113,6 +114,14 @@
 // 3.7-4): jump 8.6 deg, 26.6% over 10; stitched 100, refused 1,286
 // (misaligned 885: centroids 406); 900,800 faces; within 15,547, between
 // 86,916; 96 vertices outside the shell; user CPU 62.4 s: no better.
+// The alignment's distance weight (align_sigma, default 0.5 swatch
+// diagonals; 14:28-14:31 UTC, load 2.2-5): "near_seed" (0.2): jump 8.3 deg,
+// 26.2% over 10, stitched 79, refused 1,351 (misaligned 890), within 15,061,
+// between 85,953, user CPU 64.5 s; "wide_align" (1.0): 8.2 deg, 26.7%,
+// stitched 85, refused 1,337 (misaligned 907), within 20,268, between
+// 101,410, user CPU 66.4 s. 0.5 is the best of the three (7.5 deg, 89
+// stitched), but the differences are of the size a different order of
+// patches makes.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -203,6 +212,7 @@ int main(int argc, char** argv) {
     if (variant == "aligned_turned") qo.aligned_rotation_max_deg = 15;
     if (variant == "wide_pout") qo.subpatch_radius = 3;
     if (variant == "near_seed") qo.align_sigma = 0.2;
+    if (variant == "wide_align") qo.align_sigma = 1.0;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
