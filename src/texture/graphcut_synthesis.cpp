@@ -780,16 +780,6 @@ class GraphcutSynthesizer {
         if (r > t) s.penalty += std::isfinite(r) ? (r - t) * (r - t) : 1e30;
     return s;
   }
-  double colour_jump(int ax, int ay, int bx, int by) const {
-    const float* a = ex_.pixel(ax, ay);
-    const float* b = ex_.pixel(bx, by);
-    double s = 0.0;
-    for (int c = 0; c < ex_.channels; ++c) {
-      const double d = static_cast<double>(a[c]) - b[c];
-      s += d * d;
-    }
-    return std::sqrt(s);
-  }
   // Jump of the output pair (x, y) -> (x + dx, y + dy) (wrapped) minus the
   // exemplar's own jump at the same sources (as source_matched_line_profile).
   double pair_excess(int x, int y, int dx, int dy) const {
@@ -798,19 +788,8 @@ class GraphcutSynthesizer {
     const int ax = canvas_.source_x(x, y), ay = canvas_.source_y(x, y);
     const int bx = canvas_.source_x(x1, y1), by = canvas_.source_y(x1, y1);
     if (bx == ax + dx && by == ay + dy) return 0.0;
-    auto inside = [&](int u, int v) { return u >= 0 && v >= 0 && u < ex_.width && v < ex_.height; };
-    const double j = colour_jump(ax, ay, bx, by);
-    double nat = 0.0;
-    int terms = 0;
-    if (inside(ax + dx, ay + dy)) {
-      nat += colour_jump(ax, ay, ax + dx, ay + dy);
-      ++terms;
-    }
-    if (inside(bx - dx, by - dy)) {
-      nat += colour_jump(bx - dx, by - dy, bx, by);
-      ++terms;
-    }
-    return terms > 0 ? j - nat / terms : 0.0;
+    const double j = colour_jump(ex_, ax, ay, bx, by);
+    return j - source_natural_jump(ex_, ax, ay, bx, by, dx, dy, j);  // 0 when no exemplar neighbour
   }
 
   void repair_straight_seams(GraphcutResult& res) {

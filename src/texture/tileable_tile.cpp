@@ -12,38 +12,22 @@
 
 namespace surftex {
 
-namespace {
-double jump(const Image& img, int x0, int y0, int x1, int y1) {
-  const float* a = img.pixel(x0, y0);
-  const float* b = img.pixel(x1, y1);
-  double s = 0.0;
-  for (int c = 0; c < img.channels; ++c) {
-    const double d = static_cast<double>(a[c]) - b[c];
-    s += d * d;
-  }
-  return std::sqrt(s);
-}
-}  // namespace
-
 TorusCut choose_torus_cut(const Image& img) {
   if (img.empty() || img.width < 2 || img.height < 2)
     throw InvalidInputError("choose_torus_cut: the image must be at least 2x2, got " +
                             std::to_string(img.width) + "x" + std::to_string(img.height));
-  const int W = img.width, H = img.height;
-  // col[x]: summed jump between columns x-1 and x (mod W); row[y] likewise.
-  std::vector<double> col(static_cast<std::size_t>(W), 0.0), row(static_cast<std::size_t>(H), 0.0);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      col[static_cast<std::size_t>(x)] += jump(img, (x + W - 1) % W, y, x, y);
-      row[static_cast<std::size_t>(y)] += jump(img, x, (y + H - 1) % H, x, y);
-    }
+  return choose_torus_cut(line_jump_profile(img, /*periodic=*/true));
+}
+
+TorusCut choose_torus_cut(const LineJumpProfile& p) {
+  if (!p.periodic) throw InvalidInputError("choose_torus_cut: the line profile is not of a periodic image");
   TorusCut c;
-  for (int x = 1; x < W; ++x)
-    if (col[static_cast<std::size_t>(x)] < col[static_cast<std::size_t>(c.shift_x)]) c.shift_x = x;
-  for (int y = 1; y < H; ++y)
-    if (row[static_cast<std::size_t>(y)] < row[static_cast<std::size_t>(c.shift_y)]) c.shift_y = y;
-  c.column_jump = col[static_cast<std::size_t>(c.shift_x)] / H;
-  c.row_jump = row[static_cast<std::size_t>(c.shift_y)] / W;
+  for (std::size_t x = 1; x < p.column.size(); ++x)
+    if (p.column[x] < p.column[static_cast<std::size_t>(c.shift_x)]) c.shift_x = static_cast<int>(x);
+  for (std::size_t y = 1; y < p.row.size(); ++y)
+    if (p.row[y] < p.row[static_cast<std::size_t>(c.shift_y)]) c.shift_y = static_cast<int>(y);
+  c.column_jump = p.column[static_cast<std::size_t>(c.shift_x)];
+  c.row_jump = p.row[static_cast<std::size_t>(c.shift_y)];
   return c;
 }
 
@@ -92,7 +76,7 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
   t.source_matched_wrap_ratio_at_synthesis_cut = sm.wrap_ratio;
   t.source_matched_worst_line_ratio = sm.worst_ratio;
   if (o.choose_cut) {
-    const TorusCut c = choose_torus_cut(t.tile);
+    const TorusCut c = choose_torus_cut(prof);
     t.shift_x = c.shift_x;
     t.shift_y = c.shift_y;
     if (c.shift_x != 0 || c.shift_y != 0) t.tile = crop(t.tile, c.shift_x, c.shift_y, size, size, true);

@@ -42,6 +42,7 @@
 #include "geometry/image.h"
 #include "geometry/progress.h"
 #include "texture/graphcut_synthesis.h"
+#include "texture/wrap_seam_ratio.h"
 
 namespace surftex {
 
@@ -113,6 +114,11 @@ struct TorusCut {
 /// cut unless another line is strictly smoother). Throws InvalidInputError
 /// for an image smaller than 2x2.
 TorusCut choose_torus_cut(const Image& periodic);
+
+/// The same cut from the image's line_jump_profile (periodic = true), for a
+/// caller that already has it. Throws InvalidInputError for a non-periodic
+/// profile.
+TorusCut choose_torus_cut(const LineJumpProfile& periodic_profile);
 
 struct TileResult {
   Image tile;                  ///< size x size, exemplar channels, periodic (after the cut choice)

@@ -10,16 +10,31 @@
 
 namespace surftex {
 
-namespace {
-double jump(const Image& img, int x0, int y0, int x1, int y1) {
+double colour_jump(const Image& img, int x0, int y0, int x1, int y1) {
+  const float* a = img.pixel(x0, y0);
+  const float* b = img.pixel(x1, y1);
   double s = 0.0;
   for (int c = 0; c < img.channels; ++c) {
-    double d = static_cast<double>(img.at(x0, y0, c)) - img.at(x1, y1, c);
+    const double d = static_cast<double>(a[c]) - b[c];
     s += d * d;
   }
   return std::sqrt(s);
 }
-}  // namespace
+
+double source_natural_jump(const Image& ex, int ax, int ay, int bx, int by, int dx, int dy, double fallback) {
+  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < ex.width && y < ex.height; };
+  double nat = 0.0;
+  int terms = 0;
+  if (inside(ax + dx, ay + dy)) {
+    nat += colour_jump(ex, ax, ay, ax + dx, ay + dy);
+    ++terms;
+  }
+  if (inside(bx - dx, by - dy)) {
+    nat += colour_jump(ex, bx - dx, by - dy, bx, by);
+    ++terms;
+  }
+  return terms > 0 ? nat / terms : fallback;
+}
 
 WrapSeamStats wrap_seam_stats(const Image& img) {
   if (img.empty() || img.width < 2 || img.height < 2)
@@ -29,11 +44,11 @@ WrapSeamStats wrap_seam_stats(const Image& img) {
   double inside = 0.0, wrap = 0.0;
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
-      if (x + 1 < W) inside += jump(img, x, y, x + 1, y);
-      if (y + 1 < H) inside += jump(img, x, y, x, y + 1);
+      if (x + 1 < W) inside += colour_jump(img, x, y, x + 1, y);
+      if (y + 1 < H) inside += colour_jump(img, x, y, x, y + 1);
     }
-  for (int y = 0; y < H; ++y) wrap += jump(img, W - 1, y, 0, y);
-  for (int x = 0; x < W; ++x) wrap += jump(img, x, H - 1, x, 0);
+  for (int y = 0; y < H; ++y) wrap += colour_jump(img, W - 1, y, 0, y);
+  for (int x = 0; x < W; ++x) wrap += colour_jump(img, x, H - 1, x, 0);
   WrapSeamStats s;
   s.inside_mean = inside / (static_cast<double>(W - 1) * H + static_cast<double>(W) * (H - 1));
   s.wrap_mean = wrap / static_cast<double>(W + H);
@@ -59,8 +74,8 @@ LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
   p.row.assign(static_cast<std::size_t>(H), 0.0);
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
-      if (periodic || x > 0) p.column[static_cast<std::size_t>(x)] += jump(img, (x + W - 1) % W, y, x, y);
-      if (periodic || y > 0) p.row[static_cast<std::size_t>(y)] += jump(img, x, (y + H - 1) % H, x, y);
+      if (periodic || x > 0) p.column[static_cast<std::size_t>(x)] += colour_jump(img, (x + W - 1) % W, y, x, y);
+      if (periodic || y > 0) p.row[static_cast<std::size_t>(y)] += colour_jump(img, x, (y + H - 1) % H, x, y);
     }
   const int first = periodic ? 0 : 1;
   for (double& c : p.column) c /= H;
@@ -138,27 +153,16 @@ SourceMatchedLineProfile source_matched_line_profile(const Image& img, const Ima
       throw InvalidInputError("source_matched_line_profile: source (" + std::to_string(sx[i]) + ", " +
                               std::to_string(sy[i]) + ") of pixel " + std::to_string(i) + " is outside the " +
                               std::to_string(ex.width) + "x" + std::to_string(ex.height) + " exemplar");
-  auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < ex.width && y < ex.height; };
   SourceMatchedLineProfile p;
   std::vector<double> cj(static_cast<std::size_t>(W), 0.0), cn(cj), rj(static_cast<std::size_t>(H), 0.0), rn(rj);
   // One pair: s = (x0, y0), t = s + (dx, dy) on the torus (t = (x1, y1)).
   auto pair = [&](int x0, int y0, int x1, int y1, int dx, int dy, double& sum_jump, double& sum_natural) {
     const std::size_t a = static_cast<std::size_t>(y0) * W + x0, b = static_cast<std::size_t>(y1) * W + x1;
-    const double j = jump(img, x0, y0, x1, y1);
+    const double j = colour_jump(img, x0, y0, x1, y1);
     const int ax = sx[a], ay = sy[a], bx = sx[b], by = sy[b];
     if (!(bx == ax + dx && by == ay + dy)) ++p.seam_pairs;
-    double nat = 0.0;
-    int terms = 0;
-    if (inside(ax + dx, ay + dy)) {
-      nat += jump(ex, ax, ay, ax + dx, ay + dy);
-      ++terms;
-    }
-    if (inside(bx - dx, by - dy)) {
-      nat += jump(ex, bx - dx, by - dy, bx, by);
-      ++terms;
-    }
     sum_jump += j;
-    sum_natural += terms > 0 ? nat / terms : j;
+    sum_natural += source_natural_jump(ex, ax, ay, bx, by, dx, dy, j);
   };
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {

@@ -71,6 +71,19 @@
 
 namespace surftex {
 
+/// The colour jump between pixels (x0, y0) and (x1, y1) of `img`: the
+/// Euclidean norm of their difference over all channels. Every figure in
+/// this header (and choose_torus_cut) is built from it. No bounds check.
+double colour_jump(const Image& img, int x0, int y0, int x1, int y1);
+
+/// The exemplar's own jump for an output pair copied from exemplar pixels
+/// a = (ax, ay) and b = (bx, by), the pair's step being (dx, dy): the mean
+/// of the jumps a -> a + (dx, dy) and b - (dx, dy) -> b over those inside the
+/// exemplar, or `fallback` when neither is (the reference of
+/// source_matched_line_profile and of graph-cut's straight-seam repair).
+double source_natural_jump(const Image& exemplar, int ax, int ay, int bx, int by, int dx, int dy,
+                           double fallback);
+
 struct WrapSeamStats {
   double wrap_mean = 0.0;    ///< mean jump over the H left-right and W top-bottom wrap pairs
   double inside_mean = 0.0;  ///< mean jump over the (W-1)H + W(H-1) interior pairs

@@ -29,6 +29,16 @@ constexpr double kPi = 3.14159265358979323846;
 
 Swatch tiny_chainmail(std::uint64_t seed = 1) { return test::small_chainmail_swatch(seed, 10, 5); }
 Swatch tiny_scatter(std::uint64_t seed = 1) { return test::small_scatter_swatch(seed); }
+// A 4 x 4 thread weave (generator defaults otherwise, e.g. WeaveOptions::spacing).
+Swatch weave_4x4(int segments_per_spacing, int sides) {
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = segments_per_spacing;
+  wo.sides = sides;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  return make_swatch(wm);
+}
 
 // Fraction of elements (connected components) of `m` that are closed and consistently oriented.
 double closed_fraction(const Mesh& m, int* count = nullptr) {
@@ -281,13 +291,7 @@ namespace {
 TEST(SurfaceQuilting, CylinderWeaveThreadsAreStitchedAcrossPatchesAndStayClosed) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, test::sanitized() ? 20 : 30, test::sanitized() ? 8 : 12);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 6;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch sw = make_swatch(wm);
+  const Swatch sw = weave_4x4(6, 6);
   SurfaceQuiltOptions o;
   o.relative_size = test::sanitized() ? 0.45 : 0.35;
   o.up = {0, 0, 1};  // along the axis: one consistent grid direction everywhere
@@ -348,13 +352,7 @@ namespace {
 TEST(SurfaceQuilting, HelixFieldCylinderWeaveTurnedPlacementsStitchMoreThreads) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, 30, 12);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 6;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch sw = make_swatch(wm);
+  const Swatch sw = weave_4x4(6, 6);
   SurfaceQuiltOptions o;
   o.relative_size = test::sanitized() ? 0.45 : 0.35;
   o.up = {0.0, 0.6, 0.8};
@@ -463,13 +461,7 @@ double bare_fraction(const Mesh& base, const SurfaceQuilt& q, double radius) {
 TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, 20, 8);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 6;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch sw = make_swatch(wm);
+  const Swatch sw = weave_4x4(6, 6);
   SurfaceQuiltOptions o;
   o.relative_size = 0.45;
   o.up = {0.0, 0.6, 0.8};  // a helix field: many refused stitches
@@ -481,7 +473,7 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, sw, q, o);
     // One thread spacing (swatch units) in mesh units: wider than any gap of an intact weave.
-    bare[keep] = bare_fraction(base, q, wo.spacing * q.scale);
+    bare[keep] = bare_fraction(base, q, WeaveOptions{}.spacing * q.scale);
     Mesh displaced;
     surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, displaced);
     closed_ok[keep] = closed_fraction(displaced) >= 0.9;
@@ -529,13 +521,7 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
 TEST(SurfaceQuilting, WeaveCylinderWithCutPartsSameOutputOnOneAndTwoThreads) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, 16, 6);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 4;
-  wo.sides = 5;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch sw = make_swatch(wm);
+  const Swatch sw = weave_4x4(4, 5);
   SurfaceQuiltOptions o;
   o.relative_size = 0.5;
   o.up = {0.0, 0.6, 0.8};
