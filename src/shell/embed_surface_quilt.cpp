@@ -127,6 +127,10 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     m.tris.push_back(tri);
   }
   mesh_from_elements(els, out);
+  if (opt.measure_outside_shell) {
+    res.outside_shell = measure_outside_shell(pos, shell, map, opt.outside_shell);
+    res.outside_shell_measured = true;
+  }
   res.embed.vertices = nv;
   for (std::size_t i = 0; i < nv; ++i) {
     if (!outside[i]) continue;

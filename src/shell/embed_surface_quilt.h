@@ -10,7 +10,8 @@
 // vertex outside the texture space is extrapolated by a tet of its own base
 // face's prism, not by the nearest tet anywhere), with the exact
 // self-intersection count of the result split into pairs within one element
-// and pairs between two elements.
+// and pairs between two elements, and the count of embedded vertices outside
+// the geometric shell (embed_outside_shell.h).
 // Reads: the base mesh's points (a copy gets the atlas; `base` is unchanged).
 // Writes: `out` (cleared first): the embedded quilt, kFaceElement.
 // Throws: InvalidInputError (bad options), and what the stages throw
@@ -21,6 +22,7 @@
 #include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
 #include "shell/embed_in_shell.h"
+#include "shell/embed_outside_shell.h"
 #include "shell/shell_stretch.h"
 #include "shell/surface_quilting.h"
 
@@ -41,6 +43,9 @@ struct EmbedSurfaceQuiltOptions {
   MinimizeStretchOptions stretch;
   /// Run the exact self-intersection count on the embedded mesh.
   bool check_self_intersections = true;
+  /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
+  bool measure_outside_shell = true;
+  OutsideShellOptions outside_shell;
   ProgressCallback progress;
 };
 
@@ -59,6 +64,10 @@ struct EmbedSurfaceQuiltResult {
   /// (what the swatch's elements may already have, and deformation adds) and
   /// faces of two different elements (overlapping elements: a quilting defect).
   std::size_t self_intersections_within = 0, self_intersections_between = 0;
+  /// Embedded vertices outside the geometric shell (the union of the shell's
+  /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
+  OutsideShellResult outside_shell;
+  bool outside_shell_measured = false;
   double seconds_atlas = 0, seconds_shell = 0, seconds_stretch = 0, seconds_map = 0, seconds_embed = 0;
 };
 
