@@ -232,6 +232,7 @@ int run_quilt(QuiltArgs& a) {
     rep["outside_below"] = er.outside_below;
     rep["outside_above"] = er.outside_above;
     rep["outside_uv"] = er.outside_uv;
+    rep["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
     if (er.outside_shell_measured) {
       // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
       rep["outside_shell"] = er.outside_shell.outside;
