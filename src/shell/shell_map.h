@@ -20,9 +20,10 @@
 // coordinate) instead of the global grid. Tets are adjacent only inside one
 // chart (shell vertices are per chart), so the walk never leaves the start
 // tet's chart: texture space is continuous across prism walls within a chart
-// (section 3.2: the shell map is one piecewise-linear bijection per shell
-// patch), while the grid search would take any chart whose texture tets
-// contain the point. A walk that reaches the chart's boundary or runs
+// (section 3.2: "a piecewise-linear, bijective mapping between shell space and
+// texture space", with the lateral boundaries of each shell patch fixed; a
+// shell patch is a chart here, our reading), while the grid search would take
+// any chart whose texture tets contain the point. A walk that reaches the chart's boundary or runs
 // max_walk_steps falls back to the grid search restricted to the chart.
 //
 // The map copies what it needs from the ShellSpace at construction: rebuild it
