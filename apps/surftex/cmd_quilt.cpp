@@ -232,6 +232,15 @@ int run_quilt(QuiltArgs& a) {
     rep["outside_below"] = er.outside_below;
     rep["outside_above"] = er.outside_above;
     rep["outside_uv"] = er.outside_uv;
+    rep["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
+    if (er.outside_shell_measured) {
+      // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
+      rep["outside_shell"] = er.outside_shell.outside;
+      rep["outside_shell_below"] = er.outside_shell.below;
+      rep["outside_shell_above"] = er.outside_shell.above;
+      rep["outside_shell_side"] = er.outside_shell.side;
+      rep["outside_shell_max_distance"] = er.outside_shell.max_distance;
+    }
     if (er.embed.checked) {
       rep["self_intersections"] = er.embed.self_intersecting_pairs;
       rep["self_intersections_within_elements"] = er.self_intersections_within;

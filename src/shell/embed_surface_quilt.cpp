@@ -69,21 +69,38 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   // Tets 3f .. 3f+2 are the prism of base face f (build_shell_space order).
   if (shell.tets.size() != 3 * nf) throw InvalidInputError("embed_surface_quilt: unexpected shell layout");
   std::vector<Vec3> pos(nv);
-  std::vector<char> outside(nv, 0);
+  std::vector<char> outside(nv, 0), clamped(nv, 0);
+  std::vector<double> most_negative(nv, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& rg) {
     for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
       const SurfaceQuiltVertex& v = quilt.vertices[i];
       const auto& c = face_uv[static_cast<std::size_t>(v.face)];
-      const double b0 = 1 - v.b1 - v.b2;
-      const Vec3 uvw{b0 * c[0][0] + v.b1 * c[1][0] + v.b2 * c[2][0], b0 * c[0][1] + v.b1 * c[1][1] + v.b2 * c[2][1],
+      // The vertex lies on its face: quilt_surface settles locations up to a
+      // small negative tolerance, and on a chart-border edge such a (u, v)
+      // would fall into the atlas gap beside the chart. Clamp onto the face.
+      std::array<double, 3> b{1 - v.b1 - v.b2, v.b1, v.b2};
+      if (std::min({b[0], b[1], b[2]}) < 0) {
+        clamped[i] = 1;
+        most_negative[i] = std::min({b[0], b[1], b[2]});
+        for (double& x : b) x = std::max(0.0, x);
+        const double sum = b[0] + b[1] + b[2];
+        if (sum > 0)
+          for (double& x : b) x /= sum;
+        else
+          b = {1.0 / 3, 1.0 / 3, 1.0 / 3};
+      }
+      const Vec3 uvw{b[0] * c[0][0] + b[1] * c[1][0] + b[2] * c[2][0], b[0] * c[0][1] + b[1] * c[1][1] + b[2] * c[2][1],
                      (v.z - quilt.z_min) / dz};
-      const ShellMap::Location loc = map.locate_texture(uvw, false);
+      // Section 3.2 maps a point through the tet that contains it; where the
+      // stretch minimisation moved the offset vertices that tet may belong to
+      // a neighbouring prism of the same chart: walk there from the own prism.
+      const ShellMap::Location loc = map.locate_texture_from(uvw, 3 * v.face);
       if (loc.inside) {
         pos[i] = map.shell_point(loc);
         continue;
       }
-      // Outside the texture space (w beyond [0,1] after deformation, or
-      // (u, v) pushed out of the prism by the moved offset vertices): the
+      // Outside the chart's texture space (w beyond [0,1] after deformation;
+      // with w in [0, 1] only if the chart's tets stopped tiling it): the
       // affine map of the vertex's own prism tet with the largest smallest
       // barycentric coordinate, extrapolated. Local by construction: a global
       // nearest-tet search can pick a tet of another chart (long spikes).
@@ -127,7 +144,13 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     m.tris.push_back(tri);
   }
   mesh_from_elements(els, out);
+  if (opt.measure_outside_shell) {
+    res.outside_shell = measure_outside_shell(pos, shell, map, opt.outside_shell);
+    res.outside_shell_measured = true;
+  }
   res.embed.vertices = nv;
+  for (std::size_t i = 0; i < nv; ++i)
+    if (clamped[i]) ++res.locations_clamped, res.most_negative_barycentric = std::min(res.most_negative_barycentric, most_negative[i]);
   for (std::size_t i = 0; i < nv; ++i) {
     if (!outside[i]) continue;
     ++res.embed.outside;

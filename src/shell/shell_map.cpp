@@ -105,11 +105,14 @@ struct Space {
 
 struct ShellMap::Impl {
   std::vector<Tet> tets;
+  std::vector<int> chart;                   // per tet
+  std::vector<std::array<int, 4>> across;   // per tet, the tet across the face opposite corner k (-1: none)
+  int max_walk = 256;
   Space shell, texture;  // texture points in metric units (u, v, w * w_scale)
   double w_scale = 1;
   double tol = 1e-10;
 
-  Location locate(const Space& sp, const Vec3& x, bool nearest) const {
+  Location locate(const Space& sp, const Vec3& x, bool nearest, int only_chart = -1) const {
     Location best;
     double best_min = -std::numeric_limits<double>::infinity();
     int c[3];
@@ -125,6 +128,7 @@ struct ShellMap::Impl {
             const std::size_t cell = sp.grid.index(x0, y0, z0);
             for (int i = sp.grid.start[cell]; i < sp.grid.start[cell + 1]; ++i) {
               const int t = sp.grid.items[static_cast<std::size_t>(i)];
+              if (only_chart >= 0 && chart[static_cast<std::size_t>(t)] != only_chart) continue;
               const auto b = barycentric(sp.pts, tets[static_cast<std::size_t>(t)], x);
               const double m = min4(b);
               if (m > best_min || (m == best_min && t < best.tet)) best_min = m, best.tet = t, best.bary = b;
@@ -134,6 +138,30 @@ struct ShellMap::Impl {
     }
     best.inside = best.tet >= 0 && best_min >= -tol;
     return best;
+  }
+
+  // Walk in texture space from `start`; falls back to the chart's grid search.
+  Location walk(const Vec3& x, int start) const {
+    int cur = start;
+    for (int step = 0; step < max_walk; ++step) {
+      const auto b = barycentric(texture.pts, tets[static_cast<std::size_t>(cur)], x);
+      int k = 0;
+      for (int j = 1; j < 4; ++j)
+        if (b[static_cast<std::size_t>(j)] < b[static_cast<std::size_t>(k)]) k = j;
+      if (b[static_cast<std::size_t>(k)] >= -tol) {
+        Location loc;
+        loc.tet = cur;
+        loc.bary = b;
+        loc.inside = true;
+        return loc;
+      }
+      const int next = across[static_cast<std::size_t>(cur)][static_cast<std::size_t>(k)];
+      if (next < 0) break;  // the chart's boundary: bottom, top or a lateral wall
+      cur = next;
+    }
+    Location loc = locate(texture, x, false, chart[static_cast<std::size_t>(start)]);
+    if (!loc.inside) loc = Location{};
+    return loc;
   }
 
   Vec3 apply(const Space& sp, const Location& loc) const {
@@ -148,8 +176,42 @@ struct ShellMap::Impl {
 ShellMap::ShellMap(const ShellSpace& s, const ShellMapOptions& opt) : impl_(std::make_unique<Impl>()) {
   if (s.tets.empty()) throw InvalidInputError("shell map: the shell has no tetrahedra");
   if (!(opt.tolerance >= 0)) throw InvalidInputError("shell map: tolerance must be >= 0");
+  if (opt.max_walk_steps < 1)
+    throw InvalidInputError("shell map: max_walk_steps must be >= 1, got " + std::to_string(opt.max_walk_steps));
   impl_->tets = s.tets;
   impl_->tol = opt.tolerance;
+  impl_->max_walk = opt.max_walk_steps;
+  const std::size_t nt = s.tets.size();
+  impl_->chart.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t)
+    impl_->chart[t] = s.chart.empty() ? 0 : s.chart[static_cast<std::size_t>(s.tets[t][0])];
+  // Face adjacency: the face opposite corner k of tet t, keyed by its sorted corners.
+  {
+    struct FaceRef {
+      std::array<int, 3> key;
+      int tet, corner;
+    };
+    std::vector<FaceRef> faces;
+    faces.reserve(4 * nt);
+    for (std::size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 4; ++k) {
+        FaceRef f{{}, static_cast<int>(t), k};
+        int j = 0;
+        for (int i = 0; i < 4; ++i)
+          if (i != k) f.key[static_cast<std::size_t>(j++)] = s.tets[t][static_cast<std::size_t>(i)];
+        std::sort(f.key.begin(), f.key.end());
+        faces.push_back(f);
+      }
+    std::sort(faces.begin(), faces.end(), [](const FaceRef& a, const FaceRef& b) {
+      return a.key != b.key ? a.key < b.key : a.tet < b.tet;
+    });
+    impl_->across.assign(nt, {-1, -1, -1, -1});
+    for (std::size_t i = 0; i + 1 < faces.size(); ++i)
+      if (faces[i].key == faces[i + 1].key) {
+        impl_->across[static_cast<std::size_t>(faces[i].tet)][static_cast<std::size_t>(faces[i].corner)] = faces[i + 1].tet;
+        impl_->across[static_cast<std::size_t>(faces[i + 1].tet)][static_cast<std::size_t>(faces[i + 1].corner)] = faces[i].tet;
+      }
+  }
   impl_->w_scale = s.w_scale > 0 ? s.w_scale : 1.0;
   impl_->shell.pts = s.shell_points;
   impl_->texture.pts.resize(s.texture_points.size());
@@ -162,6 +224,20 @@ ShellMap::ShellMap(ShellMap&&) noexcept = default;
 ShellMap& ShellMap::operator=(ShellMap&&) noexcept = default;
 
 std::size_t ShellMap::num_tets() const { return impl_->tets.size(); }
+
+int ShellMap::tet_chart(int tet) const {
+  if (tet < 0 || static_cast<std::size_t>(tet) >= impl_->tets.size())
+    throw InvalidInputError("shell map: tet " + std::to_string(tet) + " out of range (" +
+                            std::to_string(impl_->tets.size()) + " tets)");
+  return impl_->chart[static_cast<std::size_t>(tet)];
+}
+
+ShellMap::Location ShellMap::locate_texture_from(const Vec3& uvw, int start_tet) const {
+  if (start_tet < 0 || static_cast<std::size_t>(start_tet) >= impl_->tets.size())
+    throw InvalidInputError("shell map: start tet " + std::to_string(start_tet) + " out of range (" +
+                            std::to_string(impl_->tets.size()) + " tets)");
+  return impl_->walk({uvw[0], uvw[1], uvw[2] * impl_->w_scale}, start_tet);
+}
 
 ShellMap::Location ShellMap::locate_texture(const Vec3& uvw, bool nearest) const {
   return impl_->locate(impl_->texture, {uvw[0], uvw[1], uvw[2] * impl_->w_scale}, nearest);

@@ -15,6 +15,17 @@
 // (deterministic). Shell-space points on a chart border belong to two charts;
 // either image is a valid answer.
 //
+// locate_texture_from() finds a texture point by walking from a given tet
+// across tet faces (to the neighbour opposite the most negative barycentric
+// coordinate) instead of the global grid. Tets are adjacent only inside one
+// chart (shell vertices are per chart), so the walk never leaves the start
+// tet's chart: texture space is continuous across prism walls within a chart
+// (section 3.2: "a piecewise-linear, bijective mapping between shell space and
+// texture space", with the lateral boundaries of each shell patch fixed; a
+// shell patch is a chart here, our reading), while the grid search would take
+// any chart whose texture tets contain the point. A walk that reaches the chart's boundary or runs
+// max_walk_steps falls back to the grid search restricted to the chart.
+//
 // The map copies what it needs from the ShellSpace at construction: rebuild it
 // after shell_map_minimize_stretch changes texture coordinates.
 // Throws: InvalidInputError (empty shell; a point outside the shell for the
@@ -32,6 +43,8 @@ namespace surftex {
 struct ShellMapOptions {
   /// Barycentric slack for "inside" (relative, unitless); >= 0.
   double tolerance = 1e-10;
+  /// Steps of locate_texture_from's walk before it falls back to the grid; >= 1.
+  int max_walk_steps = 256;
 };
 
 class ShellMap {
@@ -52,6 +65,11 @@ class ShellMap {
   /// contains the point, return the tet of the nearest grid cells whose
   /// smallest barycentric coordinate is largest (extrapolation), inside = false.
   Location locate_texture(const Vec3& uvw, bool nearest = false) const;
+  /// Locates (u, v, w) in the texture-space tets of the chart of `start_tet`,
+  /// walking from `start_tet` (see the header comment); inside = false and tet
+  /// = -1 when no tet of that chart contains the point. Throws
+  /// InvalidInputError if start_tet is out of range.
+  Location locate_texture_from(const Vec3& uvw, int start_tet) const;
   /// Locates a 3D point in shell space (same rules).
   Location locate_shell(const Vec3& p, bool nearest = false) const;
 
@@ -65,6 +83,8 @@ class ShellMap {
   Vec3 shell_to_texture(const Point3& p) const;
 
   std::size_t num_tets() const;
+  /// Chart of a tet (ShellSpace::chart of its corners).
+  int tet_chart(int tet) const;
 
  private:
   struct Impl;

@@ -85,6 +85,18 @@ struct MinimizeStretchResult {
 /// vertex drawing its direction from a generator seeded by (seed, sweep,
 /// vertex): the result does not depend on the number of threads.
 /// Modifies shell.texture_points (u, v of free layer-1 vertices).
+/// What the result keeps (the shell map stays a bijection per chart): the
+/// bottom layer, every w and the lateral vertices do not move (section 3.2),
+/// and every texture tet stays positive. The top triangles stay in the plane
+/// w = 1, positively oriented, with their chart-border edges fixed, so they
+/// still tile the chart's uv region; the chart's texture slab (uv region x
+/// [0, 1]) has the same boundary as before, and positive tets summing to its
+/// volume cover it exactly once. So every (u, v, w) with (u, v) in a base
+/// face's uv triangle and w in [0, 1] lies in a tet of the face's chart,
+/// though not always of its own prism (the prism walls lean): locate it in the
+/// chart (ShellMap::locate_texture_from), not in the prism. No move is
+/// rejected for leaning (our choice: the paper's line search has no such
+/// constraint, and the stretch gain is kept whole).
 /// Throws InvalidInputError for bad options or an empty shell.
 MinimizeStretchResult shell_map_minimize_stretch(ShellSpace& shell, const MinimizeStretchOptions& opt = {});
 

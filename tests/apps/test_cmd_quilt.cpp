@@ -62,6 +62,10 @@ TEST(CmdQuilt, SphereWritesSiblingsAndReportsStretchAndSelfIntersections) {
   EXPECT_GE(j["stretch_before"].get<double>(), 1.0 - 1e-9);
   EXPECT_LE(j["stretch_after"].get<double>(), j["stretch_before"].get<double>());
   EXPECT_TRUE(j["self_intersections"].is_number_unsigned());
+  // Every vertex with w in [0, 1] is mapped through a tet and lies in the shell.
+  EXPECT_EQ(j["outside_uv"].get<std::size_t>(), 0u);
+  EXPECT_EQ(j["outside_shell"].get<std::size_t>(), 0u);
+  EXPECT_TRUE(j["locations_clamped"].is_number_unsigned());
   EXPECT_GE(j["seconds"]["quilt"].get<double>(), 0.0);
   EXPECT_GE(j["seconds"]["embed"].get<double>(), 0.0);
   Mesh m;
