@@ -88,7 +88,8 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
   // Faces of B "with a corresponding vertex in A" (see the header): the point
   // q of A closest to the face's centroid c must be within `match` and must
-  // itself have its closest point of B at c (within half an edge of B), i.e.
+  // itself have its closest point of B at c (within opt.round_trip_edges mean
+  // edges of B), i.e.
   // A reaches this face, not merely passes near it. Past the end of A (e.g.
   // beyond the end cap of a thread, whose closest points of A all lie on the
   // cap rim) the round trip lands back at the cap, so B's faces there are
@@ -193,8 +194,18 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
 }
 }  // namespace
 
+namespace {
+void check_options(const MergeOptions& opt) {
+  if (!(opt.round_trip_edges > 0) || !std::isfinite(opt.round_trip_edges))
+    throw InvalidInputError("merge_elements: round_trip_edges must be > 0 (" + std::to_string(opt.round_trip_edges) + ")");
+  if (!(opt.match_distance >= 0))
+    throw InvalidInputError("merge_elements: match_distance must be >= 0 (" + std::to_string(opt.match_distance) + ")");
+}
+}  // namespace
+
 ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                        const MergeOptions& opt, const std::vector<char>* b_keep) {
+  check_options(opt);
   const TriangleDistance ta(a), tb(b);
   return cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, b_keep);
 }
@@ -697,6 +708,7 @@ std::vector<ElementMesh> capped_kept_components(const ElementMesh& m, const std:
 
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt) {
+  check_options(opt);
   MergeResult r;
   const TriangleDistance ta(a), tb(b);
   ElementCut ca = cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, nullptr);

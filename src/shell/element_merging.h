@@ -24,11 +24,14 @@
 // face of B); with meshes of similar resolution most faces are nobody's
 // closest face, so we read "face g has a corresponding vertex in A" in the
 // continuous sense: the point q of A closest to g's centroid c is within
-// match_distance, and c is (within half a mean edge of B) the point of B
-// closest to q, i.e. some point of A has g as its closest face. This is what
-// the rule is after: B continues where A does not. (A plain "c within
-// match_distance of A" also covers B's faces past A's end, e.g. beyond a
-// thread's end cap, so A's end was never deleted and tubes opened no loop.)
+// match_distance, and c is (within MergeOptions::round_trip_edges mean edges
+// of B) the point of B closest to q, i.e. some point of A has g as its
+// closest face. This is what the rule is after: B continues where A does
+// not. (A plain "c within match_distance of A" also covers B's faces past
+// A's end, e.g. beyond a thread's end cap, so A's end was never deleted and
+// tubes opened no loop.) By default an uncovered face counts only where B
+// runs on uncovered into its own outside (MergeOptions::uncovered_must_escape):
+// B's own end lying beside A is uncovered too, but A continues there.
 // The cut of B is "found using the exact same approach"; to make the two cut
 // paths meet (the paper only asks that they be close) the cut of B also gets
 // finite guide links: a triangle of B within match_distance of A is pulled to
@@ -157,7 +160,8 @@ struct ElementCut {
 };
 
 /// Graph cut of A against B (see header). `b_keep` (optional, per triangle of
-/// B) adds the guide links. match_distance 0 = automatic.
+/// B) adds the guide links. match_distance 0 = automatic. Throws
+/// InvalidInputError for round_trip_edges <= 0 or match_distance < 0.
 ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                        const MergeOptions& opt = {}, const std::vector<char>* b_keep = nullptr);
 
@@ -205,7 +209,7 @@ struct MergeResult {
 /// when a loop pair fails the geometric test (MergeOptions::max_loop_offset
 /// and the next two; reason starts with "misaligned") or when the stitched
 /// element crosses itself more than its parts did (reason starts with
-/// "self-intersecting").
+/// "self-intersecting"). Throws as cut_element.
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt = {});
 

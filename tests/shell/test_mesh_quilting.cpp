@@ -458,6 +458,9 @@ TEST(ElementMerging, CutEndsOfOverlappingTubesMeetAndStitchIntoOneTube) {
     }
   // Measured: 6 of the 8 before (phase 0.01: "cuts opened 0 and 1 loops").
   EXPECT_LT(stitched_before, cases);
+  MergeOptions bad;
+  bad.round_trip_edges = 0;
+  EXPECT_THROW(merge_elements(a, Region::kOld, a, Region::kNew, band, bad), InvalidInputError);
 }
 
 struct QuiltCase {
