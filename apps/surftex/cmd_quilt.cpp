@@ -3,7 +3,10 @@
 // 2006, section 3: surface quilting, shell-map embedding) or a plane (section
 // 2); `surftex elements`: edit the elements of a result by id; the demo step
 // "quilt".
+#include <algorithm>
+#include <array>
 #include <cctype>
+#include <map>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -82,6 +85,49 @@ std::string lower_ext(const std::string& path) {
   return e;
 }
 
+// The merge statistics of a quilt (planar or on a surface) into its report:
+// one writer for both branches, so that both reports carry the same keys.
+void write_stitch_stats(nlohmann::json& rep, const QuiltStepStats& st) {
+  rep["stitched"] = st.stitched;
+  rep["stitch_refused"] = st.stitch_refused;
+  rep["coincident"] = st.coincident;
+  rep["coincident_cut_added"] = st.coincident_cut_added;
+  rep["stitched_trimmed"] = st.stitched_trimmed;
+  rep["related"] = st.related;
+  rep["stitch_refused_loops"] = st.refused_loops;
+  rep["stitch_refused_border"] = st.refused_border;
+  rep["stitch_refused_geometry"] = st.refused_geometry;
+  rep["stitch_refused_infeasible"] = st.refused_infeasible;
+  rep["stitch_refused_reasons"] = st.refused_reasons;
+  rep["outputs_replaced"] = st.out_replaced;
+  rep["inputs_added"] = st.in_added;
+  rep["inputs_dropped"] = st.in_dropped;
+  rep["inputs_kept_cut"] = st.in_cut_added;
+}
+
+// Mean and largest element length of a planar quilt: each element's larger
+// xy bounding-box side, in units of `unit` (the swatch's larger side); a
+// thread-length measure (issue #8: threads ending at patch seams are short).
+std::pair<double, double> element_lengths(const Mesh& m, double unit) {
+  const auto el = find(m, kFaceElement);
+  if (!el.second || !(unit > 0)) return {0, 0};
+  std::map<int, std::array<double, 4>> box;  // id -> xmin, xmax, ymin, ymax
+  for (FaceIndex f : m.faces())
+    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) {
+      const Point3& p = m.point(v);
+      auto it = box.try_emplace(el.first[f], std::array<double, 4>{p.x(), p.x(), p.y(), p.y()}).first;
+      auto& b = it->second;
+      b = {std::min(b[0], p.x()), std::max(b[1], p.x()), std::min(b[2], p.y()), std::max(b[3], p.y())};
+    }
+  double sum = 0, mx = 0;
+  for (const auto& [id, b] : box) {
+    const double l = std::max(b[1] - b[0], b[3] - b[2]) / unit;
+    sum += l;
+    mx = std::max(mx, l);
+  }
+  return {box.empty() ? 0 : sum / static_cast<double>(box.size()), mx};
+}
+
 int run_quilt(QuiltArgs& a) {
   // With --plane the positional arguments are just the swatch.
   if (!a.plane.empty() && !a.base.empty() && a.swatch.empty()) std::swap(a.base, a.swatch);
@@ -153,10 +199,10 @@ int run_quilt(QuiltArgs& a) {
     rep["faces"] = r.faces;
     rep["vertices"] = r.vertices;
     rep["steps"] = r.steps;
-    rep["stitched"] = r.stats.stitched;
-    rep["stitch_refused"] = r.stats.stitch_refused;
-    rep["coincident"] = r.stats.coincident;
-    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
+    const auto [len_mean, len_max] = element_lengths(out, std::max(s.length(), s.width()));
+    rep["element_length_mean"] = len_mean;
+    rep["element_length_max"] = len_max;
+    write_stitch_stats(rep, r.stats);
     rep["seconds"] = {{"swatch", swatch_seconds}, {"quilt", r.seconds}, {"match", r.stats.seconds_match},
                       {"correspond", r.stats.seconds_correspond}, {"deform", r.stats.seconds_deform},
                       {"merge", r.stats.seconds_merge}};
@@ -207,10 +253,7 @@ int run_quilt(QuiltArgs& a) {
     rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
     rep["elements_stretched"] = r.elements_stretched;
-    rep["stitched"] = r.stats.stitched;
-    rep["stitch_refused"] = r.stats.stitch_refused;
-    rep["coincident"] = r.stats.coincident;
-    rep["stitched_trimmed"] = r.stats.stitched_trimmed;
+    write_stitch_stats(rep, r.stats);
     rep["charts"] = er.atlas.num_charts;
     rep["tets"] = er.tets;
     rep["shell_height"] = er.shell_height;
@@ -221,13 +264,6 @@ int run_quilt(QuiltArgs& a) {
     rep["elements_not_expressible"] = r.elements_not_expressible;
     rep["elements_partial"] = r.elements_partial;
     rep["seams_broken"] = r.seams_broken;
-    rep["stitch_refused_loops"] = r.stats.refused_loops;
-    rep["stitch_refused_border"] = r.stats.refused_border;
-    rep["stitch_refused_geometry"] = r.stats.refused_geometry;
-    rep["stitch_refused_infeasible"] = r.stats.refused_infeasible;
-    rep["stitch_refused_reasons"] = r.stats.refused_reasons;
-    rep["inputs_dropped"] = r.stats.in_dropped;
-    rep["inputs_kept_cut"] = r.stats.in_cut_added;
     rep["z_fitted_elements"] = r.z_fitted_elements;
     rep["outside_below"] = er.outside_below;
     rep["outside_above"] = er.outside_above;

@@ -81,7 +81,6 @@ namespace {
 ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side side_a, const ElementMesh& b,
                           const TriangleDistance& tb, Side side_b, const RegionFn& region, const MergeOptions& opt,
                           const std::vector<char>* b_keep) {
-  auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
   ElementCut res;
   const double match = auto_match(a, b, opt);
   const int nt = static_cast<int>(a.tris.size());
@@ -89,12 +88,13 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
   // Faces of B "with a corresponding vertex in A" (see the header): the point
   // q of A closest to the face's centroid c must be within `match` and must
-  // itself have its closest point of B at c (within half an edge of B), i.e.
+  // itself have its closest point of B at c (within opt.round_trip_edges mean
+  // edges of B), i.e.
   // A reaches this face, not merely passes near it. Past the end of A (e.g.
   // beyond the end cap of a thread, whose closest points of A all lie on the
   // cap rim) the round trip lands back at the cap, so B's faces there are
   // uncovered and the A vertices next to them are deleted.
-  const double round_trip = 0.5 * mean_edge(b);
+  const double round_trip = opt.round_trip_edges * mean_edge(b);
   std::vector<char> covered(b.tris.size());
   std::vector<char> b_in(b.tris.size());
   for (std::size_t g = 0; g < b.tris.size(); ++g) {
@@ -106,6 +106,30 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   // Edge-neighbours of B's faces.
   std::vector<std::vector<int>> b_nb(b.tris.size());
   for (const DualEdge& e : dual_edges(b)) b_nb[e.t1].push_back(e.t2), b_nb[e.t2].push_back(e.t1);
+  // MergeOptions::uncovered_must_escape: an uncovered face counts only if its
+  // connected uncovered region reaches B's own outside (B runs on past A
+  // there), not if it is a patch of B that ends beside A (B's own end cap
+  // lying along A: A continues there, and must not be deleted).
+  std::vector<char> escapes(b.tris.size(), 1);
+  if (opt.uncovered_must_escape) {
+    std::vector<int> comp(b.tris.size(), -1);
+    std::vector<char> comp_escapes;
+    for (std::size_t g0 = 0; g0 < b.tris.size(); ++g0) {
+      if (covered[g0] || comp[g0] >= 0) continue;
+      const int id = static_cast<int>(comp_escapes.size());
+      comp_escapes.push_back(0);
+      std::vector<int> stack{static_cast<int>(g0)};
+      comp[g0] = id;
+      while (!stack.empty()) {
+        const int g = stack.back();
+        stack.pop_back();
+        if (!b_in[g]) comp_escapes[id] = 1;
+        for (int n : b_nb[g])
+          if (!covered[n] && comp[n] < 0) comp[n] = id, stack.push_back(n);
+      }
+    }
+    for (std::size_t g = 0; g < b.tris.size(); ++g) escapes[g] = comp[g] < 0 || comp_escapes[comp[g]];
+  }
 
   GraphCut gc(nt);
   const auto edges = dual_edges(a);
@@ -123,9 +147,14 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
     for (int v : a.tris[t]) vtris[v].push_back(t);
   for (std::size_t v = 0; v < a.points.size(); ++v) {
     const auto& h = hit[v];
-    if (h.tri < 0 || h.distance > match || !in_overlap(a.points[v])) continue;
+    if (h.tri < 0 || h.distance > match) continue;
+    // The paper applies the SINK rule in the overlap region; with
+    // MergeOptions::delete_past_overlap also where A pokes past it into the
+    // other side (not A's own outside, not off the grid).
+    const Region rv = region(a.points[v]);
+    if (opt.delete_past_overlap ? owns(side_a, rv) || rv == Region::kNone : rv != Region::kOverlap) continue;
     bool del = !b_in[h.tri];
-    for (int g : b_nb[h.tri]) del = del || !covered[g];
+    for (int g : b_nb[h.tri]) del = del || (!covered[g] && escapes[g]);
     // Keep wins over delete where both rules hit one triangle (at the rim of
     // the overlap region an element can reach just past it): the paper's two
     // infinite rules would otherwise make every cut infinite.
@@ -144,7 +173,10 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
       if (force_keep[t] || force_del[t]) continue;
       const auto h = tb.closest(centroid(a, a.tris[t]));
       if (h.tri < 0 || h.distance > match) continue;
-      if ((*b_keep)[h.tri])
+      bool behind = (*b_keep)[h.tri];
+      if (opt.guide_by_vertices)
+        for (int v : a.tris[t]) behind = behind || (hit[v].tri >= 0 && hit[v].distance <= match && (*b_keep)[hit[v].tri]);
+      if (behind)
         gc.add_terminal(t, 0, g);
       else
         gc.add_terminal(t, g, 0);
@@ -162,8 +194,18 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
 }
 }  // namespace
 
+namespace {
+void check_options(const MergeOptions& opt) {
+  if (!(opt.round_trip_edges > 0) || !std::isfinite(opt.round_trip_edges))
+    throw InvalidInputError("merge_elements: round_trip_edges must be > 0 (" + std::to_string(opt.round_trip_edges) + ")");
+  if (!(opt.match_distance >= 0))
+    throw InvalidInputError("merge_elements: match_distance must be >= 0 (" + std::to_string(opt.match_distance) + ")");
+}
+}  // namespace
+
 ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                        const MergeOptions& opt, const std::vector<char>* b_keep) {
+  check_options(opt);
   const TriangleDistance ta(a), tb(b);
   return cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, b_keep);
 }
@@ -568,14 +610,26 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
         if (dist(P(v), P(u)) < dist(P(v), P(best))) best = u;
       return best;
     };
-    for (int v : A) {
-      const P3 q = P(nearest(v, B)), p = P(v);
-      cons.push_back({{v, v, v}, {1, 0, 0}, {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2}});
+    // The constraint targets (see MergeOptions::average_across_axis_only):
+    // the midpoint, less its component along the pair's axis.
+    P3 axis{0, 0, 0};
+    if (opt.average_across_axis_only) {
+      const P3 na = loop_area_vector(pa, la[i]), nb = loop_area_vector(pb, lb[pair_of[i]]);
+      const double len_a = dist(na, P3{0, 0, 0}), len_b = dist(nb, P3{0, 0, 0});
+      if (len_a > 0 && len_b > 0) {
+        for (int d = 0; d < 3; ++d) axis[d] = nb[d] / len_b - na[d] / len_a;
+        const double l = dist(axis, P3{0, 0, 0});
+        for (double& x : axis) x = l > 0 ? x / l : 0.0;
+      }
     }
-    for (int v : B) {
-      const P3 q = P(nearest(v, A)), p = P(v);
-      cons.push_back({{v, v, v}, {1, 0, 0}, {(p[0] + q[0]) / 2, (p[1] + q[1]) / 2, (p[2] + q[2]) / 2}});
-    }
+    auto target = [&](const P3& p, const P3& q) {
+      P3 h{(q[0] - p[0]) / 2, (q[1] - p[1]) / 2, (q[2] - p[2]) / 2};
+      const double al = h[0] * axis[0] + h[1] * axis[1] + h[2] * axis[2];
+      for (int d = 0; d < 3; ++d) h[d] -= al * axis[d];
+      return P3{p[0] + h[0], p[1] + h[1], p[2] + h[2]};
+    };
+    for (int v : A) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, B)))});
+    for (int v : B) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, A)))});
   }
   const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
   if (count_border_edges(merged) > border_before) {
@@ -654,6 +708,7 @@ std::vector<ElementMesh> capped_kept_components(const ElementMesh& m, const std:
 
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt) {
+  check_options(opt);
   MergeResult r;
   const TriangleDistance ta(a), tb(b);
   ElementCut ca = cut_with_trees(a, ta, side_a, b, tb, side_b, region, opt, nullptr);

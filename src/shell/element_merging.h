@@ -10,7 +10,7 @@
 // SOURCE (kept) with infinite weight: triangles of A whose centroid lies
 // outside the overlap region. SINK (deleted) with infinite weight: all
 // triangles around a vertex v of A (with Dist(v, B) <= match_distance and v in
-// the overlap region) whose closest face f of B lies outside the overlap
+// the overlap region, by default also past it: MergeOptions::delete_past_overlap) whose closest face f of B lies outside the overlap
 // region, or has an edge-neighbour face with "no corresponding vertex in A".
 // "Outside the overlap region" is made precise with a Region function and a
 // side per element: region(p) = kOld (processed before this step, outside the
@@ -24,16 +24,20 @@
 // face of B); with meshes of similar resolution most faces are nobody's
 // closest face, so we read "face g has a corresponding vertex in A" in the
 // continuous sense: the point q of A closest to g's centroid c is within
-// match_distance, and c is (within half a mean edge of B) the point of B
-// closest to q, i.e. some point of A has g as its closest face. This is what
-// the rule is after: B continues where A does not. (A plain "c within
-// match_distance of A" also covers B's faces past A's end, e.g. beyond a
-// thread's end cap, so A's end was never deleted and tubes opened no loop.)
+// match_distance, and c is (within MergeOptions::round_trip_edges mean edges
+// of B) the point of B closest to q, i.e. some point of A has g as its
+// closest face. This is what the rule is after: B continues where A does
+// not. (A plain "c within match_distance of A" also covers B's faces past
+// A's end, e.g. beyond a thread's end cap, so A's end was never deleted and
+// tubes opened no loop.) By default an uncovered face counts only where B
+// runs on uncovered into its own outside (MergeOptions::uncovered_must_escape):
+// B's own end lying beside A is uncovered too, but A continues there.
 // The cut of B is "found using the exact same approach"; to make the two cut
 // paths meet (the paper only asks that they be close) the cut of B also gets
 // finite guide links: a triangle of B within match_distance of A is pulled to
 // SINK if its closest face of A was kept and to SOURCE if it was deleted, with
-// weight guide_factor * the largest n-link weight.
+// weight guide_factor * the largest n-link weight (by default also to SINK if
+// the closest face of any of its vertices was kept: MergeOptions::guide_by_vertices).
 // After the two cuts (issue #8): islands are removed (kept components with
 // no SOURCE-forced triangle deleted, deleted components with no SINK-forced
 // triangle kept again), and where the cuts open different numbers of seams
@@ -45,7 +49,9 @@
 // whose next diagonal is shorter, orientations consistent with both sides),
 // then the merged element is deformed with eq. 5 constraints "average boundary
 // points" (each loop vertex pulled to the midpoint with its nearest vertex on
-// the paired loop), vertices outside the overlap region locked. A stitch that
+// the paired loop; by default only across the loop pair's axis, see
+// MergeOptions::average_across_axis_only), vertices outside the overlap
+// region locked. A stitch that
 // crosses itself more than its parts did is refused; before refusing, it is
 // retried once with B's kept part trimmed back behind A's cut where the two
 // cut ends overlap (MergeOptions::trim_overlapping_ends, our addition).
@@ -72,8 +78,51 @@ struct MergeOptions {
   double match_distance = 0;
   /// Weight of B's guide links, in units of the largest n-link weight; >= 0.
   double guide_factor = 100;
+  /// Guide links by vertices (our addition, issue #8 session 6): a triangle
+  /// of B is pulled to SINK if its centroid's closest face of A or the
+  /// closest face of any of its vertices (within match_distance) was kept,
+  /// so that B's kept part starts just past A's cut (a gap of at most one
+  /// row of B's triangles) instead of reaching up to a third of a row behind
+  /// it. With the centroid alone the two kept ends overlapped by about a
+  /// hundredth of a thread spacing on the planar weave: tubes of slightly
+  /// different radius running through each other, 56% of the refusals
+  /// ("self-intersecting stitch"). false = the centroid only (the state before).
+  bool guide_by_vertices = true;
+  /// Round-trip tolerance of "face g of B has a corresponding vertex in A"
+  /// (see the header), in mean edge lengths of B; > 0. Was 0.5: with rows of
+  /// B about one edge long, the row just past A's end then often counted as
+  /// covered, no vertex of A's end was forced to SINK and A was not cut
+  /// ("cuts opened 0 and 1 loops").
+  double round_trip_edges = 0.25;
+  /// The SINK rule's "adjacent face with no corresponding vertex in A" only
+  /// for uncovered faces whose connected uncovered region of B reaches B's
+  /// own outside region (our reading of section 2.7, issue #8 session 6):
+  /// B continues past A there. The start of B lying along A (its end cap
+  /// beside A's middle) is uncovered too, but A continues there; deleting A
+  /// at B's start as well as at its own end put A's cut at the far side of
+  /// the overlap from B's ("misaligned loops: centroids ... along").
+  bool uncovered_must_escape = true;
+  /// Apply the SINK rule of section 2.7 also to A's vertices that poke past
+  /// the overlap region into the other side (not A's own outside, not off
+  /// the grid), not only to those in the overlap (issue #8 session 6).
+  /// Elements are kept whole, so an old thread can end a little past the
+  /// processed cells; its end then had no infinite SINK link, the cut kept
+  /// all of A and the merge was refused ("cuts opened 0 and 1 loops",
+  /// "misaligned loops" on cuts through odd places). false = overlap only.
+  bool delete_past_overlap = true;
   /// mu of the stitching deformation (eq. 5); > 0.
   double mu = 1.0;
+  /// The stitching constraints "average boundary points" (section 2.7)
+  /// averaged only across the axis of each loop pair (the line from A's cut
+  /// towards B's kept part, from the loops' area vectors): each loop vertex
+  /// moves halfway to its nearest vertex of the paired loop sideways but
+  /// keeps its place along the axis, so that the zip strip bridges the gap
+  /// between the cuts with its width. Our reading: averaged in full, two
+  /// facing loops a fraction of a row apart are pulled onto one another and
+  /// the strip between them collapses into slivers that cross each other
+  /// (the paper's mesh merging [Yu et al. 2004] fuses the two boundaries
+  /// instead of bridging them). false = full averages (the state before).
+  bool average_across_axis_only = true;
   /// Geometric test of every zipped loop pair (section 2.7 stitches two
   /// elements whose cut paths are "close to each other"; the paper has no
   /// threshold, these are ours): the loops' centroids at most
@@ -111,7 +160,8 @@ struct ElementCut {
 };
 
 /// Graph cut of A against B (see header). `b_keep` (optional, per triangle of
-/// B) adds the guide links. match_distance 0 = automatic.
+/// B) adds the guide links. match_distance 0 = automatic. Throws
+/// InvalidInputError for round_trip_edges <= 0 or match_distance < 0.
 ElementCut cut_element(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                        const MergeOptions& opt = {}, const std::vector<char>* b_keep = nullptr);
 
@@ -159,7 +209,7 @@ struct MergeResult {
 /// when a loop pair fails the geometric test (MergeOptions::max_loop_offset
 /// and the next two; reason starts with "misaligned") or when the stitched
 /// element crosses itself more than its parts did (reason starts with
-/// "self-intersecting").
+/// "self-intersecting"). Throws as cut_element.
 MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh& b, Side side_b, const RegionFn& region,
                            const MergeOptions& opt = {});
 

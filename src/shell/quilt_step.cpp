@@ -382,7 +382,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
     for (std::size_t k = 1; k < outs.size(); ++k) others.emplace_back(true, outs[k]);
     for (auto& [is_out, e] : others) {
       const ElementMesh& x = is_out ? (deformed_out.count(e) ? deformed_out[e] : elements[e]) : placed[e];
-      MergeOptions mo;
+      MergeOptions mo = opt.merge;
       mo.mu = opt.mu;
       if (!opt.check_stitch_geometry) {
         mo.max_loop_offset = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "shell/element_merging.h"
 #include "shell/element_mesh.h"
 #include "shell/swatch.h"
 #include "shell/triangle_distance.h"
@@ -56,6 +57,9 @@ struct QuiltStepOptions {
   /// and refuse stitches that cross themselves. false = off (the state before
   /// issue #8's fix, for comparisons).
   bool check_stitch_geometry = true;
+  /// Options of every merge (section 2.7); its mu is replaced by `mu` above,
+  /// and check_stitch_geometry = false turns its geometric checks off.
+  MergeOptions merge;
   /// Keep only mutually strongest relations (most vertex-face pairs) between
   /// output and input elements, so that each element is merged with at most
   /// one partner (see strongest_relations in the .cpp); false = the paper's

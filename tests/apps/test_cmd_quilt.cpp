@@ -21,6 +21,18 @@ nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
 }
+// The merge statistics both branches write through one function: the same
+// keys, and the refusal reasons add up to the refusals.
+void expect_stitch_stats(const nlohmann::json& j) {
+  for (const char* k : {"stitched", "stitch_refused", "coincident", "stitched_trimmed", "related",
+                        "stitch_refused_loops", "stitch_refused_border", "stitch_refused_geometry",
+                        "stitch_refused_infeasible", "inputs_added", "inputs_dropped", "inputs_kept_cut"})
+    EXPECT_TRUE(j.contains(k) && j[k].is_number_unsigned()) << k;
+  ASSERT_TRUE(j.contains("stitch_refused_reasons") && j["stitch_refused_reasons"].is_object());
+  std::size_t sum = 0;
+  for (const auto& [why, n] : j["stitch_refused_reasons"].items()) sum += n.get<std::size_t>();
+  EXPECT_EQ(sum, j["stitch_refused"].get<std::size_t>());
+}
 }  // namespace
 
 TEST(CmdQuilt, PlaneWithGeneratedSwatchWritesMeshRenderAndReport) {
@@ -33,6 +45,9 @@ TEST(CmdQuilt, PlaneWithGeneratedSwatchWritesMeshRenderAndReport) {
   ASSERT_TRUE(fs::exists(dir + "/p_render.png"));
   const nlohmann::json j = read_json(dir + "/r.json");
   EXPECT_GT(j["elements"].get<int>(), 5);
+  expect_stitch_stats(j);
+  EXPECT_GT(j["element_length_mean"].get<double>(), 0.0);
+  EXPECT_GE(j["element_length_max"].get<double>(), j["element_length_mean"].get<double>());
   Mesh m;
   read_mesh(dir + "/p.ply", m);
   EXPECT_EQ(m.number_of_faces(), j["faces"].get<std::size_t>());
@@ -66,6 +81,7 @@ TEST(CmdQuilt, SphereWritesSiblingsAndReportsStretchAndSelfIntersections) {
   EXPECT_EQ(j["outside_uv"].get<std::size_t>(), 0u);
   EXPECT_EQ(j["outside_shell"].get<std::size_t>(), 0u);
   EXPECT_TRUE(j["locations_clamped"].is_number_unsigned());
+  expect_stitch_stats(j);
   EXPECT_GE(j["seconds"]["quilt"].get<double>(), 0.0);
   EXPECT_GE(j["seconds"]["embed"].get<double>(), 0.0);
   Mesh m;

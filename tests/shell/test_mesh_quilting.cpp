@@ -279,7 +279,14 @@ TEST(ElementMerging, ThreadsSideBySideAreNotZipped) {
     off.max_loop_offset = off.max_loop_radius_ratio = off.max_loop_angle_deg = 0;
     off.refuse_self_intersecting = false;
     const MergeResult z = merge_elements(a, Region::kOld, b, Region::kNew, band, off);
-    ASSERT_TRUE(z.stitched) << z.reason;
+    if (!z.stitched) {
+      // Since issue #8 session 6's cut rules the unchecked zip of this pair
+      // can also be refused by the topological checks (a pinched zip).
+      EXPECT_EQ(z.reason.rfind("stitched element is not manifold", 0), 0u) << z.reason;
+      std::cout << "[ side by side ] axis " << axis << ", offset " << offset << ": refused (" << r.reason
+                << "); unchecked: " << z.reason << "\n";
+      continue;
+    }
     Mesh zm;
     mesh_from_elements({z.merged}, zm);
     const std::size_t crossing = count_self_intersections(zm);
@@ -302,7 +309,9 @@ TEST(ElementMerging, SelfIntersectingStitchIsRefused) {
     mesh_from_elements({r.merged}, m);
     EXPECT_EQ(count_self_intersections(m), 0u);
   } else {
-    EXPECT_EQ(r.reason.rfind("self-intersecting", 0), 0u) << r.reason;
+    // (or, since issue #8 session 6's cut rules, by the topological check of the zip)
+    EXPECT_TRUE(r.reason.rfind("self-intersecting", 0) == 0 || r.reason.rfind("stitched element is not manifold", 0) == 0)
+        << r.reason;
   }
 }
 
@@ -342,10 +351,17 @@ TEST(ElementMerging, OverlappingCutEndsAreTrimmedAndStitched) {
     for (double dy : {0.0, 0.02, 0.04}) {
       ElementMesh b = thread(sx);
       for (P3& p : b.points) p[1] += dy;
-      MergeOptions off;
+      // The trimming is a fallback: tested with the guide links and
+      // stitching constraints that left the cut ends overlapping (before
+      // issue #8 session 6); with today's defaults see
+      // CutEndsOfOverlappingTubesMeetAndStitchIntoOneTube.
+      MergeOptions on;
+      on.guide_by_vertices = false;
+      on.average_across_axis_only = false;
+      MergeOptions off = on;
       off.trim_overlapping_ends = false;
       const MergeResult r0 = merge_elements(a, Region::kOld, b, Region::kNew, band, off);
-      const MergeResult r1 = merge_elements(a, Region::kOld, b, Region::kNew, band);
+      const MergeResult r1 = merge_elements(a, Region::kOld, b, Region::kNew, band, on);
       if (r0.stitched) {
         EXPECT_TRUE(r1.stitched) << sx << " " << dy << ": " << r1.reason;
         continue;
@@ -363,6 +379,88 @@ TEST(ElementMerging, OverlappingCutEndsAreTrimmedAndStitched) {
     }
   // Measured: 6 of these 9 (B starting at 1.95 or 2.05, every sideways offset).
   EXPECT_GE(rescued, 4);
+}
+
+/// A straight capped tube along x over [x0, x1]: rings every `h` (the last
+/// row shorter), `sides` around, radius r, centre line at (y, z) = (dy, 0),
+/// closed by a fan at each end; outward oriented.
+ElementMesh straight_tube(double x0, double x1, double h, double r, int sides, double dy) {
+  ElementMesh m;
+  std::vector<double> xs;
+  const int rows = static_cast<int>(std::ceil((x1 - x0) / h - 1e-6));
+  for (int k = 0; k < rows; ++k) xs.push_back(x0 + k * h);
+  xs.push_back(x1);
+  const double kPi = 3.14159265358979323846;
+  for (double x : xs)
+    for (int j = 0; j < sides; ++j) {
+      const double t = 2 * kPi * j / sides;
+      m.points.push_back({x, dy + r * std::cos(t), r * std::sin(t)});
+    }
+  const int n = static_cast<int>(xs.size());
+  auto id = [&](int k, int j) { return k * sides + (j % sides); };
+  for (int k = 0; k + 1 < n; ++k)
+    for (int j = 0; j < sides; ++j) {
+      m.tris.push_back({id(k, j), id(k, j + 1), id(k + 1, j + 1)});
+      m.tris.push_back({id(k, j), id(k + 1, j + 1), id(k + 1, j)});
+    }
+  const int c0 = static_cast<int>(m.points.size());
+  m.points.push_back({x0, dy, 0});
+  m.points.push_back({x1, dy, 0});
+  for (int j = 0; j < sides; ++j) {
+    m.tris.push_back({c0, id(0, j + 1), id(0, j)});
+    m.tris.push_back({c0 + 1, id(n - 1, j), id(n - 1, j + 1)});
+  }
+  return m;
+}
+
+// Issue #8, session 6: two straight tubes overlapping along [2, 3.5], B's
+// rows a fraction of a row out of phase with A's, B 4% thicker and a little
+// off sideways (a thread continued by the same thread of a new patch). The
+// cuts must meet: B's kept part starts just past A's cut (guide links by
+// vertices), the loops are zipped across the gap between them (stitching
+// constraints averaged across the axis only) and the result is one closed
+// tube over both spans that does not cross itself. With the merge options
+// before (centroid guides, full averages, round trip half an edge, SINK rule
+// in the overlap only and for any uncovered face) the row just past A's end
+// counted as covered at phase 0.01 and A was not cut.
+TEST(ElementMerging, CutEndsOfOverlappingTubesMeetAndStitchIntoOneTube) {
+  const double r = 0.12, h = 0.1;
+  const ElementMesh a = straight_tube(-0.5, 3.5, h, r, 8, 0);
+  ASSERT_TRUE(is_closed_oriented(a));
+  MergeOptions before;
+  before.guide_by_vertices = false;
+  before.average_across_axis_only = false;
+  before.round_trip_edges = 0.5;
+  before.uncovered_must_escape = false;
+  before.delete_past_overlap = false;
+  int stitched_before = 0, cases = 0;
+  for (double phase : {0.01, 0.03, 0.05, 0.07})
+    for (double dy : {0.0, 0.01}) {
+      ++cases;
+      const ElementMesh b = straight_tube(2.0 + phase, 6.0 + phase, h, 1.04 * r, 8, dy);
+      const MergeResult m = merge_elements(a, Region::kOld, b, Region::kNew, band);
+      ASSERT_TRUE(m.stitched) << "phase " << phase << ", dy " << dy << ": " << m.reason;
+      EXPECT_EQ(m.loops, 1);
+      EXPECT_TRUE(is_closed_oriented(m.merged));
+      std::vector<int> comp;
+      EXPECT_EQ(triangle_components(m.merged, comp), 1);
+      double lo = 1e9, hi = -1e9;
+      for (const P3& p : m.merged.points) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+      EXPECT_NEAR(lo, -0.5, 1e-9);
+      EXPECT_NEAR(hi, 6.0 + phase, 1e-9);
+      Mesh mm;
+      mesh_from_elements({m.merged}, mm);
+      EXPECT_EQ(count_self_intersections(mm), 0u) << "phase " << phase << ", dy " << dy;
+      const MergeResult o = merge_elements(a, Region::kOld, b, Region::kNew, band, before);
+      stitched_before += o.stitched ? 1 : 0;
+      std::cout << "[ tubes ] phase " << phase << ", dy " << dy << ": before "
+                << (o.stitched ? std::string("stitched") : o.reason) << "\n";
+    }
+  // Measured: 6 of the 8 before (phase 0.01: "cuts opened 0 and 1 loops").
+  EXPECT_LT(stitched_before, cases);
+  MergeOptions bad;
+  bad.round_trip_edges = 0;
+  EXPECT_THROW(merge_elements(a, Region::kOld, a, Region::kNew, band, bad), InvalidInputError);
 }
 
 struct QuiltCase {
@@ -434,8 +532,8 @@ namespace {
 // ("any surviving vertex-face pair") crossing threads are related too; with
 // mutually strongest relations each element keeps at most one partner, so
 // there are no more relations than with any-pair relations. The refusal
-// reasons add up to the refusals. (On this planar weave every stitch is still
-// refused for different loop counts either way: see the lead's report.)
+// reasons add up to the refusals. (Since issue #8 session 6 nearly every
+// weave merge stitches: 80 stitched, 1 refused either way.)
 TEST(QuiltStep, OneToOneRelationsAreNoMoreThanAnyPairRelationsAndRefusalsAddUp) {
   const Swatch sw = small_weave();
   PlanarQuiltOptions o;
@@ -506,6 +604,54 @@ TEST(QuiltStep, PlanarWeaveStitchesMostMergesIntoLongerClosedThreads) {
   const Swatch q = make_swatch(out);
   for (const SwatchElement& e : q.elements) EXPECT_TRUE(e.closed);
   EXPECT_GT(longest_element(q), 1.3 * longest_element(sw));
+}
+/// Mean over the elements of `s` of the larger xy side of each bounding box.
+double mean_element_length(const Swatch& s) {
+  double sum = 0;
+  for (const SwatchElement& e : s.elements)
+    sum += std::max(e.bbox_max[0] - e.bbox_min[0], e.bbox_max[1] - e.bbox_min[1]);
+  return s.elements.empty() ? 0 : sum / static_cast<double>(s.elements.size());
+}
+
+// Regression for issue #8, session 6: on the plane, where placement is
+// exact, most merges were refused ("self-intersecting stitch": B's kept end
+// reached back over A's; "cuts opened 0 and 1 loops": A's end, poking past
+// the overlap or followed by a row of B counted as covered, was never forced
+// out) and threads ended at patch seams. With the merge options before
+// (MergeOptions: centroid guides, full averages, round trip half an edge,
+// SINK rule in the overlap only, any uncovered face) this quilt gave 38
+// stitched / 41 refused, 42 elements of mean length 1.29 swatch thread
+// lengths; now 80 / 1, 18 elements of 2.89 (measured when written). Bounds: refusals under a quarter
+// of the merges, fewer elements and threads at least 1.3 times as long on
+// average than before, every element closed.
+TEST(QuiltStep, PlanarWeaveCutsMeetSoThreadsRunOnAcrossPatchSeams) {
+  const Swatch sw = small_weave();
+  const double k = test::sanitized() ? 1.6 : 2.2;
+  PlanarQuiltOptions o;
+  o.seed = 3;
+  Mesh now_mesh, before_mesh;
+  const QuiltResult now = quilt_plane(sw, k * sw.length(), k * sw.width(), now_mesh, o);
+  MergeOptions& m = o.step.merge;
+  m.guide_by_vertices = false;
+  m.average_across_axis_only = false;
+  m.round_trip_edges = 0.5;
+  m.uncovered_must_escape = false;
+  m.delete_past_overlap = false;
+  const QuiltResult before = quilt_plane(sw, k * sw.length(), k * sw.width(), before_mesh, o);
+  const Swatch qn = make_swatch(now_mesh), qb = make_swatch(before_mesh);
+  const double unit = longest_element(sw);
+  const double len_now = mean_element_length(qn) / unit, len_before = mean_element_length(qb) / unit;
+  std::cout << "[ weave seams ] now: stitched " << now.stats.stitched << ", refused " << now.stats.stitch_refused
+            << ", coincident " << now.stats.coincident << ", elements " << now.elements << ", mean length " << len_now
+            << "; before: stitched " << before.stats.stitched << ", refused " << before.stats.stitch_refused
+            << ", elements " << before.elements << ", mean length " << len_before << "\n";
+  const std::size_t tried = now.stats.stitched + now.stats.stitch_refused;
+  ASSERT_GT(tried, 0u);
+  EXPECT_LT(4 * now.stats.stitch_refused, tried);
+  EXPECT_LT(now.elements, before.elements);
+  EXPECT_GT(len_now, 1.3 * len_before);
+  EXPECT_EQ(border_edges(now_mesh), 0u);
+  for (const SwatchElement& e : qn.elements) EXPECT_TRUE(e.closed);
 }
 }  // namespace
 }  // namespace surftex
