@@ -23,6 +23,7 @@
 
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/write_mesh.h"
 #include "test_support.h"
@@ -502,6 +503,22 @@ TEST(CmdElementsHostile, IdThatDoesNotExistIsRefused) {
   Mesh m;
   read_mesh(dir + "/o.ply", m);
   EXPECT_EQ(m.number_of_faces(), 1u);
+  // Recolouring element 1 paints exactly its three vertices.
+  const test::RunResult rc = test::run_surftex("elements " + q(dir + "/two.obj") + " -o " + q(dir + "/c.ply") +
+                                               " --recolor 1=1,0,0 --quiet");
+  ASSERT_EQ(rc.exit_code, 0) << rc.err;
+  Mesh c;
+  read_mesh(dir + "/c.ply", c);
+  auto col = find(c, kVertexColor);
+  ASSERT_TRUE(col.second);
+  int red = 0;
+  for (VertexIndex v : c.vertices()) {
+    const Color3f k = col.first[v];
+    const bool is_red = k[0] == 1.f && k[1] == 0.f && k[2] == 0.f;
+    red += is_red;
+    EXPECT_EQ(is_red, c.point(v).x() >= 2.5) << c.point(v);  // element 1 is the triangle at x >= 3
+  }
+  EXPECT_EQ(red, 3);
 }
 
 TEST(CmdElementsHostile, BadColourIsRefused) {
