@@ -16,6 +16,16 @@ namespace surftex {
 
 Swatch make_swatch(const Mesh& mesh) {
   if (mesh.number_of_faces() == 0) throw InvalidInputError("swatch: the mesh has no faces");
+  // read_mesh refuses NaN/inf in files; a mesh built or transformed in code
+  // (e.g. scaled by a huge factor) can still carry them, and one non-finite
+  // point would poison every bounding box and cell size downstream.
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+      throw InvalidInputError("swatch: vertex " + std::to_string(v.idx()) + " has a non-finite coordinate (" +
+                              std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                              ")");
+  }
   Swatch s;
   s.mesh = element_mesh_from(mesh);
   const int n = triangle_components(s.mesh, s.face_element);

@@ -35,7 +35,11 @@ struct Swatch {
 
 /// Builds a swatch from a triangle mesh: elements = connected components
 /// (numbered in order of their first face). Throws InvalidInputError if the
-/// mesh has no face, a non-triangle face, or a zero xy extent.
+/// mesh has no face, a non-triangle face, a non-finite coordinate, or a zero
+/// xy extent. A zero height (flat swatch, z extent 0) is accepted: planar
+/// quilting (section 2) works in xy; embedding on a surface (section 3.2)
+/// needs a shell of positive thickness and refuses it there
+/// (embed_surface_quilt).
 Swatch make_swatch(const Mesh& mesh);
 /// read_mesh + make_swatch (any format read_mesh reads). Throws as both.
 Swatch load_swatch(const std::string& path);
