@@ -37,7 +37,10 @@ int main(int argc, char** argv) {
   }
   try {
     for (auto& [sub, run] : runs)
-      if (sub->parsed()) return run();
+      if (sub->parsed()) {
+        surftex::cli::check_parsed_arguments(*sub);
+        return run();
+      }
   } catch (const surftex::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <cstdio>
 #include <sstream>
@@ -128,6 +129,26 @@ std::pair<double, double> element_lengths(const Mesh& m, double unit) {
   return {box.empty() ? 0 : sum / static_cast<double>(box.size()), mx};
 }
 
+// Refuses runs whose output could not be held: `placements` swatch copies
+// (the plane's W x H, or the base area over the swatch's) of its faces above
+// kMaxQuiltFaces, or a --cell (in the swatch's units, 0 = automatic) that
+// cuts the swatch into more than kMaxSwatchCells cells across.
+constexpr double kMaxQuiltFaces = 5e7;
+constexpr double kMaxSwatchCells = 200;
+void check_quilt_size(const Swatch& s, double cell, double placements, const std::string& what) {
+  const double faces = placements * static_cast<double>(s.mesh.tris.size());
+  if (!(faces <= kMaxQuiltFaces))
+    throw InvalidInputError("quilt: " + what + " needs about " + std::to_string(static_cast<long long>(std::min(placements, 9e18))) +
+                            " copies of the " + std::to_string(s.mesh.tris.size()) +
+                            "-face swatch, more than the " + std::to_string(static_cast<long long>(kMaxQuiltFaces)) +
+                            " output faces this tool will build (use a smaller area or a larger --scale)");
+  const double across = std::max(s.length(), s.width()) / cell;
+  if (cell > 0 && !(across <= kMaxSwatchCells))
+    throw InvalidInputError("quilt: --cell " + std::to_string(cell) + " cuts the swatch into " +
+                            std::to_string(static_cast<long long>(std::min(across, 9e18))) + " cells across, more than " +
+                            std::to_string(static_cast<int>(kMaxSwatchCells)) + " (0 = automatic, a tenth of the swatch)");
+}
+
 int run_quilt(QuiltArgs& a) {
   // With --plane the positional arguments are just the swatch.
   if (!a.plane.empty() && !a.base.empty() && a.swatch.empty()) std::swap(a.base, a.swatch);
@@ -147,7 +168,7 @@ int run_quilt(QuiltArgs& a) {
   if (a.up.size() != 3 || !(a.up[0] * a.up[0] + a.up[1] * a.up[1] + a.up[2] * a.up[2] > 0))
     throw InvalidInputError("quilt: --up must be three numbers, not all zero");
   const std::string ext = lower_ext(a.output);
-  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".glb" && ext != ".gltf" && ext != ".stl")
+  if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".glb")
     throw InvalidInputError("quilt: unknown output format '" + a.output + "' (use .obj, .ply, .off, .glb)");
   // Outputs: OUT, its .ply and .glb siblings (mesh mode), the render.
   std::vector<std::string> outputs{a.output};
@@ -165,7 +186,8 @@ int run_quilt(QuiltArgs& a) {
   if (!a.plane.empty()) {
     char x = 0;
     std::istringstream is(a.plane);
-    if (!(is >> w >> x >> h) || (x != 'x' && x != 'X') || !(w > 0) || !(h > 0))
+    if (!(is >> w >> x >> h) || (x != 'x' && x != 'X') || !(w > 0) || !(h > 0) || !std::isfinite(w) ||
+        !std::isfinite(h) || !(is >> std::ws).eof())
       throw InvalidInputError("quilt: --plane must be WxH with positive numbers in swatch sizes (got '" + a.plane + "')");
   }
   auto limit = apply_thread_limit(a.common.threads);
@@ -185,12 +207,15 @@ int run_quilt(QuiltArgs& a) {
       sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
     }
     const Swatch s = make_swatch(sm);
+    check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
     PlanarQuiltOptions o;
     o.seed = a.common.seed;
     o.cell_size = a.cell * sc;
     o.subpatch_radius = a.subpatch;
     o.progress = terminal_progress(a.common.quiet);
     const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
+    if (out.number_of_faces() == 0)
+      throw InvalidInputError("quilt: no element was placed on the " + a.plane + " plane");
     color_by_element(out, a.common.seed);
     rep["plane"] = {w, h};
     rep["swatch_faces"] = s.mesh.tris.size();
@@ -217,6 +242,22 @@ int run_quilt(QuiltArgs& a) {
     SurfaceQuiltOptions o;
     o.relative_size = a.scale > 0 ? a.scale : 0.25;
     if (!(o.relative_size <= 10)) throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
+    {
+      // Placements needed: the base area over the scaled swatch's xy area.
+      double area = 0, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+      for (FaceIndex f : base.faces()) {
+        std::vector<Point3> p;
+        for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) p.push_back(base.point(v));
+        for (std::size_t k = 1; k + 1 < p.size(); ++k) area += std::sqrt(CGAL::cross_product(p[k] - p[0], p[k + 1] - p[0]).squared_length()) / 2;
+      }
+      for (VertexIndex v : base.vertices())
+        for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], base.point(v)[d]), hi[d] = std::max(hi[d], base.point(v)[d]);
+      const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+      const double side = o.relative_size * diag, big = std::max(s.length(), s.width());
+      const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
+      check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
+                       "--scale " + std::to_string(o.relative_size));
+    }
     o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
     o.up = {a.up[0], a.up[1], a.up[2]};
     o.cell_size = a.cell;
@@ -227,6 +268,9 @@ int run_quilt(QuiltArgs& a) {
     o.progress = terminal_progress(a.common.quiet);
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    if (q.elements == 0 || q.tris.empty())
+      throw InvalidInputError("quilt: no element was placed on '" + a.base + "' at --scale " +
+                              std::to_string(o.relative_size) + " (the swatch may be too large for the mesh: lower --scale)");
     EmbedSurfaceQuiltOptions eo;
     eo.shell_height = a.shell_height;
     eo.stretch.iterations = a.stretch_iterations;
@@ -353,7 +397,7 @@ SubcommandRegistrar reg_quilt{
                       "The paper's s. On a mesh: the swatch's larger side as a fraction of the base mesh's "
                       "bounding-box diagonal, (0, 10], 0 = 0.25. On a plane: factor applied to the swatch, "
                       "0 = 1 (default 0)")
-           ->check(CLI::NonNegativeNumber);
+           ->check(number_above(0, false));
        app.add_option("--field", a->field,
                       "Guidance field aligning the swatch's +y on a mesh: up (the projected --up vector) or none "
                       "(each patch's own flattening) (default up)")
@@ -362,13 +406,13 @@ SubcommandRegistrar reg_quilt{
        app.add_option("--shell-height", a->shell_height,
                       "Shell thickness in scaled swatch heights, > 0 (default 1); clamped locally where the "
                       "shell would fold")
-           ->check(CLI::PositiveNumber);
+           ->check(number_above(0, true));
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));
        app.add_flag("--no-check", a->no_check, "Skip the exact self-intersection count of the embedded result");
        app.add_option("--cell", a->cell, "Grid cell size in swatch units; 0 = swatch extent / 10 (default 0)")
-           ->check(CLI::NonNegativeNumber);
+           ->check(number_above(0, false));
        app.add_option("--subpatch", a->subpatch, "Output sub-patch half-size in cells; 0 = automatic (0..100, default 0)")
            ->check(CLI::Range(0, 100));
        app.add_option("--max-turn", a->max_turn,
@@ -406,7 +450,9 @@ int run_elements(const ElementsArgs& a) {
   for (const std::string& rc : a.recolor) {
     int id = -1;
     float r = 0, g = 0, b = 0;
-    if (std::sscanf(rc.c_str(), "%d=%f,%f,%f", &id, &r, &g, &b) != 4 || id < 0 || id >= n)
+    int used = 0;
+    if (std::sscanf(rc.c_str(), "%d=%f,%f,%f%n", &id, &r, &g, &b, &used) != 4 || used != static_cast<int>(rc.size()) ||
+        id < 0 || id >= n)
       throw InvalidInputError("elements: --recolor wants ID=r,g,b with 0 <= ID < " + std::to_string(n) +
                               " and colours in [0,1] (got '" + rc + "')");
     for (float c : {r, g, b})

@@ -5,7 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <mutex>
 #include <thread>
@@ -18,6 +20,21 @@ namespace surftex::cli {
 std::vector<Subcommand>& registry() {
   static std::vector<Subcommand> r;
   return r;
+}
+
+CLI::Validator number_above(double lo, bool strict) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", lo);
+  const std::string bound = std::string(strict ? "> " : ">= ") + buf;
+  return CLI::Validator(
+      [lo, strict, bound](std::string& in) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(in.c_str(), &end);
+        if (end == in.c_str() || *end != '\0') return "must be a number " + bound + " (got '" + in + "')";
+        if (!(strict ? v > lo : v >= lo)) return "must be " + bound + " (got " + in + ")";
+        return "";
+      },
+      "NUMBER " + bound);
 }
 
 void add_common_options(CLI::App& app, CommonOptions& opt) {
@@ -83,14 +100,58 @@ LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const Comm
   return r;
 }
 
+namespace {
+void check_output_folder(const std::string& output) {
+  const std::filesystem::path p(output);
+  const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw IOError("cannot write '" + output + "': folder '" + dir.string() + "' does not exist");
+}
+}  // namespace
+
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force) {
   for (const auto& in : inputs)
     if (!in.empty() && same_file(output, in))
       throw InvalidInputError("output '" + output + "' is the input file '" + in +
                               "'; refusing to overwrite an input");
+  check_output_folder(output);
   std::error_code ec;
   if (!force && std::filesystem::exists(output, ec) && !std::filesystem::is_directory(output, ec))
     throw IOError("output '" + output + "' already exists (pass --force to replace it)");
+}
+
+void check_parsed_arguments(const CLI::App& sub) {
+  std::string report;
+  const CLI::Option* report_opt = nullptr;
+  bool force = false;
+  for (const CLI::Option* o : sub.get_options()) {
+    const std::string name = o->get_name();
+    if (name == "--report" && !o->results().empty()) report = o->results().back(), report_opt = o;
+    if (name == "--force" && o->count() > 0) force = true;
+    // NaN and infinities in floating-point options (CLI11 checks compare with
+    // < and >, which NaN passes).
+    if (o->get_type_name().rfind("FLOAT", 0) == 0)
+      for (const std::string& r : o->results()) {
+        char* end = nullptr;
+        const double v = std::strtod(r.c_str(), &end);
+        if (end != r.c_str() && *end == '\0' && !std::isfinite(v))
+          throw InvalidInputError(name + ": '" + r + "' is not a finite number");
+      }
+  }
+  if (report.empty()) return;
+  for (const CLI::Option* o : sub.get_options()) {
+    if (o == report_opt) continue;
+    for (const std::string& r : o->results())
+      if (!r.empty() && same_file(report, r))
+        throw InvalidInputError("--report '" + report + "' is also given as " + o->get_name() + " '" + r +
+                                "'; refusing to overwrite it with the report");
+  }
+  check_output_folder(report);
+  std::error_code ec;
+  if (std::filesystem::is_directory(report, ec)) throw IOError("cannot write --report '" + report + "': it is a folder");
+  if (!force && std::filesystem::exists(report, ec))
+    throw IOError("--report '" + report + "' already exists (pass --force to replace it)");
 }
 
 }  // namespace surftex::cli

@@ -29,6 +29,10 @@ struct CommonOptions {
   bool quiet = false;       // no progress even on a terminal
 };
 
+/// A CLI11 check: a number > lo (strict) or >= lo; the message reads
+/// "must be > 0 (got -1)" (CLI11's PositiveNumber prints a 300-digit range).
+CLI::Validator number_above(double lo, bool strict);
+
 /// Adds --seed, --threads, --report, --force, --quiet to `app`.
 void add_common_options(CLI::App& app, CommonOptions& opt);
 
@@ -48,8 +52,18 @@ void write_report(const CommonOptions& opt, const std::string& command, nlohmann
 void require_input_file(const std::string& input, const std::string& what);
 
 /// Throws if `output` names the same file as any of `inputs` (never overwrite
-/// what the user gave), or exists while !force.
+/// what the user gave), exists while !force, or its folder does not exist
+/// (checked before any work, so that no output is written when a later one
+/// cannot be).
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force);
+
+/// Checks every subcommand's parsed arguments before it runs (main.cpp):
+/// a floating-point option given a NaN or an infinity is refused naming the
+/// option (CLI11's range checks let NaN through); the --report path must not
+/// name a file given as another argument (an input or another output), must
+/// not replace an existing file without --force, and its folder must exist.
+/// Throws InvalidInputError / IOError.
+void check_parsed_arguments(const CLI::App& sub);
 
 /// Reads and repairs a method's input mesh (geometry/load_input_mesh.h): a
 /// mesh that cannot be repaired is refused (TopologyError); what was repaired
