@@ -130,11 +130,16 @@
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
@@ -213,6 +218,13 @@ int main(int argc, char** argv) {
     if (variant == "wide_pout") qo.subpatch_radius = 3;
     if (variant == "near_seed") qo.align_sigma = 0.2;
     if (variant == "wide_align") qo.align_sigma = 1.0;
+    if (variant == "smooth") qo.smooth_field = true;
+    if (variant == "smooth_bound") qo.smooth_field = true, qo.align_field_max_deg = 10;
+    if (variant == "bound") qo.align_field_max_deg = 10;
+    if (variant == "smooth_unaligned") qo.smooth_field = true, qo.align_to_overlap = false;
+    if (variant == "no_trim") qo.trim_at_border = false;
+    if (const char* e = std::getenv("BENCH_ALIGN_FIELD_MAX_DEG")) qo.align_field_max_deg = std::atof(e);
+    if (const char* e = std::getenv("BENCH_FIELD_SMOOTHING")) qo.field_smoothing = std::atof(e);
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
@@ -235,6 +247,76 @@ int main(int argc, char** argv) {
           {"seconds", r.seconds}, {"seconds_patches", r.seconds_patch}, {"seconds_match", r.stats.seconds_match},
           {"seconds_correspond", r.stats.seconds_correspond}, {"seconds_deform", r.stats.seconds_deform},
           {"seconds_merge", r.stats.seconds_merge}, {"seconds_turn", r.seconds_turn}});
+    // Bare base surface (as in the tests' bare_fraction): the area of the
+    // base faces with no quilt vertex's foot within one thread spacing of
+    // their centroid, overall and in four bands of height along up (the top
+    // band holds the ears).
+    json bare_j;
+    std::vector<char> bare_face(base.number_of_faces(), 0);
+    {
+      const double rad = (kind == "chainmail" ? 2.8 * ChainmailOptions{}.ring_radius : WeaveOptions{}.spacing) * q.scale;
+      std::vector<std::array<Point3, 3>> fp(base.number_of_faces());
+      for (FaceIndex f : base.faces()) {
+        int k = 0;
+        for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) fp[f.idx()][static_cast<std::size_t>(k++)] = base.point(v);
+      }
+      std::unordered_map<long long, std::vector<Point3>> grid;  // buckets of side rad
+      auto key = [&](double x, double y, double z) {
+        const long long i = static_cast<long long>(std::floor(x / rad)), j = static_cast<long long>(std::floor(y / rad)),
+                        k = static_cast<long long>(std::floor(z / rad));
+        return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
+      };
+      for (const SurfaceQuiltVertex& v : q.vertices) {
+        const auto& t = fp[static_cast<std::size_t>(v.face)];
+        const double b0 = 1 - v.b1 - v.b2;
+        const Point3 p(b0 * t[0].x() + v.b1 * t[1].x() + v.b2 * t[2].x(), b0 * t[0].y() + v.b1 * t[1].y() + v.b2 * t[2].y(),
+                       b0 * t[0].z() + v.b1 * t[1].z() + v.b2 * t[2].z());
+        grid[key(p.x(), p.y(), p.z())].push_back(p);
+      }
+      const Vector3 upv(qo.up[0], qo.up[1], qo.up[2]);
+      double hmin = 1e300, hmax = -1e300;
+      for (VertexIndex v : base.vertices()) {
+        const double h = (base.point(v) - CGAL::ORIGIN) * upv;
+        hmin = std::min(hmin, h), hmax = std::max(hmax, h);
+      }
+      double area[5] = {0, 0, 0, 0, 0}, bare[5] = {0, 0, 0, 0, 0};
+      for (FaceIndex f : base.faces()) {
+        const auto& t = fp[f.idx()];
+        const Point3 c = CGAL::centroid(t[0], t[1], t[2]);
+        bool cov = false;
+        for (int di = -1; di <= 1 && !cov; ++di)
+          for (int dj = -1; dj <= 1 && !cov; ++dj)
+            for (int dk = -1; dk <= 1 && !cov; ++dk) {
+              auto it = grid.find(key(c.x() + di * rad, c.y() + dj * rad, c.z() + dk * rad));
+              if (it == grid.end()) continue;
+              for (const Point3& p : it->second)
+                if (CGAL::squared_distance(c, p) <= rad * rad) {
+                  cov = true;
+                  break;
+                }
+            }
+        const double a = std::sqrt(CGAL::squared_area(t[0], t[1], t[2]));
+        const int band = std::clamp(static_cast<int>(4 * (((c - CGAL::ORIGIN) * upv) - hmin) / (hmax - hmin)), 0, 3);
+        area[4] += a, area[band] += a;
+        if (!cov) bare[4] += a, bare[band] += a, bare_face[f.idx()] = 1;
+      }
+      bare_j = {{"bare_fraction", bare[4] / area[4]},
+                {"bare_by_height", {bare[0] / area[0], bare[1] / area[1], bare[2] / area[2], bare[3] / area[3]}}};
+    }
+    line({{"stage", "cover"}, {"variant", variant}, {"bare", bare_j},
+          {"drift_deg", r.drift_count ? r.drift_deg_sum / r.drift_count : 0.0}, {"drift_count", r.drift_count},
+          {"drift_up_deg", r.drift_up_count ? r.drift_up_deg_sum / r.drift_up_count : 0.0}, {"drift_up_count", r.drift_up_count},
+          {"patches_align_bounded", r.patches_align_bounded}, {"elements_trimmed", r.elements_trimmed}});
+    if (!outdir.empty()) {
+      // The base alone, bare faces red (what the bare figures count).
+      Mesh bm = base;
+      auto col = get_or_add(bm, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+      for (FaceIndex f : bm.faces())
+        if (bare_face[f.idx()])
+          for (VertexIndex v : bm.vertices_around_face(bm.halfedge(f))) col[v] = Color3f{0.9f, 0.1f, 0.1f};
+      write_image(outdir + "/bunny_" + kind + "_bare.png", render_preview(bm, 30.f, 20.f, 700));
+      write_image(outdir + "/bunny_" + kind + "_bare_top.png", render_preview(bm, 120.f, 60.f, 700));
+    }
     EmbedSurfaceQuiltOptions eo;
     eo.stretch.iterations = 40;
     Mesh out;

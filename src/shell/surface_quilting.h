@@ -68,8 +68,9 @@
 //    processed.
 // At the end every location is moved onto the base face that contains it
 // (walking across edges); elements with more than max_past_border of their
-// vertices past a border of the base mesh are removed (issue #8: our choice,
-// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border);
+// vertices past a border of the base mesh are trimmed at the border, their
+// cuts closed (trim_at_border), or removed (issue #8: our choice, the paper
+// does not treat borders; see SurfaceQuiltResult::elements_past_border);
 // elements with a stretched edge are removed (max_edge_stretch), and elements
 // reaching above or below the output's z range are shifted into it
 // (max_z_growth), so that every vertex has w in [0, 1] in the shell (issue #8).
@@ -116,6 +117,16 @@ struct SurfaceQuiltOptions {
   /// Default 0: on the open cylinder of the tests, 0.1 kept 2 more elements
   /// and 303 more intersecting face pairs within elements (their tips).
   double max_past_border = 0;
+  /// The elements past a border by more than max_past_border (issue #8,
+  /// session 6): true = trimmed at the border (their triangles with a vertex
+  /// past it removed, each remaining connected piece whose cut loops are
+  /// small, at most two swatch heights across, closed by a fan over each
+  /// loop and kept; see SurfaceQuiltResult::elements_trimmed); false =
+  /// removed whole (the state before). Default true: on the 20 x 8 helix
+  /// cylinder of the tests, removal threw away 2/3 of the quilt's faces
+  /// (stitched threads are long, and every oblique one crosses an open end)
+  /// and left 8.75% of the base bare, all of it along the ends.
+  bool trim_at_border = true;
   /// Rotation of each placement (issue #8; our choice, the paper's section 2.4
   /// searches translations only and section 3.1 takes the patch's frame from
   /// the guidance field): besides the field's direction (step 4) the frame is
@@ -142,6 +153,25 @@ struct SurfaceQuiltOptions {
   /// orients patches without earlier texture around them; the turn search
   /// (rotation_max_deg) runs around the aligned frame. Default true.
   bool align_to_overlap = true;
+  /// The alignment's turn is bounded relative to the guidance field (issue
+  /// #8, session 6): |turn| <= align_field_max_deg (degrees, in [0, 45]; 45
+  /// = unbounded, the state before; 0 = the field alone). The frame before
+  /// the turn follows the field at the seed, so this bounds each aligned
+  /// placement's drift from the field (SurfaceQuiltResult::drift_deg_sum).
+  double align_field_max_deg = 45;
+  /// Field::kUp: the guidance field is a smooth 4-symmetric direction field
+  /// over the base mesh (geometry/direction_field.h), interpolated from up
+  /// projected on the faces where |projection| >= field_min_projection
+  /// (constraints_from_constant_vector; in (0, 1]) and smoothed
+  /// (DirectionFieldOptions::smoothing = field_smoothing, >= 0): it varies
+  /// smoothly and has no poles where the projected up vanishes (the
+  /// interpolation fills them; singularities emerge where the geometry
+  /// needs them). false = the projected up at each seed, transported from
+  /// the earlier placements where it is shorter than transport_below (the
+  /// state before; transport_below is not used with the smooth field).
+  bool smooth_field = false;
+  double field_min_projection = 0.3;
+  double field_smoothing = 1.0;
   /// In [0, 1]; see align_to_overlap. Default 0.1.
   double align_min_overlap = 0.1;
   /// Sigma of align_to_overlap's distance weight, in (scaled) swatch
@@ -255,6 +285,16 @@ struct SurfaceQuiltResult {
   /// degrees; align_residual_sum / align_residual_weight is the mean, what
   /// the surface's curvature between two flattenings leaves to a rigid frame.
   double align_residual_sum = 0, align_residual_weight = 0;
+  /// Aligned patches whose turn was clamped to align_field_max_deg.
+  int patches_align_bounded = 0;
+  /// Drift from the guidance field (a diagnostic): per placement, the angle
+  /// between its +y at the seed and the guidance direction there (the
+  /// smooth field's, or the projected up where at least 0.2 long), folded by
+  /// a quarter turn into [0, 45] degrees; drift_deg_sum / drift_count is the
+  /// mean. drift_up_*: the same against the projected up (where at least 0.2
+  /// long) in either mode, to compare the two.
+  double drift_deg_sum = 0, drift_up_deg_sum = 0;
+  int drift_count = 0, drift_up_count = 0;
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
   double seed_scale_min = 1, seed_scale_max = 1;
@@ -271,6 +311,8 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Elements trimmed at a border instead (SurfaceQuiltOptions::trim_at_border).
+  std::size_t elements_trimmed = 0;
   /// Elements removed at the end for a stretched edge (SurfaceQuiltOptions::max_edge_stretch).
   std::size_t elements_stretched = 0;
   /// Elements shifted or squeezed in z into the output's z range and their
