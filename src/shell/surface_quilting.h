@@ -127,6 +127,13 @@ struct SurfaceQuiltOptions {
   /// (stitched threads are long, and every oblique one crosses an open end)
   /// and left 8.75% of the base bare, all of it along the ends.
   bool trim_at_border = true;
+  /// New elements whose vertex centroid falls off the patch (step 6; issue
+  /// #8, session 6): true = their part on the patch is kept (triangles with
+  /// a vertex off the patch removed, the pieces closed as trim_at_border
+  /// does; SurfaceQuiltResult::new_trimmed); false = dropped whole (the
+  /// state before). The patch faces under the footprint are marked processed
+  /// either way, so a dropped thread is never placed again there.
+  bool trim_new_to_patch = false;
   /// Rotation of each placement (issue #8; our choice, the paper's section 2.4
   /// searches translations only and section 3.1 takes the patch's frame from
   /// the guidance field): besides the field's direction (step 4) the frame is
@@ -299,6 +306,7 @@ struct SurfaceQuiltResult {
   /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
   double seed_scale_min = 1, seed_scale_max = 1;
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
+  std::size_t new_trimmed = 0; ///< of those, kept trimmed to the patch (SurfaceQuiltOptions::trim_new_to_patch)
   /// Times an output element touching a patch had a vertex that cannot be
   /// expressed in the patch frame: off the patch, farther than 2R from (or at
   /// more than 60 degrees to) the nearest patch face.
