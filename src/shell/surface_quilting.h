@@ -27,6 +27,12 @@
 //    discrete parallel transport from the neighbouring texture, our choice
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
+//    With SurfaceQuiltOptions::smooth_field the guidance is instead a smooth
+//    4-symmetric direction field over the whole base mesh, interpolated once
+//    from the projected up (geometry/direction_field.h; Ray et al. 2009,
+//    section 2.2): it has no poles where the projection vanishes, so no
+//    transport is needed; of its cross at the seed the direction nearest the
+//    projected up (else nearest the earlier placements') is taken.
 //    Then, where earlier placements cover enough of the patch around the
 //    seed, the frame is turned so that their +y directions, each mapped
 //    through this patch's own flattening face by face, agree with +y modulo
@@ -35,7 +41,10 @@
 //    5, our choice): the field then orients only patches with no texture
 //    around them, and the threads of neighbouring patches run along each
 //    other instead of meeting at the angle by which the field and the
-//    flattenings turn between two seeds.
+//    flattenings turn between two seeds. That turn is bounded by
+//    align_field_max_deg (issue #8, session 6): unbounded, the first
+//    patch's orientation was carried over the surface and the texture
+//    drifted from the field (SurfaceQuiltResult::drift_deg_sum).
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
 //    times the flattening's own scale around the seed (seed_scale), seed
 //    centroid at the origin (a cell centre); a grid of cells (as in
@@ -133,6 +142,12 @@ struct SurfaceQuiltOptions {
   /// does; SurfaceQuiltResult::new_trimmed); false = dropped whole (the
   /// state before). The patch faces under the footprint are marked processed
   /// either way, so a dropped thread is never placed again there.
+  /// Default false: on the 5K-face bunny (bench_quilt "trim_new", one run,
+  /// load 5-6) it covered the bare stripe on the ear (bare area of the top
+  /// height band 3.7% -> 0.55%, overall 1.0% -> 0.5%; 100 of 402 dropped
+  /// elements kept trimmed), but the intersecting pairs
+  /// between / within elements rose 83,070 -> 96,360 / 17,685 -> 21,887
+  /// and 27 vertices left the shell.
   bool trim_new_to_patch = false;
   /// Rotation of each placement (issue #8; our choice, the paper's section 2.4
   /// searches translations only and section 3.1 takes the patch's frame from

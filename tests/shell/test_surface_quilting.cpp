@@ -739,6 +739,36 @@ TEST(SurfaceQuilting, HelixFieldCylinderAlignedPlacementsDriftFromTheFieldBounde
   EXPECT_LT(bounded, 10.0);
 }
 
+// SurfaceQuiltOptions::trim_new_to_patch: new elements whose centroid falls
+// off the patch keep their part on the patch, closed at the cut, instead of
+// being dropped (their patch faces were marked processed all the same, so
+// the thread was never placed there: the bunny's ear stayed bare).
+TEST(SurfaceQuilting, NewElementsOffThePatchKeepTheirPartOnItClosed) {
+  Mesh base;
+  make_cylinder(base, 1.0, 2.0, 20, 8);
+  const Swatch sw = weave_4x4(4, 5);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.45;
+  o.up = {0.0, 0.6, 0.8};
+  SurfaceQuiltResult r[2];
+  std::size_t faces[2] = {0, 0};
+  for (int trim = 0; trim < 2; ++trim) {
+    o.trim_new_to_patch = trim == 1;
+    SurfaceQuilt q;
+    r[trim] = quilt_surface(base, sw, q, o);
+    Mesh displaced;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, displaced);
+    EXPECT_EQ(closed_fraction(displaced), 1.0);
+    faces[trim] = displaced.number_of_faces();
+    std::cout << "[ trim new ] " << trim << ": dropped new " << r[trim].dropped_new << ", kept trimmed "
+              << r[trim].new_trimmed << ", faces " << faces[trim] << ", elements " << r[trim].elements << "\n";
+  }
+  EXPECT_GT(r[0].dropped_new, 0u);
+  EXPECT_EQ(r[0].new_trimmed, 0u);
+  EXPECT_GT(r[1].new_trimmed, 0u);
+  EXPECT_GT(faces[1], faces[0]);
+}
+
 TEST(SurfaceQuilting, FieldOptionsAreChecked) {
   Mesh base;
   make_icosphere(base, 1);
