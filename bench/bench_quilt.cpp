@@ -228,6 +228,7 @@ int main(int argc, char** argv) {
     if (const char* e = std::getenv("BENCH_SMOOTH_FIELD")) qo.smooth_field = std::atoi(e) != 0;
     if (const char* e = std::getenv("BENCH_ALIGN_FIELD_MAX_DEG")) qo.align_field_max_deg = std::atof(e);
     if (const char* e = std::getenv("BENCH_FIELD_SMOOTHING")) qo.field_smoothing = std::atof(e);
+    if (const char* e = std::getenv("BENCH_FIELD_MIN_PROJECTION")) qo.field_min_projection = std::atof(e);
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
     line({{"stage", "quilt"}, {"variant", variant}, {"relative_size", rel}, {"steps", r.steps}, {"elements", r.elements}, {"faces", r.faces},
