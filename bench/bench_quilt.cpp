@@ -169,6 +169,8 @@
 //   "smooth" (0.3 / 1; 20 deg): drift 12.1, jump 9.1, 30.8%; between 97,609.
 //   "smooth" (0.95 / 1000, unbounded): drift 17.9, jump 8.4, 25.7%;
 //     stitched 107; between 93,665; 14 outside.
+//   "smooth" (0.95 / 1000, 25 deg): drift 12.8, jump 8.4, 26.9%; stitched
+//     104; between 89,641; 50 outside; user CPU 72.3 s.
 // Every bound trades the jump for the drift on the bunny (its curvature
 // turns the field against the neighbours' threads by more than a rigid
 // frame follows: mean alignment turn 16.6 deg), so the defaults stay

@@ -185,7 +185,7 @@ struct SurfaceQuiltOptions {
   /// drift 16.7 deg, jump 7.5 deg, 83,070 intersecting pairs between
   /// elements; 10 deg: drift 9.2, jump 10.0, 88.5K; with the smooth field,
   /// 10 deg: drift 6.6-6.9, jump 10.0-10.8, 88-93K; 20 deg: drift 12.1,
-  /// jump 9.1, 97.6K. The bunny's curvature turns the field against the
+  /// jump 9.1, 97.6K; 25 deg: drift 12.8, jump 8.4, 89.6K. The bunny's curvature turns the field against the
   /// neighbours' threads by more than a rigid frame can follow (mean
   /// alignment turn 16.6 deg). On the helix cylinder, where a smooth field
   /// can be nearly parallel, the smooth field with a bound of 10 gives
