@@ -159,6 +159,11 @@
 //   Trimming stretched elements instead of removing them (tried, removed
 //     again): top band 3.72% -> 0.54%, ear stripe still visible, between
 //     94,194, within 19,382.
+//   Marking processed only the footprint's faces that received a vertex of
+//     the step's elements (or whose neighbour did; tried, removed again):
+//     193 steps, top band 1.6%, the ear's stripe moved but stayed; jump 7.3,
+//     drift 14.4, stitched 76, between 93,350, within 18,436, 0 outside;
+//     quilt 50.8 s, wall 57.9 s, user CPU 71.4 s (load 1.5-1.6).
 // The field (align_field_max_deg, smooth_field):
 //   "bound" (10 deg, projected up): drift 9.2, jump 9.96, 34.2% over 10;
 //     stitched 67; between 88,508; 2 outside; user CPU 70.3 s.
