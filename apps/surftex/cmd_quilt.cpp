@@ -41,8 +41,8 @@ std::string render_path_for(const std::string& out) {
 
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up";
-  bool no_render = false, no_check = false, no_align = false;
-  double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0;
+  bool no_render = false, no_check = false, no_align = false, smooth_field = false;
+  double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0;
   std::vector<double> up{0, 0, 1};
   int subpatch = 0, stretch_iterations = 20;
   CommonOptions common;
@@ -264,6 +264,8 @@ int run_quilt(QuiltArgs& a) {
     o.subpatch_radius = a.subpatch;
     o.rotation_max_deg = a.max_turn;
     o.align_to_overlap = !a.no_align;
+    o.align_field_max_deg = a.align_bound;
+    o.smooth_field = a.smooth_field;
     o.seed = a.common.seed;
     o.progress = terminal_progress(a.common.quiet);
     SurfaceQuilt q;
@@ -424,6 +426,13 @@ SubcommandRegistrar reg_quilt{
        app.add_flag("--no-align", a->no_align,
                     "On a mesh: orient each patch by the guidance field at its seed only, not by the threads "
                     "already placed over the whole overlap (default: aligned to the overlap where there is one)");
+       app.add_option("--align-bound", a->align_bound,
+                      "On a mesh: largest turn of an aligned patch away from the field at its seed, in degrees; "
+                      "45 = unbounded (0..45, default 45)")
+           ->check(CLI::Range(0.0, 45.0));
+       app.add_flag("--smooth-field", a->smooth_field,
+                    "On a mesh with --field up: guide by a smooth 4-symmetric field interpolated from the projected "
+                    "up vector (no poles) instead of the projected vector itself (default: off)");
        add_common_options(app, a->common);
        return [a] { return run_quilt(*a); };
      }}};

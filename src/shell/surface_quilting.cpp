@@ -16,6 +16,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "geometry/direction_field.h"
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
@@ -388,6 +389,96 @@ bool settle_location(const Base& b, SurfaceQuiltVertex& v) {
   return true;
 }
 
+// Trims an element (SurfaceQuiltOptions::trim_at_border): the triangles
+// drop[t] (a vertex past the border of the base mesh) are removed, the rest split into connected components; a component is kept if
+// its border is a set of simple loops, each no wider than cap_max (mesh
+// units, measured between the vertices lifted by their height above z0
+// along the face normal), its cap's edges within max_edge2 (squared, as
+// max_edge_stretch measures; 0 = no limit) and the component has at least 3 triangles per
+// loop vertex (more than a ring around its cut); each loop is closed by a
+// fan from its first vertex (no new vertex; the cut of a tube is a small,
+// nearly planar polygon), so that every piece is closed again.
+void trim_element(const Base& b, const std::vector<Tri>& tris, const std::vector<SurfaceQuiltVertex>& loc,
+                  const std::vector<char>& drop, double scale, double z0, double cap_max, double max_edge2,
+                      std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>>& pieces) {
+  ElementMesh kept;
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    if (!drop[t]) kept.tris.push_back(tris[t]);
+  if (kept.tris.empty()) return;
+  kept.points.assign(loc.size(), P3{0, 0, 0});
+  std::vector<int> comp;
+  const int nc = triangle_components(kept, comp);
+  std::vector<std::vector<int>> by(static_cast<std::size_t>(nc));
+  for (std::size_t t = 0; t < comp.size(); ++t) by[static_cast<std::size_t>(comp[t])].push_back(static_cast<int>(t));
+  auto lifted = [&](const SurfaceQuiltVertex& v) {
+    const P3 p = base_point(b, v);
+    const P3& n = b.normal[v.face];
+    const double h = (v.z - z0) * scale;
+    return P3{p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
+  };
+  for (const auto& ts : by) {
+    std::vector<int> id(loc.size(), -1);
+    std::vector<Tri> pt;
+    std::vector<SurfaceQuiltVertex> pl;
+    for (int t : ts) {
+      Tri tr = kept.tris[static_cast<std::size_t>(t)];
+      for (int& v : tr) {
+        if (id[static_cast<std::size_t>(v)] < 0) {
+          id[static_cast<std::size_t>(v)] = static_cast<int>(pl.size());
+          pl.push_back(loc[static_cast<std::size_t>(v)]);
+        }
+        v = id[static_cast<std::size_t>(v)];
+      }
+      pt.push_back(tr);
+    }
+    ElementMesh m;
+    m.tris = pt;
+    m.points.assign(pl.size(), P3{0, 0, 0});
+    std::vector<std::vector<int>> loops;
+    if (!boundary_loops(m, loops)) continue;
+    std::size_t loop_vertices = 0;
+    bool ok = true;
+    for (const auto& l : loops) {
+      loop_vertices += l.size();
+      if (l.size() < 3 || l.size() > 256) {
+        ok = false;
+        break;
+      }
+      std::vector<P3> q;
+      for (int v : l) q.push_back(lifted(pl[static_cast<std::size_t>(v)]));
+      for (std::size_t i = 0; i < q.size() && ok; ++i)
+        for (std::size_t j = i + 1; j < q.size(); ++j)
+          if (dot3(sub3(q[i], q[j]), sub3(q[i], q[j])) > cap_max * cap_max) {
+            ok = false;
+            break;
+          }
+      // The cap's edges (from the loop's first vertex) obey the stretch limit too.
+      for (std::size_t i = 2; i + 1 < l.size() && ok && max_edge2 > 0; ++i) {
+        const SurfaceQuiltVertex &v0 = pl[static_cast<std::size_t>(l[0])], &v1 = pl[static_cast<std::size_t>(l[i])];
+        const P3 d = sub3(base_point(b, v0), base_point(b, v1));
+        const double dz = (v0.z - v1.z) * scale;
+        if (dot3(d, d) + dz * dz > max_edge2) ok = false;
+      }
+      if (!ok) break;
+    }
+    if (!ok || pt.size() < 3 * loop_vertices) continue;
+    // The loops follow their border edges' direction (a -> b); the caps use b -> a.
+    for (const auto& l : loops)
+      for (std::size_t i = 1; i + 1 < l.size(); ++i) pt.push_back({l[0], l[i + 1], l[i]});
+    // A cap's diagonal may coincide with an edge of the piece (a directed
+    // edge used twice: not manifold): such a piece is dropped; a vertex
+    // where caps meet gets a copy per fan.
+    std::set<std::pair<int, int>> directed;
+    bool manifold = true;
+    for (const Tri& t : pt)
+      for (int k = 0; k < 3 && manifold; ++k)
+        if (!directed.emplace(t[k], t[(k + 1) % 3]).second) manifold = false;
+    if (!manifold) continue;
+    split_pinched_vertices(pt, pl);
+    pieces.emplace_back(std::move(pt), std::move(pl));
+  }
+}
+
 void check_options(const SurfaceQuiltOptions& o) {
   auto bad = [](const std::string& what, double v) {
     throw InvalidInputError("quilt_surface: " + what + " (" + std::to_string(v) + ")");
@@ -411,6 +502,11 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.align_sigma > 0) || !std::isfinite(o.align_sigma)) bad("align_sigma must be > 0", o.align_sigma);
   if (!(o.aligned_rotation_max_deg >= 0 && o.aligned_rotation_max_deg <= 90))
     bad("aligned_rotation_max_deg must be in [0, 90]", o.aligned_rotation_max_deg);
+  if (!(o.align_field_max_deg >= 0 && o.align_field_max_deg <= 45))
+    bad("align_field_max_deg must be in [0, 45]", o.align_field_max_deg);
+  if (!(o.field_smoothing >= 0) || !std::isfinite(o.field_smoothing)) bad("field_smoothing must be >= 0", o.field_smoothing);
+  if (!(o.field_min_projection > 0 && o.field_min_projection <= 1))
+    bad("field_min_projection must be in (0, 1]", o.field_min_projection);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -448,6 +544,22 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     if (l > 0) up = {up[0] / l, up[1] / l, up[2] / l};
   }
 
+  // The smooth guidance field (SurfaceQuiltOptions::smooth_field): a
+  // 4-symmetric direction per base face interpolated from the projected up.
+  std::vector<P3> field_dir;
+  if (opt.field == SurfaceQuiltOptions::Field::kUp && opt.smooth_field) {
+    Mesh fm = mesh;  // (interpolate_direction_field writes a property map)
+    DirectionFieldOptions fo;
+    fo.symmetry = 4;
+    fo.smoothing = opt.field_smoothing;
+    interpolate_direction_field(fm, constraints_from_constant_vector(fm, up, opt.field_min_projection), fo);
+    auto dm = fm.property_map<FaceIndex, Vector3>(fo.direction_map).first;
+    field_dir.resize(static_cast<std::size_t>(nf));
+    for (FaceIndex f : fm.faces()) {
+      const Vector3& v = dm[f];
+      field_dir[f.idx()] = {v.x(), v.y(), v.z()};
+    }
+  }
   TriangleDistance tree(swatch.mesh);
   std::mt19937_64 rng(opt.seed);
   std::vector<Element> elements;
@@ -506,6 +618,10 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     const auto& st = b.faces[seed];
     const V2 q0 = flat.uv[flat.local[st[0]]], q1 = flat.uv[flat.local[st[1]]], q2 = flat.uv[flat.local[st[2]]];
     double rot_c = 1, rot_s = 0;
+    // The guidance direction at the seed (the smooth field's, or the projected
+    // up where it is long enough; zero: none) and the projected up (zero where
+    // shorter than 0.2), for the drift diagnostics.
+    P3 guide_at_seed{0, 0, 0}, up_at_seed{0, 0, 0};
     {
       // The tangent direction the swatch's +y should follow at the seed
       // (section 3.1: the guidance field aligns the grid). With Field::kUp it
@@ -523,10 +639,35 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       if (opt.field == SurfaceQuiltOptions::Field::kUp) {
         const double un = dot3(up, n);
         d = {up[0] - un * n[0], up[1] - un * n[1], up[2] - un * n[2]};
+        if (norm3(d) >= 0.2) up_at_seed = d;
       }
       const double dl = norm3(d);
-      const bool use_up = opt.field == SurfaceQuiltOptions::Field::kUp && dl >= opt.transport_below;
-      if (use_up && dl <= 0.2) d = {0, 0, 0};  // (transport_below < 0.2) too short to orient by
+      const bool smooth = !field_dir.empty();
+      if (smooth) {
+        // The smooth field's cross at the seed; of its four directions the
+        // one nearest the projected up (the swatch need not be 4-symmetric),
+        // else the one nearest the earlier placements' directions.
+        const P3& f0 = field_dir[static_cast<std::size_t>(seed)];
+        const P3 f1 = cross3(n, f0);
+        P3 ref = d;
+        if (!(dl >= 0.2)) {
+          ref = {0, 0, 0};
+          for (int f : flat.faces) {
+            const P3& g = face_dir[static_cast<std::size_t>(f)];
+            for (int k = 0; k < 3; ++k) ref[k] += b.area[f] * g[k];
+          }
+        }
+        const std::array<P3, 4> cand{f0, f1, P3{-f0[0], -f0[1], -f0[2]}, P3{-f1[0], -f1[1], -f1[2]}};
+        int best_c = 0;
+        for (int k = 1; k < 4; ++k)
+          if (dot3(cand[k], ref) > dot3(cand[best_c], ref)) best_c = k;
+        d = cand[static_cast<std::size_t>(best_c)];
+        guide_at_seed = d;
+      } else if (dl >= 0.2) {
+        guide_at_seed = d;
+      }
+      const bool use_up = opt.field == SurfaceQuiltOptions::Field::kUp && (smooth || dl >= opt.transport_below);
+      if (use_up && !smooth && dl <= 0.2) d = {0, 0, 0};  // (transport_below < 0.2) too short to orient by
       if (!use_up) {
         P3 t{0, 0, 0};
         for (int f : flat.faces) {
@@ -616,7 +757,14 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       // Only with enough overlap near the seed, and old directions that agree
       // among themselves (resultant length of the quarter-turn mean).
       if (wall > 0 && wsum >= opt.align_min_overlap * wall && std::hypot(sc, ss) >= 0.3 * wsum) {
-        const double turn0 = std::atan2(ss, sc) / 4;
+        double turn0 = std::atan2(ss, sc) / 4;
+        // Bounded relative to the guidance field (SurfaceQuiltOptions::align_field_max_deg):
+        // the frame before this turn follows the field at the seed.
+        if (norm3(guide_at_seed) > 0 && opt.field == SurfaceQuiltOptions::Field::kUp) {
+          const double lim = opt.align_field_max_deg * kPi / 180.0;
+          if (std::abs(turn0) > lim) ++res.patches_align_bounded;
+          turn0 = std::clamp(turn0, -lim, lim);
+        }
         const double ca = std::cos(turn0), sa = std::sin(turn0);
         for (auto& p : flat.uv) p = {ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]};
         ++res.patches_aligned;
@@ -878,6 +1026,31 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
       keep_loc.swap(turned_loc);
     }
     res.turn_deg_sum += std::abs(turn) * 180.0 / kPi;
+    {
+      // Drift (a diagnostic): the angle between this placement's +y at the
+      // seed and the guidance direction there, folded by a quarter turn.
+      const auto& tk = ftris[static_cast<std::size_t>(patch_slot[seed])];
+      const double m11 = tk[1][0] - tk[0][0], m12 = tk[2][0] - tk[0][0], m21 = tk[1][1] - tk[0][1], m22 = tk[2][1] - tk[0][1];
+      const double det = m11 * m22 - m12 * m21;
+      if (det != 0) {
+        const double a1 = -m12 / det, a2 = m11 / det;  // M^-1 (0, 1)
+        const P3 e1 = sub3(b.pts[st[1]], b.pts[st[0]]), e2 = sub3(b.pts[st[2]], b.pts[st[0]]);
+        const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
+        auto folded = [&](const P3& g) {
+          const double cosang = std::clamp(dot3(v, g) / (norm3(v) * norm3(g)), -1.0, 1.0);
+          const double a = std::fmod(std::acos(cosang) * 180.0 / kPi, 90.0);
+          return std::min(a, 90.0 - a);
+        };
+        if (norm3(v) > 0 && norm3(guide_at_seed) > 0) {
+          res.drift_deg_sum += folded(guide_at_seed);
+          ++res.drift_count;
+        }
+        if (norm3(v) > 0 && norm3(up_at_seed) > 0) {
+          res.drift_up_deg_sum += folded(up_at_seed);
+          ++res.drift_up_count;
+        }
+      }
+    }
     res.seconds_turn += tr.seconds();
     const PatchLocator locator = turn != 0 ? PatchLocator(ftris, c) : locator0;
     std::vector<ElementMesh> before = frame;
@@ -1005,6 +1178,28 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
         std::array<double, 3> w;
         if (locator.locate({cxs * inv, cys * inv}, w) < 0) {
           ++res.dropped_new;
+          if (!opt.trim_new_to_patch) continue;
+          // Its part on the patch is kept, the cut closed
+          // (SurfaceQuiltOptions::trim_new_to_patch).
+          std::vector<SurfaceQuiltVertex> locs(frame[k].points.size());
+          std::vector<char> off(frame[k].points.size(), 0);
+          for (std::size_t v = 0; v < frame[k].points.size(); ++v) {
+            std::array<double, 3> wv;
+            off[v] = locator.locate({frame[k].points[v][0], frame[k].points[v][1]}, wv) < 0;
+            locs[v] = to_loc(frame[k].points[v]);
+          }
+          std::vector<char> drop(frame[k].tris.size(), 0);
+          for (std::size_t t = 0; t < frame[k].tris.size(); ++t)
+            for (int v : frame[k].tris[t]) drop[t] = drop[t] || off[static_cast<std::size_t>(v)];
+          std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>> pieces;
+          trim_element(b, frame[k].tris, locs, drop, S, swatch.bbox_min[2], 2 * (swatch.bbox_max[2] - swatch.bbox_min[2]) * S, 0.0, pieces);
+          if (!pieces.empty()) ++res.new_trimmed;
+          for (auto& [tris, pl] : pieces) {
+            Element el;
+            el.mesh.tris = std::move(tris);
+            el.loc = std::move(pl);
+            elements.push_back(std::move(el));
+          }
           continue;
         }
         Element el;
@@ -1081,52 +1276,13 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
   out.scale = S;
   out.z_min = swatch.bbox_min[2];
   out.z_max = swatch.bbox_max[2];
-  for (const Element& el : elements) {
-    if (!el.alive || el.mesh.tris.empty()) continue;
-    // Elements reaching past a border of the base mesh are removed (issue #8;
-    // the paper removes "visually-displeasing elements" in a postprocessing
-    // step, section 4, and does not discuss borders): clamped onto the border
-    // they were flat ribbons (the open cylinder of the tests: 7511 of 7544
-    // intersecting face pairs within elements), extrapolated past it they
-    // leave the shell (the concave valley test).
-    // An element with at most opt.max_past_border of its vertices past a
-    // border keeps them, clamped onto the border face (a short flattened tip).
-    std::vector<SurfaceQuiltVertex> settled(el.loc.begin(), el.loc.end());
-    std::size_t past = 0;
-    for (SurfaceQuiltVertex& v : settled)
-      if (!settle_location(b, v)) {
-        ++past;
-        std::array<double, 3> w{std::max(0.0, 1 - v.b1 - v.b2), std::max(0.0, v.b1), std::max(0.0, v.b2)};
-        const double sum = w[0] + w[1] + w[2];
-        if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
-      }
-    if (static_cast<double>(past) > opt.max_past_border * static_cast<double>(settled.size())) {
-      ++res.elements_past_border;
-      continue;
-    }
-    if (opt.max_edge_stretch > 0) {
-      // Stretched elements (SurfaceQuiltOptions::max_edge_stretch): an edge
-      // whose feet on the base mesh lie far apart.
-      bool stretched = false;
-      for (const Tri& t : el.mesh.tris) {
-        for (int k = 0; k < 3 && !stretched; ++k) {
-          const SurfaceQuiltVertex &v0 = settled[static_cast<std::size_t>(t[k])], &v1 = settled[static_cast<std::size_t>(t[(k + 1) % 3])];
-          const P3 d = sub3(base_point(b, v0), base_point(b, v1));
-          const double dz = (v0.z - v1.z) * S;
-          if (dot3(d, d) + dz * dz > max_edge2) stretched = true;
-        }
-        if (stretched) break;
-      }
-      if (stretched) {
-        ++res.elements_stretched;
-        continue;
-      }
-    }
+  const double swatch_h = swatch.bbox_max[2] - swatch.bbox_min[2];
+  // Output of one element (or one trimmed piece of it): fitted into the z range, appended.
+  auto emit = [&](const std::vector<Tri>& tris, std::vector<SurfaceQuiltVertex>& settled) {
     {
       // Heights past the output's z range (SurfaceQuiltOptions::max_z_growth):
       // the element is shifted in z into it, or squeezed if taller than it.
-      const double h = swatch.bbox_max[2] - swatch.bbox_min[2];
-      const double lim_lo = swatch.bbox_min[2] - opt.max_z_growth * h, lim_hi = swatch.bbox_max[2] + opt.max_z_growth * h;
+      const double lim_lo = swatch.bbox_min[2] - opt.max_z_growth * swatch_h, lim_hi = swatch.bbox_max[2] + opt.max_z_growth * swatch_h;
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       for (const SurfaceQuiltVertex& v : settled) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
       if (lo < lim_lo || hi > lim_hi) {
@@ -1142,11 +1298,86 @@ SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, Surface
     }
     const int base_index = static_cast<int>(out.vertices.size());
     for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
-    for (const Tri& t : el.mesh.tris) {
+    for (const Tri& t : tris) {
       out.tris.push_back({t[0] + base_index, t[1] + base_index, t[2] + base_index});
       out.tri_element.push_back(out.elements);
     }
     ++out.elements;
+  };
+  // Largest diameter of a cut loop closed by trim_at_border (mesh units): two
+  // swatch heights (an element is at most as thick as the swatch is high; a
+  // longer loop runs along an element, not across it).
+  const double cap_max = 2 * swatch_h * S;
+  for (const Element& el : elements) {
+    if (!el.alive || el.mesh.tris.empty()) continue;
+    // Elements reaching past a border of the base mesh (issue #8; the paper
+    // removes "visually-displeasing elements" in a postprocessing step,
+    // section 4, and does not discuss borders): clamped onto the border they
+    // were flat ribbons (the open cylinder of the tests: 7511 of 7544
+    // intersecting face pairs within elements), extrapolated past it they
+    // leave the shell (the concave valley test). An element with at most
+    // opt.max_past_border of its vertices past a border keeps them, clamped
+    // onto the border face (a short flattened tip); the others are trimmed at
+    // the border (SurfaceQuiltOptions::trim_at_border) or removed.
+    std::vector<SurfaceQuiltVertex> settled(el.loc.begin(), el.loc.end());
+    std::vector<char> past_v(settled.size(), 0);
+    std::size_t past = 0;
+    for (std::size_t i = 0; i < settled.size(); ++i) {
+      SurfaceQuiltVertex& v = settled[i];
+      if (!settle_location(b, v)) {
+        ++past;
+        past_v[i] = 1;
+        std::array<double, 3> w{std::max(0.0, 1 - v.b1 - v.b2), std::max(0.0, v.b1), std::max(0.0, v.b2)};
+        const double sum = w[0] + w[1] + w[2];
+        if (sum > 0) v.b1 = w[1] / sum, v.b2 = w[2] / sum;
+      }
+    }
+    const bool too_far = static_cast<double>(past) > opt.max_past_border * static_cast<double>(settled.size());
+    if (too_far && !opt.trim_at_border) {
+      ++res.elements_past_border;
+      continue;
+    }
+    // Stretched triangles (SurfaceQuiltOptions::max_edge_stretch): an edge
+    // whose feet on the base mesh lie far apart.
+    std::vector<char> drop(el.mesh.tris.size(), 0);
+    bool any_stretched = false, any_past = false;
+    for (std::size_t t = 0; t < el.mesh.tris.size(); ++t) {
+      const Tri& tr = el.mesh.tris[t];
+      if (too_far && (past_v[static_cast<std::size_t>(tr[0])] || past_v[static_cast<std::size_t>(tr[1])] || past_v[static_cast<std::size_t>(tr[2])]))
+        drop[t] = 1, any_past = true;
+      if (opt.max_edge_stretch > 0 && !drop[t])  // (not the triangles trimmed off anyway)
+        for (int k = 0; k < 3; ++k) {
+          const SurfaceQuiltVertex &v0 = settled[static_cast<std::size_t>(tr[k])], &v1 = settled[static_cast<std::size_t>(tr[(k + 1) % 3])];
+          const P3 d = sub3(base_point(b, v0), base_point(b, v1));
+          const double dz = (v0.z - v1.z) * S;
+          if (dot3(d, d) + dz * dz > max_edge2) {
+            drop[t] = 1, any_stretched = true;
+            break;
+          }
+        }
+    }
+    if (!any_past && !any_stretched) {
+      emit(el.mesh.tris, settled);
+      continue;
+    }
+    if (any_stretched) {
+      ++res.elements_stretched;
+      continue;
+    }
+    // Trimmed at the border (issue #8, session 6): removing such elements
+    // whole bared the open cylinder's ends along every oblique thread.
+    // (Trimming the stretched ones likewise, their triangles with a stretched
+    // edge removed, was tried on the 5K-face bunny: 48 trimmed instead of
+    // removed, no less bare on the ears, intersecting pairs between elements
+    // 83,070 -> 94,194: not kept.)
+    std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>> pieces;
+    trim_element(b, el.mesh.tris, settled, drop, S, swatch.bbox_min[2], cap_max, opt.max_edge_stretch > 0 ? max_edge2 : 0.0, pieces);
+    if (pieces.empty()) {
+      ++res.elements_past_border;
+      continue;
+    }
+    ++res.elements_trimmed;
+    for (auto& [tris, locs] : pieces) emit(tris, locs);
   }
   {
     // The z range (SurfaceQuiltOptions::max_z_growth): widened to the

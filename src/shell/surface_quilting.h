@@ -27,6 +27,12 @@
 //    discrete parallel transport from the neighbouring texture, our choice
 //    for the field's singularities); with no earlier placement there, the
 //    up projection if longer than 0.2, else the LSCM orientation.
+//    With SurfaceQuiltOptions::smooth_field the guidance is instead a smooth
+//    4-symmetric direction field over the whole base mesh, interpolated once
+//    from the projected up (geometry/direction_field.h; Ray et al. 2009,
+//    section 2.2): it has no poles where the projection vanishes, so no
+//    transport is needed; of its cross at the seed the direction nearest the
+//    projected up (else nearest the earlier placements') is taken.
 //    Then, where earlier placements cover enough of the patch around the
 //    seed, the frame is turned so that their +y directions, each mapped
 //    through this patch's own flattening face by face, agree with +y modulo
@@ -35,7 +41,10 @@
 //    5, our choice): the field then orients only patches with no texture
 //    around them, and the threads of neighbouring patches run along each
 //    other instead of meeting at the angle by which the field and the
-//    flattenings turn between two seeds.
+//    flattenings turn between two seeds. That turn is bounded by
+//    align_field_max_deg (issue #8, session 6): unbounded, the first
+//    patch's orientation was carried over the surface and the texture
+//    drifted from the field (SurfaceQuiltResult::drift_deg_sum).
 // 5. Frame: patch uv divided by the swatch scale (mesh units per swatch unit),
 //    times the flattening's own scale around the seed (seed_scale), seed
 //    centroid at the origin (a cell centre); a grid of cells (as in
@@ -68,8 +77,9 @@
 //    processed.
 // At the end every location is moved onto the base face that contains it
 // (walking across edges); elements with more than max_past_border of their
-// vertices past a border of the base mesh are removed (issue #8: our choice,
-// the paper does not treat borders; see SurfaceQuiltResult::elements_past_border);
+// vertices past a border of the base mesh are trimmed at the border, their
+// cuts closed (trim_at_border), or removed (issue #8: our choice, the paper
+// does not treat borders; see SurfaceQuiltResult::elements_past_border);
 // elements with a stretched edge are removed (max_edge_stretch), and elements
 // reaching above or below the output's z range are shifted into it
 // (max_z_growth), so that every vertex has w in [0, 1] in the shell (issue #8).
@@ -116,6 +126,29 @@ struct SurfaceQuiltOptions {
   /// Default 0: on the open cylinder of the tests, 0.1 kept 2 more elements
   /// and 303 more intersecting face pairs within elements (their tips).
   double max_past_border = 0;
+  /// The elements past a border by more than max_past_border (issue #8,
+  /// session 6): true = trimmed at the border (their triangles with a vertex
+  /// past it removed, each remaining connected piece whose cut loops are
+  /// small, at most two swatch heights across, closed by a fan over each
+  /// loop and kept; see SurfaceQuiltResult::elements_trimmed); false =
+  /// removed whole (the state before). Default true: on the 20 x 8 helix
+  /// cylinder of the tests, removal threw away 2/3 of the quilt's faces
+  /// (stitched threads are long, and every oblique one crosses an open end)
+  /// and left 8.75% of the base bare, all of it along the ends.
+  bool trim_at_border = true;
+  /// New elements whose vertex centroid falls off the patch (step 6; issue
+  /// #8, session 6): true = their part on the patch is kept (triangles with
+  /// a vertex off the patch removed, the pieces closed as trim_at_border
+  /// does; SurfaceQuiltResult::new_trimmed); false = dropped whole (the
+  /// state before). The patch faces under the footprint are marked processed
+  /// either way, so a dropped thread is never placed again there.
+  /// Default false: on the 5K-face bunny (bench_quilt "trim_new", one run,
+  /// load 5-6) it covered the bare stripe on the ear (bare area of the top
+  /// height band 3.7% -> 0.55%, overall 1.0% -> 0.5%; 100 of 402 dropped
+  /// elements kept trimmed), but the intersecting pairs
+  /// between / within elements rose 83,070 -> 96,360 / 17,685 -> 21,887
+  /// and 27 vertices left the shell.
+  bool trim_new_to_patch = false;
   /// Rotation of each placement (issue #8; our choice, the paper's section 2.4
   /// searches translations only and section 3.1 takes the patch's frame from
   /// the guidance field): besides the field's direction (step 4) the frame is
@@ -142,6 +175,43 @@ struct SurfaceQuiltOptions {
   /// orients patches without earlier texture around them; the turn search
   /// (rotation_max_deg) runs around the aligned frame. Default true.
   bool align_to_overlap = true;
+  /// The alignment's turn is bounded relative to the guidance field (issue
+  /// #8, session 6): |turn| <= align_field_max_deg (degrees, in [0, 45]; 45
+  /// = unbounded, the state before; 0 = the field alone). The frame before
+  /// the turn follows the field at the seed, so this bounds each aligned
+  /// placement's drift from the field (SurfaceQuiltResult::drift_deg_sum).
+  /// Default 45: on the 5K-face bunny (bench_quilt, one run each, load
+  /// 4-6) every bound traded the overlap jump for the drift: unbounded,
+  /// drift 16.7 deg, jump 7.5 deg, 83,070 intersecting pairs between
+  /// elements; 10 deg: drift 9.2, jump 10.0, 88.5K; with the smooth field,
+  /// 10 deg: drift 6.6-6.9, jump 10.0-10.8, 88-93K; 20 deg: drift 12.1,
+  /// jump 9.1, 97.6K; 25 deg: drift 12.8, jump 8.4, 89.6K. The bunny's curvature turns the field against the
+  /// neighbours' threads by more than a rigid frame can follow (mean
+  /// alignment turn 16.6 deg). On the helix cylinder, where a smooth field
+  /// can be nearly parallel, the smooth field with a bound of 10 gives
+  /// drift 1.5 and jump 0 (see the tests).
+  double align_field_max_deg = 45;
+  /// Field::kUp: the guidance field is a smooth 4-symmetric direction field
+  /// over the base mesh (geometry/direction_field.h), interpolated from up
+  /// projected on the faces where |projection| >= field_min_projection
+  /// (constraints_from_constant_vector; in (0, 1]) and smoothed
+  /// (DirectionFieldOptions::smoothing = field_smoothing, >= 0): it varies
+  /// smoothly and has no poles where the projected up vanishes (the
+  /// interpolation fills them; singularities emerge where the geometry
+  /// needs them). false = the projected up at each seed, transported from
+  /// the earlier placements where it is shorter than transport_below (the
+  /// state before; transport_below is not used with the smooth field).
+  /// Default false (the bunny figures at align_field_max_deg: no better
+  /// there; unbounded with it: drift 17.9, jump 8.4, 93.7K pairs between
+  /// elements vs 16.7, 7.5, 83.1K without, one run each).
+  /// field_min_projection default 0.95, field_smoothing 1000: only where up
+  /// lies nearly in the surface is the field prescribed, elsewhere it is the
+  /// smoothest interpolation, and so turns little between seeds (on the
+  /// helix cylinder at bound 10: drift 1.5, jump 0; with 0.3 and 1, every
+  /// face's projected up kept: drift 6.3, jump 14.7).
+  bool smooth_field = false;
+  double field_min_projection = 0.95;
+  double field_smoothing = 1000.0;
   /// In [0, 1]; see align_to_overlap. Default 0.1.
   double align_min_overlap = 0.1;
   /// Sigma of align_to_overlap's distance weight, in (scaled) swatch
@@ -255,10 +325,21 @@ struct SurfaceQuiltResult {
   /// degrees; align_residual_sum / align_residual_weight is the mean, what
   /// the surface's curvature between two flattenings leaves to a rigid frame.
   double align_residual_sum = 0, align_residual_weight = 0;
+  /// Aligned patches whose turn was clamped to align_field_max_deg.
+  int patches_align_bounded = 0;
+  /// Drift from the guidance field (a diagnostic): per placement, the angle
+  /// between its +y at the seed and the guidance direction there (the
+  /// smooth field's, or the projected up where at least 0.2 long), folded by
+  /// a quarter turn into [0, 45] degrees; drift_deg_sum / drift_count is the
+  /// mean. drift_up_*: the same against the projected up (where at least 0.2
+  /// long) in either mode, to compare the two.
+  double drift_deg_sum = 0, drift_up_deg_sum = 0;
+  int drift_count = 0, drift_up_count = 0;
   double max_patch_distortion = 0;  ///< largest accepted per-triangle area distortion
   /// Range of the frame scale factor around the seeds (SurfaceQuiltOptions::seed_scale; 1 when off).
   double seed_scale_min = 1, seed_scale_max = 1;
   std::size_t dropped_new = 0; ///< new elements dropped (centroid off the patch)
+  std::size_t new_trimmed = 0; ///< of those, kept trimmed to the patch (SurfaceQuiltOptions::trim_new_to_patch)
   /// Times an output element touching a patch had a vertex that cannot be
   /// expressed in the patch frame: off the patch, farther than 2R from (or at
   /// more than 60 degrees to) the nearest patch face.
@@ -271,6 +352,8 @@ struct SurfaceQuiltResult {
   /// Elements removed at the end because too much of them lies past a
   /// border of the base mesh (SurfaceQuiltOptions::max_past_border).
   std::size_t elements_past_border = 0;
+  /// Elements trimmed at a border instead (SurfaceQuiltOptions::trim_at_border).
+  std::size_t elements_trimmed = 0;
   /// Elements removed at the end for a stretched edge (SurfaceQuiltOptions::max_edge_stretch).
   std::size_t elements_stretched = 0;
   /// Elements shifted or squeezed in z into the output's z range and their
