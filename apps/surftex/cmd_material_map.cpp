@@ -241,7 +241,7 @@ int run(const Args& a) {
     std::vector<std::string> ins;
     for (const auto& i : inputs)
       if (!i.empty()) ins.push_back(i);
-    check_output(a.out + "/" + f, ins, a.common.force);
+    check_output(a.out + "/" + f, ins, a.common.force, false);
   }
 
   Timer t;

@@ -170,7 +170,7 @@ int run(const PatchArgs& a) {
   po.resynthesize = parse_ids(a.resynth);
   for (const char* name : {"atlas.png", "mesh.obj", "mesh.mtl", "mesh.png", "mesh.glb", "render.png",
                            "report.json"})
-    check_output((fs::path(a.outdir) / name).string(), inputs, a.common.force);
+    check_output((fs::path(a.outdir) / name).string(), inputs, a.common.force, false);
   auto limit = apply_thread_limit(a.common.threads);
   Mesh mesh;
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common);

@@ -170,7 +170,7 @@ int run_subdiv(const SubdivArgs& a) {
   require_input_file(a.exemplar, "exemplar");
   const Outputs out = output_paths(a.outdir);
   for (const std::string& p : {out.ply, out.glb, out.obj, out.render})
-    check_output(p, {a.mesh, a.exemplar}, a.common.force);
+    check_output(p, {a.mesh, a.exemplar}, a.common.force, false);
   auto limit = apply_thread_limit(a.common.threads);
   Timer total, t;
   Mesh mesh;

@@ -110,12 +110,13 @@ void check_output_folder(const std::string& output) {
 }
 }  // namespace
 
-void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force) {
+void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force,
+                  bool folder_must_exist) {
   for (const auto& in : inputs)
     if (!in.empty() && same_file(output, in))
       throw InvalidInputError("output '" + output + "' is the input file '" + in +
                               "'; refusing to overwrite an input");
-  check_output_folder(output);
+  if (folder_must_exist) check_output_folder(output);
   std::error_code ec;
   if (!force && std::filesystem::exists(output, ec) && !std::filesystem::is_directory(output, ec))
     throw IOError("output '" + output + "' already exists (pass --force to replace it)");

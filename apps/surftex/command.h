@@ -52,10 +52,12 @@ void write_report(const CommonOptions& opt, const std::string& command, nlohmann
 void require_input_file(const std::string& input, const std::string& what);
 
 /// Throws if `output` names the same file as any of `inputs` (never overwrite
-/// what the user gave), exists while !force, or its folder does not exist
-/// (checked before any work, so that no output is written when a later one
-/// cannot be).
-void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force);
+/// what the user gave), exists while !force, or (folder_must_exist) its folder
+/// does not exist: checked before any work, so that no output is written when
+/// a later one cannot be. Subcommands writing into an output folder they
+/// create pass folder_must_exist = false.
+void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force,
+                  bool folder_must_exist = true);
 
 /// Checks every subcommand's parsed arguments before it runs (main.cpp):
 /// a floating-point option given a NaN or an infinity is refused naming the
