@@ -388,7 +388,7 @@ SubcommandRegistrar reg_quilt{
        app.add_option("swatch", a->swatch,
                       "Swatch: a mesh file (elements = connected components, z = thin axis) or chainmail, "
                       "weave or scatter to generate one (seeded by --seed)");
-       app.add_option("--plane", a->plane, "Quilt over a plane of W x H swatch sizes, e.g. 4x4, instead of a mesh");
+       app.add_option("--plane", a->plane, "Quilt over a plane of W x H swatch sizes, e.g. 4x4, instead of a mesh (runs that would build more than 5e7 faces, here or on a mesh, are refused)");
        app.add_option("-o,--output", a->output,
                       "Output mesh; format by extension: .obj, .ply (binary), .off, .glb; element colours as vertex "
                       "colours. On a base mesh the .ply and .glb siblings (same stem) are written too")
@@ -413,7 +413,7 @@ SubcommandRegistrar reg_quilt{
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));
        app.add_flag("--no-check", a->no_check, "Skip the exact self-intersection count of the embedded result");
-       app.add_option("--cell", a->cell, "Grid cell size in swatch units; 0 = swatch extent / 10 (default 0)")
+       app.add_option("--cell", a->cell, "Grid cell size in swatch units; 0 = swatch extent / 10; at most 200 cells across the swatch (default 0)")
            ->check(number_above(0, false));
        app.add_option("--subpatch", a->subpatch, "Output sub-patch half-size in cells; 0 = automatic (0..100, default 0)")
            ->check(CLI::Range(0, 100));
