@@ -15,6 +15,20 @@
 // every lateral quad is cut from the bottom of its smaller-index vertex to the
 // top of its larger one.
 //
+// Why prisms, not TetGen, for the shell map (a decision, issue #8 item 4):
+// section 3.2 meshes the shell with tetrahedra and maps by barycentric
+// coordinates (the shell map of Porumbescu et al. 2005, whose tets come from
+// splitting each prism). The map needs every tet corner to be a shell vertex
+// with known texture coordinates, and every tet positive in BOTH spaces.
+// The prism split guarantees both by construction. A TetGen mesh of a chart's
+// closed shell boundary (tetgen_adapter.h with shell_boundary_surface(); the
+// test TetGenAdapter.ShellGivenByItsBoundaryIsTetrahedralizedToTheSameVolume
+// checks it fills the same volume with positive tets) may add interior
+// Steiner points (no texture coordinates) and connects corners of distant
+// prisms, whose image in texture space can be inverted where the shell
+// curves; so the embedding uses the prism tets and TetGen serves shells
+// given only by their boundary.
+//
 // Texture space: a shell vertex of base vertex v in chart c has texture
 // coordinates (u, v, w) with (u, v) the atlas coordinate of v in c
 // (kCornerUV) and w = 0 (bottom) or 1 (top). For distances and volumes the w
