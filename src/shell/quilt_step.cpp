@@ -325,6 +325,17 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
   std::vector<char> add_in(ni, 1);
   std::vector<std::pair<int, ElementMesh>> replacements;
   std::vector<ElementMesh> cut_inputs;  // refused inputs' closed kept parts (keep_cut_refused_inputs)
+  // An input element not merged: its closed kept parts are added (counted in
+  // `kept`) when asked for and there are any, else it is dropped.
+  auto keep_capped_or_drop = [&](MergeResult& r, std::size_t& kept) {
+    if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
+      ++kept;
+      stats.in_cut_components += r.capped_b.size();
+      for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
+    } else {
+      ++stats.in_dropped;
+    }
+  };
   double t_deform = 0, t_merge = 0;
   for (auto& [root, g] : groups) {
     auto& [outs, ins] = g;
@@ -403,13 +414,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && add_in[e]) {
           add_in[e] = 0;
-          if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
-            ++stats.coincident_cut_added;
-            stats.in_cut_components += r.capped_b.size();
-            for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
-          } else {
-            ++stats.in_dropped;
-          }
+          keep_capped_or_drop(r, stats.coincident_cut_added);
         }
       } else {
         ++stats.stitch_refused;
@@ -425,14 +430,7 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
         if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
         if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
           add_in[e] = 0;
-          if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
-            ++stats.in_cut_added;
-
-            stats.in_cut_components += r.capped_b.size();
-            for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
-          } else {
-            ++stats.in_dropped;
-          }
+          keep_capped_or_drop(r, stats.in_cut_added);
         }
       }
     }
