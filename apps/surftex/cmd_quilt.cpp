@@ -3,6 +3,8 @@
 // 2006, section 3: surface quilting, shell-map embedding) or a plane (section
 // 2); `surftex elements`: edit the elements of a result by id; the demo step
 // "quilt".
+#include <CGAL/Polygon_mesh_processing/bbox.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -16,6 +18,7 @@
 #include "geometry/image_io.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/mesh.h"
+#include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/timer.h"
@@ -244,15 +247,12 @@ int run_quilt(QuiltArgs& a) {
     if (!(o.relative_size <= 10)) throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
     {
       // Placements needed: the base area over the scaled swatch's xy area.
-      double area = 0, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-      for (FaceIndex f : base.faces()) {
-        std::vector<Point3> p;
-        for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) p.push_back(base.point(v));
-        for (std::size_t k = 1; k + 1 < p.size(); ++k) area += std::sqrt(CGAL::cross_product(p[k] - p[0], p[k + 1] - p[0]).squared_length()) / 2;
-      }
-      for (VertexIndex v : base.vertices())
-        for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], base.point(v)[d]), hi[d] = std::max(hi[d], base.point(v)[d]);
-      const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+      // (load_method_mesh triangulated the base mesh.)
+      double area = 0;
+      for (FaceIndex f : base.faces()) area += face_area(base, f);
+      const CGAL::Bbox_3 bb = CGAL::Polygon_mesh_processing::bbox(base);
+      const double diag = std::sqrt(CGAL::square(bb.xmax() - bb.xmin()) + CGAL::square(bb.ymax() - bb.ymin()) +
+                                    CGAL::square(bb.zmax() - bb.zmin()));
       const double side = o.relative_size * diag, big = std::max(s.length(), s.width());
       const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
       check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
