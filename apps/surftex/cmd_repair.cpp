@@ -31,7 +31,6 @@ struct RepairArgs {
 int run_repair(const RepairArgs& a) {
   require_input_file(a.input, "input mesh");
   check_output(a.output, {a.input}, a.common.force);
-  if (!a.common.report_path.empty()) check_output(a.common.report_path, {a.input, a.output}, true);
   auto limit = apply_thread_limit(a.common.threads);
 
   Timer t;

@@ -22,15 +22,23 @@ std::vector<Subcommand>& registry() {
   return r;
 }
 
+namespace {
+// `in` read whole as a floating-point number (strtod: also "nan", "inf").
+bool parse_whole_number(const std::string& in, double& v) {
+  char* end = nullptr;
+  v = std::strtod(in.c_str(), &end);
+  return end != in.c_str() && *end == '\0';
+}
+}  // namespace
+
 CLI::Validator number_above(double lo, bool strict) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%g", lo);
   const std::string bound = std::string(strict ? "> " : ">= ") + buf;
   return CLI::Validator(
       [lo, strict, bound](std::string& in) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(in.c_str(), &end);
-        if (end == in.c_str() || *end != '\0') return "must be a number " + bound + " (got '" + in + "')";
+        double v = 0;
+        if (!parse_whole_number(in, v)) return "must be a number " + bound + " (got '" + in + "')";
         if (!(strict ? v > lo : v >= lo)) return "must be " + bound + " (got " + in + ")";
         return "";
       },
@@ -134,9 +142,8 @@ void check_parsed_arguments(const CLI::App& sub) {
     // < and >, which NaN passes).
     if (o->get_type_name().rfind("FLOAT", 0) == 0)
       for (const std::string& r : o->results()) {
-        char* end = nullptr;
-        const double v = std::strtod(r.c_str(), &end);
-        if (end != r.c_str() && *end == '\0' && !std::isfinite(v))
+        double v = 0;
+        if (parse_whole_number(r, v) && !std::isfinite(v))
           throw InvalidInputError(name + ": '" + r + "' is not a finite number");
       }
   }
