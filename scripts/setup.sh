@@ -40,7 +40,7 @@ for a in "$@"; do
 done
 
 # One dpkg-query for all packages (one call each took ~5 s on a loaded machine).
-installed=" $(dpkg-query -W -f='${Package} ${Status}\n' "${PKGS[@]}" 2>/dev/null |
+installed=" $({ dpkg-query -W -f='${Package} ${Status}\n' "${PKGS[@]}" 2>/dev/null || true; } |
   awk '$2 == "install" && $3 == "ok" && $4 == "installed" { printf "%s ", $1 }')"
 missing=()
 for p in "${PKGS[@]}"; do
