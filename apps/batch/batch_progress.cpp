@@ -104,9 +104,12 @@ void BatchProgress::finished(const std::string& job, const JobStatus& st) {
 
 void BatchProgress::tick() {
   if (mode_ != ProgressMode::Terminal || total_ == 0) return;
-  std::fprintf(text_, "\r\033[Kbatch: %s", status_line().c_str());
+  const std::string line = status_line();
+  if (line_shown_ && line == last_line_) return;
+  std::fprintf(text_, "\r\033[Kbatch: %s", line.c_str());
   std::fflush(text_);
   line_shown_ = true;
+  last_line_ = line;
 }
 
 void BatchProgress::end(int ok, int failed, int other, const std::string& summary_path, const std::string& index_path) {

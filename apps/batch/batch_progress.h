@@ -50,6 +50,7 @@ class BatchProgress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   int total_ = 0, all_ = 0, running_ = 0, ok_ = 0, failed_ = 0;
   bool line_shown_ = false;
+  std::string last_line_;
 };
 
 }  // namespace surftex::batch

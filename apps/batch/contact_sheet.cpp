@@ -52,14 +52,15 @@ article h2{font-size:1.05em;margin:0 0 .3em 0;word-break:break-all}
 .failed .status,.interrupted .status{background:#c33}
 .not_run .status{background:#999}
 .time{font-size:.85em;color:#555;margin-left:.5em}
-.error{color:#a00;font-family:monospace;font-size:.85em;white-space:pre-wrap;word-break:break-word}
+.error{color:#a00;font-family:monospace;font-size:.85em;white-space:pre-wrap;overflow-wrap:anywhere}
 .images{display:flex;flex-wrap:wrap;gap:4px;margin:.5em 0}
-.images img{max-width:100%;max-height:260px;background:#eee;border:1px solid #ddd}
-.images a{flex:1 1 45%}
-.images a:only-child{flex-basis:100%}
+.images a{flex:0 0 calc(33.3% - 3px)}
+.images a:first-child{flex-basis:100%}
+.images img{display:block;width:100%;height:auto;max-height:280px;object-fit:contain;background:#eee;border:1px solid #ddd}
+.images a:not(:first-child) img{height:80px}
 table{border-collapse:collapse;font-size:.85em;margin:.3em 0}
 td{padding:.1em .6em .1em 0}td.v{text-align:right;font-variant-numeric:tabular-nums}
-code{font-size:.75em;color:#444;word-break:break-all}
+code{font-size:.75em;color:#444;overflow-wrap:anywhere}
 .links{font-size:.8em}.links a{margin-right:.6em}
 )";
 
@@ -162,9 +163,10 @@ ContactSheet batch_contact_sheet(const std::string& title, const std::vector<Job
     c.error = j.error;
     c.seconds = j.seconds;
     for (const auto& [k, v] : j.figures) c.figures.emplace_back(k, format_figure(v));
-    c.images = j.images;
+    // The render large, up to three more images small; the rest as links.
+    c.images.assign(j.images.begin(), j.images.begin() + std::min<std::size_t>(j.images.size(), 4));
     for (const std::string& o : j.outputs)
-      if (std::find(j.images.begin(), j.images.end(), o) == j.images.end()) c.links.push_back(o);
+      if (std::find(c.images.begin(), c.images.end(), o) == c.images.end()) c.links.push_back(o);
     if (j.status != "ok" && !j.log.empty()) c.links.push_back(j.log);
     sheet.cards.push_back(std::move(c));
   }

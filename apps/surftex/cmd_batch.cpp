@@ -156,7 +156,7 @@ int print_dry_run(const BatchManifest& m, const EventFollower& f, bool fresh) {
     }
   }
   const std::size_t n = fresh ? m.jobs.size() : f.would_run.size();
-  std::printf("dry run: %zu of %zu jobs would run, %zu up to date (nothing written)\n", n, m.jobs.size(),
+  std::printf("dry run: %zu of %zu jobs would run, %zu up to date (no job run, summary.json and index.html unchanged)\n", n, m.jobs.size(),
               m.jobs.size() - n);
   return 0;
 }

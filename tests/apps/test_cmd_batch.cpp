@@ -327,3 +327,27 @@ TEST(BatchCli, SigtermStopsTheBatchWithoutPartialOutputAndTheNextRunCompletesIt)
   EXPECT_EQ(read_json(out / "summary.json")["counts"]["ok"], 1);
   fs::remove_all(dir);
 }
+
+TEST(BatchCli, TheDemoEndsWithTheSameContactSheet) {
+  const fs::path dir = fs::path(temp_dir("batch-demo")) / "demo";
+  const auto r = run_surftex("demo -o " + q(dir.string()) + " --threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string html = read_all(dir / "index.html");
+  const nlohmann::json report = read_json(dir / "report.json");
+  ASSERT_TRUE(report.contains("steps"));
+  for (const auto& [name, step] : report["steps"].items())
+    EXPECT_NE(html.find("id=\"card-" + name + "\""), std::string::npos) << name;
+  // Every image the page shows exists, by a relative link; every image the demo wrote is shown.
+  const std::regex src("<img src=\"([^\"]+)\"");
+  int shown = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), src); it != std::sregex_iterator(); ++it, ++shown) {
+    const std::string s = (*it)[1];
+    EXPECT_NE(s[0], '/') << s;
+    EXPECT_TRUE(fs::exists(dir / s)) << s;
+  }
+  int pngs = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) pngs += e.path().extension() == ".png" ? 1 : 0;
+  EXPECT_EQ(shown, pngs);
+  EXPECT_GE(shown, 10);
+  fs::remove_all(dir.parent_path());
+}
