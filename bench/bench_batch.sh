@@ -25,7 +25,7 @@ tex="$data/textures/leather_64.png"
     # One broken input among the 50 jobs: the patches job of the last mesh.
     if [[ $n == 25 ]]; then pm="$data/broken/truncated.off"; fi
     echo "${name}_patches: patches '$pm' '$tex' --patch-res 32 --rotations 8 --window 7 --max-patch-faces 400"
-    echo "${name}_subdiv: subdiv '$m' '$tex' --levels 1 --atlas-size 256 --region 5"
+    echo "${name}_subdiv: subdiv '$m' '$tex' --levels 0 --passes 1 --region 5 --pyramid --atlas-size 256"
   done
 } > "$manifest"
 out="$work/out"

@@ -80,14 +80,16 @@ std::vector<std::string> job_input_files(const BatchJob& job, const std::string&
       if (eq == std::string::npos) continue;
       v = v.substr(eq + 1);
     }
-    // Only words that look like paths: option values such as "up" or "0.5"
-    // must not turn into inputs because a file of that name happens to exist.
-    if (v.empty() || v.find_first_of("/.") == std::string::npos) continue;
+    // Files only from words that look like paths: an option value such as
+    // "up" is not an input because a file of that name happens to exist (the
+    // job would only re-run more often). Folders by any name but ".", "..".
+    if (v.empty() || v == "." || v == ".." || v == "/") continue;
     std::error_code ec;
-    const fs::path p = fs::path(v).is_absolute() ? fs::path(v) : fs::path(manifest_dir) / v;
-    if (fs::is_regular_file(p, ec)) {
+    const fs::path p = (fs::path(v).is_absolute() ? fs::path(v) : fs::path(manifest_dir) / v).lexically_normal();
+    const bool looks_like_path = v.find_first_of("/.") != std::string::npos;
+    if (looks_like_path && fs::is_regular_file(p, ec)) {
       add(p);
-    } else if (fs::is_directory(p, ec)) {
+    } else if (fs::is_directory(p, ec) && !inside(out, p) && p != fs::path(manifest_dir).lexically_normal()) {
       std::vector<fs::path> inner;
       for (const auto& e : fs::directory_iterator(p, ec))
         if (e.is_regular_file(ec) && inner.size() < 4096) inner.push_back(e.path());
