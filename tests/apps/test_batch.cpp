@@ -37,6 +37,12 @@ void write(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
 
+int count_substr(const std::string& t, const std::string& what) {
+  int n = 0;
+  for (std::size_t p = t.find(what); p != std::string::npos; p = t.find(what, p + 1)) ++n;
+  return n;
+}
+
 // The message of the InvalidInputError `f` throws, or "" if it throws none.
 template <class F>
 std::string error_of(F f) {
@@ -368,6 +374,34 @@ TEST(BatchProgress, EtaClockAndOneLinePerJobInPipes) {
   std::vector<std::string> events;
   for (std::string line; std::getline(in, line);) events.push_back(nlohmann::json::parse(line).at("event"));
   EXPECT_EQ(events, (std::vector<std::string>{"plan", "start", "finish", "end"}));
+}
+
+TEST(BatchProgress, OnATerminalAStatusLineIsRedrawnUnderTheJobLines) {
+  std::FILE* text = std::tmpfile();
+  {
+    BatchProgress term(ProgressMode::Terminal, text, nullptr);
+    term.plan(3, 3);
+    term.started("a", "");
+    term.started("b", "");
+    JobStatus ok, bad;
+    ok.status = "ok", ok.seconds = 2;
+    bad.status = "failed", bad.error = "error: x";
+    term.finished("a", ok);
+    term.finished("b", bad);
+    term.tick();
+    term.end(1, 1, 1, "", "");
+  }
+  std::rewind(text);
+  std::string t;
+  for (int c; (c = std::fgetc(text)) != EOF;) t += static_cast<char>(c);
+  std::fclose(text);
+  EXPECT_NE(t.find("\r\033[Kbatch: 0/3 done, 2 running, 0 failed, 0:00 elapsed, ETA --"), std::string::npos) << t;
+  EXPECT_NE(t.find("\r\033[Kbatch: [1/3] ok     a 2.0 s\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("\r\033[Kbatch: [2/3] failed b 0.0 s: error: x\n"), std::string::npos) << t;
+  EXPECT_NE(t.find("\r\033[Kbatch: 2/3 done, 0 running, 1 failed, 0:00 elapsed, ETA 0:00"), std::string::npos) << t;
+  // Redrawn only when it changes: the last tick() repeated nothing.
+  EXPECT_EQ(count_substr(t, "2/3 done, 0 running, 1 failed"), 1) << t;
+  EXPECT_EQ(t.substr(t.size() - 4), "\r\033[K");  // cleared at the end
 }
 
 TEST(SnakemakeEngine, ParsesTheJobStatsTable) {

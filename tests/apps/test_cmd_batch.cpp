@@ -293,7 +293,7 @@ TEST(BatchCli, SigtermStopsTheBatchWithoutPartialOutputAndTheNextRunCompletesIt)
   const fs::path dir = temp_dir("batch-sigterm");
   // A synthesis that takes a few seconds.
   write(dir / "jobs.txt",
-        "slow: synth " + q(shared_data("textures/leather_64.png")) + " --size 96x96 --window 9\n");
+        "slow: synth " + q(shared_data("textures/leather_64.png")) + " --size 128x128 --window 9\n");
   const fs::path out = dir / "out";
   const pid_t pid = ::fork();
   if (pid == 0) {
