@@ -84,25 +84,74 @@ std::string four_jobs() {
          "broken: render " + q(shared_data("broken/truncated.off")) + " --size 64\n";
 }
 
-// One batch of four_jobs() run once for the tests that inspect its results.
-class BatchOfFour : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = new std::string(temp_dir("batch-four"));
-    write(fs::path(*dir_) / "jobs.txt", four_jobs());
-    run_ = new surftex::test::RunResult(run_surftex("batch " + q(*dir_ + "/jobs.txt") + " -o " + q(*dir_ + "/out") + " --jobs 2"));
+void check_isolation_and_summary(const surftex::test::RunResult& run, const fs::path& out) {
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  const nlohmann::json s = read_json(out / "summary.json");
+  EXPECT_EQ(s["counts"]["ok"], 3) << s.dump(2);
+  EXPECT_EQ(s["counts"]["failed"], 1);
+  const nlohmann::json* broken = job(s, "broken");
+  ASSERT_NE(broken, nullptr);
+  EXPECT_EQ((*broken)["status"], "failed");
+  EXPECT_EQ((*broken)["exit_code"], 2);
+  EXPECT_EQ((*broken)["error"].get<std::string>().rfind("error: ", 0), 0u) << broken->dump();
+  EXPECT_NE((*broken)["command"].get<std::string>().find("truncated.off"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out / "broken"));
+  EXPECT_TRUE(!fs::exists(out / ".surftex" / "stage") || fs::is_empty(out / ".surftex" / "stage"));
+  EXPECT_NE(read_all(out / ".surftex" / "logs" / "broken.log").find("error:"), std::string::npos);
+  for (const char* ok : {"spot", "beans", "eight"}) {
+    const nlohmann::json* j = job(s, ok);
+    ASSERT_NE(j, nullptr) << ok;
+    EXPECT_EQ((*j)["status"], "ok") << j->dump();
+    EXPECT_GT((*j)["seconds"].get<double>(), 0.0);
+    EXPECT_TRUE(fs::exists(out / ok / "report.json")) << ok;
+    EXPECT_FALSE((*j)["images"].empty()) << j->dump();
+    for (const auto& f : (*j)["outputs"]) EXPECT_TRUE(fs::exists(out / f.get<std::string>())) << f;
   }
-  static void TearDownTestSuite() {
-    fs::remove_all(*dir_);
-    delete dir_;
-    delete run_;
-  }
-  static fs::path out() { return fs::path(*dir_) / "out"; }
-  static std::string* dir_;
-  static surftex::test::RunResult* run_;
-};
-std::string* BatchOfFour::dir_ = nullptr;
-surftex::test::RunResult* BatchOfFour::run_ = nullptr;
+  EXPECT_TRUE(fs::exists(out / "eight" / "render.png"));
+  EXPECT_TRUE(fs::exists(out / "spot" / "render.png"));
+  EXPECT_TRUE(fs::exists(out / "beans" / "synth.png"));
+  EXPECT_FALSE(job(s, "eight")->at("figures").empty());  // seam ratio, patches, faces
+  EXPECT_TRUE(job(s, "eight")->at("figures").contains("seam ratio"));
+  // The Snakefile has one rule per job and declares the inputs it found.
+  const std::string sf = read_all(out / "Snakefile");
+  EXPECT_EQ(count_of(sf, "\nrule job_"), 4);
+  EXPECT_NE(sf.find(shared_data("meshes/spot.ply")), std::string::npos);
+}
+
+void check_pipe_progress(const surftex::test::RunResult& run) {
+  const std::regex line(R"(batch: \[(\d)/4\] (ok|failed) +(\w+) [0-9.]+ s.*\((\d) running, (\d) failed, [0-9:]+ elapsed, ETA [-0-9:]+\))");
+  int lines = 0;
+  std::istringstream in(run.err);
+  for (std::string l; std::getline(in, l);) lines += std::regex_match(l, line) ? 1 : 0;
+  EXPECT_EQ(lines, 4) << run.err;
+  EXPECT_NE(run.err.find("batch: 4 of 4 jobs to run (0 up to date)"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("batch: 3 ok, 1 failed of 4 jobs"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find('\r'), std::string::npos);
+}
+
+void check_contact_sheet(const fs::path& out) {
+  const std::string html = read_all(out / "index.html");
+  EXPECT_EQ(count_of(html, "<article class=\"card"), 4);
+  EXPECT_LT(html.find("id=\"card-broken\""), html.find("id=\"card-spot\""));  // failed first
+  EXPECT_EQ(html.find("src=\"/"), std::string::npos);
+  EXPECT_EQ(html.find(out.string()), std::string::npos);  // relative links only
+  const fs::path profile = temp_dir("chromium-profile");
+  const fs::path dom = profile / "dom.html";
+  const std::string cmd =
+      "chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking "
+      "--disable-component-update --disable-sync --user-data-dir=" + q(profile.string()) +
+      " --virtual-time-budget=10000 --dump-dom " + q("file://" + (out / "index.html").string()) + " > " +
+      q(dom.string()) + " 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << "chromium failed (scripts/setup.sh --tests installs it)";
+  const std::string d = read_all(dom);
+  EXPECT_EQ(count_of(d, "<article class=\"card"), 4) << d.substr(0, 2000);
+  const int images = count_of(d, "<img ");
+  EXPECT_GE(images, 3);
+  EXPECT_EQ(count_of(d, "data-loaded=\"1\""), images) << "an image did not load";
+  EXPECT_EQ(count_of(d, "data-loaded=\"0\""), 0);
+  EXPECT_NE(d.find("data-images-ok=\"" + std::to_string(images) + "\""), std::string::npos);
+  fs::remove_all(profile);
+}
 
 }  // namespace
 
@@ -153,73 +202,27 @@ TEST(BatchCli, EverySubcommandIsBatchableOrRefusedOnPurpose) {
   EXPECT_GE(n, 10);
 }
 
-TEST_F(BatchOfFour, TheBrokenJobFailsAloneWithItsErrorAndLeavesNoFolder) {
-  EXPECT_EQ(run_->exit_code, 1) << run_->err;
-  const nlohmann::json s = read_json(out() / "summary.json");
-  EXPECT_EQ(s["counts"]["ok"], 3) << s.dump(2);
-  EXPECT_EQ(s["counts"]["failed"], 1);
-  const nlohmann::json* broken = job(s, "broken");
-  ASSERT_NE(broken, nullptr);
-  EXPECT_EQ((*broken)["status"], "failed");
-  EXPECT_EQ((*broken)["exit_code"], 2);
-  EXPECT_EQ((*broken)["error"].get<std::string>().rfind("error: ", 0), 0u) << broken->dump();
-  EXPECT_NE((*broken)["command"].get<std::string>().find("truncated.off"), std::string::npos);
-  EXPECT_FALSE(fs::exists(out() / "broken"));
-  EXPECT_TRUE(!fs::exists(out() / ".surftex" / "stage") || fs::is_empty(out() / ".surftex" / "stage"));
-  EXPECT_NE(read_all(out() / ".surftex" / "logs" / "broken.log").find("error:"), std::string::npos);
-  for (const char* ok : {"spot", "beans", "eight"}) {
-    const nlohmann::json* j = job(s, ok);
-    ASSERT_NE(j, nullptr) << ok;
-    EXPECT_EQ((*j)["status"], "ok") << j->dump();
-    EXPECT_GT((*j)["seconds"].get<double>(), 0.0);
-    EXPECT_TRUE(fs::exists(out() / ok / "report.json")) << ok;
-    EXPECT_FALSE((*j)["images"].empty()) << j->dump();
-    for (const auto& f : (*j)["outputs"]) EXPECT_TRUE(fs::exists(out() / f.get<std::string>())) << f;
+// One batch of four tiny jobs, one broken, checked for isolation, summary,
+// pipe progress and the contact sheet in Chromium: one test, because ctest
+// runs each test in its own process and the batch is the costly part.
+TEST(BatchCli, FourJobsOneBrokenIsolatedSummarizedAndShownOnTheContactSheet) {
+  const fs::path dir = temp_dir("batch-four");
+  write(dir / "jobs.txt", four_jobs());
+  const auto run =
+      run_surftex("batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) + " --jobs 2");
+  {
+    SCOPED_TRACE("isolation and summary");
+    check_isolation_and_summary(run, dir / "out");
   }
-  EXPECT_TRUE(fs::exists(out() / "eight" / "render.png"));
-  EXPECT_TRUE(fs::exists(out() / "spot" / "render.png"));
-  EXPECT_TRUE(fs::exists(out() / "beans" / "synth.png"));
-  EXPECT_FALSE(job(s, "eight")->at("figures").empty());  // seam ratio, patches, faces
-  EXPECT_TRUE(job(s, "eight")->at("figures").contains("seam ratio"));
-  // The Snakefile has one rule per job and declares the inputs it found.
-  const std::string sf = read_all(out() / "Snakefile");
-  EXPECT_EQ(count_of(sf, "\nrule job_"), 4);
-  EXPECT_NE(sf.find(shared_data("meshes/spot.ply")), std::string::npos);
-}
-
-TEST_F(BatchOfFour, InAPipeEachJobGetsOneProgressLine) {
-  const std::regex line(R"(batch: \[(\d)/4\] (ok|failed) +(\w+) [0-9.]+ s.*\((\d) running, (\d) failed, [0-9:]+ elapsed, ETA [-0-9:]+\))");
-  int lines = 0;
-  std::istringstream in(run_->err);
-  for (std::string l; std::getline(in, l);) lines += std::regex_match(l, line) ? 1 : 0;
-  EXPECT_EQ(lines, 4) << run_->err;
-  EXPECT_NE(run_->err.find("batch: 4 of 4 jobs to run (0 up to date)"), std::string::npos) << run_->err;
-  EXPECT_NE(run_->err.find("batch: 3 ok, 1 failed of 4 jobs"), std::string::npos) << run_->err;
-  EXPECT_EQ(run_->err.find('\r'), std::string::npos);
-}
-
-TEST_F(BatchOfFour, TheContactSheetOpensInHeadlessChromiumWithEveryImage) {
-  const std::string html = read_all(out() / "index.html");
-  EXPECT_EQ(count_of(html, "<article class=\"card"), 4);
-  EXPECT_LT(html.find("id=\"card-broken\""), html.find("id=\"card-spot\""));  // failed first
-  EXPECT_EQ(html.find("src=\"/"), std::string::npos);
-  EXPECT_EQ(html.find(out().string()), std::string::npos);  // relative links only
-  const fs::path profile = temp_dir("chromium-profile");
-  const fs::path dom = profile / "dom.html";
-  const std::string cmd =
-      "chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking "
-      "--disable-component-update --disable-sync --user-data-dir=" + q(profile.string()) +
-      " --virtual-time-budget=10000 --dump-dom " + q("file://" + (out() / "index.html").string()) + " > " +
-      q(dom.string()) + " 2>/dev/null";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << "chromium failed (scripts/setup.sh --tests installs it)";
-  const std::string d = read_all(dom);
-  EXPECT_EQ(count_of(d, "<article class=\"card"), 4) << d.substr(0, 2000);
-  const int images = count_of(d, "<img ");
-  EXPECT_GE(images, 3);
-  EXPECT_EQ(count_of(d, "data-loaded=\"1\""), images) << "an image did not load";
-  EXPECT_EQ(count_of(d, "data-loaded=\"0\""), 0);
-  EXPECT_NE(d.find("data-images-ok=\"" + std::to_string(images) + "\""), std::string::npos);
-  fs::remove_all(profile);
+  {
+    SCOPED_TRACE("one progress line per job in a pipe");
+    check_pipe_progress(run);
+  }
+  {
+    SCOPED_TRACE("the contact sheet in headless Chromium");
+    check_contact_sheet(dir / "out");
+  }
+  fs::remove_all(dir);
 }
 
 TEST(BatchCli, ASecondRunRerunsOnlyMissingOrChangedJobs) {
