@@ -177,7 +177,7 @@ void install_handlers() {
 }  // namespace
 
 int run_batch_job(const JobRunOptions& o) {
-  if (o.command.empty()) throw InvalidInputError("batch-job: no subcommand given");
+  if (o.command.empty()) throw InvalidInputError("surftex-job: no subcommand given");
   install_handlers();
   const fs::path out(o.out_dir);
   const fs::path stage = out / job_stage_path(o.name);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// One batch job as Snakemake runs it (`surftex batch-job`, issue 20 item 2):
+// One batch job as Snakemake runs it (`surftex-job`, issue 20 item 2):
 // runs `surftex SUBCOMMAND ARGS -o STAGE --report STAGE/report.json` in its
 // own process with the manifest folder as working folder, output and errors
 // into the job's log; moves the staged folder to OUT/NAME only when the job
@@ -42,7 +42,7 @@ nlohmann::json to_json(const JobStatus& s);
 bool read_job_status(const std::string& path, JobStatus& s);
 
 /// Runs the job and writes its status file; returns the exit code for
-/// `surftex batch-job` (0 only when the job succeeded and its folder is in
+/// `surftex-job` (0 only when the job succeeded and its folder is in
 /// place). SIGTERM, SIGINT or SIGHUP stop the child, remove the stage and
 /// record "interrupted".
 int run_batch_job(const JobRunOptions& o);

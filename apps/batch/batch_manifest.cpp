@@ -30,7 +30,7 @@ bool batch_output_kind(const std::string& subcommand, OutputKind& kind) {
 }
 
 const std::vector<std::string>& batch_refused_subcommands() {
-  static const std::vector<std::string> refused{"info", "version", "batch", "batch-job"};
+  static const std::vector<std::string> refused{"info", "version", "batch"};
   return refused;
 }
 

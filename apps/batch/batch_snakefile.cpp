@@ -125,11 +125,12 @@ std::string python_string(const std::string& s) {
   return o + "\"";
 }
 
-std::string snakefile_text(const BatchManifest& m, const std::string& surftex_exe, const std::string& out_dir) {
+std::string snakefile_text(const BatchManifest& m, const std::string& surftex_exe, const std::string& job_exe,
+                           const std::string& out_dir) {
   const std::vector<std::string> rules = job_rule_names(m);
   std::string t;
   t += "# Written by `surftex batch " + m.path + "`: one rule per job of the manifest.\n";
-  t += "# Each job runs `surftex batch-job`, which writes the job into .surftex/stage/NAME\n";
+  t += "# Each job runs `surftex-job`, which writes the job into .surftex/stage/NAME\n";
   t += "# and renames it to NAME only when the job succeeded (no partial folder).\n";
   t += "# Run it again through `surftex batch`, or with Snakemake itself from this folder:\n";
   t += "#   snakemake -s Snakefile -d . --jobs 2 --keep-going --rerun-incomplete\n";
@@ -153,8 +154,8 @@ std::string snakefile_text(const BatchManifest& m, const std::string& surftex_ex
          "\n";
     t += "    params: command=" + python_string(job_command_line(j)) + "\n";
     t += "    threads: " + job_threads_expression(j) + "\n";
-    std::string cmd = shell_quote(surftex_exe) + " batch-job --name " + shell_quote(j.name) + " --workdir " +
-                      shell_quote(m.dir);
+    std::string cmd = shell_quote(job_exe) + " --surftex " + shell_quote(surftex_exe) + " --name " +
+                      shell_quote(j.name) + " --workdir " + shell_quote(m.dir);
     if (!j.output.folder) cmd += " --output-file " + shell_quote(j.output.file);
     std::string shell = snakemake_literal(cmd);
     if (!has_threads_option(j, nullptr)) shell += " --threads {threads}";

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
 // The Snakefile of a batch (issue 20, item 1): one rule per manifest job, its
-// output the folder OUT/NAME (written whole by `surftex batch-job`, which
+// output the folder OUT/NAME (written whole by `surftex-job`, which
 // stages it and renames it into place), its log OUT/.surftex/logs/NAME.log and
 // status OUT/.surftex/status/NAME.json. The Snakefile runs from OUT (snakemake
 // -d OUT) and holds absolute paths of the surftex binary, the manifest folder
@@ -35,8 +35,10 @@ std::vector<std::string> job_input_files(const BatchJob& job, const std::string&
 /// cores: "workflow.cores"), else 1 (batch jobs run side by side).
 std::string job_threads_expression(const BatchJob& job);
 
-/// The Snakefile text. `surftex_exe` and `out_dir` absolute.
-std::string snakefile_text(const BatchManifest& m, const std::string& surftex_exe, const std::string& out_dir);
+/// The Snakefile text; each rule runs `job_exe` (surftex-job) on `surftex_exe`.
+/// All paths absolute.
+std::string snakefile_text(const BatchManifest& m, const std::string& surftex_exe, const std::string& job_exe,
+                           const std::string& out_dir);
 
 /// `s` as a Python string literal (double quotes, UTF-8 kept).
 std::string python_string(const std::string& s);

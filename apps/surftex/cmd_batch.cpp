@@ -2,8 +2,8 @@
 // `surftex batch MANIFEST -o OUT`: many jobs on Snakemake (issue 20). Writes
 // OUT/Snakefile (one rule per manifest job), runs snakemake on it (local cores,
 // or a cluster through --engine-args), and writes OUT/summary.json and the
-// contact sheet OUT/index.html. `surftex batch-job` (hidden) is what each
-// rule runs: one job, staged, moved into OUT/NAME only when it succeeded.
+// contact sheet OUT/index.html. Each rule runs `surftex-job` (beside the
+// surftex binary): one job, staged, moved into OUT/NAME only when it succeeded.
 #include <CLI/CLI.hpp>
 #include <sys/file.h>
 #include <fcntl.h>
@@ -46,6 +46,14 @@ std::string self_exe() {
   std::error_code ec;
   fs::path p = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw IOError("cannot find the surftex binary (/proc/self/exe): " + ec.message());
+  return p.string();
+}
+
+// surftex-job, installed beside surftex.
+std::string job_runner(const std::string& surftex) {
+  const fs::path p = fs::path(surftex).parent_path() / "surftex-job";
+  if (::access(p.c_str(), X_OK) != 0)
+    throw IOError("'" + p.string() + "' is missing: `surftex batch` needs surftex-job beside surftex (build it)");
   return p.string();
 }
 
@@ -187,7 +195,8 @@ int run_batch(const BatchArgs& a) {
   const fs::path manifest_abs = fs::absolute(a.manifest).lexically_normal();
   if (manifest_abs.parent_path() == out || std::mismatch(out.begin(), out.end(), manifest_abs.begin()).first == out.end())
     throw InvalidInputError("the manifest '" + a.manifest + "' is inside the output folder '" + a.out + "'");
-  const std::string text = snakefile_text(m, self_exe(), out.string());
+  const std::string exe = self_exe();
+  const std::string text = snakefile_text(m, exe, job_runner(exe), out.string());
   const bool fresh = !fs::is_directory(out / ".surftex", ec);
   BatchProgress progress(progress_mode(a), stderr, stdout);
   EventFollower follow{m, out, progress, a.dry_run, {}, {}, {}, false, 0};
@@ -262,24 +271,6 @@ SubcommandRegistrar reg_batch{
        app.add_flag("--force", a->force, "Use an output folder that exists and was not made by `surftex batch`");
        app.add_flag("-q,--quiet", a->quiet, "No progress lines");
        return [a] { return run_batch(*a); };
-     }}};
-
-SubcommandRegistrar reg_batch_job{
-    {"batch-job", "",  // internal: what each rule of a batch's Snakefile runs
-     [](CLI::App& app) -> std::function<int()> {
-       auto o = std::make_shared<JobRunOptions>();
-       app.group("");  // hidden from `surftex --help`
-       app.add_option("--name", o->name, "Job name")->required();
-       app.add_option("--workdir", o->workdir, "The job's working folder (the manifest's)")->required();
-       app.add_option("--output-file", o->output_file, "-o file name inside the job folder (default: -o is the folder)");
-       app.add_option("--threads", o->threads, "--threads for the job")->check(CLI::Range(0, 1024));
-       app.add_option("command", o->command, "SUBCOMMAND ARGS... after --")->required();
-       app.positionals_at_end();
-       return [o] {
-         o->out_dir = fs::current_path().string();
-         o->surftex_exe = self_exe();
-         return run_batch_job(*o);
-       };
      }}};
 
 }  // namespace

@@ -141,7 +141,7 @@ TEST(BatchSnakefile, OneRulePerJobWithQuotedCommandAndDirectoryOutput) {
   const BatchManifest m = parse_batch_manifest(
       "a-1: render 'x {y}.off' --size 64\nb: patches m.off t.png --threads 2\na.1: synth t.png --size 8x8\n", "/tmp/j.txt");
   EXPECT_EQ(job_rule_names(m), (std::vector<std::string>{"job_a_1", "job_b", "job_a_1_2"}));
-  const std::string t = snakefile_text(m, "/opt/bin/surftex", "/tmp/out");
+  const std::string t = snakefile_text(m, "/opt/bin/surftex", "/opt/bin/surftex-job", "/tmp/out");
   EXPECT_NE(t.find("rule all:"), std::string::npos);
   EXPECT_NE(t.find("rule job_a_1:"), std::string::npos);
   EXPECT_NE(t.find("rule job_a_1_2:"), std::string::npos);
@@ -153,6 +153,7 @@ TEST(BatchSnakefile, OneRulePerJobWithQuotedCommandAndDirectoryOutput) {
   // A job's own --threads is the rule's threads, and not given twice.
   EXPECT_NE(t.find("    threads: 2\n"), std::string::npos);
   EXPECT_NE(t.find("--workdir /tmp -- patches m.off t.png --threads 2"), std::string::npos) << t;
+  EXPECT_NE(t.find("shell: \"/opt/bin/surftex-job --surftex /opt/bin/surftex --name b "), std::string::npos) << t;
   EXPECT_EQ(python_string("a\"b\\c\nd"), "\"a\\\"b\\\\c\\x0ad\"");
 }
 
