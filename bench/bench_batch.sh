@@ -24,7 +24,7 @@ tex="$data/textures/leather_64.png"
     pm="$m"
     # One broken input among the 50 jobs: the patches job of the last mesh.
     if [[ $n == 25 ]]; then pm="$data/broken/truncated.off"; fi
-    echo "${name}_patches: patches '$pm' '$tex' --patch-res 32 --rotations 8 --window 7 --max-patch-faces 400"
+    echo "${name}_patches: patches '$pm' '$tex' --patch-res 48 --rotations 16 --window 7 --max-patch-faces 400"
     echo "${name}_subdiv: subdiv '$m' '$tex' --levels 0 --passes 1 --region 5 --pyramid --atlas-size 256"
   done
 } > "$manifest"
@@ -60,3 +60,23 @@ EOF
 rm -rf "$out"
 run first
 run unchanged
+# SIGTERM to the batch while the two largest jobs run: no folder of theirs may
+# appear, and the next run completes them.
+for j in bunny_75k_patches bunny_75k_subdiv; do rm -rf "${out:?}/$j"; done
+"$surftex" batch "$manifest" -o "$out" --jobs "$jobs" > "$work/sigterm.stdout" 2> "$work/sigterm.stderr" &
+pid=$!
+for _ in $(seq 1 600); do
+  n=$(find "$out/.surftex/stage" -mindepth 1 -maxdepth 1 2>/dev/null | wc -l)
+  [[ $n -ge 2 ]] && break
+  sleep 0.1
+done
+sleep 1
+kill -TERM "$pid"
+set +e
+wait "$pid"
+rc=$?
+set -e
+left="$(ls "$out/.surftex/stage" 2>/dev/null | wc -l)"
+folders="$( (ls -d "$out/bunny_75k_patches" "$out/bunny_75k_subdiv" 2>/dev/null || true) | wc -l)"
+echo "{\"bench\": \"batch\", \"run\": \"sigterm\", \"exit_code\": $rc, \"stage_entries_left\": $left, \"interrupted_job_folders\": $folders}"
+run after_sigterm

@@ -193,7 +193,7 @@ int run_batch(const BatchArgs& a) {
   const fs::path out = fs::absolute(a.out).lexically_normal();
   std::error_code ec;
   const fs::path manifest_abs = fs::absolute(a.manifest).lexically_normal();
-  if (manifest_abs.parent_path() == out || std::mismatch(out.begin(), out.end(), manifest_abs.begin()).first == out.end())
+  if (std::mismatch(out.begin(), out.end(), manifest_abs.begin(), manifest_abs.end()).first == out.end())
     throw InvalidInputError("the manifest '" + a.manifest + "' is inside the output folder '" + a.out + "'");
   const std::string exe = self_exe();
   const std::string text = snakefile_text(m, exe, job_runner(exe), out.string());
