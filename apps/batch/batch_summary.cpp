@@ -144,20 +144,21 @@ JobSummary summarize_job(const BatchJob& job, const std::string& out_dir) {
   std::error_code ec;
   const bool folder = fs::is_directory(out / job.name, ec);
   JobStatus st;
-  const bool have = read_job_status((out / job_status_path(job.name)).string(), st) && st.command == s.command;
+  const bool recorded = read_job_status((out / job_status_path(job.name)).string(), st);
+  const bool have = recorded && st.command == s.command;  // an outcome of the job's current command
   if (have) {
     s.exit_code = st.exit_code;
     s.seconds = st.seconds;
     s.cpu_seconds = st.cpu_seconds;
     s.finished_at = st.finished_at;
   }
-  if (folder && (!have || st.status == "ok")) {
-    s.status = "ok";  // no status: made by Snakemake run directly, or the status was removed
+  if (folder && (have ? st.status == "ok" : !recorded)) {
+    s.status = "ok";  // without a status file: its status was removed
   } else if (have && st.status != "ok") {
     s.status = st.status;
     s.error = st.error;
   } else {
-    s.status = "not_run";
+    s.status = "not_run";  // never run, or its folder is from an older command
   }
   if (s.status != "ok") return s;
   const nlohmann::json report = read_json_file(out / job.name / "report.json");

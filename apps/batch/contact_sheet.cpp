@@ -105,7 +105,7 @@ void card_html(std::string& h, const SheetCard& c) {
   if (!c.links.empty()) {
     h += "<p class=\"links\">";
     for (const std::string& l : c.links)
-      h += "<a href=\"" + html_escape(relative_url(l)) + "\">" + html_escape(fs::path(l).filename().string()) + "</a>";
+      h += "<a href=\"" + html_escape(relative_url(l)) + "\">" + html_escape(fs::path(l).filename().string()) + "</a> ";
     h += "</p>\n";
   }
   h += "</article>\n";

@@ -280,6 +280,10 @@ TEST(BatchSummary, AJobIsOkOnlyWithItsFolderAndAStatusForItsCurrentCommand) {
   EXPECT_EQ(b.error, "error: x");
   EXPECT_EQ(b.exit_code, 2);
   EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "not_run");
+  write(out / "c" / "render.png", "png");  // a folder made by the older command is not this job's output
+  EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "not_run");
+  fs::remove(out / job_status_path("c"));  // a folder without any status (status removed) counts
+  EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "ok");
   const nlohmann::json j = summary_json(m, {a, b});
   EXPECT_EQ(j["counts"]["ok"], 1);
   EXPECT_EQ(j["counts"]["failed"], 1);
