@@ -36,13 +36,15 @@ run() {
   local t0 t1
   t0=$(date +%s.%N)
   set +e
-  "$surftex" batch "$manifest" -o "$out" --jobs "$jobs" > "$work/$label.stdout" 2> "$work/$label.stderr"
+  /usr/bin/time -o "$work/$label.time" -f "%U %S" \
+    "$surftex" batch "$manifest" -o "$out" --jobs "$jobs" > "$work/$label.stdout" 2> "$work/$label.stderr"
   local rc=$?
   set -e
   t1=$(date +%s.%N)
-  python3 - "$out/summary.json" "$label" "$rc" "$t0" "$t1" "$load" "$jobs" <<'EOF'
+  python3 - "$out/summary.json" "$label" "$rc" "$t0" "$t1" "$load" "$jobs" "$work/$label.time" <<'EOF'
 import json, sys
-summary, label, rc, t0, t1, load, jobs = sys.argv[1:]
+summary, label, rc, t0, t1, load, jobs, timefile = sys.argv[1:]
+user, system = (float(x) for x in open(timefile).read().split()[-2:])
 s = json.load(open(summary))
 wall = float(t1) - float(t0)
 ran = [j for j in s["jobs"] if j.get("seconds") is not None]
@@ -52,6 +54,7 @@ print(json.dumps({"bench": "batch", "run": label, "exit_code": int(rc), "wall_se
                   "job_seconds_sum": round(total, 2), "jobs": int(jobs),
                   "wall_over_ideal": round(wall / (total / int(jobs)), 3) if label == "first" and total > 0 else None,
                   "cpu_seconds_sum": round(s.get("cpu_seconds_sum", 0), 2),
+                  "batch_cpu_seconds": round(user + system, 2),
                   "ok": s["counts"]["ok"], "failed": s["counts"]["failed"], "total": s["counts"]["total"],
                   "failed_errors": [f"{j['name']}: {j['error']}" for j in failed],
                   "load_before": load}))

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -185,6 +186,9 @@ std::vector<std::string> snakemake_argv(const std::string& snakemake, const fs::
 }
 
 int run_batch(const BatchArgs& a) {
+  // A closed stdout (--json-progress | head) must not kill the batch before
+  // it has stopped Snakemake and written the summary.
+  std::signal(SIGPIPE, SIG_IGN);
   const BatchManifest m = read_batch_manifest(a.manifest);
   const std::vector<std::string> engine = engine_words(a.engine_args);
   const std::string snakemake = find_snakemake();
