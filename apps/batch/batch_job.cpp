@@ -29,7 +29,7 @@ nlohmann::json to_json(const JobStatus& s) {
   return {{"name", s.name},       {"command", s.command},         {"status", s.status},
           {"exit_code", s.exit_code}, {"error", s.error},         {"seconds", s.seconds},
           {"cpu_seconds", s.cpu_seconds}, {"max_rss_mb", s.max_rss_mb}, {"started_at", s.started_at},
-          {"finished_at", s.finished_at}, {"host", s.host}};
+          {"finished_at", s.finished_at}, {"host", s.host},           {"fingerprint", s.fingerprint}};
 }
 
 bool read_job_status(const std::string& path, JobStatus& s) {
@@ -48,6 +48,7 @@ bool read_job_status(const std::string& path, JobStatus& s) {
   s.started_at = j.value("started_at", "");
   s.finished_at = j.value("finished_at", "");
   s.host = j.value("host", "");
+  s.fingerprint = j.value("fingerprint", "");
   return !s.status.empty();
 }
 
@@ -196,6 +197,10 @@ int run_batch_job(const JobRunOptions& o) {
   for (const std::string& a : o.command) s.command += " " + shell_quote(a);
   char host[256] = {0};
   if (::gethostname(host, sizeof host - 1) == 0) s.host = host;
+  BatchJob job;
+  job.subcommand = o.command[0];
+  job.args.assign(o.command.begin() + 1, o.command.end());
+  s.fingerprint = job_fingerprint(job, o.workdir, o.out_dir);  // before the job: a change while it runs counts
   s.started_at = utc_now();
   const auto t0 = std::chrono::steady_clock::now();
   const ChildResult r = run_child(child_argv(o, stage), o.workdir, log);

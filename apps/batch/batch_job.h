@@ -35,6 +35,7 @@ struct JobStatus {
   double max_rss_mb = 0;      ///< its peak resident memory
   std::string started_at, finished_at;  ///< UTC, ISO 8601
   std::string host;
+  std::string fingerprint;    ///< job_fingerprint() when the job started
 };
 
 nlohmann::json to_json(const JobStatus& s);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -98,6 +99,21 @@ std::vector<std::string> job_input_files(const BatchJob& job, const std::string&
     }
   }
   return files;
+}
+
+std::string job_fingerprint(const BatchJob& job, const std::string& manifest_dir, const std::string& out_dir) {
+  std::string text = job_command_line(job) + "\n" + manifest_dir + "\n";
+  for (const std::string& f : job_input_files(job, manifest_dir, out_dir)) {
+    std::error_code ec;
+    const auto size = fs::file_size(f, ec);
+    const auto mtime = fs::last_write_time(f, ec).time_since_epoch().count();
+    text += f + " " + std::to_string(size) + " " + std::to_string(mtime) + "\n";
+  }
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a, 64 bits
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
 }
 
 std::string job_threads_expression(const BatchJob& job) {

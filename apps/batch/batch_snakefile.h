@@ -31,6 +31,13 @@ std::vector<std::string> job_rule_names(const BatchManifest& m);
 std::vector<std::string> job_input_files(const BatchJob& job, const std::string& manifest_dir,
                                          const std::string& out_dir);
 
+/// A hex digest of the job's command and of the path, size and modification
+/// time of each of its input files (job_input_files): equal digests mean the
+/// job would run the same command on the same files. A job that failed with
+/// exit code 2 (bad input, surftex's deterministic refusal) is not retried
+/// while its digest is unchanged.
+std::string job_fingerprint(const BatchJob& job, const std::string& manifest_dir, const std::string& out_dir);
+
 /// The threads a job's rule declares: its --threads value if given (0 = all
 /// cores: "workflow.cores"), else 1 (batch jobs run side by side).
 std::string job_threads_expression(const BatchJob& job);

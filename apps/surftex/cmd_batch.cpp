@@ -40,7 +40,7 @@ using namespace surftex::batch;
 struct BatchArgs {
   std::string manifest, out, engine_args;
   int jobs = 0;
-  bool dry_run = false, json_progress = false, force = false, quiet = false;
+  bool dry_run = false, json_progress = false, force = false, quiet = false, retry_failed = false;
 };
 
 std::string self_exe() {
@@ -154,7 +154,7 @@ struct EventFollower {
   }
 };
 
-int print_dry_run(const BatchManifest& m, const EventFollower& f, bool fresh) {
+int print_dry_run(const BatchManifest& m, const EventFollower& f, bool fresh, std::size_t not_retried) {
   if (fresh) {
     for (const BatchJob& j : m.jobs) std::printf("would run %s: no output yet\n", j.name.c_str());
   } else {
@@ -165,21 +165,42 @@ int print_dry_run(const BatchManifest& m, const EventFollower& f, bool fresh) {
     }
   }
   const std::size_t n = fresh ? m.jobs.size() : f.would_run.size();
-  std::printf("dry run: %zu of %zu jobs would run, %zu up to date (no job run, summary.json and index.html unchanged)\n", n, m.jobs.size(),
-              m.jobs.size() - n);
+  std::printf("dry run: %zu of %zu jobs would run, %zu up to date", n, m.jobs.size(), m.jobs.size() - n - not_retried);
+  if (not_retried > 0) std::printf(", %zu failed and not retried", not_retried);
+  std::printf(" (no job run, summary.json and index.html unchanged)\n");
   return 0;
 }
 
+// Jobs that failed with exit code 2 (bad input: surftex refuses it the same
+// way every time) and whose command and input files are unchanged since: not
+// run again unless --retry-failed.
+std::vector<std::string> jobs_not_retried(const BatchManifest& m, const fs::path& out, bool retry_failed) {
+  std::vector<std::string> names;
+  if (retry_failed) return names;
+  for (const BatchJob& j : m.jobs) {
+    JobStatus st;
+    if (read_job_status((out / job_status_path(j.name)).string(), st) && st.status == "failed" && st.exit_code == 2 &&
+        !st.fingerprint.empty() && st.fingerprint == job_fingerprint(j, m.dir, out.string()))
+      names.push_back(j.name);
+  }
+  return names;
+}
+
 std::vector<std::string> snakemake_argv(const std::string& snakemake, const fs::path& snakefile, const fs::path& out,
-                                        const BatchArgs& a, const std::vector<std::string>& engine) {
+                                        const BatchArgs& a, const std::vector<std::string>& engine,
+                                        const std::vector<std::string>& targets) {
   const int jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> argv{snakemake,
                                 "--snakefile", snakefile.string(),
-                                "--directory", out.string(),
-                                "--jobs", std::to_string(jobs),
-                                "--keep-going", "--rerun-incomplete", "--nolock",
-                                "--scheduler", "greedy",
-                                "--log-handler-script", (out / ".surftex" / "snakemake_events.py").string()};
+                                "--directory", out.string()};
+  // Targets right after a one-value option: engine options that take a list
+  // (--default-resources a=1 b=2) would swallow them at the end.
+  argv.insert(argv.end(), targets.begin(), targets.end());
+  argv.insert(argv.end(), {
+                              "--jobs", std::to_string(jobs),
+                              "--keep-going", "--rerun-incomplete", "--nolock",
+                              "--scheduler", "greedy",
+                              "--log-handler-script", (out / ".surftex" / "snakemake_events.py").string()});
   if (a.dry_run) argv.push_back("--dry-run");
   argv.insert(argv.end(), engine.begin(), engine.end());
   return argv;
@@ -207,22 +228,36 @@ int run_batch(const BatchArgs& a) {
   const std::vector<std::string> rules = job_rule_names(m);
   for (std::size_t i = 0; i < m.jobs.size(); ++i) follow.job_of_rule[rules[i]] = m.jobs[i].name;
 
-  if (a.dry_run && fresh) return print_dry_run(m, follow, true);  // nothing to compare with: all would run
+  if (a.dry_run && fresh) return print_dry_run(m, follow, true, 0);  // nothing to compare with: all would run
   if (!a.dry_run) prepare_out(out, a.force);
   const int lock = lock_out(out);
   const fs::path snakefile = a.dry_run ? out / ".surftex" / "Snakefile.dry-run" : out / "Snakefile";
   write_if_changed(snakefile, text);
   write_if_changed(out / ".surftex" / "snakemake_events.py", snakemake_event_handler_script());
   const std::string log = (out / ".surftex" / (a.dry_run ? "snakemake.dry-run.log" : "snakemake.log")).string();
-  const EngineResult r = run_snakemake(snakemake_argv(snakemake, snakefile, out, a, engine), log, std::ref(follow),
-                                       [&] { progress.tick(); });
+  const std::vector<std::string> skipped = jobs_not_retried(m, out, a.retry_failed);
+  std::vector<std::string> targets;  // empty: the Snakefile's default, every job
+  for (const BatchJob& j : m.jobs)
+    if (!skipped.empty() && std::find(skipped.begin(), skipped.end(), j.name) == skipped.end()) targets.push_back(j.name);
+  if (!skipped.empty() && !a.json_progress && !a.quiet)
+    std::fprintf(stderr, "batch: %zu failed job%s not retried (exit code 2 on the same command and inputs; "
+                 "--retry-failed runs them): %s%s\n", skipped.size(), skipped.size() == 1 ? "" : "s",
+                 skipped.front().c_str(), skipped.size() > 1 ? ", ..." : "");
+  if (!skipped.empty() && a.json_progress) {
+    std::printf("%s\n", nlohmann::json{{"event", "not_retried"}, {"jobs", skipped}}.dump().c_str());
+    std::fflush(stdout);
+  }
+  EngineResult r;
+  if (skipped.size() < m.jobs.size())
+    r = run_snakemake(snakemake_argv(snakemake, snakefile, out, a, engine, targets), log, std::ref(follow),
+                      [&] { progress.tick(); });
   if (a.dry_run) {
     fs::remove(snakefile, ec);
     ::close(lock);
     if (r.exit_code != 0)
       throw IOError("snakemake failed on the dry run (exit code " + std::to_string(r.exit_code) + "):\n" +
                     snakemake_error_excerpt(read_text(log)));
-    return print_dry_run(m, follow, false);
+    return print_dry_run(m, follow, false, skipped.size());
   }
   std::vector<JobSummary> summaries;
   for (const BatchJob& j : m.jobs) summaries.push_back(summarize_job(j, out.string()));
@@ -272,6 +307,9 @@ SubcommandRegistrar reg_batch{
        app.add_flag("-n,--dry-run", a->dry_run, "Print which jobs would run and why; write nothing");
        app.add_flag("--json-progress", a->json_progress,
                     "Progress as newline-delimited JSON events on stdout (plan, start, finish, end)");
+       app.add_flag("--retry-failed", a->retry_failed,
+                    "Run again jobs that failed with exit code 2 (bad input) although their command and input files "
+                    "did not change (default: they are not retried; other failures always are)");
        app.add_flag("--force", a->force, "Use an output folder that exists and was not made by `surftex batch`");
        app.add_flag("-q,--quiet", a->quiet, "No progress lines");
        return [a] { return run_batch(*a); };

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -157,6 +158,27 @@ TEST(BatchSnakefile, OneRulePerJobWithQuotedCommandAndDirectoryOutput) {
   EXPECT_EQ(python_string("a\"b\\c\nd"), "\"a\\\"b\\\\c\\x0ad\"");
 }
 
+TEST(BatchSnakefile, TheFingerprintFollowsTheCommandAndTheInputFiles) {
+  const fs::path dir = surftex::test::temp_dir("batch-fingerprint");
+  write(dir / "m.off", "OFF\n0 0 0\n");
+  BatchJob j;
+  j.subcommand = "render";
+  j.args = {"m.off", "--size", "64"};
+  const std::string out = (dir / "out").string();
+  const std::string f0 = job_fingerprint(j, dir.string(), out);
+  EXPECT_EQ(f0.size(), 16u);
+  EXPECT_EQ(job_fingerprint(j, dir.string(), out), f0);
+  BatchJob k = j;
+  k.args[2] = "32";
+  EXPECT_NE(job_fingerprint(k, dir.string(), out), f0);
+  fs::last_write_time(dir / "m.off", fs::last_write_time(dir / "m.off") - std::chrono::seconds(10));
+  const std::string f1 = job_fingerprint(j, dir.string(), out);
+  EXPECT_NE(f1, f0);
+  write(dir / "m.off", "OFF\n0 0 0 \n");
+  EXPECT_NE(job_fingerprint(j, dir.string(), out), f1);
+  fs::remove_all(dir);
+}
+
 TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
   const fs::path out = surftex::test::temp_dir("batch-job-ok");
   const fs::path work = surftex::test::temp_dir("batch-job-work");
@@ -179,6 +201,9 @@ TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
   EXPECT_EQ(s.status, "ok");
   EXPECT_EQ(s.exit_code, 0);
   EXPECT_EQ(s.command, "surftex job.sh");
+  BatchJob as_job;
+  as_job.subcommand = "job.sh";
+  EXPECT_EQ(s.fingerprint, job_fingerprint(as_job, work.string(), out.string()));
   EXPECT_GE(s.seconds, 0.0);
   // A second run replaces the folder whole.
   write(work / "job.sh", "echo again > \"$2/other.txt\"\n");

@@ -271,6 +271,31 @@ TEST(BatchCli, ASecondRunRerunsOnlyMissingOrChangedJobs) {
   fs::remove_all(dir);
 }
 
+TEST(BatchCli, ABadInputIsNotRetriedUntilItChangesOrRetryFailedIsGiven) {
+  const fs::path dir = temp_dir("batch-retry");
+  fs::copy_file(shared_data("broken/truncated.off"), dir / "in.off");
+  write(dir / "jobs.txt", "bad: render in.off --size 16\n");
+  const std::string run = "batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) + " --json-progress";
+  auto r = run_surftex(run);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(started_jobs(json_lines(r.out)), (std::vector<std::string>{"bad"}));
+  // Unchanged: exit code 2 is surftex's refusal of a bad input, the same every time.
+  r = run_surftex(run);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_TRUE(started_jobs(json_lines(r.out)).empty()) << r.out;
+  EXPECT_EQ(read_json(dir / "out" / "summary.json")["jobs"][0]["status"], "failed");
+  r = run_surftex(run + " --retry-failed");
+  EXPECT_EQ(started_jobs(json_lines(r.out)), (std::vector<std::string>{"bad"})) << r.out;
+  // A changed input is tried again, and now succeeds.
+  fs::permissions(dir / "in.off", fs::perms::owner_write, fs::perm_options::add);
+  fs::copy_file(shared_data("meshes/eight_genus2.off"), dir / "in.off", fs::copy_options::overwrite_existing);
+  r = run_surftex(run);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(started_jobs(json_lines(r.out)), (std::vector<std::string>{"bad"})) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "out" / "bad" / "render.png"));
+  fs::remove_all(dir);
+}
+
 TEST(BatchCli, TheSnakefileRunsThroughGenericClusterModeWithAStandInSubmitScript) {
   const fs::path dir = temp_dir("batch-cluster");
   // A stand-in for sbatch/qsub: records the submission, runs Snakemake's job
