@@ -304,9 +304,9 @@ SubcommandRegistrar reg_batch{
        app.add_option("--engine-args", a->engine_args,
                       "More snakemake options, as one string: e.g. \"--slurm --default-resources "
                       "slurm_account=A slurm_partition=P\", \"--profile DIR\", \"--cluster 'qsub'\"");
-       app.add_flag("-n,--dry-run", a->dry_run, "Print which jobs would run and why; write nothing");
+       app.add_flag("-n,--dry-run", a->dry_run, "Print which jobs would run and why (Snakemake's reason); run no job, leave summary and page as they are");
        app.add_flag("--json-progress", a->json_progress,
-                    "Progress as newline-delimited JSON events on stdout (plan, start, finish, end)");
+                    "Progress as newline-delimited JSON events on stdout (not_retried, plan, start, finish, end)");
        app.add_flag("--retry-failed", a->retry_failed,
                     "Run again jobs that failed with exit code 2 (bad input) although their command and input files "
                     "did not change (default: they are not retried; other failures always are)");
