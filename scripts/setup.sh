@@ -24,15 +24,27 @@ PKGS=(
   # unless OPENBLAS_CORETYPE is set (periodic_global_parameterization.cpp,
   # configure_blas, blas_allows_concurrent_calls).
   libopenblas0-pthread
+  # `surftex batch` runs its jobs on Snakemake (local cores, --cluster, --slurm).
+  snakemake
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
+# Only for the tests (`setup.sh --tests`, as scripts/test.sh calls it): a
+# headless browser that opens the batch's contact sheet.
+for a in "$@"; do
+  case "$a" in
+    --tests) PKGS+=(chromium) ;;
+    -h|--help) echo "usage: scripts/setup.sh [--tests]"; exit 0 ;;
+    *) echo "error: unknown option '$a'" >&2; exit 2 ;;
+  esac
+done
 
+# One dpkg-query for all packages (one call each took ~5 s on a loaded machine).
+installed=" $({ dpkg-query -W -f='${Package} ${Status}\n' "${PKGS[@]}" 2>/dev/null || true; } |
+  awk '$2 == "install" && $3 == "ok" && $4 == "installed" { printf "%s ", $1 }')"
 missing=()
 for p in "${PKGS[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("$p")
-  fi
+  if [[ "$installed" != *" $p "* ]]; then missing+=("$p"); fi
 done
 
 if (( ${#missing[@]} == 0 )); then

@@ -15,7 +15,7 @@ for a in "$@"; do
 done
 if [[ "${CI:-}" == "true" ]]; then sanitize=1; fi
 
-bash "$root/scripts/setup.sh"
+bash "$root/scripts/setup.sh" --tests
 SURFTEX_BUILD_DIR="$root/build" bash "$root/scripts/build.sh"
 (cd "$root/build" && ctest --output-on-failure -j "$(nproc)")
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "batch/contact_sheet.h"
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
@@ -175,6 +176,7 @@ std::function<int()> setup(CLI::App& app) {
     CommonOptions ro = *common;
     if (ro.report_path.empty()) ro.report_path = (fs::path(*dir) / "report.json").string();
     write_report(ro, "demo", report);
+    batch::write_demo_contact_sheet(*dir, report);  // DIR/index.html (issue 20, item 4)
     std::printf("demo: done in %.1f s; results in %s (report.json lists them)\n", total.seconds(), dir->c_str());
     return 0;
   };
