@@ -30,8 +30,11 @@ PKGS=(
   # configure_blas, blas_allows_concurrent_calls).
   libopenblas0-pthread
   # The glTF-Validator's runtime (the tests call it through node).
-  nodejs npm
+  nodejs
 )
+# Debian's npm, unless an npm is already there (NodeSource's nodejs package
+# bundles its own, which Debian's npm package conflicts with).
+if ! command -v npm >/dev/null 2>&1; then PKGS+=(npm); fi
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
 

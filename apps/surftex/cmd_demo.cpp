@@ -58,8 +58,9 @@ void prepare_demo_dir(const std::string& dir, bool force) {
   write_file_atomic((fs::path(dir) / kMarker).string(), "made by surftex demo\n", true);
 }
 
-// The files the steps named (ctx.path) that exist now, folders expanded, in
-// the order first named; the marker and the report itself are left out.
+// The files the steps named (ctx.path) or reported (ctx.wrote) that exist
+// now, folders expanded, in the order first named; the marker and the report
+// itself are left out.
 std::vector<std::string> demo_outputs(const DemoContext& ctx, const std::string& report_path) {
   std::vector<std::string> out;
   auto add = [&](const fs::path& p) {
@@ -76,6 +77,7 @@ std::vector<std::string> demo_outputs(const DemoContext& ctx, const std::string&
       add(p);
     }
   }
+  for (const std::string& f : ctx.written) add(f);
   return out;
 }
 
@@ -154,7 +156,7 @@ nlohmann::json step_textured_torus(DemoContext& ctx) {
   WriteMeshOptions wo;
   wo.texture = &ctx.tile;
   // The OBJ's texture is torus_tiled.png (write_mesh), so the render is named apart.
-  write_mesh(ctx.path("torus_tiled.obj"), torus, wo);
+  ctx.wrote(write_mesh(ctx.path("torus_tiled.obj"), torus, wo));
   write_mesh(ctx.path("torus_tiled.glb"), torus, wo);
   ViewOptions view;
   view.azimuth_deg = 20.f;

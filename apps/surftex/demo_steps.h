@@ -30,6 +30,10 @@ struct DemoContext {
     return (std::filesystem::path(dir) / name).string();
   }
   mutable std::vector<std::string> named;
+  /// Files a step wrote besides the names it asked path() for (write_mesh's
+  /// list: an OBJ's .mtl and texture), as paths.
+  void wrote(const std::vector<std::string>& paths) { written.insert(written.end(), paths.begin(), paths.end()); }
+  std::vector<std::string> written;
 };
 
 struct DemoStep {

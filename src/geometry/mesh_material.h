@@ -20,10 +20,10 @@ struct MeshMaterial {
   /// With a texture, a glTF viewer multiplies the two; an OBJ read with a
   /// map_Kd gets (1,1,1) here, as Blender's importer ignores Kd then.
   std::array<float, 3> base_color{1.f, 1.f, 1.f};
-  /// The base-colour texture, at most one of: a file (OBJ map_Kd resolved
-  /// against the .mtl's folder, a glTF image URI resolved against the .gltf)
-  /// or the encoded image bytes held inside the mesh file (GLB buffer view,
-  /// data: URI). Neither = no texture.
+  /// The base-colour texture: the file it is in (OBJ map_Kd resolved against
+  /// the .mtl's folder, a glTF image URI resolved against the .gltf) and/or
+  /// its encoded bytes as read with the mesh file (GLB buffer view, data: URI,
+  /// an external glTF image; decoded first when present). Neither = no texture.
   std::string texture_file;
   std::string texture_bytes;
   /// Where the texture was named, for messages (e.g. "map_Kd in 'a.mtl'").

@@ -518,14 +518,15 @@ std::vector<MeshMaterial> read_materials(const std::string& path, const tinygltf
         fail_io(path, "", "texture " + std::to_string(bt.index) + " of material '" + mm.name + "' has no image surftex can read");
       const tinygltf::Image& im = m.images[static_cast<std::size_t>(src)];
       mm.texture_origin = "image " + std::to_string(src) + " of '" + path + "'";
-      if (!im.image.empty()) {
-        mm.texture_bytes.assign(im.image.begin(), im.image.end());
-      } else {
-        mm.texture_file = (fs::path(path).parent_path() / im.uri).lexically_normal().string();
-        if (existing_path(mm.texture_file).empty())
+      if (!im.uri.empty() && im.uri.rfind("data:", 0) != 0) {  // a file beside the .gltf
+        mm.texture_file = existing_path((fs::path(path).parent_path() / im.uri).lexically_normal().string());
+        if (mm.texture_file.empty())
           throw IOError("'" + path + "': texture image '" + im.uri + "' of material '" + mm.name + "' does not exist");
-        mm.texture_file = existing_path(mm.texture_file);
+        mm.texture_origin = "'" + im.uri + "', image " + std::to_string(src) + " of '" + path + "'";
       }
+      if (!im.image.empty()) mm.texture_bytes.assign(im.image.begin(), im.image.end());
+      else if (mm.texture_file.empty())
+        fail_io(path, "", "image " + std::to_string(src) + " of material '" + mm.name + "' holds no data");
     }
     out.push_back(std::move(mm));
   }

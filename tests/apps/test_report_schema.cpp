@@ -27,10 +27,10 @@ namespace {
 
 std::string q(const std::string& s) { return "'" + s + "'"; }
 
-// Runs `args` with --report DIR/report.json and checks the report's schema.
+// Runs `args` with --report DIR/COMMAND_report.json and checks the report's schema.
 nlohmann::json run_and_check(const std::string& dir, const std::string& command, const std::string& args,
                              const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
-  const std::string report = dir + "/report.json";
+  const std::string report = dir + "/" + command + "_report.json";
   const test::RunResult r = test::run_surftex(command + " " + args + " --report " + q(report) + " -q");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   if (r.exit_code != 0) return {};
