@@ -11,11 +11,12 @@
 #include "surftex/command.h"
 
 int main(int argc, char** argv) {
+  surftex::cli::record_command_line(argc, argv);  // for the reports (surftex/report.h)
   CLI::App app{
       "surftex: decorate 3D surface meshes with textures grown from examples.\n"
       "Run `surftex demo` for a tour on built-in data, `surftex SUBCOMMAND --help` for details."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "surftex 0.1.0");
+  app.set_version_flag("--version", std::string("surftex ") + surftex::cli::surftex_version());
   auto& reg = surftex::cli::registry();
   std::vector<std::pair<CLI::App*, std::function<int()>>> runs;
   for (auto& sc : reg) {

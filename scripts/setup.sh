@@ -1,8 +1,13 @@
 #!/usr/bin/env bash
-# Installs every system dependency surftex needs from Debian 12 packages.
-# Idempotent: packages already present are not reinstalled; apt is only
-# consulted when something is missing.
+# Installs every system dependency surftex needs from Debian 12 packages,
+# then the Khronos glTF-Validator (npm gltf-validator, pinned) that the tests
+# run on every GLB they write, into the build tree:
+# ${SURFTEX_BUILD_DIR:-build}/tools/gltf-validator (no global npm install).
+# Idempotent: packages already present are not reinstalled; apt and npm are
+# only consulted when something is missing.
 set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+GLTF_VALIDATOR_VERSION="2.0.0-dev.3.10"
 
 PKGS=(
   cmake g++ make ninja-build ccache pkg-config
@@ -26,7 +31,12 @@ PKGS=(
   libopenblas0-pthread
   # `surftex batch` runs its jobs on Snakemake (local cores, --cluster, --slurm).
   snakemake
+  # The glTF-Validator's runtime (the tests call it through node).
+  nodejs
 )
+# Debian's npm, unless an npm is already there (NodeSource's nodejs package
+# bundles its own, which Debian's npm package conflicts with).
+if ! command -v npm >/dev/null 2>&1; then PKGS+=(npm); fi
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
 # Only for the tests (`setup.sh --tests`, as scripts/test.sh calls it): a
@@ -49,13 +59,25 @@ done
 
 if (( ${#missing[@]} == 0 )); then
   echo "setup: all ${#PKGS[@]} packages present"
-  exit 0
+else
+  SUDO=""
+  if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
-echo "setup: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The glTF-Validator, pinned, in the build tree (CMake's
+# SURFTEX_GLTF_VALIDATOR_DIR points there by default).
+validator="${SURFTEX_BUILD_DIR:-$root/build}/tools/gltf-validator"
+installed="$(node -p "require('$validator/node_modules/gltf-validator/package.json').version" 2>/dev/null || true)"
+if [[ "$installed" != "$GLTF_VALIDATOR_VERSION" ]]; then
+  echo "setup: installing gltf-validator@$GLTF_VALIDATOR_VERSION into $validator"
+  mkdir -p "$validator"
+  npm install --prefix "$validator" --no-save --no-audit --no-fund --loglevel=error \
+    "gltf-validator@$GLTF_VALIDATOR_VERSION"
+else
+  echo "setup: gltf-validator $installed present in $validator"
+fi
 echo "setup: done"

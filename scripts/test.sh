@@ -22,7 +22,8 @@ SURFTEX_BUILD_DIR="$root/build" bash "$root/scripts/build.sh"
 if [[ $sanitize == 1 ]]; then
   echo "== sanitizer suite (ASan + UBSan) =="
   SURFTEX_BUILD_DIR="$root/build-asan" bash "$root/scripts/build.sh" \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSURFTEX_SANITIZE=ON -DSURFTEX_BUILD_BENCH=OFF
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSURFTEX_SANITIZE=ON -DSURFTEX_BUILD_BENCH=OFF \
+    -DSURFTEX_GLTF_VALIDATOR_DIR="$root/build/tools/gltf-validator"
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   # Fast (frame-pointer) unwinding on malloc, LSan's default: full unwinding
   # made the allocation-heavy quilting tests 6x slower (64 s -> 11 s for

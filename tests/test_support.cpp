@@ -5,10 +5,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -41,6 +46,122 @@ std::string cgal_data(const std::string& name) {
   return p.string();
 }
 
+namespace {
+// The temporary folders of the running test, and the GLBs to leave out.
+struct TestFolders {
+  std::mutex mu;
+  std::vector<std::string> dirs, skipped;
+};
+TestFolders& test_folders() {
+  static TestFolders t;
+  return t;
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+bool starts_with_gltf_magic(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  char m[4] = {};
+  return f.read(m, 4) && std::string(m, 4) == "glTF";
+}
+
+// Validates the GLBs of the test that just ended (gtest calls the listeners'
+// OnTestEnd in reverse order, so a failure added here still counts for it).
+class GlbValidationListener : public testing::EmptyTestEventListener {
+  void OnTestStart(const testing::TestInfo&) override {
+    std::lock_guard<std::mutex> lock(test_folders().mu);
+    test_folders().dirs.clear();
+    test_folders().skipped.clear();
+  }
+  void OnTestEnd(const testing::TestInfo&) override {
+    std::vector<std::string> files;
+    {
+      std::lock_guard<std::mutex> lock(test_folders().mu);
+      for (const std::string& d : test_folders().dirs) {
+        std::error_code ec;
+        for (auto it = fs::recursive_directory_iterator(d, ec); !ec && it != fs::recursive_directory_iterator();
+             it.increment(ec)) {
+          const fs::path p = it->path();
+          std::string ext = p.extension().string();
+          std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+          if (ext != ".glb" || !it->is_regular_file(ec) || !starts_with_gltf_magic(p)) continue;
+          const auto& sk = test_folders().skipped;
+          if (std::find(sk.begin(), sk.end(), p.string()) == sk.end()) files.push_back(p.string());
+        }
+      }
+    }
+    if (files.empty()) return;
+    std::sort(files.begin(), files.end());
+    const std::vector<GlbValidation> results = validate_glbs(files);
+    // SURFTEX_GLB_VALIDATION_LOG=FILE appends every file's counts (to total
+    // them over a whole test run).
+    if (const char* log = std::getenv("SURFTEX_GLB_VALIDATION_LOG")) {
+      std::ofstream out(log, std::ios::app);
+      for (const GlbValidation& v : results)
+        out << v.file << " errors " << v.errors << " warnings " << v.warnings << " infos " << v.infos << " hints "
+            << v.hints << "\n";
+    }
+    for (const GlbValidation& v : results)
+      if (v.errors != 0 || v.warnings != 0)
+        ADD_FAILURE() << "glTF-Validator: " << v.file << ": " << v.errors << " errors, " << v.warnings
+                      << " warnings\n" << v.messages;
+  }
+};
+
+struct RegisterListener {
+  RegisterListener() { testing::UnitTest::GetInstance()->listeners().Append(new GlbValidationListener); }
+} register_listener;
+}  // namespace
+
+void skip_glb_validation(const std::string& path) {
+  std::lock_guard<std::mutex> lock(test_folders().mu);
+  test_folders().skipped.push_back(fs::path(path).string());
+}
+
+std::vector<GlbValidation> validate_glbs(const std::vector<std::string>& files) {
+  std::vector<GlbValidation> out;
+  if (files.empty()) return out;
+  std::string cmd = quote(SURFTEX_NODE) + " " + quote(std::string(SURFTEX_SOURCE_DIR) + "/tests/tools/validate_glb.js") +
+                    " " + quote(SURFTEX_GLTF_VALIDATOR_DIR);
+  for (const std::string& f : files) cmd += " " + quote(f);
+  cmd += " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) {
+    ADD_FAILURE() << "cannot run the glTF-Validator: " << cmd;
+    return out;
+  }
+  std::string text;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
+  const int status = ::pclose(p);
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("file")) continue;
+    GlbValidation v;
+    v.file = j["file"].get<std::string>();
+    v.errors = j["errors"].get<int>();
+    v.warnings = j["warnings"].get<int>();
+    v.infos = j["infos"].get<int>();
+    v.hints = j["hints"].get<int>();
+    for (const auto& m : j["messages"])
+      v.messages += "  " + m["severity"].get<std::string>() + " " + m["code"].get<std::string>() + " " +
+                    m["message"].get<std::string>() + " " + m["pointer"].get<std::string>() + "\n";
+    out.push_back(v);
+  }
+  if (out.size() != files.size())
+    ADD_FAILURE() << "the glTF-Validator did not report on every file (exit status " << status
+                  << "; run scripts/setup.sh to install it into " << SURFTEX_GLTF_VALIDATOR_DIR << "):\n"
+                  << text;
+  return out;
+}
+
 std::string temp_dir(const std::string& tag) {
   static std::atomic<int> counter{0};
   fs::path p = fs::temp_directory_path() /
@@ -48,6 +169,8 @@ std::string temp_dir(const std::string& tag) {
                 std::to_string(counter.fetch_add(1)));
   fs::remove_all(p);
   fs::create_directories(p);
+  std::lock_guard<std::mutex> lock(test_folders().mu);
+  test_folders().dirs.push_back(p.string());
   return p.string();
 }
 

@@ -3,6 +3,7 @@
 // Shared helpers for the test suites: where the real data lives, temporary
 // folders, running the surftex binary.
 #include <string>
+#include <vector>
 
 namespace surftex::test {
 
@@ -20,5 +21,21 @@ struct RunResult {
 };
 /// Runs the built `surftex` binary with `args` (shell-quoted by the caller).
 RunResult run_surftex(const std::string& args);
+
+/// The Khronos glTF-Validator's counts for one file (tests/tools/validate_glb.js).
+struct GlbValidation {
+  std::string file;
+  int errors = -1, warnings = -1, infos = -1, hints = -1;
+  std::string messages;  ///< the errors and warnings, one per line
+};
+/// Validates `files` in one run of the validator (scripts/setup.sh installs it
+/// into BUILD/tools/gltf-validator). Fails the test if it cannot run.
+std::vector<GlbValidation> validate_glbs(const std::vector<std::string>& files);
+
+/// Every GLB file (a .glb starting with the "glTF" magic) in the temporary
+/// folders a test made with temp_dir() is validated when the test ends: any
+/// error or warning fails the test. A test that writes a broken GLB on
+/// purpose names it here to leave it out.
+void skip_glb_validation(const std::string& path);
 
 }  // namespace surftex::test

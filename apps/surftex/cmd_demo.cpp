@@ -3,6 +3,7 @@
 // project generates itself (procedural textures and meshes built in code), so
 // it runs on a fresh machine with no data. Each step writes its outputs into
 // DIR and a line into DIR/report.json.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -18,6 +19,7 @@
 #include "geometry/properties.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
+#include "geometry/up_axis.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
@@ -55,6 +57,29 @@ void prepare_demo_dir(const std::string& dir, bool force) {
   }
   ensure_directory(dir);
   write_file_atomic((fs::path(dir) / kMarker).string(), "made by surftex demo\n", true);
+}
+
+// The files the steps named (ctx.path) or reported (ctx.wrote) that exist
+// now, folders expanded, in the order first named; the marker and the report
+// itself are left out.
+std::vector<std::string> demo_outputs(const DemoContext& ctx, const std::string& report_path) {
+  std::vector<std::string> out;
+  auto add = [&](const fs::path& p) {
+    std::error_code ec;
+    if (p.filename() == kMarker || same_file(p.string(), report_path) || !fs::is_regular_file(p, ec)) return;
+    if (std::find(out.begin(), out.end(), p.string()) == out.end()) out.push_back(p.string());
+  };
+  for (const std::string& name : ctx.named) {
+    const fs::path p = fs::path(ctx.dir) / name;
+    std::error_code ec;
+    if (fs::is_directory(p, ec)) {
+      for (const std::string& f : files_in_folder(p.string())) add(f);
+    } else {
+      add(p);
+    }
+  }
+  for (const std::string& f : ctx.written) add(f);
+  return out;
 }
 
 // Step 1: image synthesis from a generated exemplar by the three 2D engines.
@@ -128,17 +153,21 @@ nlohmann::json step_textured_torus(DemoContext& ctx) {
   Mesh torus;
   make_torus(torus, 2.0, 0.7, 96, 48);
   assign_torus_uvs(torus, 2.0, 4.0, 2.0);
+  z_up_to_y_up(torus);  // lying flat in glTF viewers (geometry/up_axis.h)
   WriteMeshOptions wo;
   wo.texture = &ctx.tile;
-  write_mesh(ctx.path("torus_tiled.obj"), torus, wo);
+  // The OBJ's texture is torus_tiled.png (write_mesh), so the render is named apart.
+  ctx.wrote(write_mesh(ctx.path("torus_tiled.obj"), torus, wo));
   write_mesh(ctx.path("torus_tiled.glb"), torus, wo);
   ViewOptions view;
   view.azimuth_deg = 20.f;
   view.elevation_deg = 35.f;
   view.texture = &ctx.tile;
   view.wrap = RenderOptions::Wrap::Repeat;  // the tile repeats 4 x 2 times around the torus
-  write_image(ctx.path("torus_tiled.png"), render_view(torus, view));
-  return {{"faces", torus.number_of_faces()}, {"files", {"torus_tiled.obj", "torus_tiled.glb", "torus_tiled.png"}}};
+  write_image(ctx.path("torus_tiled_render.png"), render_view(torus, view));
+  return {{"faces", torus.number_of_faces()},
+          {"outputs", {"torus_tiled.obj", "torus_tiled.mtl", "torus_tiled.png", "torus_tiled.glb",
+                       "torus_tiled_render.png"}}};
 }
 
 std::function<int()> setup(CLI::App& app) {
@@ -167,15 +196,13 @@ std::function<int()> setup(CLI::App& app) {
     for (auto& s : steps) {
       std::fprintf(stderr, "demo: %s\n", s.description.c_str());
       Timer t;
-      nlohmann::json r = s.run(ctx);
-      r["seconds_total"] = t.seconds();
-      report["steps"][s.name] = r;
+      report["steps"][s.name] = s.run(ctx);
+      report["seconds"][s.name] = t.seconds();
     }
-    report["seconds"] = total.seconds();
     report["output_dir"] = *dir;
     CommonOptions ro = *common;
     if (ro.report_path.empty()) ro.report_path = (fs::path(*dir) / "report.json").string();
-    write_report(ro, "demo", report);
+    write_report(ro, "demo", report, {{}, demo_outputs(ctx, ro.report_path)});
     batch::write_demo_contact_sheet(*dir, report);  // DIR/index.html (issue 20, item 4)
     std::printf("demo: done in %.1f s; results in %s (report.json lists them)\n", total.seconds(), dir->c_str());
     return 0;

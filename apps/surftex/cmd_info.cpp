@@ -52,12 +52,12 @@ MeshTopology topology(const Mesh& m) {
 }
 
 SubcommandRegistrar reg{
-    {"info", "Print the counts, topology and repairs of a mesh file (OFF, OBJ, PLY, STL)",
+    {"info", "Print the counts, topology, materials and repairs of a mesh file (OFF, OBJ, PLY, STL, GLB, glTF)",
      [](CLI::App& app) -> std::function<int()> {
        auto input = std::make_shared<std::string>();
        auto common = std::make_shared<CommonOptions>();
        auto no_tri = std::make_shared<bool>(false);
-       app.add_option("mesh", *input, "Mesh file to inspect (.off, .obj, .ply, .stl; other names by content)")
+       app.add_option("mesh", *input, "Mesh file to inspect (.off, .obj, .ply, .stl, .glb, .gltf; other names by content)")
            ->required();
        app.add_flag("--no-triangulate", *no_tri,
                     "Keep polygons as they are instead of triangulating them (default: triangulate)");
@@ -67,10 +67,10 @@ SubcommandRegistrar reg{
          require_input_file(*input, "mesh");
          Timer timer;
          Mesh mesh;
-         SoupRepairCounts c;
          SoupToMeshOptions opt;
          opt.triangulate = !*no_tri;
-         read_mesh(*input, mesh, opt, &c);
+         const MeshFileContents in = read_mesh_file(*input, mesh, opt);
+         const SoupRepairCounts& c = in.counts;
          const double seconds = timer.seconds();
          MeshTopology t = topology(mesh);
          std::printf("mesh:            %s\n", input->c_str());
@@ -97,6 +97,11 @@ SubcommandRegistrar reg{
                      c.faces_triangulated, c.faces_fan_triangulated, c.short_polygons_dropped);
          if (c.uv_corners + c.uv_corners_dropped > 0)
            std::printf("uv corners:      %zu mapped, %zu without a UV\n", c.uv_corners, c.uv_corners_dropped);
+         for (const MeshMaterial& m : in.materials)
+           std::printf("material:        %s, colour %.3g %.3g %.3g%s%s\n", m.name.c_str(), m.base_color[0],
+                       m.base_color[1], m.base_color[2], m.has_texture() ? ", texture " : "",
+                       m.texture_file.empty() ? (m.texture_bytes.empty() ? "" : "embedded") : m.texture_file.c_str());
+         for (const std::string& w : in.warnings) std::printf("warning:         %s\n", w.c_str());
          std::printf("read time:       %.3f s\n", seconds);
          nlohmann::json r;
          r["mesh"] = *input;
@@ -112,8 +117,15 @@ SubcommandRegistrar reg{
          if (t.closed) r["genus"] = (2 * static_cast<long long>(t.components) - t.euler) / 2;
          else r["genus"] = nullptr;
          r["repair"] = to_json(c);
-         r["timings"] = {{"read_seconds", seconds}};
-         write_report(*common, "info", r);
+         r["materials"] = nlohmann::json::array();
+         for (const MeshMaterial& m : in.materials)
+           r["materials"].push_back({{"name", m.name},
+                                     {"base_color", m.base_color},
+                                     {"texture", m.texture_file.empty() ? (m.texture_bytes.empty() ? "" : "embedded")
+                                                                        : m.texture_file}});
+         r["warnings"] = in.warnings;
+         r["seconds"] = {{"read", seconds}};
+         write_report(*common, "info", r, {in.files_read, {}});
          return 0;
        };
      }}};

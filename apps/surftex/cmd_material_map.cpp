@@ -33,6 +33,7 @@
 #include "geometry/render_mesh.h"
 #include "geometry/scalar_field_interpolation.h"
 #include "geometry/timer.h"
+#include "geometry/up_axis.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
@@ -402,11 +403,12 @@ int run(const Args& a) {
   rep["seconds"] = sec;
   rep["tile"] = {{"dir", a.tile}, {"layers", tile.layers.size()}, {"size", tile.size}};
   rep["mesh"] = a.mesh;
-  nlohmann::json full = rep;
-  full["command"] = "material-map";
-  full["seed"] = a.common.seed;
-  write_file_atomic(a.out + "/report.json", full.dump(2) + "\n", a.common.force);
-  write_report(a.common, "material-map", rep);
+  RunFiles run_files{{a.mesh, a.tile, a.constraints, a.update, a.state}, {}};
+  for (const char* f : files)
+    if (std::string(f) != "report.json") run_files.outputs.push_back(a.out + "/" + f);
+  write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
+                    a.common.force);
+  write_report(a.common, "material-map", rep, run_files);
   if (!a.common.quiet)
     std::fprintf(stderr, "material-map: %zu faces, %.1f%% singular, written to %s (%.2f s)\n",
                  static_cast<std::size_t>(mesh.number_of_faces()), 100 * sing.singular_fraction, a.out.c_str(),
@@ -511,6 +513,7 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   interpolate_scalar_field(mesh, mat, material_field_options());
   periodic_global_parameterization(mesh);
   const PgpSingularities sing = detect_pgp_singularities(mesh);
+  z_up_to_y_up(mesh);  // the torus was built around z: lying flat in glTF viewers
   write_meshes(mesh, ctx.dir, true);
   fs::rename(ctx.path("mesh.obj"), ctx.path("material_map.obj"));
   fs::rename(ctx.path("mesh.glb"), ctx.path("material_map.glb"));

@@ -76,9 +76,11 @@ int run(const Args& a) {
   rep["layers_per_pair"] = a.layers;
   rep["sign_changes"] = r.sign_changes;
   rep["mask_agreement"] = r.mask_agreement;
-  rep["seconds"] = {{"keys", r.seconds_keys}, {"morph", r.seconds_morph},
-                    {"synthesis", r.seconds_synthesis}, {"total", r.seconds_total}};
-  write_report(a.common, "material-tile", rep);
+  rep["seconds"] = {{"keys", r.seconds_keys}, {"morph", r.seconds_morph}, {"synthesis", r.seconds_synthesis}};
+  RunFiles files{a.inputs, files_in_folder(a.out)};
+  for (const std::string& m : a.masks)
+    if (m != "-") files.inputs.push_back(m);
+  write_report(a.common, "material-tile", rep, files);
   if (!a.common.quiet)
     std::fprintf(stderr, "material-tile: %zu layers of %dx%d written to %s (%.2f s)\n", r.layers.size(), a.size,
                  a.size, a.out.c_str(), r.seconds_total);

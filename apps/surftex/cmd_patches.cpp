@@ -19,6 +19,7 @@
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
+#include "geometry/up_axis.h"
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
@@ -197,8 +198,12 @@ int run(const PatchArgs& a) {
   rep["multi"] = a.multi;
   rep["resynthesized"] = po.resynthesize;
   rep["faces"] = mesh.number_of_faces();
-  write_file_atomic((fs::path(a.outdir) / "report.json").string(), rep.dump(2) + "\n", true);
-  write_report(a.common, "patches", rep);
+  RunFiles files{inputs, {}};
+  for (const auto& name : rep["outputs"]) files.outputs.push_back((fs::path(a.outdir) / name.get<std::string>()).string());
+  rep.erase("outputs");  // a shared report key (surftex/report.h): paths, not names
+  write_file_atomic((fs::path(a.outdir) / "report.json").string(),
+                    make_report(a.common, "patches", rep, files).dump(2) + "\n", true);
+  write_report(a.common, "patches", rep, files);
   if (!a.common.quiet)
     std::printf("%s: %d patches, %zu texels in %.2f s (%.0f texels/s), seam ratio %.3f\n",
                 a.outdir.c_str(), rep["patches"].get<int>(), rep["texels_synthesized"].get<std::size_t>(),
@@ -269,6 +274,7 @@ DemoStepRegistrar demo{{30, "patches",
                         [](DemoContext& ctx) {
                           Mesh mesh;
                           make_torus(mesh, 1.0, 0.4, 48, 24);
+                          z_up_to_y_up(mesh);  // lying flat in glTF viewers
                           const Image ex = make_stripes(48, 8, 0);
                           write_image(ctx.path("patches_exemplar.png"), ex);
                           PatchSynthesisOptions po;

@@ -358,10 +358,8 @@ int run_quilt(QuiltArgs& a) {
     write_image(a.render, render_preview(scene), io);
     rep["render"] = a.render;
   }
-  rep["files"] = outputs;
   rep["seconds"]["write"] = t.seconds();
-  rep["seconds"]["total"] = total.seconds();
-  write_report(a.common, "quilt", rep);
+  write_report(a.common, "quilt", rep, {inputs, outputs});
   if (!a.common.quiet) {
     std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
                  static_cast<std::size_t>(out.number_of_faces()), total.seconds(), a.output.c_str());
@@ -494,7 +492,7 @@ int run_elements(const ElementsArgs& a) {
   rep["output"] = a.output;
   rep["elements"] = n;
   rep["faces_removed"] = removed;
-  write_report(a.common, "elements", rep);
+  write_report(a.common, "elements", rep, {{a.input}, {a.output}});
   if (!a.common.quiet) std::fprintf(stderr, "elements: %d elements, %zu faces removed -> %s\n", n, removed, a.output.c_str());
   return 0;
 }

@@ -2,11 +2,14 @@
 // `surftex render`: a preview image of a mesh from the software rasterizer
 // (geometry/rasterizer.h), with its vertex colours or an image texture mapped
 // through its texture coordinates.
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "geometry/errors.h"
+#include "geometry/face_material.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
@@ -42,6 +45,51 @@ Vec3f rgb(const std::vector<float>& v, const std::string& name) {
   return {v[0], v[1], v[2]};
 }
 
+// True when the file's materials change how it looks (a texture or a
+// colour other than white): then they are what a glTF viewer or Blender shows.
+bool shows_materials(const std::vector<MeshMaterial>& materials) {
+  for (const MeshMaterial& m : materials)
+    if (m.has_texture() || m.base_color != std::array<float, 3>{1.f, 1.f, 1.f}) return true;
+  return false;
+}
+
+// The base colour a glTF viewer shows (glTF 2.0 section 3.9.2): the
+// material's baseColorFactor times its texture at the corner UVs times the
+// vertex colour, each where present.
+FragmentCallback material_shader(const Mesh& mesh, const RenderMesh& rm, const std::vector<MeshMaterial>& materials,
+                                 RenderOptions::Wrap wrap) {
+  auto fm = find(mesh, kFaceMaterial);
+  std::vector<int> tri_material(rm.triangles.size(), -1);
+  if (fm.second)
+    for (std::size_t t = 0; t < rm.triangles.size(); ++t) {
+      const int m = fm.first[FaceIndex(static_cast<std::uint32_t>(rm.triangle_face[t]))];
+      tri_material[t] = m >= 0 && static_cast<std::size_t>(m) < materials.size() ? m : -1;
+    }
+  return [&rm, &materials, wrap, tri_material](int t, const Vec3f& b) -> Vec3f {
+    Vec3f c{1.f, 1.f, 1.f};
+    const int m = tri_material[static_cast<std::size_t>(t)];
+    if (m >= 0) {
+      const MeshMaterial& mat = materials[static_cast<std::size_t>(m)];
+      for (int k = 0; k < 3; ++k) c[k] = mat.base_color[k];
+      if (!mat.texture.empty() && !rm.corner_uvs.empty()) {
+        float u = 0, v = 0;
+        for (int k = 0; k < 3; ++k) {
+          u += b[k] * rm.corner_uvs[3 * t + k][0];
+          v += b[k] * rm.corner_uvs[3 * t + k][1];
+        }
+        const Vec3f s = sample_texture(mat.texture, u, v, wrap);
+        for (int k = 0; k < 3; ++k) c[k] *= s[k];
+      }
+    }
+    if (!rm.vertex_colors.empty()) {
+      const auto& tri = rm.triangles[static_cast<std::size_t>(t)];
+      for (int k = 0; k < 3; ++k)
+        c[k] *= b[0] * rm.vertex_colors[tri[0]][k] + b[1] * rm.vertex_colors[tri[1]][k] + b[2] * rm.vertex_colors[tri[2]][k];
+    }
+    return c;
+  };
+}
+
 int run(RenderArgs& a) {
   auto limit = apply_thread_limit(a.common.threads);
   ProgressCallback progress = terminal_progress(a.common.quiet);
@@ -58,15 +106,19 @@ int run(RenderArgs& a) {
   Timer total, t;
   report_progress(progress, "read", 0.0);
   Mesh mesh;
-  SoupRepairCounts counts;
-  read_mesh(a.input, mesh, {}, &counts);
+  MeshFileContents in = read_mesh_file(a.input, mesh);
   Image texture;
   if (!a.texture.empty()) texture = read_image(a.texture);
+  const bool has_uvs = find(mesh, kCornerUV).second;
+  const bool material_colors =
+      a.texture.empty() && (a.colors == "material" || (a.colors == "auto" && shows_materials(in.materials)));
+  if (a.colors == "material" && in.materials.empty())
+    throw InvalidInputError("--colors material: mesh '" + a.input + "' has no materials");
+  if (material_colors) load_material_textures(in.materials);
   const double t_read = t.seconds();
   report_progress(progress, "read", 1.0);
 
   const bool has_colors = find(mesh, kVertexColor).second;
-  const bool has_uvs = find(mesh, kCornerUV).second;
   RenderOptions opt;
   opt.width = opt.height = a.size;
   opt.supersample = a.supersample;
@@ -84,6 +136,11 @@ int run(RenderArgs& a) {
     opt.color_source = RenderOptions::ColorSource::Texture;
     opt.texture = &texture;
     source = "texture";
+  } else if (material_colors) {
+    mopt.corner_uvs = has_uvs;
+    mopt.vertex_colors = has_colors;
+    opt.color_source = RenderOptions::ColorSource::Callback;
+    source = "material";
   } else if (a.colors == "vertex" || (a.colors == "auto" && has_colors)) {
     if (!has_colors) throw InvalidInputError("--colors vertex: mesh '" + a.input + "' has no vertex colours");
     mopt.vertex_colors = true;
@@ -94,6 +151,7 @@ int run(RenderArgs& a) {
   t.reset();
   report_progress(progress, "render", 0.0);
   RenderMesh rm = make_render_mesh(mesh, mopt);
+  if (material_colors) opt.callback = material_shader(mesh, rm, in.materials, opt.wrap);
   const Camera cam = fit_camera(bounding_box(rm), a.view[0], a.view[1],
                                 a.ortho ? Camera::Projection::Orthographic : Camera::Projection::Perspective, 1.f);
   RenderResult res = render(rm, cam, opt);
@@ -121,16 +179,22 @@ int run(RenderArgs& a) {
   rep["view"] = {a.view[0], a.view[1]};
   rep["projection"] = a.ortho ? "orthographic" : "perspective";
   rep["colors"] = source;
+  rep["materials"] = in.materials.size();
+  rep["warnings"] = in.warnings;
   rep["coverage"] = covered / (double(opt.width) * opt.height);
   rep["triangles_clipped"] = res.triangles_clipped;
-  rep["seconds"] = {{"read", t_read}, {"render", t_render}, {"write", t_write}, {"total", total.seconds()}};
-  write_report(a.common, "render", rep);
+  rep["seconds"] = {{"read", t_read}, {"render", t_render}, {"write", t_write}};
+  RunFiles files{in.files_read, {a.output}};
+  files.inputs.push_back(a.texture);
+  for (const MeshMaterial& m : in.materials)
+    if (!m.texture.empty()) files.inputs.push_back(m.texture_file);
+  write_report(a.common, "render", rep, files);
   return 0;
 }
 
 SubcommandRegistrar reg{{"render", "Render a mesh to an image with the software rasterizer", [](CLI::App& app) -> std::function<int()> {
   auto a = std::make_shared<RenderArgs>();
-  app.add_option("input", a->input, "Mesh to render (OFF, OBJ, PLY, STL)")->required();
+  app.add_option("input", a->input, "Mesh to render (OFF, OBJ with its .mtl, PLY, STL, GLB, glTF)")->required();
   app.add_option("-o,--output", a->output, "Image to write (PNG, JPEG, TIFF, EXR: by extension)")->required();
   app.add_option("--texture", a->texture,
                  "Image texture mapped through the mesh's texture coordinates (the mesh must have them)");
@@ -153,9 +217,11 @@ SubcommandRegistrar reg{{"render", "Render a mesh to an image with the software 
       ->delimiter(',')
       ->expected(3);
   app.add_option("--colors", a->colors,
-                 "Vertex colours: auto (use them if the mesh has them), vertex (require them), none "
-                 "(default auto; --texture takes precedence)")
-      ->check(CLI::IsMember({"auto", "vertex", "none"}));
+                 "Colours: auto (the file's materials if they carry a texture or a colour, as a glTF "
+                 "viewer shows them: base colour x texture x vertex colour; else vertex colours if the mesh "
+                 "has them; else --color), material (require materials), vertex (require vertex colours), "
+                 "none (default auto; --texture takes precedence)")
+      ->check(CLI::IsMember({"auto", "material", "vertex", "none"}));
   app.add_flag("--flat", a->flat, "Flat shading with face normals (default: smooth vertex normals)");
   app.add_flag("--no-shade", a->no_shade, "No lighting: the raw colours (default: Lambert + ambient 0.25)");
   app.add_flag("--clamp", a->clamp, "Clamp texture coordinates to [0,1] (default: repeat)");

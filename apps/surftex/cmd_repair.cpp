@@ -71,7 +71,7 @@ int run_repair(const RepairArgs& a) {
   wo.overwrite = a.common.force;
   write_mesh(a.output, mesh, wo);
   report["seconds"]["write"] = t.seconds();
-  write_report(a.common, "repair", report);
+  write_report(a.common, "repair", report, {{a.input}, {a.output}});
 
   if (!a.common.quiet) {
     const RepairFound& f = r.found;

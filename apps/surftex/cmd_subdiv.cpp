@@ -105,8 +105,8 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
   WriteMeshOptions wo;
   wo.overwrite = force;
   wo.write_uvs = false;
-  write_mesh(o.ply, mesh, wo);
-  write_mesh(o.glb, mesh, wo);
+  std::vector<std::string> files = write_mesh(o.ply, mesh, wo);
+  for (const std::string& f : write_mesh(o.glb, mesh, wo)) files.push_back(f);
   j["seconds_write_mesh"] = t.seconds();
   t.reset();
   Mesh tri = triangulated_copy(mesh);
@@ -118,7 +118,7 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
   ao.overwrite = force;
   ao.write_colors = false;
   ao.texture = &baked.image;
-  write_mesh(o.obj, tri, ao);
+  for (const std::string& f : write_mesh(o.obj, tri, ao)) files.push_back(f);
   j["atlas"] = {{"charts", ar.num_charts}, {"size", atlas_size}, {"coverage", double(baked.covered) / (double(atlas_size) * atlas_size)},
                 {"mean_area_distortion", ar.mean_area_distortion}, {"flipped_faces", ar.flipped_faces},
                 {"seconds", t.seconds()}};
@@ -129,7 +129,8 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
   io.overwrite = force;
   write_image(o.render, render_view(mesh, view), io);
   j["seconds_render"] = t.seconds();
-  j["files"] = {o.ply, o.glb, o.obj, o.render};
+  files.push_back(o.render);
+  j["files"] = files;
   return j;
 }
 
@@ -204,15 +205,21 @@ int run_subdiv(const SubdivArgs& a) {
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
-  rep["seconds_read"] = seconds_read;
-  rep["outputs"] = write_outputs(mesh, out, a.common.force, a.atlas);
-  rep["seconds_total"] = total.seconds();
+  nlohmann::json written = write_outputs(mesh, out, a.common.force, a.atlas);
+  const RunFiles files{{a.mesh, a.exemplar}, written["files"].get<std::vector<std::string>>()};
+  rep["seconds"] = {{"read", seconds_read},
+                    {"synthesis", r.seconds_total},
+                    {"write_mesh", written["seconds_write_mesh"]},
+                    {"atlas", written["atlas"]["seconds"]},
+                    {"render", written["seconds_render"]}};
+  written.erase("files");
+  rep["export"] = written;
   CommonOptions ro = a.common;
   if (ro.report_path.empty()) {
     ro.report_path = (fs::path(a.outdir) / "report.json").string();
     ro.force = true;
   }
-  write_report(ro, "subdiv", rep);
+  write_report(ro, "subdiv", rep, files);
   if (!a.common.quiet)
     std::fprintf(stderr, "subdiv: %zu vertices after %d levels, %.1f s -> %s\n", static_cast<std::size_t>(mesh.number_of_vertices()), a.levels,
                  total.seconds(), a.outdir.c_str());

@@ -50,7 +50,7 @@ int run_swatch(const SwatchArgs& a) {
   r["vertices"] = m.number_of_vertices();
   r["elements"] = s.elements.size();
   r["extent"] = {s.length(), s.width(), s.height()};
-  write_report(a.common, "swatch", r);
+  write_report(a.common, "swatch", r, {{}, {a.output}});
   if (!a.common.quiet)
     std::fprintf(stderr, "%s swatch: %zu elements, %zu faces, %.3g x %.3g x %.3g -> %s\n", a.kind.c_str(),
                  s.elements.size(), static_cast<std::size_t>(m.number_of_faces()), s.length(), s.width(), s.height(),

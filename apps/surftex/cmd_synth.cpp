@@ -127,7 +127,7 @@ int run(const SynthArgs& a) {
     rep["orientations_searched"] = r.rotations_used;
     rep["seeded_pixels"] = r.seeded;
   }
-  rep["seconds"] = seconds;
+  rep["seconds"] = {{"synthesis", seconds}};
   rep["texels_per_second"] = (w * static_cast<double>(h)) / std::max(seconds, 1e-9);
   rep["bidirectional_similarity"] = {{"patch", bo.patch},
                                      {"stride", bo.stride},
@@ -136,8 +136,8 @@ int run(const SynthArgs& a) {
                                      {"completeness", bs.completeness},
                                      {"total", bs.total}};
   rep["histogram_chi_square"] = chi;
-  rep["metrics_seconds"] = mt.seconds();
-  write_report(a.common, "synth", rep);
+  rep["seconds"]["metrics"] = mt.seconds();
+  write_report(a.common, "synth", rep, {inputs, {a.output}});
   if (!a.common.quiet)
     std::printf("%s: %dx%d in %.2f s (%.0f texels/s), coherence %.5f, completeness %.5f, "
                 "histogram chi2 %.4f\n",

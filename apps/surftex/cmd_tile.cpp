@@ -60,7 +60,7 @@ int run_tile(const TileArgs& a) {
   report["overlap"] = a.overlap;
   report["passes"] = a.passes;
   report["straight_seam_steps"] = a.straight_seam_steps;
-  report["seconds"] = seconds;
+  report["seconds"] = {{"synthesis", seconds}};
   report["wrap_seam_ratio"] = t.wrap_seam_ratio;
   report["wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
   report["choose_cut"] = o.choose_cut;
@@ -72,7 +72,9 @@ int run_tile(const TileArgs& a) {
   report["synthesis_cut_percentile"] = {t.synthesis_column_percentile, t.synthesis_row_percentile};
   report["source_matched_wrap_ratio_at_synthesis_cut"] = t.source_matched_wrap_ratio_at_synthesis_cut;
   report["source_matched_worst_line_ratio"] = t.source_matched_worst_line_ratio;
-  write_report(a.common, "tile", report);
+  RunFiles files{{a.input}, {a.output}};
+  if (!a.preview.empty()) files.outputs.push_back(a.preview);
+  write_report(a.common, "tile", report, files);
   if (!a.common.quiet)
     std::fprintf(stderr,
                  "tile %dx%d written to %s in %.2f s, wrap-seam ratio %.3f (%.3f at the synthesis "

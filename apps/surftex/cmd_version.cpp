@@ -14,7 +14,7 @@ namespace {
 SubcommandRegistrar reg{{"version", "Print the versions of surftex and its libraries",
                          [](CLI::App&) -> std::function<int()> {
                            return [] {
-                             std::printf("surftex 0.1.0 (AGPL-3.0-or-later)\n");
+                             std::printf("surftex %s (AGPL-3.0-or-later)\n", surftex_version());
                              std::printf("CGAL %s, Eigen %d.%d.%d, OpenImageIO %s, Boost %d.%d\n",
                                          CGAL_VERSION_STR, EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION,
                                          EIGEN_MINOR_VERSION, OIIO_VERSION_STRING,

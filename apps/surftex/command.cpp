@@ -81,14 +81,6 @@ ProgressCallback terminal_progress(bool quiet) {
   };
 }
 
-void write_report(const CommonOptions& opt, const std::string& command, nlohmann::json report) {
-  if (opt.report_path.empty()) return;
-  report["command"] = command;
-  report["seed"] = opt.seed;
-  report["threads"] = opt.threads;
-  write_file_atomic(opt.report_path, report.dump(2) + "\n", true);
-}
-
 void require_input_file(const std::string& input, const std::string& what) {
   std::error_code ec;
   if (input.empty()) throw InvalidInputError(what + " path is empty");

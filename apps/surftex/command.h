@@ -17,6 +17,7 @@
 #include "geometry/load_input_mesh.h"
 #include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
+#include "surftex/report.h"
 
 namespace surftex::cli {
 
@@ -43,10 +44,6 @@ std::shared_ptr<void> apply_thread_limit(int threads);
 /// A progress callback that draws on stderr when it is a terminal and
 /// !quiet, and does nothing in pipes.
 ProgressCallback terminal_progress(bool quiet);
-
-/// Writes `report` (adds "command", "seed", "threads") atomically to
-/// opt.report_path if set.
-void write_report(const CommonOptions& opt, const std::string& command, nlohmann::json report);
 
 /// Throws InvalidInputError if `input` does not exist or is not a regular file.
 void require_input_file(const std::string& input, const std::string& what);

@@ -22,7 +22,18 @@ struct DemoContext {
   ProgressCallback progress;
   Image exemplar;  ///< a generated structured exemplar (step "synthesis")
   Image tile;      ///< a periodic tile (step "synthesis")
-  std::string path(const std::string& name) const { return (std::filesystem::path(dir) / name).string(); }
+  /// DIR/name. Every name asked for is remembered: the files (and the files
+  /// of the folders) among them that exist at the end are the demo report's
+  /// "outputs".
+  std::string path(const std::string& name) const {
+    named.push_back(name);
+    return (std::filesystem::path(dir) / name).string();
+  }
+  mutable std::vector<std::string> named;
+  /// Files a step wrote besides the names it asked path() for (write_mesh's
+  /// list: an OBJ's .mtl and texture), as paths.
+  void wrote(const std::vector<std::string>& paths) { written.insert(written.end(), paths.begin(), paths.end()); }
+  std::vector<std::string> written;
 };
 
 struct DemoStep {

@@ -28,6 +28,11 @@ PolygonSoup read_off(const std::string& path, std::string_view data);
 PolygonSoup read_obj(const std::string& path, std::string_view data);
 PolygonSoup read_ply(const std::string& path, std::string_view data);
 PolygonSoup read_stl(const std::string& path, std::string_view data);
+/// glTF 2.0: `binary` = GLB container, else the JSON text of a .gltf.
+PolygonSoup read_gltf(const std::string& path, std::string_view data, bool binary);
+/// Reads the .mtl files an OBJ soup names (soup.material_libraries, relative to
+/// the OBJ's folder) into soup.materials (read_mtl.cpp).
+void read_obj_materials(const std::string& obj_path, PolygonSoup& soup);
 
 /// True if the 84-byte header's triangle count matches the file size exactly.
 bool looks_like_binary_stl(std::string_view data);

@@ -18,6 +18,7 @@
 #include <unordered_map>
 
 #include "geometry/errors.h"
+#include "geometry/face_material.h"
 #include "geometry/mesh.h"
 #include "geometry/mesh_parsers.h"
 #include "geometry/properties.h"
@@ -150,7 +151,7 @@ namespace {
 
 using namespace mesh_io;
 
-enum class Format { Off, Obj, Ply, Stl, Unknown };
+enum class Format { Off, Obj, Ply, Stl, Glb, Gltf, Unknown };
 
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -167,6 +168,7 @@ bool is_off_keyword(std::string_view t) {
 }
 
 Format sniff(std::string_view data) {
+  if (data.substr(0, 4) == "glTF") return Format::Glb;
   if (data.substr(0, 4) == "ply\n" || data.substr(0, 5) == "ply\r\n") return Format::Ply;
   if (looks_like_binary_stl(data)) return Format::Stl;
   // First token of the first non-comment line.
@@ -226,25 +228,32 @@ PolygonSoup read_polygon_soup(const std::string& path) {
   std::string bytes = read_whole_file(path);
   if (bytes.empty()) throw IOError("'" + path + "' is empty (0 bytes)");
   std::string ext = lower(fs::path(path).extension().string());
-  Format fmt = ext == ".off"   ? Format::Off
-               : ext == ".obj" ? Format::Obj
-               : ext == ".ply" ? Format::Ply
-               : ext == ".stl" ? Format::Stl
-                               : sniff(bytes);
-  if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl") {
+  Format fmt = ext == ".off"    ? Format::Off
+               : ext == ".obj"  ? Format::Obj
+               : ext == ".ply"  ? Format::Ply
+               : ext == ".stl"  ? Format::Stl
+               : ext == ".glb"  ? Format::Glb
+               : ext == ".gltf" ? Format::Gltf
+                                : sniff(bytes);
+  if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl" && ext != ".glb" && ext != ".gltf") {
     const std::string image = image_signature(bytes);
     if (!image.empty())
-      throw IOError("'" + path + "' is a " + image + " image, not a mesh (mesh formats: OFF, OBJ, PLY, STL)");
+      throw IOError("'" + path + "' is a " + image + " image, not a mesh (mesh formats: OFF, OBJ, PLY, STL, glTF)");
   }
   PolygonSoup soup;
   switch (fmt) {
     case Format::Off: soup = read_off(path, bytes); break;
-    case Format::Obj: soup = read_obj(path, bytes); break;
+    case Format::Obj:
+      soup = read_obj(path, bytes);
+      read_obj_materials(path, soup);
+      break;
     case Format::Ply: soup = read_ply(path, bytes); break;
     case Format::Stl: soup = read_stl(path, bytes); break;
+    case Format::Glb: soup = read_gltf(path, bytes, true); break;
+    case Format::Gltf: soup = read_gltf(path, bytes, false); break;
     case Format::Unknown:
       throw IOError("'" + path + "': unknown mesh format (extension '" + ext +
-                    "' and content is none of OFF, OBJ, PLY, STL)");
+                    "' and content is none of OFF, OBJ, PLY, STL, GLB)");
   }
   soup.source = path;
   if (soup.polygons.empty())
@@ -332,6 +341,17 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
     }
   }
 
+  const bool has_materials = !soup.polygon_material.empty();
+  if (has_materials) {
+    if (soup.polygon_material.size() != soup.polygons.size())
+      throw InvalidInputError("'" + src + "': polygon_material does not match polygons");
+    for (std::size_t i = 0; i < soup.polygons.size(); ++i)
+      if (soup.polygon_material[i] < -1 || soup.polygon_material[i] >= static_cast<int>(soup.materials.size()))
+        throw InvalidInputError("'" + src + "' polygon " + std::to_string(i) + ": material " +
+                                std::to_string(soup.polygon_material[i]) + " out of range (" +
+                                std::to_string(soup.materials.size()) + " materials)");
+  }
+
   std::vector<Point3> pts;
   pts.reserve(soup.points.size());
   for (const auto& p : soup.points) pts.emplace_back(p[0], p[1], p[2]);
@@ -355,6 +375,12 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
       }
       uv_source.emplace(std::move(key), std::move(corners));
     }
+
+  // polygon key -> its material; the first polygon wins.
+  std::map<std::vector<Pos>, int> material_source;
+  if (has_materials)
+    for (std::size_t i = 0; i < soup.polygons.size(); ++i)
+      material_source.emplace(polygon_key(pts, soup.polygons[i]), soup.polygon_material[i]);
 
   auto& polys = soup.polygons;
   // The steps of PMP::repair_polygon_soup (CGAL 5.5, Polygon_soup_fixer), in
@@ -417,8 +443,21 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
     }
   }
 
+  if (has_materials) {
+    auto mat = get_or_add(mesh, kFaceMaterial, -1);
+    for (FaceIndex f : mesh.faces()) {
+      auto it = material_source.find(polygon_key(pts, polys[f.idx()]));
+      mat[f] = it == material_source.end() ? -1 : it->second;
+    }
+  }
+
   if (opt.triangulate) {
     std::vector<std::size_t> origin(mesh.number_of_faces(), SIZE_MAX);
+    std::vector<int> material_before;  // by face index, before splitting
+    if (has_materials) {
+      auto mat = find(mesh, kFaceMaterial).first;
+      for (FaceIndex f : mesh.faces()) material_before.push_back(mat[f]);
+    }
     std::size_t current = 0, split = 0;
     // UVs of the corners of each non-triangular face, before it is split.
     std::unordered_map<std::size_t, std::vector<std::pair<VertexIndex, UV>>> face_uvs;
@@ -453,6 +492,13 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
       }
     }
     c.faces_triangulated = split;
+    if (has_materials) {
+      auto mat = find(mesh, kFaceMaterial).first;
+      for (FaceIndex f : mesh.faces()) {
+        std::size_t i = f.idx();
+        if (i < origin.size() && origin[i] != SIZE_MAX) mat[f] = material_before[origin[i]];
+      }
+    }
     if (uvm.second)
       for (FaceIndex f : mesh.faces()) {
         std::size_t i = f.idx();
@@ -473,6 +519,17 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
 
 void read_mesh(const std::string& path, Mesh& mesh, const SoupToMeshOptions& opt, SoupRepairCounts* counts) {
   soup_to_mesh(read_polygon_soup(path), mesh, opt, counts);
+}
+
+MeshFileContents read_mesh_file(const std::string& path, Mesh& mesh, const SoupToMeshOptions& opt) {
+  PolygonSoup soup = read_polygon_soup(path);
+  MeshFileContents out;
+  out.materials = soup.materials;  // (soup_to_mesh checks the indices against them)
+  out.files_read.push_back(path);
+  for (std::string& f : soup.files_read) out.files_read.push_back(std::move(f));
+  out.warnings = std::move(soup.warnings);
+  soup_to_mesh(std::move(soup), mesh, opt, &out.counts);
+  return out;
 }
 
 }  // namespace surftex

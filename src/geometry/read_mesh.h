@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Mesh input: OFF, OBJ, PLY (ascii and binary), STL (ascii and binary).
+// Mesh input: OFF, OBJ (+ its .mtl materials), PLY (ascii and binary), STL
+// (ascii and binary), glTF 2.0 (.glb binary and .gltf JSON).
 // Files are parsed by surftex's own defensive readers into a polygon soup
 // (every count and index validated against the file size before allocating,
 // NaN/inf refused), which is then repaired and oriented (CGAL PMP
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
+#include "geometry/mesh_material.h"
 
 namespace surftex {
 
@@ -35,10 +37,27 @@ struct PolygonSoup {
   /// names where the first one was (file line or face number).
   std::size_t short_polygons_dropped = 0;
   std::string first_short_polygon;
+  /// Optional materials (OBJ usemtl + .mtl, glTF materials) and, parallel to
+  /// `polygons` when non-empty, each polygon's index into them (-1 = none).
+  std::vector<MeshMaterial> materials;
+  std::vector<int> polygon_material;
+  /// OBJ `mtllib` names as written (resolved by read_polygon_soup).
+  std::vector<std::string> material_libraries;
+  /// Files read besides `source` (.mtl files; external glTF buffers and images).
+  std::vector<std::string> files_read;
+  /// What was in the file but is not used, one line each (a missing .mtl, a
+  /// material no .mtl defines, glTF points and lines skipped, ...).
+  std::vector<std::string> warnings;
 };
 
-/// Reads any supported format (chosen by the extension .off/.obj/.ply/.stl,
-/// case-insensitive; by content for any other extension). Formats: OFF with
+/// Reads any supported format (chosen by the extension .off/.obj/.ply/.stl/
+/// .glb/.gltf, case-insensitive; by content for any other extension, a GLB by
+/// its "glTF" magic). OBJ: `mtllib` files are read from the OBJ's folder
+/// (newmtl, Kd, map_Kd: materials, texture files resolved against the .mtl's
+/// folder, not decoded here); a missing .mtl or an undefined material is a
+/// warning, not an error. glTF: see read_gltf.cpp (triangles of the default
+/// scene with node transforms; POSITION, indices, TEXCOORD_n of the
+/// base-colour texture, COLOR_0, materials; embedded or external textures). Formats: OFF with
 /// the ST/C/N prefixes (COFF colours as 0-255 integers or 0-1 floats), OBJ
 /// (v, vt, f with v/vt/vn forms and negative relative indices, polygons;
 /// `v x y z r g b` colours), PLY ascii / binary little / big endian (x,y,z of
@@ -100,5 +119,18 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt = {
 /// read_polygon_soup + soup_to_mesh.
 void read_mesh(const std::string& path, Mesh& mesh, const SoupToMeshOptions& opt = {},
                SoupRepairCounts* counts = nullptr);
+
+/// What read_mesh_file found besides the mesh.
+struct MeshFileContents {
+  SoupRepairCounts counts;
+  std::vector<MeshMaterial> materials;  ///< kFaceMaterial indexes these (textures not decoded)
+  std::vector<std::string> files_read;  ///< the mesh file, then .mtl / buffer / image files
+  std::vector<std::string> warnings;
+};
+
+/// read_mesh keeping the materials: kFaceMaterial is written when the file
+/// has any (through repair and triangulation, by the face's positions, as
+/// kCornerUV).
+MeshFileContents read_mesh_file(const std::string& path, Mesh& mesh, const SoupToMeshOptions& opt = {});
 
 }  // namespace surftex

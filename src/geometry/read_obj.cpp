@@ -2,8 +2,10 @@
 // OBJ reader: "v x y z [w]" or "v x y z r g b" (colours), "vt u [v [w]]",
 // "f a b c ..." with corners "v", "v/vt", "v//vn", "v/vt/vn" (1-based, or
 // negative = relative to the elements defined so far). Lines ending in '\'
-// continue on the next. vn, vp, l, p, o, g, s, mtllib, usemtl and unknown
-// keywords are ignored.
+// continue on the next. `mtllib` names are kept (soup.material_libraries,
+// read by read_mtl.cpp) and `usemtl` sets the material of the faces that
+// follow (soup.polygon_material). vn, vp, l, p, o, g, s and unknown keywords
+// are ignored.
 #include <algorithm>
 
 #include "geometry/errors.h"
@@ -39,6 +41,7 @@ PolygonSoup read_obj(const std::string& path, std::string_view data) {
   bool all_colored = true;
   std::size_t faces_with_uv = 0;
   std::vector<std::size_t> poly, puv;
+  int material = -1;  // usemtl in force, index into soup.materials
   while (lines.next(raw)) {
     std::size_t line_no = lines.line_no();
     std::string_view line = strip_comment(raw);
@@ -112,6 +115,7 @@ PolygonSoup read_obj(const std::string& path, std::string_view data) {
         continue;
       }
       soup.polygons.push_back(poly);
+      soup.polygon_material.push_back(material);
       if (uv_complete) {
         if (soup.polygon_uvs.size() < soup.polygons.size() - 1) soup.polygon_uvs.resize(soup.polygons.size() - 1);
         soup.polygon_uvs.push_back(puv);
@@ -119,9 +123,27 @@ PolygonSoup read_obj(const std::string& path, std::string_view data) {
       } else if (!soup.polygon_uvs.empty()) {
         soup.polygon_uvs.emplace_back();
       }
+    } else if (kw == "mtllib" || kw == "usemtl") {
+      // The rest of the line (names may hold blanks).
+      std::string_view rest = line.substr(line.find(kw) + kw.size());
+      while (!rest.empty() && (rest.front() == ' ' || rest.front() == '\t')) rest.remove_prefix(1);
+      while (!rest.empty() && (rest.back() == ' ' || rest.back() == '\t' || rest.back() == '\r')) rest.remove_suffix(1);
+      if (kw == "mtllib") {
+        if (!rest.empty()) soup.material_libraries.emplace_back(rest);
+      } else {
+        const std::string name(rest);
+        auto it = std::find_if(soup.materials.begin(), soup.materials.end(),
+                               [&](const MeshMaterial& m) { return m.name == name; });
+        material = static_cast<int>(it - soup.materials.begin());
+        if (it == soup.materials.end()) {
+          soup.materials.emplace_back();
+          soup.materials.back().name = name;
+        }
+      }
     }
-    // vn, vp, l, p, o, g, s, mtllib, usemtl, ...: not needed here.
+    // vn, vp, l, p, o, g, s, ...: not needed here.
   }
+  if (soup.materials.empty()) soup.polygon_material.clear();
   if (!all_colored || soup.colors.size() != soup.points.size()) soup.colors.clear();
   if (faces_with_uv == 0) {
     soup.uvs.clear();

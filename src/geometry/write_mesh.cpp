@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "geometry/errors.h"
+#include "geometry/face_material.h"
 #include "geometry/newell.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
@@ -134,27 +135,114 @@ void write_bytes(std::ofstream& f, const std::string& path) {
   if (!f) throw IOError("write to '" + path + "' failed (disk full?)");
 }
 
+// ------------------------------------------------------------------ materials
+/// A material as written: WriteMeshOptions::materials, or the one material
+/// of WriteMeshOptions::texture.
+struct OutMaterial {
+  std::string name;
+  std::array<float, 3> color{1.f, 1.f, 1.f};
+  const Image* texture = nullptr;
+};
+
+struct MaterialGroups {
+  std::vector<OutMaterial> materials;  // empty: no material at all (OBJ without .mtl)
+  std::vector<std::size_t> face;       // per gathered face: index into materials
+};
+
+// OBJ names end at a blank for many readers: blanks become '_', and repeated
+// names get a suffix.
+std::string unique_name(std::string name, const std::vector<OutMaterial>& taken) {
+  if (name.empty()) name = "material";
+  for (char& c : name)
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') c = '_';
+  std::string n = name;
+  for (int k = 2;; ++k) {
+    bool used = false;
+    for (const auto& t : taken) used = used || t.name == n;
+    if (!used) return n;
+    n = name + "_" + std::to_string(k);
+  }
+}
+
+MaterialGroups material_groups(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  MaterialGroups g;
+  const bool listed = opt.materials != nullptr && !opt.materials->empty();
+  if (listed && opt.texture != nullptr)
+    throw InvalidInputError("cannot write '" + path + "': both a texture and a material list given");
+  g.face.assign(mesh.number_of_faces(), 0);
+  if (!listed) {
+    if (opt.texture != nullptr && !opt.texture->empty()) g.materials.push_back({"surftex_material", {1.f, 1.f, 1.f}, opt.texture});
+    return g;
+  }
+  for (const MeshMaterial& m : *opt.materials)
+    g.materials.push_back({unique_name(m.name, g.materials), m.base_color, m.texture.empty() ? nullptr : &m.texture});
+  auto fm = find(mesh, kFaceMaterial);
+  std::size_t k = 0, fallback = SIZE_MAX;
+  for (FaceIndex f : mesh.faces()) {
+    const int id = fm.second ? fm.first[f] : 0;
+    if (id >= 0 && static_cast<std::size_t>(id) < opt.materials->size()) {
+      g.face[k++] = static_cast<std::size_t>(id);
+      continue;
+    }
+    if (fallback == SIZE_MAX) {
+      fallback = g.materials.size();
+      g.materials.push_back({unique_name("surftex_default", g.materials), {1.f, 1.f, 1.f}, nullptr});
+    }
+    g.face[k++] = fallback;
+  }
+  return g;
+}
+
+// The texture file of material k beside an OBJ: <stem>.png when one material
+// has a texture, else <stem>_<k>.png.
+std::vector<std::string> texture_names(const std::string& stem, const MaterialGroups& g) {
+  std::size_t textured = 0;
+  for (const auto& m : g.materials) textured += m.texture != nullptr;
+  std::vector<std::string> names(g.materials.size());
+  for (std::size_t k = 0; k < g.materials.size(); ++k)
+    if (g.materials[k].texture)
+      names[k] = textured == 1 ? stem + ".png" : stem + "_" + std::to_string(k) + ".png";
+  return names;
+}
+
 // ------------------------------------------------------------------ OBJ
-void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+std::string obj_mtl_text(const MaterialGroups& g, const std::vector<std::string>& png) {
+  std::string m = "# written by surftex\n";
+  for (std::size_t k = 0; k < g.materials.size(); ++k) {
+    const auto& c = g.materials[k].color;
+    m += "newmtl " + g.materials[k].name + "\nKa 1 1 1\nKd ";
+    for (int i = 0; i < 3; ++i) {
+      append_num(m, c[i]);
+      m += i < 2 ? " " : "\n";
+    }
+    m += "Ks 0 0 0\nd 1\nillum 1\n";
+    if (!png[k].empty()) m += "map_Kd " + png[k] + "\n";
+  }
+  return m;
+}
+
+std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   Gathered g = gather(path, mesh, opt, true);
+  const MaterialGroups groups = material_groups(path, mesh, opt);
   fs::path p(path);
   const std::string stem = p.stem().string();
-  const bool textured = opt.texture != nullptr && !opt.texture->empty();
+  const bool with_mtl = !groups.materials.empty();
   const fs::path dir = p.parent_path();
-  const std::string mtl_name = stem + ".mtl", png_name = stem + ".png";
-  // All three files are prepared as temporaries first and renamed at the end,
-  // so a failure leaves none of them (and !overwrite refuses before writing).
+  const std::string mtl_name = stem + ".mtl";
+  const std::vector<std::string> png_names = texture_names(stem, groups);
+  // Every file is prepared as a temporary first and renamed at the end, so a
+  // failure leaves none of them (and !overwrite refuses before writing).
   AtomicOutputFile obj_out(path, opt.overwrite);
-  std::unique_ptr<AtomicOutputFile> mtl_out, png_out;
-  if (textured) {
-    mtl_out = std::make_unique<AtomicOutputFile>((dir / mtl_name).string(), opt.overwrite);
-    png_out = std::make_unique<AtomicOutputFile>((dir / png_name).string(), opt.overwrite);
-  }
+  std::unique_ptr<AtomicOutputFile> mtl_out;
+  std::vector<std::unique_ptr<AtomicOutputFile>> png_out(groups.materials.size());
+  if (with_mtl) mtl_out = std::make_unique<AtomicOutputFile>((dir / mtl_name).string(), opt.overwrite);
+  for (std::size_t k = 0; k < png_names.size(); ++k)
+    if (!png_names[k].empty()) png_out[k] = std::make_unique<AtomicOutputFile>((dir / png_names[k]).string(), opt.overwrite);
 
   std::string s;
   s.reserve(g.pos.size() * 60 + g.faces.size() * 40);
   s += "# written by surftex\n";
-  if (textured) s += "mtllib " + mtl_name + "\n";
+  if (with_mtl) s += "mtllib " + mtl_name + "\n";
   for (std::size_t i = 0; i < g.pos.size(); ++i) {
     s += "v ";
     append_num(s, g.pos[i][0]);
@@ -197,26 +285,30 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     append_num(s, n[2]);
     s += '\n';
   }
-  if (textured) s += "usemtl surftex_material\n";
-  for (std::size_t f = 0; f < g.faces.size(); ++f) {
-    s += 'f';
-    for (std::size_t k = 0; k < g.faces[f].size(); ++k) {
-      const std::string v = std::to_string(g.faces[f][k] + 1);
-      s += ' ';
-      s += v;
-      if (g.has_uv) s += "/" + std::to_string(face_vt[f][k] + 1);
-      if (!g.normals.empty()) s += (g.has_uv ? "/" : "//") + v;
+  // Faces grouped by material (file order within a group).
+  for (std::size_t k = 0; k < std::max<std::size_t>(groups.materials.size(), 1); ++k) {
+    if (with_mtl) s += "usemtl " + groups.materials[k].name + "\n";
+    for (std::size_t f = 0; f < g.faces.size(); ++f) {
+      if (with_mtl && groups.face[f] != k) continue;
+      s += 'f';
+      for (std::size_t c = 0; c < g.faces[f].size(); ++c) {
+        const std::string v = std::to_string(g.faces[f][c] + 1);
+        s += ' ';
+        s += v;
+        if (g.has_uv) s += "/" + std::to_string(face_vt[f][c] + 1);
+        if (!g.normals.empty()) s += (g.has_uv ? "/" : "//") + v;
+      }
+      s += '\n';
     }
-    s += '\n';
   }
 
-  if (textured) {
-    write_image(png_out->temp_path(), *opt.texture);
-    std::string m = "# written by surftex\nnewmtl surftex_material\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n";
-    m += "map_Kd " + png_name + "\n";
+  std::vector<std::string> written{path};
+  if (with_mtl) {
+    for (std::size_t k = 0; k < png_out.size(); ++k)
+      if (png_out[k]) write_image(png_out[k]->temp_path(), *groups.materials[k].texture);
     std::ofstream f(mtl_out->temp_path(), std::ios::binary);
     if (!f) throw IOError("cannot open '" + mtl_out->temp_path() + "' for writing");
-    f << m;
+    f << obj_mtl_text(groups, png_names);
     write_bytes(f, mtl_out->destination());
   }
   {
@@ -225,11 +317,17 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     f.write(s.data(), static_cast<std::streamsize>(s.size()));
     write_bytes(f, path);
   }
-  if (textured) {
-    png_out->commit();
+  for (auto& out : png_out)
+    if (out) {
+      out->commit();
+      written.push_back(out->destination());
+    }
+  if (with_mtl) {
     mtl_out->commit();
+    written.insert(written.begin() + 1, mtl_out->destination());
   }
   obj_out.commit();
+  return written;
 }
 
 // ------------------------------------------------------------------ PLY
@@ -312,11 +410,17 @@ std::string png_bytes(const std::string& beside, const Image& img) {
 
 void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   Gathered g = gather(path, mesh, opt, true);
-  const bool textured = opt.texture != nullptr && !opt.texture->empty();
+  MaterialGroups groups = material_groups(path, mesh, opt);
+  if (groups.materials.empty()) groups.materials.push_back({"surftex_material", {1.f, 1.f, 1.f}, nullptr});
+  for (const auto& m : groups.materials)
+    if (m.texture && !g.has_uv)
+      throw InvalidInputError("cannot write '" + path + "': material '" + m.name +
+                              "' has a texture but the mesh has no texture coordinates to map it with");
   // One glTF vertex per distinct (vertex, uv) pair: vertices are split at UV seams.
   std::vector<std::size_t> src;          // glTF vertex -> mesh vertex (compact id)
   std::vector<std::array<float, 2>> tc;  // glTF TEXCOORD_0 (v flipped)
-  std::vector<std::uint32_t> indices;
+  // Triangles per material: one primitive each, sharing the vertex attributes.
+  std::vector<std::vector<std::uint32_t>> indices(groups.materials.size());
   std::map<std::pair<std::size_t, std::array<double, 2>>, std::uint32_t> key_to_id;
   auto vid = [&](std::size_t v, HalfedgeIndex h) -> std::uint32_t {
     std::array<double, 2> uv{0.0, 0.0};
@@ -332,10 +436,11 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
   for (std::size_t f = 0; f < g.faces.size(); ++f) {
     const auto& fv = g.faces[f];
     const std::uint32_t a = vid(fv[0], g.corners[f][0]);
+    std::vector<std::uint32_t>& out = indices[groups.face[f]];
     for (std::size_t k = 1; k + 1 < fv.size(); ++k) {  // fan over polygons
-      indices.push_back(a);
-      indices.push_back(vid(fv[k], g.corners[f][k]));
-      indices.push_back(vid(fv[k + 1], g.corners[f][k + 1]));
+      out.push_back(a);
+      out.push_back(vid(fv[k], g.corners[f][k]));
+      out.push_back(vid(fv[k + 1], g.corners[f][k + 1]));
     }
   }
   if (src.size() > 0xffffffffu) throw InvalidInputError("cannot write '" + path + "': too many vertices for glTF");
@@ -410,44 +515,54 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     prim.attributes["_" + opt.vertex_scalar_property] =
         add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, src.size());
   }
-  {
-    int view = add_view(indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-    prim.indices = add_accessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
-  }
 
-  tinygltf::Material mat;
-  mat.name = "surftex_material";
-  mat.pbrMetallicRoughness.metallicFactor = 0.0;
-  mat.pbrMetallicRoughness.roughnessFactor = 1.0;
-  mat.doubleSided = true;
-  if (textured) {
-    std::string png = png_bytes(path, *opt.texture);
-    int view = add_view(png.data(), png.size(), 0);
-    model.bufferViews[view].target = 0;
-    tinygltf::Image im;
-    im.name = "texture";
-    im.mimeType = "image/png";
-    im.bufferView = view;
-    model.images.push_back(im);
-    tinygltf::Sampler smp;
-    smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-    smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-    smp.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
-    smp.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
-    model.samplers.push_back(smp);
-    tinygltf::Texture tex;
-    tex.source = 0;
-    tex.sampler = 0;
-    model.textures.push_back(tex);
-    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+  // One glTF material per material (metallic 0, roughness 1, double-sided),
+  // its texture embedded as PNG; one sampler for all (repeat, trilinear).
+  for (std::size_t k = 0; k < groups.materials.size(); ++k) {
+    const OutMaterial& om = groups.materials[k];
+    tinygltf::Material mat;
+    mat.name = om.name;
+    mat.pbrMetallicRoughness.baseColorFactor = {om.color[0], om.color[1], om.color[2], 1.0};
+    mat.pbrMetallicRoughness.metallicFactor = 0.0;
+    mat.pbrMetallicRoughness.roughnessFactor = 1.0;
+    mat.doubleSided = true;
+    if (om.texture) {
+      std::string png = png_bytes(path, *om.texture);
+      int view = add_view(png.data(), png.size(), 0);
+      model.bufferViews[view].target = 0;
+      tinygltf::Image im;
+      im.name = model.images.empty() ? "texture" : "texture_" + std::to_string(model.images.size());
+      im.mimeType = "image/png";
+      im.bufferView = view;
+      model.images.push_back(im);
+      if (model.samplers.empty()) {
+        tinygltf::Sampler smp;
+        smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+        smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+        smp.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
+        smp.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
+        model.samplers.push_back(smp);
+      }
+      tinygltf::Texture tex;
+      tex.source = static_cast<int>(model.images.size() - 1);
+      tex.sampler = 0;
+      model.textures.push_back(tex);
+      mat.pbrMetallicRoughness.baseColorTexture.index = static_cast<int>(model.textures.size() - 1);
+    }
+    model.materials.push_back(mat);
   }
-  model.materials.push_back(mat);
-  prim.material = 0;
-  while (buf.size() % 4) buf.push_back(0);
-
   tinygltf::Mesh gm;
   gm.name = "surftex_mesh";
-  gm.primitives.push_back(prim);
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (indices[k].empty()) continue;
+    int view = add_view(indices[k].data(), indices[k].size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Primitive p = prim;
+    p.indices = add_accessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices[k].size());
+    p.material = static_cast<int>(k);
+    gm.primitives.push_back(p);
+  }
+  while (buf.size() % 4) buf.push_back(0);
+
   model.meshes.push_back(gm);
   tinygltf::Node node;
   node.mesh = 0;
@@ -466,15 +581,16 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
 
 }  // namespace
 
-void write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   const std::string ext = lower(fs::path(path).extension().string());
-  if (ext == ".obj") write_obj(path, mesh, opt);
-  else if (ext == ".ply") write_ply(path, mesh, opt);
+  if (ext == ".obj") return write_obj(path, mesh, opt);
+  if (ext == ".ply") write_ply(path, mesh, opt);
   else if (ext == ".off") write_off(path, mesh, opt);
   else if (ext == ".glb") write_glb(path, mesh, opt);
   else
     throw InvalidInputError("cannot write '" + path + "': unknown mesh format '" + ext +
                             "' (supported: .obj, .ply, .off, .glb)");
+  return {path};
 }
 
 }  // namespace surftex

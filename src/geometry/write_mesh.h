@@ -6,9 +6,11 @@
 // PNG texture). Every writer is atomic (temporary + rename).
 
 #include <string>
+#include <vector>
 
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
+#include "geometry/mesh_material.h"
 
 namespace surftex {
 
@@ -20,8 +22,14 @@ struct WriteMeshOptions {
   /// Use kVertexNormal if present, else compute smooth normals (glTF, OBJ).
   bool write_normals = true;
   /// Texture image for OBJ (written as <stem>.png beside it, referenced by the
-  /// .mtl) and glTF (embedded). Ignored if empty.
+  /// .mtl) and glTF (embedded): one material for every face. Ignored if empty.
   const Image* texture = nullptr;
+  /// Several materials instead (not with `texture`): faces choose theirs by
+  /// kFaceMaterial (all faces the first when the mesh has no such map; faces
+  /// with -1 or an index past the list get a white "surftex_default"). Each
+  /// is written with its name (blanks become '_'), base colour and decoded
+  /// texture (MeshMaterial::texture; empty = none). Not owned.
+  const std::vector<MeshMaterial>* materials = nullptr;
   /// Extra per-vertex scalar written as a PLY property / glTF attribute
   /// "_<name>" (e.g. the material coordinate m). Empty = none.
   std::string vertex_scalar_property;
@@ -31,9 +39,11 @@ struct WriteMeshOptions {
 /// Format by extension (case-insensitive):
 /// - .obj: `v x y z [r g b]` (colours if kVertexColor and write_colors), `vt`
 ///   per distinct corner UV of kCornerUV (v as stored: origin bottom-left),
-///   `vn` per vertex, `f v/vt/vn`. With a texture: `mtllib <stem>.mtl`, and
-///   <stem>.mtl (map_Kd <stem>.png) and <stem>.png written beside it. The
-///   three files are renamed into place together at the end.
+///   `vn` per vertex, `f v/vt/vn`. With a texture or materials: `mtllib
+///   <stem>.mtl`, faces grouped under `usemtl NAME`, and <stem>.mtl (newmtl,
+///   Kd, map_Kd) with the textures beside it: <stem>.png when one material has
+///   a texture, <stem>_<k>.png for material k otherwise. The files are renamed
+///   into place together at the end.
 /// - .ply: binary little-endian, float x/y/z, optional uchar red/green/blue,
 ///   optional float <vertex_scalar_property>, face list uchar (uint if a face
 ///   has > 255 corners) int vertex_indices.
@@ -42,14 +52,17 @@ struct WriteMeshOptions {
 /// - .glb: glTF 2.0 binary, one triangle primitive (polygons fanned):
 ///   POSITION (with min/max), NORMAL, TEXCOORD_0 (vertices split at UV seams,
 ///   one glTF vertex per distinct (vertex, uv); stored as (u, 1 - v) since
-///   glTF's UV origin is top-left), COLOR_0 (float RGB), "_<scalar>"; a PBR
-///   material (metallic 0, roughness 1, double-sided) with the texture
-///   embedded as PNG as its base colour.
-/// Properties read: kVertexColor, kCornerUV, kVertexNormal (else computed,
+///   glTF's UV origin is top-left), COLOR_0 (float RGB), "_<scalar>"; one
+///   primitive per material used (all sharing the vertex attributes), one
+///   PBR material (metallic 0, roughness 1, double-sided, baseColorFactor)
+///   per material with its texture embedded as PNG as its base colour. A
+///   texture on a mesh without kCornerUV is refused (InvalidInputError).
+/// Properties read: kVertexColor, kCornerUV, kFaceMaterial, kVertexNormal (else computed,
 /// area-weighted), the named scalar. Throws InvalidInputError (unknown
 /// extension, no faces, non-finite position, missing scalar property) or
 /// IOError (cannot write; output exists and !overwrite). A failed write
-/// leaves no file behind.
-void write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt = {});
+/// leaves no file behind. Returns the paths of the files written (`path`
+/// first, then an OBJ's .mtl and texture images), for the run's report.
+std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt = {});
 
 }  // namespace surftex

@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// write_mesh with several materials (WriteMeshOptions::materials): one glTF
+// material and primitive per material, OBJ usemtl groups and one texture file
+// per textured material; they read back as written.
+#include <gtest/gtest.h>
+#include <tiny_gltf.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "geometry/errors.h"
+#include "geometry/face_material.h"
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/write_mesh.h"
+#include "test_support.h"
+
+using namespace surftex;
+namespace fs = std::filesystem;
+
+namespace {
+
+Image flat(float r, float g, float b) {
+  Image img(4, 4, 3);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) img.at(x, y, 0) = r, img.at(x, y, 1) = g, img.at(x, y, 2) = b;
+  return img;
+}
+
+// A torus with UVs whose faces use three materials by their index mod 3:
+// red texture, blue texture, and a plain green colour.
+Mesh three_material_torus(std::vector<MeshMaterial>& mats) {
+  Mesh m;
+  make_torus(m, 1.0, 0.4, 12, 6);
+  assign_torus_uvs(m, 1.0, 1.0, 1.0);
+  auto fm = get_or_add(m, kFaceMaterial, -1);
+  for (FaceIndex f : m.faces()) fm[f] = static_cast<int>(f.idx() % 3);
+  mats.resize(3);
+  mats[0].name = "red paint";
+  mats[0].texture = flat(1, 0, 0);
+  mats[1].name = "blue";
+  mats[1].texture = flat(0, 0, 1);
+  mats[2].name = "green";
+  mats[2].base_color = {0.f, 1.f, 0.f};
+  return m;
+}
+
+std::string slurp(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST(WriteMeshMaterials, GlbHasOneMaterialAndPrimitivePerMaterial) {
+  std::vector<MeshMaterial> mats;
+  const Mesh m = three_material_torus(mats);
+  const std::string d = test::temp_dir("wmm");
+  WriteMeshOptions wo;
+  wo.materials = &mats;
+  EXPECT_EQ(write_mesh(d + "/t.glb", m, wo), std::vector<std::string>{d + "/t.glb"});
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, d + "/t.glb")) << err;
+  ASSERT_EQ(model.materials.size(), 3u);
+  EXPECT_EQ(model.materials[0].name, "red_paint");
+  EXPECT_EQ(model.materials[2].pbrMetallicRoughness.baseColorTexture.index, -1);
+  EXPECT_DOUBLE_EQ(model.materials[2].pbrMetallicRoughness.baseColorFactor[1], 1.0);
+  EXPECT_DOUBLE_EQ(model.materials[2].pbrMetallicRoughness.baseColorFactor[0], 0.0);
+  EXPECT_EQ(model.images.size(), 2u);
+  ASSERT_EQ(model.meshes[0].primitives.size(), 3u);
+  std::size_t tris = 0;
+  for (const auto& p : model.meshes[0].primitives) tris += model.accessors[p.indices].count / 3;
+  EXPECT_EQ(tris, m.number_of_faces());
+  // Read back: the faces keep their materials, the textures their colours.
+  Mesh back;
+  MeshFileContents in = read_mesh_file(d + "/t.glb", back);
+  ASSERT_EQ(in.materials.size(), 3u);
+  load_material_textures(in.materials);
+  EXPECT_FLOAT_EQ(in.materials[1].texture.at(1, 1, 2), 1.f);
+  auto fm = find(back, kFaceMaterial).first;
+  std::vector<int> count(3, 0);
+  for (FaceIndex f : back.faces()) ++count[static_cast<std::size_t>(fm[f])];
+  EXPECT_EQ(count, std::vector<int>(3, static_cast<int>(m.number_of_faces() / 3)));
+}
+
+TEST(WriteMeshMaterials, ObjWritesUsemtlGroupsAndATextureEach) {
+  std::vector<MeshMaterial> mats;
+  const Mesh m = three_material_torus(mats);
+  const std::string d = test::temp_dir("wmm");
+  WriteMeshOptions wo;
+  wo.materials = &mats;
+  const auto files = write_mesh(d + "/t.obj", m, wo);
+  EXPECT_EQ(files, (std::vector<std::string>{d + "/t.obj", d + "/t.mtl", d + "/t_0.png", d + "/t_1.png"}));
+  const std::string mtl = slurp(d + "/t.mtl");
+  EXPECT_NE(mtl.find("newmtl red_paint\n"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("map_Kd t_1.png"), std::string::npos) << mtl;
+  EXPECT_NE(mtl.find("newmtl green\nKa 1 1 1\nKd 0 1 0\n"), std::string::npos) << mtl;
+  Mesh back;
+  MeshFileContents in = read_mesh_file(d + "/t.obj", back);
+  ASSERT_EQ(in.materials.size(), 3u);
+  EXPECT_EQ(fs::path(in.materials[0].texture_file).filename(), "t_0.png");
+  EXPECT_FLOAT_EQ(in.materials[2].base_color[1], 1.f);
+  auto fm = find(back, kFaceMaterial).first;
+  std::vector<int> count(3, 0);
+  for (FaceIndex f : back.faces()) ++count[static_cast<std::size_t>(fm[f])];
+  EXPECT_EQ(count, std::vector<int>(3, static_cast<int>(m.number_of_faces() / 3)));
+}
+
+TEST(WriteMeshMaterials, TextureWithoutUvsIsRefused) {
+  // A GLB whose texture has no TEXCOORD_0 is invalid glTF
+  // (MESH_PRIMITIVE_TOO_FEW_TEXCOORDS): refused, nothing written.
+  Mesh m;
+  make_icosphere(m, 1);
+  const Image tex = flat(1, 1, 0);
+  const std::string d = test::temp_dir("wmm");
+  WriteMeshOptions wo;
+  wo.texture = &tex;
+  EXPECT_THROW(write_mesh(d + "/s.glb", m, wo), InvalidInputError);
+  EXPECT_FALSE(fs::exists(d + "/s.glb"));
+}
