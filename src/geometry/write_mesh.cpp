@@ -135,6 +135,46 @@ void write_bytes(std::ofstream& f, const std::string& path) {
 }
 
 // ------------------------------------------------------------------ OBJ
+/// The PBR maps of an OBJ's material (write_mesh.h): staged files beside the
+/// OBJ and their MTL lines.
+struct ObjPbrMap {
+  std::unique_ptr<AtomicOutputFile> file;
+  const Image* image = nullptr;
+  bool sixteen_bit = false;
+  void write() const {
+    WriteImageOptions io;
+    io.sixteen_bit = sixteen_bit;
+    write_image(file->temp_path(), *image, io);
+  }
+};
+struct ObjPbrMaps {
+  std::vector<ObjPbrMap> maps;
+  std::string mtl_lines;
+};
+
+ObjPbrMaps obj_pbr_maps(const fs::path& dir, const std::string& stem, const WriteMeshOptions& opt, bool textured) {
+  ObjPbrMaps r;
+  if (!textured) return r;
+  auto add = [&](const Image* img, const std::string& suffix, bool wide, const std::string& lines) {
+    if (img == nullptr || img->empty()) return;
+    const std::string name = stem + suffix;
+    ObjPbrMap m;
+    m.file = std::make_unique<AtomicOutputFile>((dir / name).string(), opt.overwrite);
+    m.image = img;
+    m.sixteen_bit = wide;
+    r.maps.push_back(std::move(m));
+    std::string l = lines;
+    for (std::size_t at; (at = l.find('@')) != std::string::npos;) l.replace(at, 1, name);
+    r.mtl_lines += l;
+  };
+  // `norm` (tangent-space normal map) and `map_Bump` with the same file:
+  // Blender's importer reads map_Bump as a normal map.
+  add(opt.normal_texture, "_normal.png", false, "norm @\nmap_Bump @\n");
+  add(opt.height_texture, "_height.png", true, "disp @\n");
+  add(opt.metallic_roughness_texture, "_roughness.png", false, "map_Pr -imfchan g @\n");
+  return r;
+}
+
 void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   Gathered g = gather(path, mesh, opt, true);
   fs::path p(path);
@@ -142,7 +182,7 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
   const bool textured = opt.texture != nullptr && !opt.texture->empty();
   const fs::path dir = p.parent_path();
   const std::string mtl_name = stem + ".mtl", png_name = stem + ".png";
-  // All three files are prepared as temporaries first and renamed at the end,
+  // All files are prepared as temporaries first and renamed at the end,
   // so a failure leaves none of them (and !overwrite refuses before writing).
   AtomicOutputFile obj_out(path, opt.overwrite);
   std::unique_ptr<AtomicOutputFile> mtl_out, png_out;
@@ -150,6 +190,7 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     mtl_out = std::make_unique<AtomicOutputFile>((dir / mtl_name).string(), opt.overwrite);
     png_out = std::make_unique<AtomicOutputFile>((dir / png_name).string(), opt.overwrite);
   }
+  ObjPbrMaps pbr = obj_pbr_maps(dir, stem, opt, textured);
 
   std::string s;
   s.reserve(g.pos.size() * 60 + g.faces.size() * 40);
@@ -214,6 +255,7 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     write_image(png_out->temp_path(), *opt.texture);
     std::string m = "# written by surftex\nnewmtl surftex_material\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\n";
     m += "map_Kd " + png_name + "\n";
+    m += pbr.mtl_lines;
     std::ofstream f(mtl_out->temp_path(), std::ios::binary);
     if (!f) throw IOError("cannot open '" + mtl_out->temp_path() + "' for writing");
     f << m;
@@ -226,7 +268,9 @@ void write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     write_bytes(f, path);
   }
   if (textured) {
+    for (auto& m : pbr.maps) m.write();
     png_out->commit();
+    for (auto& m : pbr.maps) m.file->commit();
     mtl_out->commit();
   }
   obj_out.commit();
@@ -401,7 +445,7 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     for (std::size_t i = 0; i < src.size(); ++i)
       for (int k = 0; k < 3; ++k) c[3 * i + k] = std::clamp(g.colors[src[i]][k], 0.f, 1.f);
     int view = add_view(c.data(), c.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["COLOR_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
+    prim.attributes[opt.color_attribute] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
   }
   if (!g.scalar.empty()) {
     std::vector<float> sv(src.size());
@@ -420,26 +464,36 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
   mat.pbrMetallicRoughness.metallicFactor = 0.0;
   mat.pbrMetallicRoughness.roughnessFactor = 1.0;
   mat.doubleSided = true;
-  if (textured) {
-    std::string png = png_bytes(path, *opt.texture);
+  // One embedded PNG per map, all through one sampler.
+  auto add_texture = [&](const Image& img, const char* name) -> int {
+    if (model.samplers.empty()) {
+      tinygltf::Sampler smp;
+      smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+      smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+      smp.wrapS = smp.wrapT = opt.texture_repeat ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      model.samplers.push_back(smp);
+    }
+    std::string png = png_bytes(path, img);
     int view = add_view(png.data(), png.size(), 0);
     model.bufferViews[view].target = 0;
     tinygltf::Image im;
-    im.name = "texture";
+    im.name = name;
     im.mimeType = "image/png";
     im.bufferView = view;
     model.images.push_back(im);
-    tinygltf::Sampler smp;
-    smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-    smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-    smp.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
-    smp.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
-    model.samplers.push_back(smp);
     tinygltf::Texture tex;
-    tex.source = 0;
+    tex.source = static_cast<int>(model.images.size() - 1);
     tex.sampler = 0;
     model.textures.push_back(tex);
-    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+    return static_cast<int>(model.textures.size() - 1);
+  };
+  if (textured) {
+    mat.pbrMetallicRoughness.baseColorTexture.index = add_texture(*opt.texture, "texture");
+    if (opt.normal_texture != nullptr && !opt.normal_texture->empty())
+      mat.normalTexture.index = add_texture(*opt.normal_texture, "normal");
+    if (opt.metallic_roughness_texture != nullptr && !opt.metallic_roughness_texture->empty())
+      mat.pbrMetallicRoughness.metallicRoughnessTexture.index =
+          add_texture(*opt.metallic_roughness_texture, "metallic_roughness");
   }
   model.materials.push_back(mat);
   prim.material = 0;
