@@ -2,15 +2,17 @@
 #pragma once
 // A multi-chart uv atlas of a triangle mesh ready for baking at a given
 // texel size with mip-safe gutters (issue 16 item 3): the charts of
-// geometry/base_mesh_atlas.h packed with a spacing of more than twice the
-// gutter of geometry/atlas_gutter.h, every face rasterised in uv space
-// (geometry/uv_raster.h, one texel band), and the spacing verified on the
-// texels: if a chart's gutter would reach another chart's texels, the atlas
-// is rebuilt with 1.5x the spacing (at most 3 times; the spacing is capped at
-// the atlas's limit of 0.099 of the side, reported by `violations`).
+// geometry/base_mesh_atlas.h (segmentation, LSCM, rotation) repacked in
+// texels: shelf packing of their boxes (tallest first) with 2 g + 3 texels
+// between boxes and from the border (g = the gutter of geometry/
+// atlas_gutter.h, plus the raster's one-texel band on each side), at the
+// largest common scale that fits (bisection). Then every face is rasterised
+// in uv space (geometry/uv_raster.h) and the gutters are verified on the
+// texels (`violations`, 0 by construction).
 //
 // Writes kCornerUV and kFacePatch. Throws what compute_base_mesh_atlas and
-// rasterize_uv_triangles throw.
+// rasterize_uv_triangles throw, and InvalidInputError when the charts cannot
+// fit with their gutters.
 
 #include <vector>
 
@@ -26,7 +28,7 @@ struct GutterAtlas {
   std::vector<int> chart;   ///< per texel: chart id, -1 = empty
   std::vector<int> owner;   ///< per texel: chart after dilation (every texel >= 0)
   int gutter = 0;           ///< texels (atlas_gutter_texels)
-  double margin = 0;        ///< chart spacing used, fraction of the side
+  double margin = 0;        ///< chart spacing (2 g + 3 texels) as a fraction of the side
   std::size_t violations = 0;  ///< gutter_violations of the final atlas (0 wanted)
   double seconds = 0;
 };

@@ -21,6 +21,7 @@
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
 #include "geometry/properties.h"
+#include "geometry/vertex_tangents.h"
 
 namespace fs = std::filesystem;
 
@@ -439,6 +440,19 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
   if (g.has_uv) {
     int view = add_view(tc.data(), tc.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER);
     prim.attributes["TEXCOORD_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, src.size());
+  }
+  if (textured && g.has_uv && !g.normals.empty() && opt.normal_texture != nullptr && !opt.normal_texture->empty()) {
+    // TANGENT for the normal map (geometry/vertex_tangents.h), from the uv with v up.
+    std::vector<std::array<float, 3>> p(src.size()), n(src.size());
+    std::vector<std::array<float, 2>> t(src.size());
+    for (std::size_t i = 0; i < src.size(); ++i) {
+      for (int c = 0; c < 3; ++c) p[i][c] = static_cast<float>(g.pos[src[i]][c]);
+      n[i] = g.normals[src[i]];
+      t[i] = {tc[i][0], 1.f - tc[i][1]};
+    }
+    const std::vector<std::array<float, 4>> tan = vertex_tangents(p, n, t, indices);
+    int view = add_view(tan.data(), tan.size() * 16, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["TANGENT"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, src.size());
   }
   if (!g.colors.empty()) {
     std::vector<float> c(src.size() * 3);

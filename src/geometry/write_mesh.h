@@ -24,8 +24,9 @@ struct WriteMeshOptions {
   const Image* texture = nullptr;
   /// PBR maps beside the base colour (issue 16 item 2), each ignored if null
   /// or empty. Tangent-space normal map (+Y up, encoded (n+1)/2): glTF
-  /// normalTexture (no TANGENT attribute: viewers compute MikkTSpace
-  /// tangents), OBJ `norm` and `map_Bump` (<stem>_normal.png).
+  /// normalTexture with a TANGENT attribute (geometry/vertex_tangents.h,
+  /// MikkTSpace-style, w = +1 where cross(N, T) points along +v), OBJ `norm`
+  /// and `map_Bump` (<stem>_normal.png).
   const Image* normal_texture = nullptr;
   /// Height map in [0,1], OBJ only: `disp` <stem>_height.png as 16-bit PNG
   /// (glTF 2.0 has no height slot).

@@ -127,10 +127,10 @@ std::vector<Image> resample_patch_map(const PatchSynthesisResult& res, const Ima
       const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
       const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
       const auto pq = fq.to_pixel(u, v);
-      float* v = &out[p].data[i * C];
-      if (!sample_inside(fq, out[q], pq[0], pq[1], v) || !tangent_normal) continue;
+      float* value = &out[p].data[i * C];
+      if (!sample_inside(fq, out[q], pq[0], pq[1], value) || !tangent_normal) continue;
       auto mine = ring.find(f);
-      if (mine != ring.end()) turn_normal(v, edge_angle(*mine->second) - edge_angle(tq));
+      if (mine != ring.end()) turn_normal(value, edge_angle(*mine->second) - edge_angle(tq));
     }
   }
   return out;

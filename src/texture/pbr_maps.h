@@ -10,9 +10,9 @@
 // edge, flat where a texel has no same-chart neighbour on either side):
 //   n = normalize(-k dh/du, -k dh/dv, 1),  k = strength_per_texel,
 // in the tangent frame of the atlas uv (x along +u, y along +v: "+Y up", the
-// OpenGL / glTF convention), stored as (n + 1) / 2. The GLB carries no
-// TANGENT attribute: glTF viewers then compute MikkTSpace tangents from the
-// uv themselves (glTF 2.0, 3.7.2.1), which follow +u and +v as this map does.
+// OpenGL / glTF convention), stored as (n + 1) / 2. The GLB carries a
+// TANGENT attribute in that frame (geometry/vertex_tangents.h), so viewers do
+// not have to generate one (the glTF validator warns when they must).
 // No CGAL here.
 
 #include <vector>
