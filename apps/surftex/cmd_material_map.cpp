@@ -105,7 +105,7 @@ BakedAsset bake_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTi
   MaterialBakeOptions bo;
   bo.size = atlas_size;
   a.bake = bake_material_space(mesh, sing, tile, bo);
-  a.normal = normal_map_from_height(a.bake.height, a.bake.owner, bump * period * a.bake.texels_per_length);
+  a.normal = normal_map_from_height(a.bake.height, a.bake.chart, bump * period * a.bake.texels_per_length);
   return a;
 }
 

@@ -135,7 +135,7 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
   if (!maps.roughness.empty()) mr = metallic_roughness_from_roughness(height_from_luminance(map_atlas(maps.roughness, false)));
   PatchAtlas atlas = pack_patch_atlas(mesh, r.flat, r.images);
   if (height.empty()) height = height_from_luminance(atlas.image);
-  if (normal.empty()) normal = normal_map_from_height(height, atlas.owner, bump);
+  if (normal.empty()) normal = normal_map_from_height(height, atlas.chart, bump);
   const double s_atlas = tout.seconds();
   Timer tseam;
   SeamRatioOptions so;

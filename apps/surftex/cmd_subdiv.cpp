@@ -136,7 +136,7 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
   const BakeResult baked = bake_vertex_colors(tri, bo);
   const Image height = height_from_luminance(baked.image);
   const double atlas_per_exemplar = ga.atlas.uv_per_length * pbr.atlas_size / pbr.texels_per_length;
-  const Image normal = normal_map_from_height(height, baked.owner, pbr.bump * atlas_per_exemplar);
+  const Image normal = normal_map_from_height(height, baked.chart, pbr.bump * atlas_per_exemplar);
   WriteMeshOptions ao;
   ao.overwrite = force;
   ao.write_colors = false;

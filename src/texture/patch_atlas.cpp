@@ -2,7 +2,9 @@
 // Patch image atlas with mip gutters (Gorla et al. 2003, 3.2 / 4.1; see patch_atlas.h).
 #include "texture/patch_atlas.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <string>
 
 #include "geometry/atlas_gutter.h"
@@ -13,35 +15,57 @@ namespace surftex {
 
 namespace {
 
-struct Layout {
-  int side = 0, gutter = 0;
+// Bounding box of a patch's Inside and Boundary pixels (its chart), inclusive.
+struct Box {
+  int x0, y0, x1, y1;
+  int w() const { return x1 - x0 + 1; }
+  int h() const { return y1 - y0 + 1; }
 };
 
-// The square side and gutter for `cols` cells of `res` texels per row.
-Layout atlas_layout(int cols, int res, const PatchAtlasOptions& opt) {
-  if (opt.power_of_two) {
-    for (int s = 64; s <= opt.max_size; s *= 2) {
-      const int g = atlas_gutter_texels(s, opt.min_mip_size);
-      if (static_cast<long>(cols) * (res + 2 * g) <= s) return {s, g};
-    }
-  } else {
-    int g = 1;
-    for (int it = 0; it < 16; ++it) {
-      const long s = static_cast<long>(cols) * (res + 2 * g);
-      if (s > opt.max_size) break;
-      const int g2 = atlas_gutter_texels(static_cast<int>(s), opt.min_mip_size);
-      if (g2 == g) return {static_cast<int>(s), g};
-      g = g2;
-    }
+Box chart_box(const FlatPatch& fp) {
+  Box b{fp.res, fp.res, -1, -1};
+  for (int y = 0; y < fp.res; ++y)
+    for (int x = 0; x < fp.res; ++x)
+      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Outside)
+        b = {std::min(b.x0, x), std::min(b.y0, y), std::max(b.x1, x), std::max(b.y1, y)};
+  if (b.x1 < 0) b = {0, 0, 0, 0};  // an empty raster still gets a texel
+  return b;
+}
+
+// Shelf packing (tallest first) of the boxes into a `side` square, `gap`
+// texels between boxes and g = gap / 2 from the border; top-left corner of
+// each box, false if they do not fit.
+bool shelf_pack(const std::vector<Box>& box, const std::vector<int>& order, int side, int g,
+                std::vector<std::array<int, 2>>& at) {
+  const int gap = 2 * g + 1;
+  int x = g, y = g, shelf = 0;
+  for (int p : order) {
+    if (x + box[p].w() + g > side && x > g) y += shelf + gap, x = g, shelf = 0;
+    if (x + box[p].w() + g > side || y + box[p].h() + g > side) return false;
+    at[p] = {x, y};
+    x += box[p].w() + gap;
+    shelf = std::max(shelf, box[p].h());
   }
-  // The largest side with the largest power-of-two gutter that fits.
-  int s = opt.power_of_two ? 64 : opt.max_size;
-  while (opt.power_of_two && s * 2 <= opt.max_size) s *= 2;
-  for (int g = atlas_gutter_texels(s, opt.min_mip_size); g >= 1; g /= 2)
-    if (static_cast<long>(cols) * (res + 2 * g) <= s) return {s, g};
-  throw InvalidInputError("pack_patch_atlas: " + std::to_string(cols) + " cells of " + std::to_string(res) +
-                          " texels per row do not fit in max_size " + std::to_string(opt.max_size) +
-                          " (fewer, larger patches or a smaller patch resolution)");
+  return true;
+}
+
+// The smallest side (a power of two unless !power_of_two) whose gutter lets
+// the boxes fit; at max_size the largest power-of-two gutter that fits.
+int atlas_layout(const std::vector<Box>& box, const std::vector<int>& order, const PatchAtlasOptions& opt,
+                 int& gutter, std::vector<std::array<int, 2>>& at) {
+  for (int s = 64; s <= opt.max_size; s = opt.power_of_two ? 2 * s : s + std::max(1, s / 16)) {
+    gutter = atlas_gutter_texels(s, opt.min_mip_size);
+    if (shelf_pack(box, order, s, gutter, at)) return s;
+  }
+  const int s = opt.power_of_two ? [&] {
+    int p = 64;
+    while (2 * p <= opt.max_size) p *= 2;
+    return p;
+  }() : opt.max_size;
+  for (gutter = atlas_gutter_texels(s, opt.min_mip_size); gutter >= 1; gutter /= 2)
+    if (shelf_pack(box, order, s, gutter, at)) return s;
+  throw InvalidInputError("pack_patch_atlas: " + std::to_string(box.size()) + " patches do not fit in max_size " +
+                          std::to_string(opt.max_size) + " (fewer, larger patches or a smaller patch resolution)");
 }
 
 }  // namespace
@@ -61,23 +85,24 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
         flat.patches[p].res != R)
       throw InvalidInputError("pack_patch_atlas: patch " + std::to_string(p) +
                               " image does not match the raster size " + std::to_string(R));
+  std::vector<Box> box(P);
+  for (int p = 0; p < P; ++p) box[p] = chart_box(flat.patches[p]);
+  std::vector<int> order(P);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return box[a].h() > box[b].h(); });
+  std::vector<std::array<int, 2>> corner(P);
   PatchAtlas at;
-  at.cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(P))));
-  at.rows = (P + at.cols - 1) / at.cols;
-  const Layout lay = atlas_layout(at.cols, R, opt);
-  at.gutter = lay.gutter;
-  at.cell = R + 2 * lay.gutter;
-  const int W = lay.side, H = lay.side;
-  at.protected_mip_size = W / lay.gutter;
+  const int W = atlas_layout(box, order, opt, at.gutter, corner), H = W;
+  at.protected_mip_size = W / at.gutter;
   at.image = Image(W, H, C, 0.f);
   at.chart.assign(static_cast<std::size_t>(W) * H, -1);
   at.offset.resize(P);
   for (int p = 0; p < P; ++p) {
-    const int ox = lay.gutter + (p % at.cols) * at.cell, oy = lay.gutter + (p / at.cols) * at.cell;
+    const int ox = corner[p][0] - box[p].x0, oy = corner[p][1] - box[p].y0;
     at.offset[p] = {ox, oy};
     const FlatPatch& fp = flat.patches[p];
-    for (int y = 0; y < R; ++y)
-      for (int x = 0; x < R; ++x) {
+    for (int y = box[p].y0; y <= box[p].y1; ++y)
+      for (int x = box[p].x0; x <= box[p].x1; ++x) {
         if (fp.pixel[static_cast<std::size_t>(y) * R + x] == PatchPixel::Outside) continue;
         for (int c = 0; c < C; ++c) at.image.at(ox + x, oy + y, c) = images[p].at(x, y, c);
         at.chart[static_cast<std::size_t>(oy + y) * W + ox + x] = p;

@@ -5,14 +5,15 @@
 // lapped textures" as the alternative; we pack one atlas so that the result
 // opens as a standard textured OBJ/glTF).
 //
-// Every patch image (all res x res, flatten_patch.h) goes into a grid cell
-// of res + 2 g texels, cols = ceil(sqrt(P)) cells per row, g = the mip gutter
-// of geometry/atlas_gutter.h for the atlas side (2^K texels for the K
-// halvings down to `min_mip_size`). The atlas is square, by default the
-// smallest power of two that holds the grid with that gutter; when even
-// `max_size` cannot (the gutter grows with the side: at most ~32 cells per
-// row), it is `max_size` with the largest power-of-two gutter that fits
-// (`gutter` and `protected_mip_size` say which levels stay clean).
+// Every patch's chart (the bounding box of its Inside and Boundary pixels in
+// its res x res raster, flatten_patch.h) is shelf-packed, tallest first, with
+// 2 g + 1 texels between charts and g from the border, g = the mip gutter of
+// geometry/atlas_gutter.h for the atlas side (2^K texels for the K halvings
+// down to `min_mip_size`). The atlas is square, by default the smallest power
+// of two whose gutter lets every chart fit; when even `max_size` cannot (the
+// gutter grows with the side), it is `max_size` with the largest
+// power-of-two gutter that fits (`gutter` and `protected_mip_size` say which
+// levels stay clean). One atlas texel is one patch texel (no resampling).
 // Inside and Boundary pixels (Boundary pixels hold the neighbour's texture,
 // patch_synthesis.h step 7) are the charts; every other texel is filled by
 // dilating them (geometry/atlas_gutter.h: each patch's gutter from its own
@@ -40,10 +41,9 @@ struct PatchAtlasOptions {
 
 struct PatchAtlas {
   Image image;
-  int cols = 0, rows = 0, cell = 0;
-  int gutter = 0;              ///< texels of gutter around every cell's raster
+  int gutter = 0;              ///< texels of gutter around every chart
   int protected_mip_size = 0;  ///< smallest mip side whose texels stay inside one patch's gutter
-  std::vector<std::array<int, 2>> offset;  ///< per patch: top-left pixel of its raster
+  std::vector<std::array<int, 2>> offset;  ///< per patch: atlas pixel of its raster's pixel (0, 0)
   std::vector<int> chart;      ///< per texel: patch of an Inside/Boundary pixel, -1 = other
   std::vector<int> owner;      ///< per texel after dilation
 };

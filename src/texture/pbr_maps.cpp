@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "geometry/atlas_gutter.h"
 #include "geometry/errors.h"
 
 namespace surftex {
@@ -47,6 +48,7 @@ Image normal_map_from_height(const Image& h, const std::vector<int>& owner, doub
   Image n(W, H, 3);
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
+      if (chart(x, y) < 0) continue;  // gutter: dilated below
       const double du = slope(x, y, 1, 0);
       const double dv = -slope(x, y, 0, 1);  // rows go down, v goes up
       double nx = -k * du, ny = -k * dv, nz = 1.0;
@@ -56,6 +58,12 @@ Image normal_map_from_height(const Image& h, const std::vector<int>& owner, doub
       n.at(x, y, 1) = static_cast<float>(0.5 * ny + 0.5);
       n.at(x, y, 2) = static_cast<float>(0.5 * nz + 0.5);
     }
+  if (!owner.empty()) {
+    std::vector<int> label = owner;
+    bool any = false;
+    for (int l : label) any = any || l >= 0;
+    if (any) dilate_charts(n, label);
+  }
   return n;
 }
 

@@ -25,7 +25,9 @@ namespace surftex {
 Image height_from_luminance(const Image& color);
 
 /// Tangent-space normal map (3 channels, encoded (n+1)/2) of `height` (one
-/// channel, [0,1]); `owner` = chart per texel (empty = one chart);
+/// channel, [0,1]); `owner` = chart per texel before the gutter dilation
+/// (empty = one chart): texels of label < 0 (gutters) are filled by dilating
+/// the charts' normals (geometry/atlas_gutter.h), not from the gutter's height;
 /// `strength_per_texel` = tilt per unit of height per atlas texel, >= 0.
 /// Throws InvalidInputError on a bad size or strength.
 Image normal_map_from_height(const Image& height, const std::vector<int>& owner, double strength_per_texel);
