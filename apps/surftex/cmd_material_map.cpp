@@ -113,6 +113,7 @@ nlohmann::json bake_report(const BakedAsset& a) {
   const MaterialBakeResult& b = a.bake;
   return {{"size", b.color.width},          {"charts", b.charts},
           {"gutter", b.gutter},             {"gutter_violations", b.gutter_violations},
+          {"protected_mip_size", b.protected_mip_size},
           {"margin", b.margin},             {"coverage", b.coverage},
           {"texels_per_length", b.texels_per_length},
           {"seconds", {{"atlas", b.seconds_atlas}, {"lookup", b.seconds_lookup}, {"gutter", b.seconds_gutter}}}};

@@ -152,6 +152,7 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
   const double N2 = double(pbr.atlas_size) * pbr.atlas_size;
   j["atlas"] = {{"charts", ga.atlas.num_charts}, {"size", pbr.atlas_size}, {"coverage", double(baked.covered) / N2},
                 {"gutter", ga.gutter}, {"gutter_violations", ga.violations}, {"margin", ga.margin},
+                {"protected_mip_size", ga.protected_mip_size},
                 {"mean_area_distortion", ga.atlas.mean_area_distortion}, {"flipped_faces", ga.atlas.flipped_faces},
                 {"bump", pbr.bump}, {"atlas_texels_per_exemplar_texel", atlas_per_exemplar},
                 {"seconds", t.seconds()}};

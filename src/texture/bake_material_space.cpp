@@ -55,6 +55,7 @@ MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing,
   r.charts = ga.atlas.num_charts;
   r.texels_per_length = ga.atlas.uv_per_length * N;
   r.gutter = ga.gutter;
+  r.protected_mip_size = ga.protected_mip_size;
   r.margin = ga.margin;
   r.gutter_violations = ga.violations;
   r.chart = std::move(ga.chart);

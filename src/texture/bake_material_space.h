@@ -44,7 +44,8 @@ struct MaterialBakeResult {
   std::vector<int> chart;    ///< per texel before dilation: chart id, -1 = gutter/background
   std::vector<int> owner;    ///< per texel after dilation: the chart it belongs to
   int charts = 0;
-  int gutter = 0;            ///< texels, 2^K
+  int gutter = 0;            ///< texels: 2^K, or less for many small charts (geometry/gutter_atlas.h)
+  int protected_mip_size = 0;  ///< smallest mip side kept free of bleeding
   double margin = 0;         ///< atlas chart spacing used (fraction of the side)
   std::size_t gutter_violations = 0;  ///< texels within `gutter` of a chart not owned by it (0 wanted)
   double coverage = 0;       ///< fraction of texels covered by charts

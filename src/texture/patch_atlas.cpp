@@ -103,7 +103,13 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
     const FlatPatch& fp = flat.patches[p];
     for (int y = box[p].y0; y <= box[p].y1; ++y)
       for (int x = box[p].x0; x <= box[p].x1; ++x) {
-        if (fp.pixel[static_cast<std::size_t>(y) * R + x] == PatchPixel::Outside) continue;
+        const PatchPixel state = fp.pixel[static_cast<std::size_t>(y) * R + x];
+        if (state == PatchPixel::Outside) continue;
+        // A Boundary pixel whose neighbour lookup found no Inside texel stays
+        // all zero in the patch image: the dilation fills it instead.
+        bool zero = true;
+        for (int c = 0; c < C && zero; ++c) zero = images[p].at(x, y, c) == 0.f;
+        if (state == PatchPixel::Boundary && zero) continue;
         for (int c = 0; c < C; ++c) at.image.at(ox + x, oy + y, c) = images[p].at(x, y, c);
         at.chart[static_cast<std::size_t>(oy + y) * W + ox + x] = p;
       }
