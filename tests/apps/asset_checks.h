@@ -3,6 +3,8 @@
 // Checks of finished assets shared by the CLI tests (issue 16 items 1-3):
 // byte-identical files in an output folder, the JSON chunk of a GLB, the
 // bit depth of a PNG, and whether a normal map follows a height map's slopes.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -14,6 +16,10 @@
 #include <vector>
 
 #include "geometry/image.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/uv_raster.h"
 
 namespace surftex::test {
 
@@ -56,15 +62,40 @@ inline int png_bit_depth(const std::string& path) {
   return static_cast<unsigned char>(b[24]);
 }
 
-/// Fraction of texels with a clear height slope along u (|dh| > 0.05 over
-/// two texels) whose normal map x component tilts against it (n.x < 0.5 for
-/// a rising slope): near 1 on the charts of a normal map derived from that
-/// height, 0.5 for an unrelated one; the gutters (normals dilated from the
-/// charts, heights from the colour's dilation) bring a derived map to ~0.8.
-inline double normal_follows_height(const Image& normal, const Image& height) {
+/// Atlas texels (W x H) whose centre lies inside a face of the mesh file's
+/// uv (its charts), 1 per texel; its 3x3 interior only (no chart edge).
+inline std::vector<char> chart_interior(const std::string& mesh_path, int W, int H) {
+  Mesh m;
+  read_mesh(mesh_path, m);
+  auto uv = find(m, kCornerUV).first;
+  std::vector<UvTriangle> tris;
+  for (FaceIndex f : m.faces()) {
+    std::vector<UV> c;
+    for (HalfedgeIndex h : m.halfedges_around_face(m.halfedge(f))) c.push_back(uv[h]);
+    for (std::size_t k = 1; k + 1 < c.size(); ++k)
+      tris.push_back({{{c[0][0], c[0][1]}, {c[k][0], c[k][1]}, {c[k + 1][0], c[k + 1][1]}}});
+  }
+  const UvRaster r = rasterize_uv_triangles(tris, W, H, 0.0);
+  std::vector<char> in(static_cast<std::size_t>(W) * H, 0);
+  for (int y = 1; y + 1 < H; ++y)
+    for (int x = 1; x + 1 < W; ++x) {
+      bool all = true;
+      for (int dy = -1; dy <= 1 && all; ++dy)
+        for (int dx = -1; dx <= 1 && all; ++dx) all = r.triangle[static_cast<std::size_t>(y + dy) * W + x + dx] >= 0;
+      in[static_cast<std::size_t>(y) * W + x] = all;
+    }
+  return in;
+}
+
+/// Fraction of chart-interior texels (`mask`; empty = all) with a clear
+/// height slope along u (|dh| > 0.05 over two texels) whose normal map x
+/// component tilts against it (n.x < 0.5 for a rising slope): near 1 for a
+/// normal map derived from that height, 0.5 for an unrelated one.
+inline double normal_follows_height(const Image& normal, const Image& height, const std::vector<char>& mask = {}) {
   std::size_t n = 0, agree = 0;
   for (int y = 0; y < height.height; ++y)
     for (int x = 1; x + 1 < height.width; ++x) {
+      if (!mask.empty() && !mask[static_cast<std::size_t>(y) * height.width + x]) continue;
       const float d = height.at(x + 1, y, 0) - height.at(x - 1, y, 0);
       if (std::abs(d) < 0.05f) continue;
       ++n;
