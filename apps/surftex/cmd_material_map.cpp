@@ -13,8 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <tbb/parallel_invoke.h>
-
 #include "geometry/direction_field.h"
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
@@ -40,13 +38,15 @@
 #include "texture/material_tile.h"
 #include "texture/material_tile_io.h"
 #include "texture/procedural_texture.h"
+#include "texture/bake_material_space.h"
+#include "texture/material_mapping.h"
+#include "texture/pbr_maps.h"
 #include "texture/render_material_space.h"
 
 namespace surftex::cli {
 namespace {
 
 namespace fs = std::filesystem;
-using Cplx = std::complex<double>;
 
 struct Args {
   std::string mesh, tile, constraints, update, state, out;
@@ -54,123 +54,13 @@ struct Args {
   double edges_per_period = 8;  // auto scale
   std::string field = "curvature";
   int render_size = 768;
+  int atlas_size = 2048;
   std::vector<float> view{30.f, 20.f};
   double bump = 0.03;
   bool curl_correction = false;
   bool no_swap = false;  // PgpOptions::swap_coordinates = false
   CommonOptions common;
 };
-
-// ---- solver state (S.json) -------------------------------------------------
-
-// Version 2: z_s, z_t are stored in per-vertex frames (s/t coupled across
-// field cuts); version-1 states (independent s and t) are refused.
-// "swap_coordinates": false when solved with --no-swap (the paper's
-// simplified PGP: no frames, every corner turn 0); absent = true.
-const char* const kStateFormat = "surftex material-map state v2";
-
-void save_state(const std::string& path, const Mesh& mesh, const PeriodicGlobalParameterization& pgp,
-                double default_scale, bool curl_correction, bool swap_coordinates, bool overwrite) {
-  nlohmann::json j;
-  j["format"] = kStateFormat;
-  j["curl_correction"] = curl_correction;
-  j["swap_coordinates"] = swap_coordinates;
-  j["vertices"] = mesh.num_vertices();
-  j["faces"] = mesh.num_faces();
-  j["default_scale"] = default_scale;
-  auto dir = find(mesh, kFaceDirection).first;
-  auto sc = find(mesh, kVertexScale).first;
-  auto mat = find(mesh, kVertexMaterial).first;
-  std::vector<double> zs, zt, d, s, m;
-  for (std::size_t i = 0; i < mesh.num_vertices(); ++i) {
-    zs.push_back(pgp.z_s()[i].real());
-    zs.push_back(pgp.z_s()[i].imag());
-    zt.push_back(pgp.z_t()[i].real());
-    zt.push_back(pgp.z_t()[i].imag());
-    s.push_back(sc[VertexIndex(static_cast<std::uint32_t>(i))]);
-    m.push_back(mat[VertexIndex(static_cast<std::uint32_t>(i))]);
-  }
-  for (std::size_t i = 0; i < mesh.num_faces(); ++i) {
-    const Vector3 v = dir[FaceIndex(static_cast<std::uint32_t>(i))];
-    d.insert(d.end(), {v.x(), v.y(), v.z()});
-  }
-  j["z_s"] = zs;  // re, im per vertex (doubles round-trip exactly)
-  j["z_t"] = zt;
-  j["direction"] = d;
-  j["scale"] = s;
-  j["material"] = m;
-  write_file_atomic(path, j.dump() + "\n", overwrite);
-}
-
-std::vector<double> state_array(const nlohmann::json& j, const char* key, std::size_t n, const std::string& path) {
-  auto it = j.find(key);
-  if (it == j.end() || !it->is_array())
-    throw InvalidInputError("state '" + path + "': field '" + key + "' missing or not an array");
-  if (it->size() != n)
-    throw InvalidInputError("state '" + path + "': field '" + key + "' has " + std::to_string(it->size()) +
-                            " values, expected " + std::to_string(n) + " (was it written for this mesh?)");
-  std::vector<double> v;
-  v.reserve(n);
-  for (const auto& x : *it) {
-    if (!x.is_number()) throw InvalidInputError("state '" + path + "': field '" + key + "' holds a non-number");
-    v.push_back(x.get<double>());
-  }
-  return v;
-}
-
-nlohmann::json read_state(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IOError("cannot open state file '" + path + "'");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(buf.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InvalidInputError("state '" + path + "': malformed JSON at byte " + std::to_string(e.byte));
-  }
-  if (!j.is_object() || j.value("format", "") != kStateFormat)
-    throw InvalidInputError("state '" + path + "': not a material-map state of this version (field 'format' is '" +
-                            j.value("format", std::string()) + "', expected '" + kStateFormat +
-                            "'; re-run material-map without --update to make one)");
-  return j;
-}
-
-/// The curl correction the state was solved with (states written before it
-/// existed were solved without).
-bool state_curl_correction(const nlohmann::json& j) {
-  auto it = j.find("curl_correction");
-  return it != j.end() && it->is_boolean() && it->get<bool>();
-}
-
-/// Whether the state's s and t were swapped across the field's cuts (the
-/// coupled form; states written before the option existed were).
-bool state_swap_coordinates(const nlohmann::json& j) {
-  auto it = j.find("swap_coordinates");
-  return it == j.end() || !it->is_boolean() || it->get<bool>();
-}
-
-double load_state(const nlohmann::json& j, const std::string& path, Mesh& mesh,
-                  PeriodicGlobalParameterization& pgp) {
-  const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
-  const auto zs = state_array(j, "z_s", 2 * nv, path), zt = state_array(j, "z_t", 2 * nv, path);
-  const auto d = state_array(j, "direction", 3 * nf, path);
-  const auto s = state_array(j, "scale", nv, path), m = state_array(j, "material", nv, path);
-  auto dir = get_or_add(mesh, kFaceDirection, Vector3(1, 0, 0));
-  auto sc = get_or_add(mesh, kVertexScale, 1.0);
-  auto mat = get_or_add(mesh, kVertexMaterial, 0.0);
-  std::vector<Cplx> zsv(nv), ztv(nv);
-  for (std::size_t i = 0; i < nv; ++i) {
-    zsv[i] = Cplx(zs[2 * i], zs[2 * i + 1]);
-    ztv[i] = Cplx(zt[2 * i], zt[2 * i + 1]);
-    sc[VertexIndex(static_cast<std::uint32_t>(i))] = s[i];
-    mat[VertexIndex(static_cast<std::uint32_t>(i))] = m[i];
-  }
-  for (std::size_t i = 0; i < nf; ++i)
-    dir[FaceIndex(static_cast<std::uint32_t>(i))] = Vector3(d[3 * i], d[3 * i + 1], d[3 * i + 2]);
-  pgp.set_state(std::move(zsv), std::move(ztv));
-  return j.value("default_scale", 0.0);
-}
 
 // ---- pipeline --------------------------------------------------------------
 
@@ -202,27 +92,75 @@ Outputs render_all(const Mesh& mesh, const PgpSingularities& sing, const Materia
   return o;
 }
 
-void write_meshes(Mesh& mesh, const std::string& out, bool force) {
-  auto stm = find(mesh, kCornerSTM).first;
-  auto uv = get_or_add(mesh, kCornerUV);
-  for (HalfedgeIndex h : mesh.halfedges())
-    if (!mesh.is_border(h)) uv[h] = {stm[h][0], stm[h][1]};
+// The PBR set of the baked atlas: height (the tile's luminance through the
+// same lookups) and its tangent-space normal map; `bump` is the tilt per
+// unit of height per period, as in the render.
+struct BakedAsset {
+  MaterialBakeResult bake;
+  Image normal;
+};
+
+BakedAsset bake_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int atlas_size,
+                      double bump, double period) {
+  BakedAsset a;
+  MaterialBakeOptions bo;
+  bo.size = atlas_size;
+  a.bake = bake_material_space(mesh, sing, tile, bo);
+  a.normal = normal_map_from_height(a.bake.height, a.bake.chart, bump * period * a.bake.texels_per_length);
+  return a;
+}
+
+nlohmann::json bake_report(const BakedAsset& a) {
+  const MaterialBakeResult& b = a.bake;
+  return {{"size", b.color.width},          {"charts", b.charts},
+          {"gutter", b.gutter},             {"gutter_violations", b.gutter_violations},
+          {"protected_mip_size", b.protected_mip_size},
+          {"margin", b.margin},             {"coverage", b.coverage},
+          {"texels_per_length", b.texels_per_length},
+          {"seconds", {{"atlas", b.seconds_atlas}, {"lookup", b.seconds_lookup}, {"gutter", b.seconds_gutter}}}};
+}
+
+// OBJ (+MTL, base colour, normal and 16-bit height maps), GLB (base colour
+// and normal texture, the material m as a vertex attribute) with the atlas
+// uv; PLY with m as a vertex scalar.
+void write_meshes(Mesh& mesh, const BakedAsset& a, const std::string& obj, const std::string& glb,
+                  const std::string& ply, bool force) {
   auto mat = find(mesh, kVertexMaterial).first;
   auto scalar = mesh.add_property_map<VertexIndex, double>("material", 0.0).first;
   for (VertexIndex v : mesh.vertices()) scalar[v] = mat[v];
   WriteMeshOptions wo;
   wo.overwrite = force;
-  write_mesh(out + "/mesh.obj", mesh, wo);
+  wo.texture = &a.bake.color;
+  wo.normal_texture = &a.normal;
+  wo.height_texture = &a.bake.height;
+  wo.texture_repeat = false;
+  write_mesh(obj, mesh, wo);
+  wo.height_texture = nullptr;
   wo.vertex_scalar_property = "material";
-  write_mesh(out + "/mesh.glb", mesh, wo);
-  write_mesh(out + "/mesh.ply", mesh, wo);
+  write_mesh(glb, mesh, wo);
+  WriteMeshOptions po;
+  po.overwrite = force;
+  po.write_uvs = false;
+  po.vertex_scalar_property = "material";
+  write_mesh(ply, mesh, po);
   mesh.remove_property_map(scalar);
 }
 
-int run(const Args& a) {
-  auto keep = apply_thread_limit(a.common.threads);
-  Timer total;
-  nlohmann::json rep, sec;
+MaterialMappingOptions mapping_options(const Args& a) {
+  MaterialMappingOptions o;
+  o.scale = a.scale;
+  o.edges_per_period = a.edges_per_period;
+  o.field = a.field == "constant" ? MaterialMappingOptions::Field::Constant : MaterialMappingOptions::Field::Curvature;
+  o.curl_correction = a.curl_correction;
+  o.swap_coordinates = !a.no_swap;
+  return o;
+}
+
+const char* const kOutputs[] = {"mesh.obj",         "mesh.mtl",         "mesh.png",         "mesh_normal.png",
+                                "mesh_height.png",  "mesh.glb",         "mesh.ply",         "render_plain.png",
+                                "render_fixed.png", "render_normalmap.png", "report.json",  "state.json"};
+
+void check_args(const Args& a) {
   require_input_file(a.mesh, "mesh");
   if (!a.constraints.empty()) require_input_file(a.constraints, "--constraints");
   if (!a.update.empty() != !a.state.empty())
@@ -235,176 +173,78 @@ int run(const Args& a) {
   }
   if (a.view.size() != 2 || !(a.view[1] >= -90.f && a.view[1] <= 90.f) || !std::isfinite(a.view[0]))
     throw InvalidInputError("--view needs two angles az,el in degrees (el in [-90,90])");
-  const std::vector<std::string> inputs{a.mesh, a.constraints, a.update, a.state};
-  const char* files[] = {"mesh.obj", "mesh.glb", "mesh.ply", "render_plain.png", "render_fixed.png",
-                         "render_normalmap.png", "report.json", "state.json"};
-  for (const char* f : files) {
-    std::vector<std::string> ins;
-    for (const auto& i : inputs)
-      if (!i.empty()) ins.push_back(i);
-    check_output(a.out + "/" + f, ins, a.common.force, false);
-  }
+  std::vector<std::string> ins;
+  for (const auto& i : {a.mesh, a.constraints, a.update, a.state})
+    if (!i.empty()) ins.push_back(i);
+  for (const char* f : kOutputs) check_output(a.out + "/" + f, ins, a.common.force, false);
+}
 
+int run(const Args& a) {
+  auto keep = apply_thread_limit(a.common.threads);
+  Timer total;
+  nlohmann::json rep;
+  check_args(a);
   Timer t;
   const MaterialTile tile = read_material_tile(a.tile);
-  sec["read_tile"] = t.seconds();
-  t = Timer();
+  const double s_tile = t.seconds();
+  t.reset();
   Mesh mesh;
   rep["input_mesh"] = to_json(load_method_mesh(a.mesh, mesh, a.common));
   require_triangle_mesh(mesh, "material-map");
-  sec["read_mesh"] = t.seconds();
+  const double s_mesh = t.seconds();
   rep["vertices"] = mesh.number_of_vertices();
   rep["faces"] = mesh.number_of_faces();
 
-  // The curl correction of the PGP's target (pgp_curl_correction.h); an
-  // update keeps the one its state was solved with.
-  nlohmann::json state;
-  if (!a.update.empty()) state = read_state(a.state);
-  PgpOptions popt;
-  popt.curl_correction = a.update.empty() ? a.curl_correction : state_curl_correction(state);
-  rep["curl_correction"] = popt.curl_correction;
-  // The paper's simplified PGP (no swapping of s and t, section 2.3) or the
-  // coupled form; an update keeps the state's (its z are in that form's frames).
-  popt.swap_coordinates = a.update.empty() ? !a.no_swap : state_swap_coordinates(state);
-  rep["swap_coordinates"] = popt.swap_coordinates;
-  PeriodicGlobalParameterization pgp(mesh, popt);
-  double default_scale = 0;
+  MaterialMapping mapping(mesh, mapping_options(a));
   if (a.update.empty()) {
-    t = Timer();
+    t.reset();
     MaterialConstraints c;
     if (!a.constraints.empty()) c = read_material_constraints(a.constraints, mesh);
-    sec["read_constraints"] = t.seconds();
-    t = Timer();
-    std::vector<DirectionConstraint> dirs = c.directions;
-    std::string field_source = "strokes";
-    DirectionFieldOptions dopt;  // strokes and a constant vector: exact
-    // The PGP's connectivity-only work (topology, METIS order) runs beside
-    // the curvature and direction field (it reads no property map).
-    double prepare_seconds = 0;
-    auto field = [&] {
-      if (dirs.empty()) {
-        field_source = a.field;
-        if (a.field == "curvature") {
-          // Principal directions are noisy: the constraints are made soft by a
-          // smoothing step (over ~8 face rings), which removes field
-          // singularities where nearby constraints disagree; armadillo_52k:
-          // 313 -> 243 field-singular vertices, singular faces 33.8% -> 28.2%
-          // (bench_pgp --field-sweep; 4-ring jets would give 26.7% for ~3x
-          // the curvature time).
-          compute_principal_curvatures(mesh);
-          dirs = constraints_from_principal_directions(mesh, 0.1);
-          dopt.smoothing = 64;
-        }
-        if (dirs.empty()) dirs = constraints_from_constant_vector(mesh, {0.0, 1.0, 0.0});
-      }
-      interpolate_direction_field(mesh, dirs, dopt);
-    };
-    tbb::parallel_invoke(field, [&] {
-      Timer tp;
-      pgp.prepare();
-      prepare_seconds = tp.seconds();
-    });
-    sec["direction_field"] = t.seconds();  // with the PGP preparation alongside
-    sec["pgp_prepare"] = prepare_seconds;
-    rep["field_source"] = field_source;
-    rep["direction_constraints"] = dirs.size();
-    t = Timer();
-    default_scale = a.scale > 0 ? a.scale : pgp_default_scale(mesh, a.edges_per_period);
-    interpolate_scalar_field(mesh, c.scale, scale_field_options(1e-9 * default_scale, default_scale));
-    interpolate_scalar_field(mesh, c.material, material_field_options());
-    sec["scalar_fields"] = t.seconds();
-    t = Timer();
-    pgp.initialize();
-    sec["pgp"] = t.seconds();
-    rep["mode"] = "initialize";
+    const double s_c = t.seconds();
+    mapping.map(c);
+    rep.update(to_json(mapping.result()));
+    rep["seconds"]["read_constraints"] = s_c;
   } else {
-    t = Timer();
-    default_scale = load_state(state, a.state, mesh, pgp);
-    sec["read_state"] = t.seconds();
-    t = Timer();
+    mapping.load_state(a.state);
+    const double s_state = mapping.result().seconds.at("read_state");
+    t.reset();
     const MaterialConstraints c = read_material_constraints(a.update, mesh);
     if (c.seed_vertices.empty())
       throw InvalidInputError("--update '" + a.update + "' holds no constraint (strokes, scale or material)");
-    EffectAreaOptions eo;
-    eo.radius = c.effect_radius;
-    const EffectArea area = compute_effect_area(mesh, c.seed_vertices, eo);
-    sec["read_constraints_and_effect_area"] = t.seconds();
-    rep["effect_area"] = {{"radius", std::isfinite(c.effect_radius) ? nlohmann::json(c.effect_radius) : nlohmann::json()},
-                          {"faces", area.free_faces},
-                          {"vertices", area.free_vertices}};
-    // Orientation and scalar fields are independent (a face map, vertex
-    // maps that all exist after load_state), and so is the PGP's order of
-    // the area's free vertices (connectivity only): side by side.
-    t = Timer();
-    double direction_seconds = 0, scalar_seconds = 0;
-    tbb::parallel_invoke([&] { pgp.prepare(area); }, [&] {
-      Timer td;
-      if (!c.directions.empty()) {
-        DirectionFieldOptions dopt;
-        dopt.area = &area;
-        interpolate_direction_field(mesh, c.directions, dopt);
-      }
-      direction_seconds = td.seconds();
-    }, [&] {
-      Timer ts;
-      if (!c.scale.empty()) {
-        ScalarFieldOptions so = scale_field_options(1e-9 * default_scale, default_scale);
-        so.area = &area;
-        interpolate_scalar_field(mesh, c.scale, so);
-      }
-      if (!c.material.empty()) {
-        ScalarFieldOptions so = material_field_options();
-        so.area = &area;
-        interpolate_scalar_field(mesh, c.material, so);
-      }
-      scalar_seconds = ts.seconds();
-    });
-    sec["direction_field"] = direction_seconds;
-    sec["scalar_fields"] = scalar_seconds;
-    sec["fields_wall"] = t.seconds();
-    t = Timer();
-    pgp.write_corners();  // the loaded mesh has no corners yet; those outside the area stay as written now
-    pgp.update(area);
-    sec["pgp"] = t.seconds();
-    rep["mode"] = "update";
+    const double s_c = t.seconds();
+    mapping.update(c);
+    rep.update(to_json(mapping.result()));
+    rep["seconds"]["read_state"] = s_state;
+    rep["seconds"]["read_constraints"] = s_c;
   }
-  rep["default_scale"] = default_scale;
-
-  t = Timer();
-  PgpSingularityOptions sopt;
-  sopt.pgp = popt;
-  const PgpSingularities sing = detect_pgp_singularities(mesh, sopt);
-  sec["singularities"] = t.seconds();
-  std::size_t distorted = 0, mismatched = 0, sv = 0;
-  for (char x : sing.distorted_face) distorted += x;
-  for (char x : sing.mismatched_edge) mismatched += x;
-  for (char x : sing.singular_vertex) sv += x;
-  rep["singular_fraction"] = sing.singular_fraction;
-  rep["singular_faces"] = sing.singular_faces;
-  rep["distorted_faces"] = distorted;
-  rep["mismatched_edges"] = mismatched;
-  rep["singular_vertices"] = sv;
+  nlohmann::json& sec = rep["seconds"];
+  sec["read_tile"] = s_tile;
+  sec["read_mesh"] = s_mesh;
+  const PgpSingularities& sing = mapping.result().singularities;
 
   ensure_directory(a.out);
-  t = Timer();
-  write_meshes(mesh, a.out, a.common.force);
-  sec["write_meshes"] = t.seconds();
-  t = Timer();
+  // Renders first: the bake replaces the corner uv by the atlas's.
+  t.reset();
   const Outputs img = render_all(mesh, sing, tile, a.render_size, a.view, a.bump);
   sec["render"] = t.seconds();
+  t.reset();
+  const BakedAsset baked = bake_asset(mesh, sing, tile, a.atlas_size, a.bump, mapping.result().default_scale);
+  sec["bake"] = t.seconds();
+  rep["atlas"] = bake_report(baked);
+  t.reset();
+  write_meshes(mesh, baked, a.out + "/mesh.obj", a.out + "/mesh.glb", a.out + "/mesh.ply", a.common.force);
+  sec["write_meshes"] = t.seconds();
   WriteImageOptions io;
   io.overwrite = a.common.force;
   write_image(a.out + "/render_plain.png", img.plain, io);
   write_image(a.out + "/render_fixed.png", img.fixed, io);
   write_image(a.out + "/render_normalmap.png", img.normal, io);
-  save_state(a.out + "/state.json", mesh, pgp, default_scale, popt.curl_correction, popt.swap_coordinates,
-             a.common.force);
+  mapping.save_state(a.out + "/state.json", a.common.force);
   sec["total"] = total.seconds();
-  rep["seconds"] = sec;
   rep["tile"] = {{"dir", a.tile}, {"layers", tile.layers.size()}, {"size", tile.size}};
   rep["mesh"] = a.mesh;
   RunFiles run_files{{a.mesh, a.tile, a.constraints, a.update, a.state}, {}};
-  for (const char* f : files)
+  for (const char* f : kOutputs)
     if (std::string(f) != "report.json") run_files.outputs.push_back(a.out + "/" + f);
   write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
                     a.common.force);
@@ -434,8 +274,11 @@ SubcommandRegistrar reg{
                       "(effect_radius around them) is re-solved; the rest stays bit for bit");
        app.add_option("--state", a->state, "state.json of a previous run (with --update)");
        app.add_option("-o,--output", a->out,
-                      "Output folder: mesh.obj (UV = (s,t)), mesh.glb and mesh.ply (material as vertex scalar), "
-                      "render_plain.png, render_fixed.png, render_normalmap.png, report.json, state.json")
+                      "Output folder: mesh.obj/.mtl and mesh.glb with the mapping baked into a uv atlas "
+                      "(mesh.png base colour with the singularity fix and the material blend, mesh_normal.png "
+                      "tangent-space normal map, mesh_height.png 16-bit height), mesh.ply (material m as vertex "
+                      "scalar, also in the GLB as _material), render_plain.png, render_fixed.png, "
+                      "render_normalmap.png, report.json, state.json")
            ->required();
        app.add_option("--scale", a->scale,
                       "Texture period S in mesh units where no scale constraint applies (> 0; default 0 = "
@@ -450,8 +293,14 @@ SubcommandRegistrar reg{
            ->check(CLI::IsMember({"curvature", "constant"}));
        app.add_option("--render-size", a->render_size, "Side of the renders in pixels (16..4096, default 768)")
            ->check(CLI::Range(16, 4096));
+       app.add_option("--atlas-size", a->atlas_size,
+                      "Side of the baked texture atlas (mesh.png, mesh_normal.png, mesh_height.png) in texels, "
+                      "64..8192 (default 2048; powers of two mip-map best)")
+           ->check(CLI::Range(64, 8192));
        app.add_option("--view", a->view, "Render view: azimuth elevation in degrees (default 30 20)")->expected(2);
-       app.add_option("--bump", a->bump, "Normal-map strength: tilt per unit height slope (0..10, default 0.03)")
+       app.add_option("--bump", a->bump,
+                      "Normal-map strength (render_normalmap.png and mesh_normal.png; height = tile luminance): "
+                      "tilt per unit height slope, height per period (0..10, default 0.03)")
            ->check(CLI::Range(0.0, 10.0));
        app.add_flag("--curl-correction", a->curl_correction,
                     "Rescale the PGP's target gradients d/S towards curl-free before the solve (Ray et al. "
@@ -495,41 +344,39 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
 
   Mesh mesh;
   make_torus(mesh, 1.0, 0.4, 96, 40);
-  // A stroke along the big circle on top, and a material gradient from one side to the other.
-  std::vector<DirectionConstraint> dirs;
+  // A stroke along the big circle on top, and a material gradient from one
+  // side to the other, through the same driver as the CLI (6 edges per period).
+  MaterialConstraints c;
   for (FaceIndex f : mesh.faces()) {
-    Vector3 c(0, 0, 0);
-    for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) c = c + (mesh.point(v) - CGAL::ORIGIN) / 3.0;
-    if (c.z() > 0.35 && f.idx() % 7 == 0) dirs.push_back({static_cast<std::uint32_t>(f.idx()), {-c.y(), c.x(), 0.0}});
+    Vector3 p(0, 0, 0);
+    for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) p = p + (mesh.point(v) - CGAL::ORIGIN) / 3.0;
+    if (p.z() > 0.35 && f.idx() % 7 == 0) c.directions.push_back({static_cast<std::uint32_t>(f.idx()), {-p.y(), p.x(), 0.0}});
   }
-  interpolate_direction_field(mesh, dirs);
-  const double S = pgp_default_scale(mesh, 6);
-  interpolate_scalar_field(mesh, {}, scale_field_options(1e-9, S));
-  std::vector<ScalarConstraint> mat;
   for (VertexIndex v : mesh.vertices()) {
-    if (mesh.point(v).x() < -1.2) mat.push_back({static_cast<std::uint32_t>(v.idx()), 0.0});
-    if (mesh.point(v).x() > 1.2) mat.push_back({static_cast<std::uint32_t>(v.idx()), 1.0});
+    if (mesh.point(v).x() < -1.2) c.material.push_back({static_cast<std::uint32_t>(v.idx()), 0.0});
+    if (mesh.point(v).x() > 1.2) c.material.push_back({static_cast<std::uint32_t>(v.idx()), 1.0});
   }
-  interpolate_scalar_field(mesh, mat, material_field_options());
-  periodic_global_parameterization(mesh);
-  const PgpSingularities sing = detect_pgp_singularities(mesh);
+  MaterialMappingOptions mo;
+  mo.edges_per_period = 6;
+  MaterialMapping mapping(mesh, mo);
+  mapping.map(c);
+  const PgpSingularities& sing = mapping.result().singularities;
   z_up_to_y_up(mesh);  // the torus was built around z: lying flat in glTF viewers
-  write_meshes(mesh, ctx.dir, true);
-  fs::rename(ctx.path("mesh.obj"), ctx.path("material_map.obj"));
-  fs::rename(ctx.path("mesh.glb"), ctx.path("material_map.glb"));
-  fs::rename(ctx.path("mesh.ply"), ctx.path("material_map.ply"));
-  std::error_code ec;
-  if (fs::exists(ctx.path("mesh.png"), ec)) fs::remove(ctx.path("mesh.png"), ec);
   const Outputs img = render_all(mesh, sing, tile, 384, {20.f, 45.f}, 0.03);
+  const BakedAsset baked = bake_asset(mesh, sing, tile, 512, 0.03, mapping.result().default_scale);
+  write_meshes(mesh, baked, ctx.path("material_map.obj"), ctx.path("material_map.glb"), ctx.path("material_map.ply"),
+               true);
   write_image(ctx.path("material_map_plain.png"), img.plain);
   write_image(ctx.path("material_map_fixed.png"), img.fixed);
   write_image(ctx.path("material_map_normalmap.png"), img.normal);
   return {{"faces", mesh.number_of_faces()},
           {"tile_layers", tile.layers.size()},
           {"singular_fraction", sing.singular_fraction},
+          {"atlas", bake_report(baked)},
           {"seconds", timer.seconds()},
           {"files",
-           {"material_tile/", "material_map.obj", "material_map.glb", "material_map.ply", "material_map_plain.png",
+           {"material_tile/", "material_map.obj", "material_map.mtl", "material_map.png", "material_map_normal.png",
+            "material_map_height.png", "material_map.glb", "material_map.ply", "material_map_plain.png",
             "material_map_fixed.png", "material_map_normalmap.png"}}};
 }
 

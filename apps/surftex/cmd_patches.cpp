@@ -5,6 +5,7 @@
 // and a report with timings and the on-surface seam figure.
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -25,6 +26,8 @@
 #include "surftex/demo_steps.h"
 #include "texture/image_ops.h"
 #include "texture/patch_atlas.h"
+#include "texture/patch_exemplar_maps.h"
+#include "texture/pbr_maps.h"
 #include "texture/patch_seam_ratio.h"
 #include "texture/patch_synthesis.h"
 #include "texture/procedural_texture.h"
@@ -35,11 +38,12 @@ namespace surftex::cli {
 namespace {
 
 struct PatchArgs {
+  std::string exemplar_normal, exemplar_height, exemplar_roughness;
   std::string mesh, exemplar, outdir, field = "up", order = "random", resynth, exemplar2,
                                      multi = "none", fill = "onion";
   int patch_res = 128, max_faces = 200, window = 11, preselect = 0, rotations = 64,
       exemplar_size = 0;
-  double max_angle = 30.0;
+  double max_angle = 30.0, bump = 2.0;
   CommonOptions common;
 };
 
@@ -99,14 +103,40 @@ MultiTexture parse_multi(const std::string& m) {
   throw InvalidInputError("--multi '" + m + "' is not none|illumination|curvature|height");
 }
 
-// The pipeline and every output into `dir`; returns the report.
+// Maps given beside the colour exemplar (--exemplar-normal, --exemplar-height,
+// --exemplar-roughness), each empty when not given.
+struct ExemplarMaps {
+  Image normal, height, roughness;
+};
+
+// The pipeline and every output into `dir`; returns the report. The atlas
+// (mesh.png, power of two, mip gutters) comes with a height map
+// (mesh_height.png, 16-bit) and a tangent-space normal map (mesh_normal.png):
+// exemplar maps resampled through the same synthesis coordinates when given
+// (texture/patch_exemplar_maps.h), else height = luminance and the normal
+// from the height (`bump` = tilt per unit height slope, height per exemplar
+// texel: one atlas texel is one exemplar texel); roughness -> mesh_roughness.png
+// and the GLB's metallicRoughnessTexture.
 nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
                             const PatchSynthesisOptions& po, const std::string& dir,
-                            std::uint64_t seed) {
+                            std::uint64_t seed, double bump, const ExemplarMaps& maps = {}) {
   Timer total;
   PatchSynthesisResult r = synthesize_patches(mesh, exemplars, po);
   Timer tout;
+  const std::array<int, 2> ex_size{exemplars[0].width, exemplars[0].height};
+  auto map_atlas = [&](const Image& m, bool normal) {
+    return pack_patch_atlas(mesh, r.flat, resample_patch_map(r, m, ex_size, po.el, normal)).image;
+  };
+  Image height, normal, mr;
+  if (!maps.height.empty()) {
+    height = map_atlas(maps.height, false);
+    if (height.channels != 1) height = height_from_luminance(height);
+  }
+  if (!maps.normal.empty()) normal = map_atlas(maps.normal, true);
+  if (!maps.roughness.empty()) mr = metallic_roughness_from_roughness(height_from_luminance(map_atlas(maps.roughness, false)));
   PatchAtlas atlas = pack_patch_atlas(mesh, r.flat, r.images);
+  if (height.empty()) height = height_from_luminance(atlas.image);
+  if (normal.empty()) normal = normal_map_from_height(height, atlas.chart, bump);
   const double s_atlas = tout.seconds();
   Timer tseam;
   SeamRatioOptions so;
@@ -115,11 +145,15 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
   const double s_seam = tseam.seconds();
   tout.reset();
   ensure_directory(dir);
-  write_image((fs::path(dir) / "atlas.png").string(), atlas.image);
   WriteMeshOptions wo;
   wo.texture = &atlas.image;
+  wo.normal_texture = &normal;
+  wo.height_texture = &height;
+  wo.metallic_roughness_texture = &mr;
+  wo.texture_repeat = false;
   wo.write_colors = false;
   write_mesh((fs::path(dir) / "mesh.obj").string(), mesh, wo);
+  wo.height_texture = nullptr;
   write_mesh((fs::path(dir) / "mesh.glb").string(), mesh, wo);
   ViewOptions view;
   view.texture = &atlas.image;
@@ -150,8 +184,13 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
                {"pairs_across", seam.pairs_across},
                {"pairs_within", seam.pairs_within},
                {"step_texels", so.step_texels}};
-  j["atlas"] = {{"width", atlas.image.width}, {"height", atlas.image.height}};
-  j["outputs"] = {"atlas.png", "mesh.obj", "mesh.mtl", "mesh.png", "mesh.glb", "render.png"};
+  j["atlas"] = {{"width", atlas.image.width}, {"height", atlas.image.height}, {"gutter", atlas.gutter},
+                {"protected_mip_size", atlas.protected_mip_size}, {"bump", bump},
+                {"normal_source", maps.normal.empty() ? "height" : "exemplar_normal"},
+                {"height_source", maps.height.empty() ? "luminance" : "exemplar_height"},
+                {"roughness", !maps.roughness.empty()}};
+  j["outputs"] = {"mesh.obj", "mesh.mtl", "mesh.png", "mesh_normal.png", "mesh_height.png", "mesh.glb", "render.png"};
+  if (!maps.roughness.empty()) j["outputs"].push_back("mesh_roughness.png");
   return j;
 }
 
@@ -163,19 +202,45 @@ int run(const PatchArgs& a) {
     require_input_file(a.exemplar2, "exemplar2");
     inputs.push_back(a.exemplar2);
   }
+  for (const auto& [path, what] : {std::pair{a.exemplar_normal, "--exemplar-normal"},
+                                   {a.exemplar_height, "--exemplar-height"},
+                                   {a.exemplar_roughness, "--exemplar-roughness"}})
+    if (!path.empty()) {
+      require_input_file(path, what);
+      inputs.push_back(path);
+      if (!a.exemplar2.empty())
+        throw InvalidInputError(std::string(what) + " with --exemplar2: exemplar maps follow the first exemplar "
+                                "only; multi-texturing with maps is not supported");
+    }
   PatchSynthesisOptions po;
   po.field = parse_field(a.field);
   po.multi = parse_multi(a.multi);
   if (po.multi != MultiTexture::None && a.exemplar2.empty())
     throw InvalidInputError("--multi " + a.multi + " needs --exemplar2");
   po.resynthesize = parse_ids(a.resynth);
-  for (const char* name : {"atlas.png", "mesh.obj", "mesh.mtl", "mesh.png", "mesh.glb", "render.png",
-                           "report.json"})
+  for (const char* name : {"mesh.obj", "mesh.mtl", "mesh.png", "mesh_normal.png", "mesh_height.png",
+                           "mesh_roughness.png", "mesh.glb", "render.png", "report.json"})
     check_output((fs::path(a.outdir) / name).string(), inputs, a.common.force, false);
   auto limit = apply_thread_limit(a.common.threads);
   Mesh mesh;
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common);
-  std::vector<Image> ex{as_rgb(read_image(a.exemplar), a.exemplar_size)};
+  const Image colour = read_image(a.exemplar);
+  // Exemplar maps: the colour exemplar's size, resized with it.
+  ExemplarMaps maps;
+  auto read_map = [&](const std::string& path, const char* what) -> Image {
+    if (path.empty()) return {};
+    Image m = read_image(path);
+    if (m.width != colour.width || m.height != colour.height)
+      throw InvalidInputError(std::string(what) + " '" + path + "' is " + std::to_string(m.width) + " x " +
+                              std::to_string(m.height) + ", the colour exemplar '" + a.exemplar + "' is " +
+                              std::to_string(colour.width) + " x " + std::to_string(colour.height) +
+                              " (exemplar maps must match it texel for texel)");
+    return as_rgb(m, a.exemplar_size);
+  };
+  maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");
+  maps.height = read_map(a.exemplar_height, "--exemplar-height");
+  maps.roughness = read_map(a.exemplar_roughness, "--exemplar-roughness");
+  std::vector<Image> ex{as_rgb(colour, a.exemplar_size)};
   if (!a.exemplar2.empty()) ex.push_back(as_rgb(read_image(a.exemplar2), a.exemplar_size));
   po.partition.max_angle_deg = a.max_angle;
   po.partition.max_faces = a.max_faces;
@@ -188,7 +253,7 @@ int run(const PatchArgs& a) {
   po.el.order = a.fill == "direction" ? FillOrder::Direction : FillOrder::OnionPeel;
   po.seed = a.common.seed;
   po.progress = terminal_progress(a.common.quiet);
-  nlohmann::json rep = run_pipeline(mesh, ex, po, a.outdir, a.common.seed);
+  nlohmann::json rep = run_pipeline(mesh, ex, po, a.outdir, a.common.seed, a.bump, maps);
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
@@ -220,7 +285,9 @@ SubcommandRegistrar reg{
        app.add_option("MESH", a->mesh, "Input mesh (OFF/OBJ/PLY/STL)")->required();
        app.add_option("EXEMPLAR", a->exemplar, "Exemplar image (grey or RGB; alpha ignored)")->required();
        app.add_option("-o,--output", a->outdir,
-                      "Output folder: atlas.png, mesh.obj/.mtl/.png, mesh.glb, render.png, report.json")
+                      "Output folder: mesh.obj/.mtl with mesh.png (the atlas: power of two, mip gutters), "
+                      "mesh_normal.png (tangent-space, +Y up), mesh_height.png (16-bit), mesh.glb (base colour "
+                      "and normal texture), render.png, report.json")
            ->required();
        app.add_option("--field", a->field,
                       "Texture orientation: up (projected +y), kmax|kmin (greatest/least signed "
@@ -248,6 +315,19 @@ SubcommandRegistrar reg{
                       "Comma-separated patch ids to re-synthesise after the main pass, keeping the "
                       "others as boundary (default none)");
        app.add_option("--exemplar2", a->exemplar2, "Second exemplar for multi-texturing");
+       app.add_option("--exemplar-normal", a->exemplar_normal,
+                      "Tangent-space normal map of the exemplar (RGB = (n+1)/2, +Y up, the exemplar's size): "
+                      "resampled through the same synthesis into mesh_normal.png (default: from the height)");
+       app.add_option("--exemplar-height", a->exemplar_height,
+                      "Height map of the exemplar (grey, the exemplar's size): resampled into mesh_height.png "
+                      "(default: the luminance of the synthesised colour)");
+       app.add_option("--exemplar-roughness", a->exemplar_roughness,
+                      "Roughness map of the exemplar (grey, the exemplar's size): resampled into "
+                      "mesh_roughness.png, the GLB's metallicRoughnessTexture (metallic 0) and the MTL's map_Pr");
+       app.add_option("--bump", a->bump,
+                      "Normal-map strength (mesh_normal.png, from the height = luminance): tilt per unit "
+                      "height slope, height per exemplar texel, 0..100 (default 2)")
+           ->check(CLI::Range(0.0, 100.0));
        app.add_option("--multi", a->multi,
                       "Multi-texturing index function: none, illumination (Lambert with a fixed "
                       "light), curvature (mean curvature) or height (along +y); needs --exemplar2 "
@@ -286,7 +366,7 @@ DemoStepRegistrar demo{{30, "patches",
                           po.el.rotations = 32;
                           po.seed = ctx.seed;
                           nlohmann::json j =
-                              run_pipeline(mesh, {ex}, po, ctx.path("patches"), ctx.seed);
+                              run_pipeline(mesh, {ex}, po, ctx.path("patches"), ctx.seed, 2.0);
                           write_file_atomic(ctx.path("patches/report.json"), j.dump(2) + "\n", true);
                           return j;
                         }}};

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "geometry/bake_vertex_colors.h"
-#include "geometry/base_mesh_atlas.h"
+#include "geometry/gutter_atlas.h"
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
@@ -25,6 +25,7 @@
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
 #include "texture/displace_by_vertex_color.h"
+#include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
 #include "texture/subdivision_synthesis.h"
 
@@ -99,28 +100,61 @@ Outputs output_paths(const std::string& dir) {
   return {p("surface.ply"), p("surface.glb"), p("surface_atlas.obj"), p("render.png")};
 }
 
-nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas_size) {
+/// Every file written into the output folder (for the overwrite check).
+std::vector<std::string> output_files(const std::string& dir) {
+  std::vector<std::string> f;
+  for (const char* n : {"surface.ply", "surface.glb", "surface_atlas.obj", "surface_atlas.mtl", "surface_atlas.png",
+                        "surface_atlas_normal.png", "surface_atlas_height.png", "render.png", "report.json"})
+    f.push_back((fs::path(dir) / n).string());
+  return f;
+}
+
+struct PbrSettings {
+  int atlas_size = 1024;
+  double bump = 2;              ///< tilt per unit height slope, height per exemplar texel
+  double texels_per_length = 0; ///< exemplar texels per mesh unit
+};
+
+// The vertex colours baked into a gutter atlas of a triangulated copy, with
+// height (luminance) and normal maps: surface_atlas.obj (+MTL, maps) and
+// surface.glb (atlas as base colour, normal map, vertex colours kept as
+// _COLOR beside the texture that holds them: COLOR_0 would multiply it);
+// surface.ply keeps the polygons with COLOR_0-style vertex colours.
+nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const PbrSettings& pbr) {
   nlohmann::json j;
   Timer t;
   WriteMeshOptions wo;
   wo.overwrite = force;
   wo.write_uvs = false;
   std::vector<std::string> files = write_mesh(o.ply, mesh, wo);
-  for (const std::string& f : write_mesh(o.glb, mesh, wo)) files.push_back(f);
   j["seconds_write_mesh"] = t.seconds();
   t.reset();
   Mesh tri = triangulated_copy(mesh);
-  const BaseMeshAtlasResult ar = compute_base_mesh_atlas(tri);
+  const GutterAtlas ga = compute_gutter_atlas(tri, pbr.atlas_size);
   BakeOptions bo;
-  bo.size = atlas_size;
+  bo.size = pbr.atlas_size;
   const BakeResult baked = bake_vertex_colors(tri, bo);
+  const Image height = height_from_luminance(baked.image);
+  const double atlas_per_exemplar = ga.atlas.uv_per_length * pbr.atlas_size / pbr.texels_per_length;
+  const Image normal = normal_map_from_height(height, baked.chart, pbr.bump * atlas_per_exemplar);
   WriteMeshOptions ao;
   ao.overwrite = force;
   ao.write_colors = false;
   ao.texture = &baked.image;
+  ao.normal_texture = &normal;
+  ao.height_texture = &height;
+  ao.texture_repeat = false;
   for (const std::string& f : write_mesh(o.obj, tri, ao)) files.push_back(f);
-  j["atlas"] = {{"charts", ar.num_charts}, {"size", atlas_size}, {"coverage", double(baked.covered) / (double(atlas_size) * atlas_size)},
-                {"mean_area_distortion", ar.mean_area_distortion}, {"flipped_faces", ar.flipped_faces},
+  ao.height_texture = nullptr;
+  ao.write_colors = true;
+  ao.color_attribute = "_COLOR";
+  for (const std::string& f : write_mesh(o.glb, tri, ao)) files.push_back(f);
+  const double N2 = double(pbr.atlas_size) * pbr.atlas_size;
+  j["atlas"] = {{"charts", ga.atlas.num_charts}, {"size", pbr.atlas_size}, {"coverage", double(baked.covered) / N2},
+                {"gutter", ga.gutter}, {"gutter_violations", ga.violations}, {"margin", ga.margin},
+                {"protected_mip_size", ga.protected_mip_size},
+                {"mean_area_distortion", ga.atlas.mean_area_distortion}, {"flipped_faces", ga.atlas.flipped_faces},
+                {"bump", pbr.bump}, {"atlas_texels_per_exemplar_texel", atlas_per_exemplar},
                 {"seconds", t.seconds()}};
   t.reset();
   ViewOptions view;
@@ -162,6 +196,7 @@ struct SubdivArgs {
   std::string mesh, exemplar, outdir;
   double rscale = 100, adaptive = 0, displace = 0, region = 9, sigma = 1;
   int levels = 3, passes = 2, adaptive_steps = 4, atlas = 1024;
+  double bump = 2;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
   CommonOptions common;
 };
@@ -170,8 +205,10 @@ int run_subdiv(const SubdivArgs& a) {
   require_input_file(a.mesh, "mesh");
   require_input_file(a.exemplar, "exemplar");
   const Outputs out = output_paths(a.outdir);
-  for (const std::string& p : {out.ply, out.glb, out.obj, out.render})
+  for (const std::string& p : output_files(a.outdir)) {
+    if (fs::path(p).filename() == "report.json") continue;  // the report is replaced (as before)
     check_output(p, {a.mesh, a.exemplar}, a.common.force, false);
+  }
   auto limit = apply_thread_limit(a.common.threads);
   Timer total, t;
   Mesh mesh;
@@ -205,7 +242,11 @@ int run_subdiv(const SubdivArgs& a) {
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
-  nlohmann::json written = write_outputs(mesh, out, a.common.force, a.atlas);
+  PbrSettings pbr;
+  pbr.atlas_size = a.atlas;
+  pbr.bump = a.bump;
+  pbr.texels_per_length = o.r_scale / r.object_unit;
+  nlohmann::json written = write_outputs(mesh, out, a.common.force, pbr);
   const RunFiles files{{a.mesh, a.exemplar}, written["files"].get<std::vector<std::string>>()};
   rep["seconds"] = {{"read", seconds_read},
                     {"synthesis", r.seconds_total},
@@ -247,8 +288,9 @@ SubcommandRegistrar reg_subdiv{
        app.add_option("exemplar", a->exemplar, "Exemplar image (any format OpenImageIO reads; treated as periodic)")
            ->required();
        app.add_option("-o,--output", a->outdir,
-                      "Output folder: surface.ply (vertex colours), surface.glb (COLOR_0), surface_atlas.obj/.mtl/.png "
-                      "(baked texture atlas), render.png, report.json")
+                      "Output folder: surface.ply (vertex colours), surface.glb (baked atlas as base colour, "
+                      "normal map, vertex colours as _COLOR), surface_atlas.obj/.mtl/.png (baked atlas) with "
+                      "surface_atlas_normal.png and surface_atlas_height.png (16-bit), render.png, report.json")
            ->required();
        app.add_option("--rscale", a->rscale,
                       "r_scale: texels per object unit, the object unit being the longest bounding-box side; "
@@ -273,8 +315,14 @@ SubcommandRegistrar reg_subdiv{
            ->check(CLI::Range(0.5, 64.0));
        app.add_option("--sigma", a->sigma, "sigma of the graph-cut edge weight (equation 1), > 0 (default 1)")
            ->check(CLI::Range(1e-3, 1e3));
-       app.add_option("--atlas-size", a->atlas, "Baked atlas width = height in pixels, 64..8192 (default 1024)")
+       app.add_option("--atlas-size", a->atlas,
+                      "Baked atlas width = height in pixels, 64..8192 (default 1024; charts keep a gutter of "
+                      "size/64 texels so every mip level down to 64 px is free of bleeding)")
            ->check(CLI::Range(64, 8192));
+       app.add_option("--bump", a->bump,
+                      "Normal-map strength (surface_atlas_normal.png, from the height = luminance): tilt per "
+                      "unit height slope, height per exemplar texel, 0..100 (default 2)")
+           ->check(CLI::Range(0.0, 100.0));
        app.add_flag("--pyramid", a->pyramid, "Match against a Gaussian pyramid instead of the stack (faster, coarser)");
        app.add_flag("--fixed-region", a->fixed_region,
                     "Region size n in level-0 texels at every level (the paper's a = 1 for a stack); default: n "
@@ -298,7 +346,10 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  const std::string dir = ctx.path("subdiv");
                                  ensure_directory(dir);
                                  nlohmann::json j = synthesis_report(r, {});
-                                 j["outputs"] = write_outputs(mesh, output_paths(dir), true, 512);
+                                 PbrSettings pbr;
+                                 pbr.atlas_size = 512;
+                                 pbr.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
+                                 j["outputs"] = write_outputs(mesh, output_paths(dir), true, pbr);
                                  return j;
                                }}};
 

@@ -106,7 +106,7 @@ int run(const SynthArgs& a) {
     r = run_el2pass(a, exemplar, w, h);
   }
   const double seconds = timer.seconds();
-  write_image(a.output, r.image, {true, true});
+  write_image(a.output, r.image, {.eight_bit = true, .overwrite = true});
   Timer mt;
   BidirectionalOptions bo;
   bo.periodic_exemplar = a.periodic;

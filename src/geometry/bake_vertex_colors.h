@@ -3,17 +3,19 @@
 // Bakes per-vertex colours into a texture atlas image, so a vertex-coloured
 // result also exists as an image (Bangay & Morkel 2006, section 3.5: "the
 // surface colouring can be converted into a conventional texture map").
-// Every triangle is drawn in UV space (kCornerUV, v up: v = 0 is the bottom
-// row) by a small scan-converter: a pixel whose centre lies inside the
-// triangle (barycentrics >= -1e-6) gets the barycentric blend of the three
-// vertex colours. Then `dilate` rings of empty pixels around the charts are
-// filled with the mean of their filled 8-neighbours (against bleeding when
-// mip-mapped). Empty pixels stay `background`.
+// Every triangle is rasterised in uv space (kCornerUV, v up; geometry/
+// uv_raster.h: texel centres inside, plus a one-texel band at the nearest
+// point), each texel the barycentric blend of the three vertex colours; then
+// every empty texel is filled by dilating the charts (geometry/atlas_gutter.h:
+// no background, each chart's gutter from its own colours). Charts are
+// kFacePatch when present (geometry/gutter_atlas.h spaces them for mip
+// gutters), else one chart.
 //
-// Reads kCornerUV and kVertexColor. Throws InvalidInputError (non-triangle
-// face, missing map, size outside 1..16384, dilate < 0).
+// Reads kCornerUV, kVertexColor, kFacePatch (optional). Throws
+// InvalidInputError (non-triangle face, missing map, size outside 1..16384).
 
 #include <array>
+#include <vector>
 
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
@@ -21,14 +23,14 @@
 namespace surftex {
 
 struct BakeOptions {
-  int size = 1024;                                ///< atlas width = height, pixels
-  int dilate = 4;                                 ///< gutter rings filled
-  std::array<float, 3> background{0.f, 0.f, 0.f};
+  int size = 1024;  ///< atlas width = height, pixels
 };
 
 struct BakeResult {
   Image image;                 ///< size x size x 3
-  std::size_t covered = 0;     ///< pixels covered by a triangle
+  std::size_t covered = 0;     ///< pixels covered by a triangle (or its one-texel band)
+  std::vector<int> chart;      ///< per texel before dilation (-1 = empty)
+  std::vector<int> owner;      ///< per texel after dilation
 };
 
 BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt = {});

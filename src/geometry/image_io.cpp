@@ -128,12 +128,13 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
   return in;
 }
 
-OIIO::ImageSpec spec_for(const Image& img, const std::string& path, bool eight_bit) {
+OIIO::ImageSpec spec_for(const Image& img, const std::string& path, bool eight_bit, bool sixteen_bit = false) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   bool float_ok = (ext == ".exr" || ext == ".tif" || ext == ".tiff" || ext == ".hdr" || ext == ".pfm");
   OIIO::TypeDesc fmt = (eight_bit || !float_ok) ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
   if (ext == ".exr" && fmt == OIIO::TypeDesc::UINT8) fmt = OIIO::TypeDesc::HALF;
+  if (sixteen_bit && ext != ".exr") fmt = OIIO::TypeDesc::UINT16;
   return OIIO::ImageSpec(img.width, img.height, img.channels, fmt);
 }
 
@@ -169,7 +170,7 @@ void write_image(const std::string& path, const Image& img, const WriteImageOpti
   AtomicOutputFile out(path, opt.overwrite);
   auto writer = OIIO::ImageOutput::create(path);
   if (!writer) throw IOError("no image writer for '" + path + "': " + OIIO::geterror());
-  OIIO::ImageSpec spec = spec_for(img, path, opt.eight_bit);
+  OIIO::ImageSpec spec = spec_for(img, path, opt.eight_bit, opt.sixteen_bit);
   if (!writer->open(out.temp_path(), spec))
     throw IOError("cannot open '" + path + "' for writing: " + writer->geterror());
   if (!writer->write_image(OIIO::TypeDesc::FLOAT, img.data.data()))

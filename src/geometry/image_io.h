@@ -19,6 +19,8 @@ struct WriteImageOptions {
   /// Store as 8-bit (PNG/JPEG default) when true, else as 32-bit float where
   /// the format supports it (EXR, TIFF). Values are clamped to [0,1] for 8-bit.
   bool eight_bit = true;
+  /// Store as 16-bit integers (PNG, TIFF: height maps); overrides eight_bit.
+  bool sixteen_bit = false;
   /// Allow replacing an existing file.
   bool overwrite = true;
 };

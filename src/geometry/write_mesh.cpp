@@ -22,6 +22,7 @@
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
 #include "geometry/properties.h"
+#include "geometry/vertex_tangents.h"
 
 namespace fs = std::filesystem;
 
@@ -221,6 +222,46 @@ std::string obj_mtl_text(const MaterialGroups& g, const std::vector<std::string>
   return m;
 }
 
+/// The PBR maps of an OBJ's material (write_mesh.h): staged files beside the
+/// OBJ and their MTL lines.
+struct ObjPbrMap {
+  std::unique_ptr<AtomicOutputFile> file;
+  const Image* image = nullptr;
+  bool sixteen_bit = false;
+  void write() const {
+    WriteImageOptions io;
+    io.sixteen_bit = sixteen_bit;
+    write_image(file->temp_path(), *image, io);
+  }
+};
+struct ObjPbrMaps {
+  std::vector<ObjPbrMap> maps;
+  std::string mtl_lines;
+};
+
+ObjPbrMaps obj_pbr_maps(const fs::path& dir, const std::string& stem, const WriteMeshOptions& opt, bool textured) {
+  ObjPbrMaps r;
+  if (!textured) return r;
+  auto add = [&](const Image* img, const std::string& suffix, bool wide, const std::string& lines) {
+    if (img == nullptr || img->empty()) return;
+    const std::string name = stem + suffix;
+    ObjPbrMap m;
+    m.file = std::make_unique<AtomicOutputFile>((dir / name).string(), opt.overwrite);
+    m.image = img;
+    m.sixteen_bit = wide;
+    r.maps.push_back(std::move(m));
+    std::string l = lines;
+    for (std::size_t at; (at = l.find('@')) != std::string::npos;) l.replace(at, 1, name);
+    r.mtl_lines += l;
+  };
+  // `norm` (tangent-space normal map) and `map_Bump` with the same file:
+  // Blender's importer reads map_Bump as a normal map.
+  add(opt.normal_texture, "_normal.png", false, "norm @\nmap_Bump @\n");
+  add(opt.height_texture, "_height.png", true, "disp @\n");
+  add(opt.metallic_roughness_texture, "_roughness.png", false, "map_Pr -imfchan g @\n");
+  return r;
+}
+
 std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   Gathered g = gather(path, mesh, opt, true);
   const MaterialGroups groups = material_groups(path, mesh, opt);
@@ -238,6 +279,8 @@ std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, co
   if (with_mtl) mtl_out = std::make_unique<AtomicOutputFile>((dir / mtl_name).string(), opt.overwrite);
   for (std::size_t k = 0; k < png_names.size(); ++k)
     if (!png_names[k].empty()) png_out[k] = std::make_unique<AtomicOutputFile>((dir / png_names[k]).string(), opt.overwrite);
+  const bool pbr_textured = opt.texture != nullptr && !opt.texture->empty();
+  ObjPbrMaps pbr = obj_pbr_maps(dir, stem, opt, pbr_textured);
 
   std::string s;
   s.reserve(g.pos.size() * 60 + g.faces.size() * 40);
@@ -308,7 +351,7 @@ std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, co
       if (png_out[k]) write_image(png_out[k]->temp_path(), *groups.materials[k].texture);
     std::ofstream f(mtl_out->temp_path(), std::ios::binary);
     if (!f) throw IOError("cannot open '" + mtl_out->temp_path() + "' for writing");
-    f << obj_mtl_text(groups, png_names);
+    f << obj_mtl_text(groups, png_names) << pbr.mtl_lines;
     write_bytes(f, mtl_out->destination());
   }
   {
@@ -317,12 +360,17 @@ std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, co
     f.write(s.data(), static_cast<std::streamsize>(s.size()));
     write_bytes(f, path);
   }
+  for (auto& m : pbr.maps) m.write();
   for (auto& out : png_out)
     if (out) {
       out->commit();
       written.push_back(out->destination());
     }
   if (with_mtl) {
+  for (auto& m : pbr.maps) {
+    m.file->commit();
+    written.push_back(m.file->destination());
+  }
     mtl_out->commit();
     written.insert(written.begin() + 1, mtl_out->destination());
   }
@@ -501,12 +549,28 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     int view = add_view(tc.data(), tc.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER);
     prim.attributes["TEXCOORD_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, src.size());
   }
+  if (opt.texture != nullptr && !opt.texture->empty() && g.has_uv && !g.normals.empty() &&
+      opt.normal_texture != nullptr && !opt.normal_texture->empty()) {
+    // TANGENT for the normal map (geometry/vertex_tangents.h), from the uv with v up.
+    std::vector<std::array<float, 3>> p(src.size()), n(src.size());
+    std::vector<std::array<float, 2>> t(src.size());
+    for (std::size_t i = 0; i < src.size(); ++i) {
+      for (int c = 0; c < 3; ++c) p[i][c] = static_cast<float>(g.pos[src[i]][c]);
+      n[i] = g.normals[src[i]];
+      t[i] = {tc[i][0], 1.f - tc[i][1]};
+    }
+    std::vector<std::uint32_t> all;
+    for (const auto& part : indices) all.insert(all.end(), part.begin(), part.end());
+    const std::vector<std::array<float, 4>> tan = vertex_tangents(p, n, t, all);
+    int view = add_view(tan.data(), tan.size() * 16, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["TANGENT"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, src.size());
+  }
   if (!g.colors.empty()) {
     std::vector<float> c(src.size() * 3);
     for (std::size_t i = 0; i < src.size(); ++i)
       for (int k = 0; k < 3; ++k) c[3 * i + k] = std::clamp(g.colors[src[i]][k], 0.f, 1.f);
     int view = add_view(c.data(), c.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["COLOR_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
+    prim.attributes[opt.color_attribute] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
   }
   if (!g.scalar.empty()) {
     std::vector<float> sv(src.size());
@@ -516,8 +580,31 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
         add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, src.size());
   }
 
+  // One embedded PNG per map, all through one sampler.
+  auto add_texture = [&](const Image& img, const char* name) -> int {
+    if (model.samplers.empty()) {
+      tinygltf::Sampler smp;
+      smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+      smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+      smp.wrapS = smp.wrapT = opt.texture_repeat ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      model.samplers.push_back(smp);
+    }
+    std::string png = png_bytes(path, img);
+    int view = add_view(png.data(), png.size(), 0);
+    model.bufferViews[view].target = 0;
+    tinygltf::Image im;
+    im.name = name;
+    im.mimeType = "image/png";
+    im.bufferView = view;
+    model.images.push_back(im);
+    tinygltf::Texture tex;
+    tex.source = static_cast<int>(model.images.size() - 1);
+    tex.sampler = 0;
+    model.textures.push_back(tex);
+    return static_cast<int>(model.textures.size() - 1);
+  };
   // One glTF material per material (metallic 0, roughness 1, double-sided),
-  // its texture embedded as PNG; one sampler for all (repeat, trilinear).
+  // its texture embedded as PNG. The PBR maps go with WriteMeshOptions::texture.
   for (std::size_t k = 0; k < groups.materials.size(); ++k) {
     const OutMaterial& om = groups.materials[k];
     tinygltf::Material mat;
@@ -527,27 +614,15 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     mat.pbrMetallicRoughness.roughnessFactor = 1.0;
     mat.doubleSided = true;
     if (om.texture) {
-      std::string png = png_bytes(path, *om.texture);
-      int view = add_view(png.data(), png.size(), 0);
-      model.bufferViews[view].target = 0;
-      tinygltf::Image im;
-      im.name = model.images.empty() ? "texture" : "texture_" + std::to_string(model.images.size());
-      im.mimeType = "image/png";
-      im.bufferView = view;
-      model.images.push_back(im);
-      if (model.samplers.empty()) {
-        tinygltf::Sampler smp;
-        smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-        smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-        smp.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
-        smp.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
-        model.samplers.push_back(smp);
-      }
-      tinygltf::Texture tex;
-      tex.source = static_cast<int>(model.images.size() - 1);
-      tex.sampler = 0;
-      model.textures.push_back(tex);
-      mat.pbrMetallicRoughness.baseColorTexture.index = static_cast<int>(model.textures.size() - 1);
+      const std::string name = model.images.empty() ? "texture" : "texture_" + std::to_string(model.images.size());
+      mat.pbrMetallicRoughness.baseColorTexture.index = add_texture(*om.texture, name.c_str());
+    }
+    if (om.texture != nullptr && om.texture == opt.texture) {
+      if (opt.normal_texture != nullptr && !opt.normal_texture->empty())
+        mat.normalTexture.index = add_texture(*opt.normal_texture, "normal");
+      if (opt.metallic_roughness_texture != nullptr && !opt.metallic_roughness_texture->empty())
+        mat.pbrMetallicRoughness.metallicRoughnessTexture.index =
+            add_texture(*opt.metallic_roughness_texture, "metallic_roughness");
     }
     model.materials.push_back(mat);
   }

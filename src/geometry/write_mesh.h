@@ -30,6 +30,25 @@ struct WriteMeshOptions {
   /// is written with its name (blanks become '_'), base colour and decoded
   /// texture (MeshMaterial::texture; empty = none). Not owned.
   const std::vector<MeshMaterial>* materials = nullptr;
+  /// PBR maps beside the base colour (issue 16 item 2), each ignored if null
+  /// or empty. Tangent-space normal map (+Y up, encoded (n+1)/2): glTF
+  /// normalTexture with a TANGENT attribute (geometry/vertex_tangents.h,
+  /// MikkTSpace-style, w = +1 where cross(N, T) points along +v), OBJ `norm`
+  /// and `map_Bump` (<stem>_normal.png).
+  const Image* normal_texture = nullptr;
+  /// Height map in [0,1], OBJ only: `disp` <stem>_height.png as 16-bit PNG
+  /// (glTF 2.0 has no height slot).
+  const Image* height_texture = nullptr;
+  /// glTF metallicRoughnessTexture (G = roughness, B = metallic), OBJ
+  /// `map_Pr` <stem>_roughness.png (its G channel).
+  const Image* metallic_roughness_texture = nullptr;
+  /// Sampler wrap of the glTF textures: REPEAT (periodic tiles) or
+  /// CLAMP_TO_EDGE (atlases: charts end in gutters). Default true.
+  bool texture_repeat = true;
+  /// glTF attribute of kVertexColor: "COLOR_0" (multiplies the base colour
+  /// in viewers) or an application name such as "_COLOR" to carry vertex
+  /// colours beside a texture that already holds them. Default "COLOR_0".
+  std::string color_attribute = "COLOR_0";
   /// Extra per-vertex scalar written as a PLY property / glTF attribute
   /// "_<name>" (e.g. the material coordinate m). Empty = none.
   std::string vertex_scalar_property;

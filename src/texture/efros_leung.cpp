@@ -412,6 +412,11 @@ class Synthesizer {
   std::vector<int> pre_;
   std::vector<Scored> scored_, collect_;
   std::size_t synthesized_ = 0, seeded_ = 0;
+  std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
+  std::vector<ElSource> source_;         // per pixel: where its value came from
+  void record_source(int q, int p, int id, const SearchImage& s) {
+    source_[q] = {pair_of_[p] / opt_.rotations, pair_of_[p] % opt_.rotations, id % s.pw, id / s.pw};
+  }
 };
 
 void Synthesizer::validate() {
@@ -516,6 +521,8 @@ void Synthesizer::prepare_search_images() {
   key_.assign(n, -1);
   for (std::size_t p = 0; p < n; ++p)
     if (pair_of[p] >= 0) key_[p] = slot[pair_of[p]];
+  pair_of_ = std::move(pair_of);
+  source_.assign(n, ElSource());
 }
 
 void Synthesizer::gather_known(int p, const SearchImage& s) {
@@ -699,6 +706,7 @@ void Synthesizer::seed_patch(int p) {
       // a seed never puts texture k where the index map asks for another.
       if (state_[q] != PixelState::Fill || known_[q] || key_[q] != key_[p]) continue;
       for (int c = 0; c < C; ++c) out_.at(x, y, c) = s.plane(c)[id + dy * s.pw + dx];
+      record_source(q, p, id + dy * s.pw + dx, s);
       mark_filled(q);
       ++seeded_;
     }
@@ -739,6 +747,7 @@ void Synthesizer::synthesize_pixel(int p) {
   const int id = scored_[k > 1 ? rng_() % k : 0].second;
   const int px = p % W, py = p / W;
   for (int c = 0; c < C; ++c) out_.at(px, py, c) = s.plane(c)[id];
+  record_source(p, p, id, s);
   mark_filled(p);
   ++synthesized_;
 }
@@ -781,6 +790,7 @@ ElResult Synthesizer::run() {
   res.rotations_used = static_cast<int>(search_.size());
   if (to_fill == 0) {
     res.image = std::move(out_);
+    res.source = std::move(source_);
     res.seconds = timer.seconds();
     return res;
   }
@@ -859,6 +869,7 @@ ElResult Synthesizer::run() {
     }
   }
   res.image = std::move(out_);
+  res.source = std::move(source_);
   res.synthesized = synthesized_;
   res.seeded = seeded_;
   res.seconds = timer.seconds();

@@ -163,8 +163,18 @@ struct ElInput {
   std::vector<int> exemplar_index;
 };
 
+/// Where a synthesised pixel took its value: pixel (x, y) of exemplar
+/// `exemplar` rotated by orientation `rotation` (rotate_exemplar with the
+/// run's periodic_exemplar and a margin of window / 2); exemplar -1 = not
+/// synthesised (Known or Outside pixels). Other maps of the same exemplar
+/// resampled there follow the same synthesis.
+struct ElSource {
+  int exemplar = -1, rotation = 0, x = 0, y = 0;
+};
+
 struct ElResult {
   Image image;                 ///< the target with every Fill pixel synthesised
+  std::vector<ElSource> source;  ///< per pixel, row-major: where its value came from
   std::size_t synthesized = 0; ///< pixels filled by the two-pass search
   std::size_t seeded = 0;      ///< pixels filled by random seed patches
   int window = 0;              ///< effective full window

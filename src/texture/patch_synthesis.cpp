@@ -287,6 +287,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   const int R = opt.flatten.resolution;
   const std::size_t N = static_cast<std::size_t>(R) * R;
   res.images.assign(P, Image(R, R, C, 0.f));
+  res.sources.assign(P, std::vector<ElSource>(static_cast<std::size_t>(R) * R));
   // Exemplar rotations prepared once for every patch (not once per patch).
   const std::shared_ptr<const ElPreparedExemplars> prepared = el_prepare_exemplars(exemplars, opt.el);
   // Per patch: texels filled, of which seeded, Known boundary pixels.
@@ -391,8 +392,10 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
     Image& img = res.images[p];
     for (std::size_t j = 0; j < BN; ++j) {
       const std::size_t i = static_cast<std::size_t>(y0 + j / BW) * R + x0 + j % BW;
-      if (fp.pixel[i] == PatchPixel::Inside)
+      if (fp.pixel[i] == PatchPixel::Inside) {
         for (int c = 0; c < C; ++c) img.data[i * C + c] = r.image.data[j * C + c];
+        res.sources[p][i] = r.source[j];
+      }
     }
     if (opt.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);

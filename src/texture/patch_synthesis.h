@@ -110,6 +110,10 @@ struct PatchSynthesisResult {
   PartitionResult partition;
   FlattenResult flat;            ///< rasters per patch (pixel states, faces, barycentrics)
   std::vector<Image> images;     ///< per patch, res x res, exemplar channels
+  /// Per patch and pixel: where an Inside pixel's value came from
+  /// (efros_leung.h ElSource; exemplar -1 elsewhere), to resample other maps
+  /// of the exemplar through the same synthesis (texture/patch_exemplar_maps.h).
+  std::vector<std::vector<ElSource>> sources;
   std::vector<int> order;        ///< patch ids in synthesis order (main pass)
   int split_patches = 0;         ///< patches split because their projection overlapped
   std::size_t texels = 0;        ///< pixels synthesised (main pass + resynthesis)

@@ -2,6 +2,7 @@
 // `surftex material-map`: outputs, and the local update through the CLI path.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,8 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/read_mesh.h"
 #include "geometry/write_mesh.h"
+#include "apps/asset_checks.h"
+#include "geometry/image_io.h"
 #include "test_support.h"
 #include "texture/material_tile.h"
 
@@ -57,11 +60,12 @@ std::vector<double> arr(const nlohmann::json& j, const char* k) { return j.at(k)
 
 TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
   const std::string dir = make_inputs(test::temp_dir("cmd-matmap"));
-  const std::string base = "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 96 -q ";
+  const std::string base = "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 96 --atlas-size 128 -q ";
   test::RunResult r = test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/out1'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* f : {"mesh.obj", "mesh.glb", "mesh.ply", "render_plain.png", "render_fixed.png",
-                        "render_normalmap.png", "report.json", "state.json"})
+  for (const char* f : {"mesh.obj", "mesh.mtl", "mesh.png", "mesh_normal.png", "mesh_height.png", "mesh.glb",
+                        "mesh.ply", "render_plain.png", "render_fixed.png", "render_normalmap.png", "report.json",
+                        "state.json"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/out1/" + f)) << f;
   nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir + "/out1/report.json"));
   EXPECT_EQ(rep["faces"], 48 * 20 * 2);
@@ -123,7 +127,7 @@ TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
 TEST(CmdMaterialMap, CurlCorrectionIsOptInAndTheStateKeepsIt) {
   const std::string dir = make_inputs(test::temp_dir("cmd-matmap-curl"));
   const std::string base =
-      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 -q ";
+      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 --atlas-size 128 -q ";
   ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/off'").exit_code, 0);
   test::RunResult r = test::run_surftex(base + "--constraints '" + dir +
                                         "/c1.json' --curl-correction -o '" + dir + "/on'");
@@ -149,7 +153,7 @@ TEST(CmdMaterialMap, CurlCorrectionIsOptInAndTheStateKeepsIt) {
 TEST(CmdMaterialMap, NoSwapIsOptInAndTheStateKeepsIt) {
   const std::string dir = make_inputs(test::temp_dir("cmd-matmap-noswap"));
   const std::string base =
-      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 -q ";
+      "material-map '" + dir + "/torus.ply' --tile '" + dir + "/tile' --render-size 64 --atlas-size 128 -q ";
   ASSERT_EQ(test::run_surftex(base + "--constraints '" + dir + "/c1.json' -o '" + dir + "/swap'").exit_code, 0);
   test::RunResult r =
       test::run_surftex(base + "--constraints '" + dir + "/c1.json' --no-swap -o '" + dir + "/noswap'");
@@ -166,4 +170,50 @@ TEST(CmdMaterialMap, NoSwapIsOptInAndTheStateKeepsIt) {
   EXPECT_EQ(json("/update/state.json")["swap_coordinates"], false);
   r = test::run_surftex("material-map --help");
   EXPECT_NE(r.out.find("--no-swap"), std::string::npos) << r.out;
+}
+
+namespace {
+double psnr(const Image& a, const Image& b) {
+  EXPECT_EQ(a.data.size(), b.data.size());
+  double se = 0;
+  for (std::size_t i = 0; i < std::min(a.data.size(), b.data.size()); ++i)
+    se += (a.data[i] - b.data[i]) * (a.data[i] - b.data[i]);
+  return 10 * std::log10(1.0 / std::max(se / static_cast<double>(a.data.size()), 1e-20));
+}
+}  // namespace
+
+// Issue 16 item 1: the mapping baked into a standard asset. surftex's render of
+// the written mesh with its own texture (the OBJ's uv and mesh.png, through
+// `surftex render`) matches the singularity-fixed render at >= 30 dB; the GLB
+// carries the atlas as base colour and its normal map; no file twice.
+TEST(CmdMaterialMap, BakedAssetRendersLikeTheFixedRender) {
+  const std::string dir = make_inputs(test::temp_dir("cmd-matmap-bake"));
+  const std::string out = dir + "/out";
+  test::RunResult r = test::run_surftex("material-map '" + dir + "/torus.ply' --tile '" + dir +
+                                        "/tile' --render-size 256 --atlas-size 1024 -q --constraints '" + dir +
+                                        "/c1.json' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::run_surftex("render '" + out + "/mesh.obj' --texture '" + out + "/mesh.png' --clamp --size 256 -q -o '" +
+                        dir + "/obj_render.png'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double db = psnr(read_image(out + "/render_fixed.png"), read_image(dir + "/obj_render.png"));
+  EXPECT_GE(db, 30.0);
+  // The plain (unfixed) render is further away: the bake holds the fix.
+  EXPECT_LT(psnr(read_image(out + "/render_plain.png"), read_image(dir + "/obj_render.png")), db);
+  const nlohmann::json g = test::glb_json(out + "/mesh.glb");
+  ASSERT_TRUE(g.contains("materials"));
+  EXPECT_TRUE(g["materials"][0]["pbrMetallicRoughness"].contains("baseColorTexture"));
+  EXPECT_TRUE(g["materials"][0].contains("normalTexture"));
+  EXPECT_TRUE(g["meshes"][0]["primitives"][0]["attributes"].contains("TEXCOORD_0"));
+  EXPECT_TRUE(g["meshes"][0]["primitives"][0]["attributes"].contains("_material"));
+  EXPECT_TRUE(test::duplicate_files(out).empty()) << test::duplicate_files(out).front();
+  EXPECT_EQ(test::png_bit_depth(out + "/mesh_height.png"), 16);
+  const Image height = read_image(out + "/mesh_height.png");
+  EXPECT_GT(test::normal_follows_height(read_image(out + "/mesh_normal.png"), height,
+                                        test::chart_interior(out + "/mesh.obj", height.width, height.height)),
+            0.9);
+  const nlohmann::json rep = nlohmann::json::parse(std::ifstream(out + "/report.json"));
+  EXPECT_EQ(rep["atlas"]["size"], 1024);
+  EXPECT_EQ(rep["atlas"]["gutter"], 16);
+  EXPECT_EQ(rep["atlas"]["gutter_violations"], 0);
 }

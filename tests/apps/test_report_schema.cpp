@@ -125,7 +125,7 @@ TEST(ReportSchema, Patches) {
                                {d + "/s.obj", ex}, {d + "/out/mesh.glb", d + "/out/mesh.obj", d + "/out/render.png"});
   EXPECT_TRUE(j["seconds"].contains("synthesis"));
   std::ifstream f(d + "/out/report.json");
-  test::expect_report_schema(nlohmann::json::parse(f), "patches", {ex}, {d + "/out/atlas.png"});
+  test::expect_report_schema(nlohmann::json::parse(f), "patches", {ex}, {d + "/out/mesh.png"});
 }
 
 TEST(ReportSchema, Subdiv) {

@@ -453,7 +453,7 @@ TEST(ReadGltf, TruncatedAndCorruptGlbNeverCrash) {
       read_mesh(d + "/cut.glb", m);
     } catch (const Error& e) {
       ++refused;
-      if (len >= 12) EXPECT_NE(std::string(e.what()).find("cut.glb"), std::string::npos) << e.what();
+      if (len >= 12) { EXPECT_NE(std::string(e.what()).find("cut.glb"), std::string::npos) << e.what(); }
     }
   }
   EXPECT_EQ(refused, tried);  // a cut GLB never reads as a mesh
