@@ -27,6 +27,9 @@ PKGS=(
 )
 # Optional peers used only by benchmarks (bench/): G'MIC.
 if [[ "${SURFTEX_BENCH_PEERS:-0}" == "1" ]]; then PKGS+=(gmic); fi
+# Only to build the libFuzzer targets (scripts/fuzz.sh): Debian's clang and
+# its runtime libraries (libFuzzer, ASan, UBSan).
+if [[ "${SURFTEX_FUZZ:-0}" == "1" ]]; then PKGS+=(clang libclang-rt-14-dev); fi
 
 missing=()
 for p in "${PKGS[@]}"; do

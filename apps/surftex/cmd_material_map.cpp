@@ -254,6 +254,9 @@ int run(const Args& a) {
   sec["read_mesh"] = t.seconds();
   rep["vertices"] = mesh.number_of_vertices();
   rep["faces"] = mesh.number_of_faces();
+  check_budget(estimate_material_map(mesh.number_of_faces(), tile.layers.size() * tile.layers[0].data.size() * 4,
+                                     a.render_size),
+               a.common);
 
   // The curl correction of the PGP's target (pgp_curl_correction.h); an
   // update keeps the one its state was solved with.
@@ -489,7 +492,7 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   info.layers_per_pair = to.layers;
   const std::string tile_dir = ctx.path("material_tile");
   write_material_tile(tile_dir, tr, info, true);
-  const MaterialTile tile = read_material_tile(tile_dir);
+  const MaterialTile tile = read_material_tile(staged_path(tile_dir));
 
   Mesh mesh;
   make_torus(mesh, 1.0, 0.4, 96, 40);
@@ -512,11 +515,10 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   periodic_global_parameterization(mesh);
   const PgpSingularities sing = detect_pgp_singularities(mesh);
   write_meshes(mesh, ctx.dir, true);
-  fs::rename(ctx.path("mesh.obj"), ctx.path("material_map.obj"));
-  fs::rename(ctx.path("mesh.glb"), ctx.path("material_map.glb"));
-  fs::rename(ctx.path("mesh.ply"), ctx.path("material_map.ply"));
-  std::error_code ec;
-  if (fs::exists(ctx.path("mesh.png"), ec)) fs::remove(ctx.path("mesh.png"), ec);
+  rename_output(ctx.path("mesh.obj"), ctx.path("material_map.obj"));
+  rename_output(ctx.path("mesh.glb"), ctx.path("material_map.glb"));
+  rename_output(ctx.path("mesh.ply"), ctx.path("material_map.ply"));
+  discard_output(ctx.path("mesh.png"));
   const Outputs img = render_all(mesh, sing, tile, 384, {20.f, 45.f}, 0.03);
   write_image(ctx.path("material_map_plain.png"), img.plain);
   write_image(ctx.path("material_map_fixed.png"), img.fixed);

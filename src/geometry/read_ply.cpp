@@ -136,7 +136,7 @@ class BodyReader {
 }  // namespace
 
 PolygonSoup read_ply(const std::string& path, std::string_view data) {
-  TextLines header(path, data);
+  TextLines header(path, data, utf8_bom_length(data));
   std::string_view line;
   std::vector<std::string_view> tok;
   if (!header.next(line) || line != "ply") fail_io(path, at_line(1), "not a PLY file (no 'ply' magic)");
