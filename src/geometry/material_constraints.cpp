@@ -159,8 +159,7 @@ struct Locator {
     }
     mean_edge = n ? sum / n : 0;
     if (!verts.empty()) {
-      tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-      tree->buildIndex();
+      tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));  // builds the index
     }
   }
   VertexIndex nearest_vertex(const std::array<double, 3>& u) const {

@@ -312,7 +312,8 @@ void recover_area(const fs::path& area) {
       const fs::path slot = area / ("e" + std::to_string(*it));
       const fs::path& dest = e->second.first;
       // Only a destination inside the folder the area sits in is ours to touch.
-      if (dest.parent_path() != area.parent_path() || dest.filename() != e->second.second) continue;
+      std::error_code e2;
+      if (dest.filename() != e->second.second || !fs::equivalent(dest.parent_path(), area.parent_path(), e2)) continue;
       if (!exists_nofollow(slot / e->second.second)) fs::remove_all(dest, ec);  // it was moved in: undo
       if (exists_nofollow(slot / kBackup)) {
         if (exists_nofollow(dest)) fs::remove_all(slot / kBackup, ec);

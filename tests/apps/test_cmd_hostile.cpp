@@ -60,6 +60,17 @@ struct Inputs {
   std::string out(const std::string& name = "") const { return dir + "/out" + (name.empty() ? "" : "/" + name); }
 };
 
+// A two-layer 8x8 material tile in DIR/tile (for material-map).
+std::string make_tile(const std::string& dir) {
+  fs::create_directories(dir + "/tile");
+  write_image(dir + "/tile/layer_000.png", Image(8, 8, 3, 0.2f));
+  write_image(dir + "/tile/layer_001.png", Image(8, 8, 3, 0.8f));
+  std::ofstream(dir + "/tile/tile.json")
+      << R"({"format": "surftex material tile", "size": 8, "channels": 3, "layers": 2, "layers_per_pair": 1,
+             "layer_list": [{"m": 0, "file": "layer_000.png"}, {"m": 1, "file": "layer_001.png"}]})";
+  return dir + "/tile";
+}
+
 // Runs with SURFTEX_TEST_FAULT set (the output staging sends itself a signal
 // at that point: geometry/output_file.cpp).
 test::RunResult run_with_fault(const std::string& fault, const std::string& args) {
@@ -253,6 +264,7 @@ TEST(OutputsAsOneUnit, SigintDuringALongRunStopsItAndLeavesNothing) {
 // field whose message printed it, too; raw JSON-library text reached users.
 TEST(HostileConstraints, MaterialMapRefusesHostileConstraintFilesCleanly) {
   Inputs in("hostile_constraints", 2);
+  const std::string tile = make_tile(in.dir + "/in");
   struct Case {
     std::string name, text, expect;
   };
@@ -266,8 +278,8 @@ TEST(HostileConstraints, MaterialMapRefusesHostileConstraintFilesCleanly) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     std::ofstream(in.dir + "/in/" + c.name) << c.text;
-    auto r = test::run_surftex("material-map '" + in.mesh + "' --constraints '" + in.dir + "/in/" + c.name +
-                               "' -o '" + in.out("m") + "' -q");
+    auto r = test::run_surftex("material-map '" + in.mesh + "' --tile '" + tile + "' --constraints '" + in.dir +
+                               "/in/" + c.name + "' -o '" + in.out("m") + "' -q");
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_EQ(r.err.rfind("error: " + in.dir + "/in/" + c.name + ": line ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
@@ -319,4 +331,50 @@ TEST(HostileImages, HelpStatesTheImageLimitsAndTheOptionRaisesThem) {
   EXPECT_NE(low.err.find("24x24"), std::string::npos) << low.err;
   auto ok = test::run_surftex("synth '" + in.exemplar + "' -o '" + in.out("s.png") + "' --size 16x16 --max-image-pixels 600 -q");
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
+// An 8 KB TIFF declaring width 8043 made a 64x64 synthesis take 76 s: the
+// search's cost grows with the exemplar's width, so each method bounds it.
+TEST(HostileImages, AnExemplarTooWideForTheSearchIsRefusedUpFront) {
+  Inputs in("hostile_wide_exemplar");
+  write_image(in.dir + "/in/wide.tif", Image(8043, 3, 3, 0.5f));
+  auto r = test::run_surftex("synth '" + in.dir + "/in/wide.tif' -o '" + in.out("s.png") + "' --size 64x64 -q");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("8043x3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("2048 px a side"), std::string::npos) << r.err;
+  EXPECT_TRUE(listing(in.out()).empty());
+}
+
+// --- item 5: work bounded before it starts -------------------------------------
+
+// Every texturing subcommand estimates its memory and refuses a run over the
+// budget before the work, naming the estimate and --max-memory.
+TEST(WorkBudget, EveryTexturingSubcommandRefusesOverTheBudgetBeforeWorking) {
+  Inputs in("hostile_budget");
+  make_tile(in.dir + "/in");
+  const std::string m = "'" + in.mesh + "'", ex = "'" + in.exemplar + "'";
+  const std::vector<std::pair<std::string, std::string>> runs{
+      {"patches", "patches " + m + " " + ex + " -o '" + in.out("p") + "'"},
+      {"subdiv", "subdiv " + m + " " + ex + " -o '" + in.out("s") + "'"},
+      {"material-map", "material-map " + m + " --tile '" + in.dir + "/in/tile' -o '" + in.out("m") + "'"},
+      {"material-tile", "material-tile " + ex + " " + ex + " -o '" + in.out("t") + "'"},
+      {"quilt", "quilt " + m + " weave -o '" + in.out("q.obj") + "'"},
+      {"synth", "synth " + ex + " -o '" + in.out("s.png") + "'"},
+      {"tile", "tile " + ex + " -o '" + in.out("t.png") + "'"},
+  };
+  for (const auto& [name, cmd] : runs) {
+    SCOPED_TRACE(name);
+    auto r = test::run_surftex(cmd + " --max-memory 1M");
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("needs about"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--max-memory"), std::string::npos) << r.err;
+    EXPECT_TRUE(listing(in.out()).empty()) << joined(listing(in.out()));
+  }
+  auto bad = test::run_surftex("synth " + ex + " -o '" + in.out("s.png") + "' --max-memory lots");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--max-memory"), std::string::npos) << bad.err;
+  // Under the budget the estimate is said in a note (not with -q).
+  auto ok = test::run_surftex("synth " + ex + " -o '" + in.out("s.png") + "' --size 16x16 --max-memory 50%");
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_NE(ok.err.find("note: estimate: synth"), std::string::npos) << ok.err;
 }

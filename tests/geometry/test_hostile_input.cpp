@@ -372,15 +372,22 @@ TEST(OutputStaging, SweepRemovesOnlyWhatDeadRunsLeft) {
   // Pid 2^22+1 is above Linux's default pid_max: never alive.
   fs::create_directories(dir + "/.surftex-stage-4194305-123/e0");
   write_file(dir, ".surftex-tmp-4194305-123-0.ply", "x");
-  const std::string live = ".surftex-stage-" + std::to_string(::getpid()) + "-1";
+  // Our own pid with another start time is a reused pid: stale too.
+  fs::create_directories(dir + "/.surftex-stage-" + std::to_string(::getpid()) + "-1");
+  // This process, with its real start time (/proc/self/stat field 22): alive, kept.
+  std::ifstream st("/proc/self/stat");
+  std::string stat((std::istreambuf_iterator<char>(st)), std::istreambuf_iterator<char>());
+  std::istringstream rest(stat.substr(stat.rfind(')') + 1));
+  std::string tok, start;
+  for (int field = 3; field <= 22 && (rest >> tok); ++field) start = tok;
+  const std::string live = ".surftex-stage-" + std::to_string(::getpid()) + "-" + start;
   fs::create_directories(dir + "/" + live);
   write_file(dir, "keep.txt", "k");
-  EXPECT_EQ(sweep_stale_outputs(dir), 2u);
+  EXPECT_EQ(sweep_stale_outputs(dir), 3u);
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  // Our own pid with another start time is a reused pid: stale too.
-  EXPECT_EQ(names, (std::vector<std::string>{"keep.txt"}));
+  EXPECT_EQ(names, (std::vector<std::string>{live, "keep.txt"}));
 }
 
 // ---------------------------------------------------------------- polygons
