@@ -111,11 +111,12 @@ TEST(NoSilentLoss, TwoOutputsNamingOneFileAreRefused) {
 // caught when the second write happens; the run leaves nothing.
 TEST(NoSilentLoss, ReportNamingADerivedOutputLeavesNothing) {
   Inputs in("hostile_report_derived");
+  fs::create_directories(in.out("p"));
   auto r = test::run_surftex("patches '" + in.mesh + "' '" + in.exemplar + "' -o '" + in.out("p") + "' --report '" +
                              in.out("p/report.json") + "' --patch-res 16 --window 5 --rotations 4 -q");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("written twice"), std::string::npos) << r.err;
-  EXPECT_TRUE(listing(in.out()).empty()) << joined(listing(in.out()));
+  EXPECT_TRUE(listing(in.out("p")).empty()) << joined(listing(in.out("p")));
 }
 
 // `--angle ""` and `--view "" ""` silently became 0.
