@@ -9,6 +9,7 @@ Three families, each run through the CLI one process at a time:
 
 Every run is classified:
   clean_error    exit 2, one `error: ...` line, nothing left in OUT
+  unclean_error  exit 2, nothing left, but library text before our `error:` line
   success        exit 0, every expected output present, nothing else in OUT
   crash          killed by a signal, or an exit code other than 0 and 2, or a
                  sanitizer / `terminate called` message
@@ -18,9 +19,10 @@ Every run is classified:
                  number spelling) whose result differs from the seed's
   partial_output something left in OUT after a failure, a missing or extra
                  output after a success, or a staging folder / temporary left
-Usage: bench/hostile_campaign.py --binary build/apps/surftex [--family meshes|images|json|all]
-       [--count N] [--seed S] [--out results.jsonl]
-Prints one JSON line per family with the counts (and writes every run to --out).
+Usage: bench/hostile_campaign.py --binary build/bin/surftex [--server build/bench/hostile_fork_server]
+       [--family meshes|images|json|all] [--count N] [--seed S] [--out results.jsonl]
+Prints one JSON line per family with the counts (and writes every run to --out);
+bench/hostile_campaign.py --summarize LOG... prints the README's table from the logs.
 """
 import argparse
 import json
@@ -44,8 +46,19 @@ GiB = 1 << 30
 # ---------------------------------------------------------------- running
 
 
+SERVER = None  # the fork server (bench/hostile_fork_server.cpp), when --server is given
+
+
 def run(binary, args, out_dir, timeout):
     """Runs surftex once; returns (status, stderr, seconds, max_rss_bytes of that run)."""
+    if SERVER is not None:
+        err_path = os.path.join(out_dir, "..", "stderr")
+        SERVER.stdin.write(json.dumps([err_path, timeout] + args) + "\n")
+        SERVER.stdin.flush()
+        r = json.loads(SERVER.stdout.readline())
+        err = open(err_path, "rb").read(1 << 16).decode("utf-8", "replace")
+        status = "hang" if r["hang"] else r["status"]
+        return status, err, r["seconds"], r["max_rss_kb"] * 1024
     start = time.monotonic()
     with tempfile.TemporaryFile() as errf:
         p = subprocess.Popen(["nice", "-n", "10", binary] + args, stdout=subprocess.DEVNULL, stderr=errf,
@@ -87,7 +100,8 @@ def classify(status, err, seconds, rss_delta, out_dir, expected):
     if status == 2:
         if left:
             return "partial_output"
-        outcome = "clean_error" if err.startswith("error: ") else "crash"
+        # Exit 2 with library text before or instead of our one `error:` line.
+        outcome = "clean_error" if err.startswith("error: ") else "unclean_error"
     else:
         outcome = "success" if sorted(expected) == [x for x in left if x in expected] and set(left) <= set(
             expected) | {os.path.dirname(e) for e in expected} else "partial_output"
@@ -223,10 +237,27 @@ def small_files(folder, exts, limit=256 * 1024):
     return out
 
 
-def mesh_seeds():
+def mesh_seeds(binary, work):
+    """The shared data's meshes up to 64 KB, plus PLY (ascii, binary) and binary STL seeds made here
+    (the shared data has no small ones)."""
     seeds = []
     for sub in ("meshes", "broken", "swatches"):
-        seeds += small_files(os.path.join(DATA, sub), (".off", ".obj", ".ply", ".stl"))
+        seeds += small_files(os.path.join(DATA, sub), (".off", ".obj", ".ply", ".stl"), 64 * 1024)
+    for src in ("broken/fused_vertices.off", "swatches/tube_ring.off", "broken/quads_to_stitch.off"):
+        src = os.path.join(DATA, src)
+        if not os.path.exists(src):
+            continue
+        for ext in (".ply", ".stl"):
+            dst = os.path.join(work, "seed_" + os.path.basename(src)[:-4] + ext)
+            if subprocess.call([binary, "convert", src, "-o", dst, "-q"], stderr=subprocess.DEVNULL) == 0:
+                seeds.append(dst)
+    # An ascii PLY with colours and a quad.
+    p = os.path.join(work, "seed_ascii.ply")
+    open(p, "w").write("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 3\n"
+                       "property list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n"
+                       "1 1 0 0 0 255\n0 1 0 9 9 9\n0.5 0.5 1 1 2 3\n4 0 1 2 3\n3 0 1 4\n3 1 2 4\n")
+    seeds.append(p)
     return seeds
 
 
@@ -241,7 +272,7 @@ def report_counts(path):
 
 
 def campaign_meshes(args, rnd, work, log):
-    seeds = mesh_seeds()
+    seeds = mesh_seeds(args.binary, work)
     reference = {}
     counts = {}
     for i in range(args.count):
@@ -273,7 +304,7 @@ def campaign_meshes(args, rnd, work, log):
                 outcome = "silent_misread" if status == 0 else outcome + "_on_neutral"
         counts[outcome] = counts.get(outcome, 0) + 1
         log.write(json.dumps({"family": "meshes", "seed": os.path.basename(seed), "mutation": kind,
-                              "outcome": outcome, "status": status, "seconds": round(sec, 3),
+                              "outcome": outcome, "status": status, "seconds": round(sec, 3), "max_rss_mb": round(rss / 2**20),
                               "error": err.strip().splitlines()[0][:200] if err.strip() else ""}) + "\n")
     return counts, len(seeds)
 
@@ -324,7 +355,7 @@ def campaign_images(args, rnd, work, log):
                 outcome = "silent_misread" if status == 0 else outcome + "_on_neutral"
         counts[outcome] = counts.get(outcome, 0) + 1
         log.write(json.dumps({"family": "images", "seed": os.path.basename(seed), "mutation": kind,
-                              "outcome": outcome, "status": status, "seconds": round(sec, 3),
+                              "outcome": outcome, "status": status, "seconds": round(sec, 3), "max_rss_mb": round(rss / 2**20),
                               "error": err.strip().splitlines()[0][:200] if err.strip() else ""}) + "\n")
     return counts, len(seeds)
 
@@ -415,12 +446,39 @@ def campaign_json(args, rnd, work, log):
             outcome = "unnamed_error"
         counts[outcome] = counts.get(outcome, 0) + 1
         log.write(json.dumps({"family": "json", "file": "tile.json" if tile_case else "constraints", "mutation": kind,
-                              "outcome": outcome, "status": status, "seconds": round(sec, 3),
+                              "outcome": outcome, "status": status, "seconds": round(sec, 3), "max_rss_mb": round(rss / 2**20),
                               "error": err.strip().splitlines()[0][:200] if err.strip() else ""}) + "\n")
     return counts, len(CONSTRAINT_SEEDS) + 1
 
 
+OUTCOMES = ["clean_error", "success", "crash", "hang", "silent_misread", "partial_output", "over_limits",
+            "unclean_error", "unnamed_error"]
+
+
+def summarize(paths):
+    """A markdown table (one row per family) from campaign logs."""
+    rows = {}
+    for path in paths:
+        for line in open(path):
+            r = json.loads(line)
+            fam = rows.setdefault(r["family"], {"n": 0, "max_s": 0.0})
+            fam["n"] += 1
+            fam[r["outcome"]] = fam.get(r["outcome"], 0) + 1
+            fam["max_s"] = max(fam["max_s"], r.get("seconds", 0))
+            fam["max_mb"] = max(fam.get("max_mb", 0), r.get("max_rss_mb", 0))
+    print("| family | inputs | " + " | ".join(o.replace("_", " ") for o in OUTCOMES) + " | other | slowest run | largest run |")
+    print("| --- " * (len(OUTCOMES) + 5) + "|")
+    for fam, c in rows.items():
+        other = c["n"] - sum(c.get(o, 0) for o in OUTCOMES)
+        mb = ("%d MiB" % c["max_mb"]) if c.get("max_mb") else "n/a"
+        print("| %s | %d | %s | %d | %.2f s | %s |" % (fam, c["n"], " | ".join(str(c.get(o, 0)) for o in OUTCOMES),
+                                                      other, c["max_s"], mb))
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--summarize":
+        summarize(sys.argv[2:])
+        return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--binary", required=True)
     ap.add_argument("--family", default="all", choices=["meshes", "images", "json", "all"])
@@ -428,7 +486,14 @@ def main():
     ap.add_argument("--seed", type=int, default=21)
     ap.add_argument("--timeout", type=float, default=10.0)
     ap.add_argument("--out", default="hostile_campaign.jsonl")
+    ap.add_argument("--server", help="build/bench/hostile_fork_server: run each input in a forked child of one "
+                                     "process instead of starting surftex each time (same code, no start-up cost)")
     args = ap.parse_args()
+    global SERVER
+    if args.server:
+        env = dict(os.environ, OPENBLAS_NUM_THREADS="1")  # no BLAS threads in the parent: safe to fork
+        SERVER = subprocess.Popen(["nice", "-n", "10", args.server], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                  text=True, env=env)
     families = ["meshes", "images", "json"] if args.family == "all" else [args.family]
     with open(args.out, "a") as log:
         for fam in families:

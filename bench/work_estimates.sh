@@ -6,6 +6,9 @@
 # (docs/decisions/602-work-estimates.md). One run at a time, niced, each
 # bounded by `timeout`.
 # Usage: bench/work_estimates.sh BUILD_DIR [FACES...] (default 2000 8000 32000)
+# SURFTEX_EXTRA_ARGS is appended to every command (e.g. "--max-memory 4G" for
+# the goal: at 500K faces every texturing subcommand finishes within
+# 4 GB or refuses up front). SURFTEX_ONLY_MESH=1 skips the image-only ones.
 set -euo pipefail
 build="$1"; shift
 sizes=("$@"); ((${#sizes[@]})) || sizes=(2000 8000 32000)
@@ -40,7 +43,8 @@ measure() {  # measure NAME FACES ARGS...
   rm -rf "$work/out"; mkdir -p "$work/out"
   local t0 rc=0
   t0=$(date +%s.%N)
-  nice -n 10 timeout 1800 /usr/bin/time -f "%M %U %S" -o "$work/time" "$bin" "$@" >"$work/stdout" 2>"$work/stderr" || rc=$?
+  # shellcheck disable=SC2086
+  nice -n 10 timeout 1800 /usr/bin/time -f "%M %U %S" -o "$work/time" "$bin" "$@" ${SURFTEX_EXTRA_ARGS:-} >"$work/stdout" 2>"$work/stderr" || rc=$?
   local wall; wall=$(echo "$(date +%s.%N) - $t0" | bc)
   read -r rss user sys <"$work/time" || true
   local est; est=$(grep -m1 "^note: estimate" "$work/stderr" | sed 's/"/\\"/g' || true)
@@ -48,9 +52,12 @@ measure() {  # measure NAME FACES ARGS...
   echo "{\"bench\":\"work_estimates\",\"command\":\"$name\",\"faces\":$faces,\"exit\":$rc,\"max_rss_mib\":$((${rss:-0} / 1024)),\"user_s\":${user:-0},\"sys_s\":${sys:-0},\"wall_s\":$wall,\"load\":$(cut -d' ' -f1 /proc/loadavg),\"estimate\":\"$est\",\"error\":\"$err\"}"
 }
 # Image-only subcommands once (they do not depend on a mesh).
-measure synth 0 synth "$ex" -o "$work/out/s.png"
-measure tile 0 tile "$ex" -o "$work/out/t.png"
-measure material-tile 0 material-tile "$data/textures/fabric_brown_256.png" "$data/textures/denim_256.png" -o "$work/tile"
+if [[ "${SURFTEX_ONLY_MESH:-0}" != 1 ]]; then
+  measure synth 0 synth "$ex" -o "$work/out/s.png"
+  measure tile 0 tile "$ex" -o "$work/out/t.png"
+fi
+# material-map needs a tile (made without the extra arguments).
+SURFTEX_EXTRA_ARGS="" measure material-tile 0 material-tile "$data/textures/fabric_brown_256.png" "$data/textures/denim_256.png" -o "$work/tile"
 for F in "${sizes[@]}"; do
   torus "$F" "$work/torus.off"
   measure patches "$F" patches "$work/torus.off" "$ex" -o "$work/out/p"

@@ -40,7 +40,13 @@ void install_cancel_handlers() {
   sa.sa_handler = on_cancel_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = SA_RESTART;  // interrupted reads and writes resume; the flag is polled
-  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaction(s, &sa, nullptr);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) {
+    // A signal ignored on entry stays ignored (nohup, background jobs of a
+    // non-interactive shell): the caller asked not to be stopped by it.
+    struct sigaction old {};
+    if (sigaction(s, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(s, &sa, nullptr);
+  }
 }
 
 int cancel_signal() noexcept { return g_signal; }

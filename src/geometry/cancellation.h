@@ -24,7 +24,7 @@ class Cancelled : public Error {
 };
 
 /// Installs the flag-setting handler for SIGINT, SIGTERM and SIGHUP (the CLI
-/// calls it once in main).
+/// calls it once in main); a signal ignored on entry (nohup) stays ignored.
 void install_cancel_handlers();
 
 /// The signal that asked the run to stop, or 0.

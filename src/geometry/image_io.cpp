@@ -88,6 +88,24 @@ std::uint32_t be32(const unsigned char* p) {
   return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
 }
 
+// The IHDR fields (PNG specification, section 11.2.2): libpng refuses
+// invalid ones by printing "libpng error: Invalid IHDR data" itself.
+void check_png_header(const unsigned char* d, std::uint32_t len, const std::string& what) {
+  if (len != 13) throw IOError(what + "the PNG header (IHDR) has " + std::to_string(len) + " bytes, not 13");
+  const std::uint32_t w = be32(d), h = be32(d + 4);
+  const int depth = d[8], type = d[9];
+  if (w == 0 || h == 0 || w > 0x7FFFFFFFu || h > 0x7FFFFFFFu)
+    throw IOError(what + "the PNG header claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
+  const bool ok_type = (type == 0 && (depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16)) ||
+                       (type == 3 && (depth == 1 || depth == 2 || depth == 4 || depth == 8)) ||
+                       ((type == 2 || type == 4 || type == 6) && (depth == 8 || depth == 16));
+  if (!ok_type)
+    throw IOError(what + "the PNG header's colour type " + std::to_string(type) + " with bit depth " +
+                  std::to_string(depth) + " is not a PNG format");
+  if (d[10] != 0 || d[11] != 0 || d[12] > 1)
+    throw IOError(what + "the PNG header's compression, filter or interlace method is unknown");
+}
+
 // A PNG file's chunk structure checked before libpng sees it: every chunk
 // inside the file with a matching CRC, IHDR first and IEND last (PNG
 // specification, sections 5.3-5.6). libpng reports a truncated or damaged
@@ -121,7 +139,6 @@ void check_png_structure(const std::string& path) {
                     " bytes)");
     if (first && type != "IHDR")
       throw IOError(what + "the first PNG chunk is '" + type + "', not IHDR");
-    first = false;
     buf.resize(static_cast<std::size_t>(len) + 4);
     f.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
     std::uint32_t crc = png_crc(head + 4, 4);
@@ -129,6 +146,8 @@ void check_png_structure(const std::string& path) {
     if (crc != be32(buf.data() + len))
       throw IOError(what + "PNG chunk '" + type + "' at byte " + std::to_string(at) +
                     " fails its CRC check");
+    if (first) check_png_header(buf.data(), len, what);
+    first = false;
     at += 12 + static_cast<std::uintmax_t>(len);
     if (type == "IEND") return;
   }

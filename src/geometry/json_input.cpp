@@ -103,7 +103,8 @@ class Builder {
       return stop(line, "number " + show_token(last_token) + " is out of range (beyond +-1.8e308)");
     if (last_token.empty() || furthest_pos() >= text_.size())
       return stop(line, "malformed JSON: the file ends before the value is complete");
-    return stop(line, "malformed JSON: unexpected '" + show_token(last_token) + "'");
+    const std::size_t at = furthest_pos() > 0 ? furthest_pos() - 1 : 0;
+    return stop(line, "malformed JSON: unexpected '" + show_token(text_.substr(at, 1)) + "'");
   }
 
   std::size_t furthest_pos() const { return static_cast<std::size_t>(*furthest_ - text_.data()); }
@@ -130,11 +131,15 @@ class Builder {
 
   std::string path() const {
     std::string p;
-    for (const Frame& f : frames_) {
+    for (std::size_t i = 0; i < frames_.size(); ++i) {
+      const Frame& f = frames_[i];
       if (f.node->is_object()) {
         if (!f.key.empty()) p += (p.empty() ? "" : ".") + f.key;
       } else {
-        p += "[" + std::to_string(f.node->size()) + "]";
+        // An enclosing array's last element is the open child; the innermost
+        // array is at its next element.
+        const std::size_t n = f.node->size();
+        p += "[" + std::to_string(i + 1 < frames_.size() && n > 0 ? n - 1 : n) + "]";
       }
     }
     return p.empty() ? "(top level)" : p;

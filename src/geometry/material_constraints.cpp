@@ -93,7 +93,7 @@ struct Frame {
       u[k] = (p[k] / 2 - centre[k] / 2) / (half / 2);
       if (!(std::fabs(u[k]) <= kReach)) {
         char b[160];
-        std::snprintf(b, sizeof b, "coordinate %.17g is far outside the mesh (its box spans %.6g..%.6g on that axis; ",
+        std::snprintf(b, sizeof b, "coordinate %.6g is far outside the mesh (its box spans %.6g..%.6g on that axis; ",
                       p[k], lo[k], hi[k]);
         fail(c, line, field, std::string(b) + "points must lie within one box size of it)");
       }
@@ -204,6 +204,16 @@ struct Parser {
   std::vector<char> face_taken;
   std::vector<std::uint32_t> seeds;
 
+  // True if `d` has a part in the plane of face f (the direction field
+  // projects it there and refuses a direction normal to the face).
+  bool tangent_to(FaceIndex f, const std::array<double, 3>& d) const {
+    const Vector3 n = robust_face_normal(c.mesh, f);
+    const double dn = d[0] * n.x() + d[1] * n.y() + d[2] * n.z();
+    const double t2 = (d[0] - dn * n.x()) * (d[0] - dn * n.x()) + (d[1] - dn * n.y()) * (d[1] - dn * n.y()) +
+                      (d[2] - dn * n.z()) * (d[2] - dn * n.z());
+    return t2 > 1e-12;  // d is a unit vector
+  }
+
   void add_face(FaceIndex f, const std::array<double, 3>& d) {
     if (face_taken[f.idx()]) return;
     face_taken[f.idx()] = 1;
@@ -228,6 +238,9 @@ struct Parser {
       if (neg || fi >= mesh.num_faces() || mesh.is_removed(FaceIndex(static_cast<std::uint32_t>(fi))))
         fail(c, line, fw,
              "face " + ji::describe(faces[k]) + " out of range (" + std::to_string(mesh.number_of_faces()) + " faces)");
+      if (!tangent_to(FaceIndex(static_cast<std::uint32_t>(fi)), d))
+        fail(c, ji::line_of(s, "direction"), where + ".direction",
+             "is normal to face " + std::to_string(fi) + " (it needs a part along the surface)");
       add_face(FaceIndex(static_cast<std::uint32_t>(fi)), d);
     }
   }
@@ -273,7 +286,8 @@ struct Parser {
           const double a = (q + 0.5) / n;
           const std::array<double, 3> p{pts[k][0] + a * d[0], pts[k][1] + a * d[1], pts[k][2] + a * d[2]};
           const FaceIndex f = loc.nearest_face(p, frame);
-          if (f != Mesh::null_face()) add_face(f, t);
+          // A stroke crossing the surface straight through gives that face no direction.
+          if (f != Mesh::null_face() && tangent_to(f, t)) add_face(f, t);
         }
       }
   }

@@ -22,7 +22,8 @@
 // face over all strokes together); each sample's nearest face (the
 // incident face, around the nearest vertex, whose centroid is nearest) gets
 // the segment's unit tangent as direction (projected on the face plane by the
-// direction field). A face constrained twice keeps its first direction. Scale
+// direction field; a sample whose tangent is normal to its face is skipped, a
+// "faces" direction normal to one of its faces is refused). A face constrained twice keeps its first direction. Scale
 // and material points go to their nearest vertex (a later point on the same
 // vertex replaces the earlier one).
 //

@@ -172,7 +172,6 @@ TEST(HostileConstraints, MalformedJsonAndOverflowsAreOurOwnWords) {
       {"{\"strokes\": [{\"faces\": [1,, 2]}]}", "c.json: line 1: field strokes[0].faces[1]: malformed JSON: unexpected ','"},
       {"{\"strokes\": [", "c.json: line 1: field strokes[0]: malformed JSON: the file ends before the value is complete"},
       {"{\n\n\"a\" 1}", "c.json: line 3: field a: malformed JSON"},
-      {"\xEF\xBB\xBF{}", "c.json: line 1: field (top level): malformed JSON"},
       {"[1, 2]", "c.json: line 1: field (top level): must be an object, got an array of 2 elements"},
       {"{\"strokes\": [{\"faces\": [1e300], \"direction\": [1,0,0]}]}", "field strokes[0].faces[0]: must be an integer, got 1.0000000000000001e+300"},
       {"{\"strokes\": [{\"faces\": [18446744073709551615], \"direction\": [1,0,0]}]}", "face 18446744073709551615 out of range"},
@@ -181,6 +180,8 @@ TEST(HostileConstraints, MalformedJsonAndOverflowsAreOurOwnWords) {
       {"{\"scale\": [{\"point\": [0,0,0], \"value\": 1e300}]}", "field scale[0].value: must be a number in ["},
       {"{\"" + std::string(5000, 'k') + "\": 1}", "field kkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkk...: unknown field"},
   };
+  // A UTF-8 byte-order mark is skipped (the JSON reader's own rule), not eaten with a field.
+  EXPECT_EQ(constraint_error("\xEF\xBB\xBF{\"material\": [{\"point\": [0,0,1], \"value\": 1}]}", m), "(no error)");
   for (const auto& [text, expect] : cases) {
     const std::string e = constraint_error(text, m);
     EXPECT_NE(e.find(expect), std::string::npos) << "input " << text.substr(0, 80) << "\ngot " << e;
