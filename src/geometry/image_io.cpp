@@ -90,7 +90,8 @@ std::uint32_t be32(const unsigned char* p) {
 
 // The IHDR fields (PNG specification, section 11.2.2): libpng refuses
 // invalid ones by printing "libpng error: Invalid IHDR data" itself.
-void check_png_header(const unsigned char* d, std::uint32_t len, const std::string& what) {
+void check_png_header(const unsigned char* d, std::uint32_t len, const std::string& what, const std::string& path,
+                      const ImageLimits& lim) {
   if (len != 13) throw IOError(what + "the PNG header (IHDR) has " + std::to_string(len) + " bytes, not 13");
   const std::uint32_t w = be32(d), h = be32(d + 4);
   const int depth = d[8], type = d[9];
@@ -104,6 +105,13 @@ void check_png_header(const unsigned char* d, std::uint32_t len, const std::stri
                   std::to_string(depth) + " is not a PNG format");
   if (d[10] != 0 || d[11] != 0 || d[12] > 1)
     throw IOError(what + "the PNG header's compression, filter or interlace method is unknown");
+  // Our limits before libpng's own (1,000,000 px a side, refused with its own text).
+  const long long side = std::min(lim.max_side(), 1000000LL);
+  if (w > side || h > side || static_cast<long long>(w) * h > lim.max_pixels)
+    throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) +
+                            " (PNG header); the limit is " + std::to_string(side) + " px a side and " +
+                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
+                            " MiB decoded): pass --max-image-pixels to raise it");
 }
 
 // A PNG file's chunk structure checked before libpng sees it: every chunk
@@ -115,7 +123,7 @@ void check_png_header(const unsigned char* d, std::uint32_t len, const std::stri
 // offset instead. Damage inside the compressed pixel data with a valid CRC
 // (rare: the CRC covers it) still reaches libpng. Files that do not start
 // with the PNG signature are left to OpenImageIO.
-void check_png_structure(const std::string& path) {
+void check_png_structure(const std::string& path, const ImageLimits& lim) {
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::ifstream f(path, std::ios::binary);
   if (!f) return;  // OpenImageIO reports it
@@ -146,20 +154,20 @@ void check_png_structure(const std::string& path) {
     if (crc != be32(buf.data() + len))
       throw IOError(what + "PNG chunk '" + type + "' at byte " + std::to_string(at) +
                     " fails its CRC check");
-    if (first) check_png_header(buf.data(), len, what);
+    if (first) check_png_header(buf.data(), len, what, path, lim);
     first = false;
     at += 12 + static_cast<std::uintmax_t>(len);
     if (type == "IEND") return;
   }
 }
 
-std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
+std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const ImageLimits& lim) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw IOError("image '" + path + "' does not exist");
   if (std::filesystem::is_directory(path, ec)) throw IOError("image '" + path + "' is a folder");
   if (std::filesystem::file_size(path, ec) == 0 && !ec)
     throw IOError("image '" + path + "' is empty (0 bytes)");
-  check_png_structure(path);
+  check_png_structure(path, lim);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     const std::string why = take_errors(nullptr);
@@ -195,7 +203,7 @@ void set_image_limits(const ImageLimits& limits) { g_limits = limits; }
 const ImageLimits& image_limits() { return g_limits; }
 
 ImageHeader read_image_header(const std::string& path, const ImageLimits& limits) {
-  auto in = open_input(path);
+  auto in = open_input(path, limits);
   const OIIO::ImageSpec spec = in->spec();
   ImageHeader h;
   h.width = spec.width;
@@ -209,14 +217,14 @@ ImageHeader read_image_header(const std::string& path, const ImageLimits& limits
 }
 
 Image read_image(const std::string& path) {
-  auto in = open_input(path);
+  auto in = open_input(path, g_limits);
   Image img = read_current(*in, path);
   in->close();
   return img;
 }
 
 std::vector<Image> read_image_layers(const std::string& path) {
-  auto in = open_input(path);
+  auto in = open_input(path, g_limits);
   std::vector<Image> layers;
   int sub = 0;
   long long bytes = 0;

@@ -365,8 +365,7 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
   c.polygons_simplified = PMP::internal::simplify_polygons_in_polygon_soup(pts, polys, Kernel());
   std::size_t before_split = polys.size();
   // Linear-time split first (CGAL's is quadratic in a polygon's corners).
-  split_pinched_polygons(polys, pts.size());
-  polys.erase(std::remove_if(polys.begin(), polys.end(), [](const auto& p) { return p.size() < 3; }), polys.end());
+  split_pinched_polygons(polys, pts.size());  // a polygon left with no cycle is emptied: removed and counted below
   PMP::internal::split_pinched_polygons_in_polygon_soup(pts, polys, Kernel());
   c.pinched_polygons_split = polys.size() - std::min(before_split, polys.size());
   c.degenerate_polygons_removed = PMP::internal::remove_invalid_polygons_in_polygon_soup(pts, polys);

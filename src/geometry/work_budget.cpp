@@ -144,7 +144,7 @@ WorkEstimate estimate_subdiv(std::size_t faces, int exemplar_width, int exemplar
   e.what = "subdiv on " + std::to_string(faces) + " faces (" + std::to_string(static_cast<long long>(F)) +
            " after " + std::to_string(levels) + " levels)";
   e.bytes = kBase + 3000.0 * F + static_cast<double>(exemplar_pixels) * 200.0 + static_cast<double>(atlas) * atlas * 40.0;
-  e.seconds = 4e-4 * F;
+  e.seconds = 1e-2 * F * std::max(1.0, exemplar_pixels / 65536.0);
   e.shrink = "--levels, a smaller mesh";
   exemplar(e, exemplar_width, exemplar_height, kElSide);
   return e;
@@ -155,7 +155,7 @@ WorkEstimate estimate_material_map(std::size_t faces, std::size_t tile_bytes, in
   WorkEstimate e;
   e.what = "material-map on " + std::to_string(faces) + " faces";
   e.bytes = kBase + 5000.0 * F + 2.0 * static_cast<double>(tile_bytes) + static_cast<double>(render_size) * render_size * 100.0;
-  e.seconds = 2e-4 * F;
+  e.seconds = 1.0 + 2e-4 * F + 3e-6 * static_cast<double>(render_size) * render_size;
   e.shrink = "a smaller mesh";
   return e;
 }
@@ -178,8 +178,8 @@ WorkEstimate estimate_quilt(std::size_t faces, double output_faces) {
   WorkEstimate e;
   e.what = "quilt on " + std::to_string(faces) + " faces (about " + std::to_string(static_cast<long long>(output_faces)) +
            " output faces)";
-  e.bytes = kBase + 3000.0 * static_cast<double>(faces) + 600.0 * output_faces;
-  e.seconds = 1e-4 * static_cast<double>(faces) + 2e-5 * output_faces;
+  e.bytes = kBase + 3000.0 * static_cast<double>(faces) + 800.0 * output_faces;
+  e.seconds = 1e-4 * static_cast<double>(faces) + 1.5e-4 * output_faces;
   e.shrink = "a larger element spacing, a smaller mesh";
   return e;
 }
@@ -192,8 +192,10 @@ WorkEstimate estimate_synth(int width, int height, int exemplar_width, int exemp
   WorkEstimate e;
   e.what = std::string("synth (") + (graphcut ? "graphcut" : "el2pass") + ") of " + std::to_string(width) + "x" +
            std::to_string(height) + " from a " + std::to_string(exemplar_pixels) + "-pixel exemplar";
-  e.bytes = kBase + out * 200.0 + ex * std::max(1, rotations) * static_cast<double>(window) * window * 8.0;
-  e.seconds = graphcut ? out * 2e-5 : out * std::max(1, rotations) * 3e-9 * ex / 64;
+  // Rotated copies of the exemplar (RGB floats) and per-pixel buffers; the
+  // search compares every output pixel with the exemplar's candidates.
+  e.bytes = kBase + out * 200.0 + ex * std::max(1, rotations) * 12.0 + ex * 64.0;
+  e.seconds = graphcut ? out * 2e-5 : out * ex * 1.5e-8 * (window * window) / 121.0;
   e.shrink = graphcut ? "--size" : "--size, a smaller exemplar, --rotations";
   exemplar(e, exemplar_width, exemplar_height, graphcut ? kGraphcutSide : kElSide);
   return e;
