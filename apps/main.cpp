@@ -7,7 +7,9 @@
 #include <exception>
 #include <new>
 
+#include "geometry/cancellation.h"
 #include "geometry/errors.h"
+#include "geometry/output_file.h"
 #include "surftex/command.h"
 
 int main(int argc, char** argv) {
@@ -36,21 +38,32 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "Run with --help for the options.\n");
     return 2;
   }
+  // Every output of the run is staged and moved into place only when the
+  // whole subcommand succeeded (geometry/output_file.h); SIGINT/SIGTERM/SIGHUP
+  // stop it at the next check and leave nothing (geometry/cancellation.h).
+  surftex::install_cancel_handlers();
+  auto failed = [](const char* what) {
+    const int sig = surftex::cancel_signal();  // whatever failed, a signal stopped it
+    std::fprintf(stderr, "error: %s\n", sig != 0 ? surftex::Cancelled(sig).what() : what);
+    return sig != 0 ? 128 + sig : 2;
+  };
   try {
     for (auto& [sub, run] : runs)
       if (sub->parsed()) {
+        surftex::cli::sweep_stale_outputs_of_arguments(*sub);
         surftex::cli::check_parsed_arguments(*sub);
-        return run();
+        surftex::OutputStaging staging;
+        const int rc = run();
+        if (rc != 0) return rc;  // the staging is abandoned: nothing is written
+        staging.commit();
+        return 0;
       }
   } catch (const surftex::Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    return failed(e.what());
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "error: out of memory\n");
-    return 2;
+    return failed("out of memory");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    return failed(e.what());
   }
   return 2;
 }

@@ -48,6 +48,9 @@ for a in "$@"; do
     *) echo "error: unknown option '$a'" >&2; exit 2 ;;
   esac
 done
+# Only to build the libFuzzer targets (scripts/fuzz.sh): Debian's clang and
+# its runtime libraries (libFuzzer, ASan, UBSan).
+if [[ "${SURFTEX_FUZZ:-0}" == "1" ]]; then PKGS+=(clang libclang-rt-14-dev); fi
 
 # One dpkg-query for all packages (one call each took ~5 s on a loaded machine).
 installed=" $({ dpkg-query -W -f='${Package} ${Status}\n' "${PKGS[@]}" 2>/dev/null || true; } |

@@ -194,6 +194,9 @@ int run(const Args& a) {
   const double s_mesh = t.seconds();
   rep["vertices"] = mesh.number_of_vertices();
   rep["faces"] = mesh.number_of_faces();
+  check_budget(estimate_material_map(mesh.number_of_faces(), tile.layers.size() * tile.layers[0].data.size() * 4,
+                                     a.render_size),
+               a.common);
 
   MaterialMapping mapping(mesh, mapping_options(a));
   if (a.update.empty()) {
@@ -340,7 +343,7 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   info.layers_per_pair = to.layers;
   const std::string tile_dir = ctx.path("material_tile");
   write_material_tile(tile_dir, tr, info, true);
-  const MaterialTile tile = read_material_tile(tile_dir);
+  const MaterialTile tile = read_material_tile(staged_path(tile_dir));
 
   Mesh mesh;
   make_torus(mesh, 1.0, 0.4, 96, 40);

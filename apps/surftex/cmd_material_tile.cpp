@@ -59,6 +59,9 @@ int run(const Args& a) {
   opt.auto_mask.rule =
       a.auto_rule == "gradient" ? FeatureMaskOptions::Rule::Gradient : FeatureMaskOptions::Rule::Luminance;
   opt.progress = terminal_progress(a.common.quiet);
+  check_budget(estimate_material_tile(a.size, a.layers, static_cast<int>(keys.size()), keys[0].texture.width,
+                                      keys[0].texture.height),
+               a.common);
   MaterialTileResult r = make_material_tile(keys, opt);
 
   MaterialTileInfo info;

@@ -253,6 +253,9 @@ int run(const PatchArgs& a) {
   po.el.order = a.fill == "direction" ? FillOrder::Direction : FillOrder::OnionPeel;
   po.seed = a.common.seed;
   po.progress = terminal_progress(a.common.quiet);
+  check_budget(estimate_patches(mesh.number_of_faces(), ex[0].width, ex[0].height, static_cast<int>(ex.size()),
+                                a.patch_res, a.max_faces, a.window, a.rotations),
+               a.common);
   nlohmann::json rep = run_pipeline(mesh, ex, po, a.outdir, a.common.seed, a.bump, maps);
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);

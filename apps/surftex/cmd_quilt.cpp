@@ -211,6 +211,7 @@ int run_quilt(QuiltArgs& a) {
     }
     const Swatch s = make_swatch(sm);
     check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
+    check_budget(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())), a.common);
     PlanarQuiltOptions o;
     o.seed = a.common.seed;
     o.cell_size = a.cell * sc;
@@ -257,6 +258,9 @@ int run_quilt(QuiltArgs& a) {
       const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
       check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
                        "--scale " + std::to_string(o.relative_size));
+      check_budget(estimate_quilt(base.number_of_faces(),
+                                  (swatch_area > 0 ? area / swatch_area : 0.0) * static_cast<double>(s.mesh.tris.size())),
+                   a.common);
     }
     o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
     o.up = {a.up[0], a.up[1], a.up[2]};

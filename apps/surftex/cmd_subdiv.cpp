@@ -232,6 +232,7 @@ int run_subdiv(const SubdivArgs& a) {
   o.coordinates = a.projection ? LocalCoordinates::kTangentProjection : LocalCoordinates::kUnfolding;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
+  check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, a.levels, a.atlas), a.common);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
   DisplaceResult disp;
   if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);

@@ -94,6 +94,8 @@ int run(const SynthArgs& a) {
     throw InvalidInputError("--angle / --angle-field need --method el2pass (graph-cut synthesis is not oriented)");
   auto limit = apply_thread_limit(a.common.threads);
   const Image exemplar = read_image(a.exemplar);
+  check_budget(estimate_synth(w, h, exemplar.width, exemplar.height, a.window, a.rotations, a.method == "graphcut"),
+               a.common);
   Timer timer;
   ElResult r;
   if (a.method == "graphcut") {

@@ -38,6 +38,7 @@ int run_tile(const TileArgs& a) {
   o.choose_cut = !a.synthesis_cut;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
+  check_budget(estimate_tile(a.size, ex.width, ex.height, a.passes), a.common);
   Timer timer;
   TileResult t = make_tileable_detailed(ex, a.size, o);
   const double seconds = timer.seconds();

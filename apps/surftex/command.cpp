@@ -5,15 +5,21 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
+#include <set>
 #include <thread>
 
+#include "geometry/cancellation.h"
 #include "geometry/errors.h"
+#include "geometry/image_io.h"
 #include "geometry/output_file.h"
+#include "geometry/work_budget.h"
 
 namespace surftex::cli {
 
@@ -30,6 +36,22 @@ bool parse_whole_number(const std::string& in, double& v) {
   return end != in.c_str() && *end == '\0';
 }
 }  // namespace
+
+CLI::Validator whole_unsigned_64() {
+  return CLI::Validator(
+      [](std::string& in) -> std::string {
+        const std::string range = "an integer 0..18446744073709551615";
+        if (in.empty() || !std::isdigit(static_cast<unsigned char>(in[0])))
+          return "must be " + range + " (got '" + in + "')";
+        errno = 0;
+        char* end = nullptr;
+        (void)std::strtoull(in.c_str(), &end, 10);
+        if (*end != '\0') return "must be " + range + " (got '" + in + "')";
+        if (errno == ERANGE) return "must be " + range + " (got " + in + ", out of range)";
+        return "";
+      },
+      "UINT64");
+}
 
 CLI::Validator number_above(double lo, bool strict) {
   char buf[64];
@@ -48,8 +70,8 @@ CLI::Validator number_above(double lo, bool strict) {
 void add_common_options(CLI::App& app, CommonOptions& opt) {
   app.add_option("--seed", opt.seed,
                  "Seed for every random choice; the same input and seed give the same output "
-                 "(any non-negative integer, default 1)")
-      ->check(CLI::NonNegativeNumber);
+                 "(an integer 0..18446744073709551615, default 1)")
+      ->check(whole_unsigned_64());
   app.add_option("--threads", opt.threads,
                  "Worker threads (0 = all cores, default 0; 1..1024)")
       ->check(CLI::Range(0, 1024));
@@ -57,6 +79,14 @@ void add_common_options(CLI::App& app, CommonOptions& opt) {
                  "Write a JSON report (timings, counts, quality figures) to this file");
   app.add_flag("--force", opt.force, "Replace output files that already exist (default: refuse)");
   app.add_flag("-q,--quiet", opt.quiet, "No progress display, even on a terminal");
+  app.add_option("--max-image-pixels", opt.max_image_pixels,
+                 "Largest image read, in pixels, checked from its header before decoding (default 16777216 = "
+                 "4096x4096, 256 MiB decoded as 4-channel float; no side longer than 16384 px unless this "
+                 "asks for more; 1..2^40)")
+      ->check(CLI::Range(1LL, 1LL << 40));
+  app.add_option("--max-memory", opt.max_memory,
+                 "Memory budget: a run whose estimate (printed with the progress) is over it is refused "
+                 "before it starts. A size (4G, 512M, bytes) or a share of RAM (50%); default 75% of RAM");
 }
 
 std::shared_ptr<void> apply_thread_limit(int threads) {
@@ -66,10 +96,13 @@ std::shared_ptr<void> apply_thread_limit(int threads) {
 }
 
 ProgressCallback terminal_progress(bool quiet) {
-  if (quiet || !::isatty(STDERR_FILENO)) return {};
+  // Never empty: every report is a cancellation point (SIGINT/SIGTERM), also
+  // in pipes where nothing is drawn.
+  if (quiet || !::isatty(STDERR_FILENO)) return [](std::string_view, double) { throw_if_cancelled(); };
   auto last = std::make_shared<std::pair<std::string, int>>("", -1);
   auto mu = std::make_shared<std::mutex>();
   return [last, mu](std::string_view stage, double fraction) {
+    throw_if_cancelled();
     std::lock_guard<std::mutex> lock(*mu);
     int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
     if (last->first == stage && last->second == pct) return;
@@ -100,6 +133,11 @@ LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const Comm
   return r;
 }
 
+void check_budget(const WorkEstimate& estimate, const CommonOptions& opt) {
+  const std::string note = check_work_budget(estimate);
+  if (!opt.quiet) std::fprintf(stderr, "note: %s\n", note.c_str());
+}
+
 namespace {
 void check_output_folder(const std::string& output) {
   const std::filesystem::path p(output);
@@ -122,6 +160,48 @@ void check_output(const std::string& output, const std::vector<std::string>& inp
     throw IOError("output '" + output + "' already exists (pass --force to replace it)");
 }
 
+namespace {
+// Numeric by the option's declared type (CLI11 type names: FLOAT, INT, UINT,
+// NUMBER, UINT64, ... optionally followed by ':' and validator descriptions;
+// several values as "[FLOAT,FLOAT]").
+bool is_numeric_option(const CLI::Option& o) {
+  std::string t = o.get_type_name();
+  t = t.substr(0, t.find(':'));
+  for (const char* k : {"FLOAT", "INT", "NUMBER", "UINT"})
+    if (t.find(k) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+// --max-image-pixels and --max-memory for the whole run.
+static void apply_limits(const CLI::App& sub) {
+  for (const CLI::Option* o : sub.get_options()) {
+    if (o->results().empty()) continue;
+    const std::string& v = o->results().back();
+    if (o->get_name() == "--max-image-pixels") {
+      ImageLimits lim;
+      lim.max_pixels = std::stoll(v);
+      set_image_limits(lim);
+    }
+    if (o->get_name() == "--max-memory") set_memory_budget(parse_memory_size(v));
+  }
+}
+
+void sweep_stale_outputs_of_arguments(const CLI::App& sub) {
+  namespace fs = std::filesystem;
+  std::set<std::string> dirs;
+  for (const CLI::Option* o : sub.get_options())
+    for (const std::string& r : o->results()) {
+      if (r.empty() || r.size() > 4096 || dirs.size() >= 32) continue;
+      std::error_code ec;
+      const fs::path p(r);
+      if (fs::is_directory(p, ec)) dirs.insert(p.string());
+      const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+      if (fs::is_directory(parent, ec)) dirs.insert(parent.string());
+    }
+  for (const std::string& d : dirs) sweep_stale_outputs(d);
+}
+
 void check_parsed_arguments(const CLI::App& sub) {
   std::string report;
   const CLI::Option* report_opt = nullptr;
@@ -130,6 +210,11 @@ void check_parsed_arguments(const CLI::App& sub) {
     const std::string name = o->get_name();
     if (name == "--report" && !o->results().empty()) report = o->results().back(), report_opt = o;
     if (name == "--force" && o->count() > 0) force = true;
+    // An empty or blank string given to a numeric option (CLI11 reads it as 0).
+    if (is_numeric_option(*o))
+      for (const std::string& r : o->results())
+        if (r.find_first_not_of(" \t\n\r\f\v") == std::string::npos)
+          throw InvalidInputError(name + ": an empty string is not a number");
     // NaN and infinities in floating-point options (CLI11 checks compare with
     // < and >, which NaN passes).
     if (o->get_type_name().rfind("FLOAT", 0) == 0)
@@ -139,6 +224,7 @@ void check_parsed_arguments(const CLI::App& sub) {
           throw InvalidInputError(name + ": '" + r + "' is not a finite number");
       }
   }
+  apply_limits(sub);
   if (report.empty()) return;
   for (const CLI::Option* o : sub.get_options()) {
     if (o == report_opt) continue;

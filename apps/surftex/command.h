@@ -18,6 +18,7 @@
 #include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
 #include "surftex/report.h"
+#include "geometry/work_budget.h"
 
 namespace surftex::cli {
 
@@ -28,13 +29,20 @@ struct CommonOptions {
   std::string report_path;  // JSON report, empty = none
   bool force = false;       // replace existing outputs
   bool quiet = false;       // no progress even on a terminal
+  long long max_image_pixels = 1LL << 24;  // --max-image-pixels (geometry/image_io.h ImageLimits)
+  std::string max_memory;                  // --max-memory, empty = 75% of RAM (geometry/work_budget.h)
 };
 
 /// A CLI11 check: a number > lo (strict) or >= lo; the message reads
 /// "must be > 0 (got -1)" (CLI11's PositiveNumber prints a 300-digit range).
 CLI::Validator number_above(double lo, bool strict);
 
-/// Adds --seed, --threads, --report, --force, --quiet to `app`.
+/// A CLI11 check: a whole unsigned 64-bit integer ("18446744073709551616"
+/// and "-1" are refused, not saturated or wrapped).
+CLI::Validator whole_unsigned_64();
+
+/// Adds --seed, --threads, --report, --force, --quiet, --max-image-pixels
+/// and --max-memory to `app` (check_parsed_arguments applies the last two).
 void add_common_options(CLI::App& app, CommonOptions& opt);
 
 /// Applies --threads to TBB/OpenMP-style pools for the rest of the run; the
@@ -56,7 +64,16 @@ void require_input_file(const std::string& input, const std::string& what);
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force,
                   bool folder_must_exist = true);
 
+/// Removes what runs killed earlier (SIGKILL, crash) left in the folders the
+/// arguments name or sit in: their staging folders and temporaries (undoing
+/// a half-finished move of outputs; geometry/output_file.h
+/// sweep_stale_outputs). Called before the arguments are checked, so that a
+/// re-run is not refused because of a dead run's partial outputs.
+void sweep_stale_outputs_of_arguments(const CLI::App& sub);
+
 /// Checks every subcommand's parsed arguments before it runs (main.cpp):
+/// --max-image-pixels and --max-memory are applied (set_image_limits,
+/// set_memory_budget); an empty string given to a numeric option is refused;
 /// a floating-point option given a NaN or an infinity is refused naming the
 /// option (CLI11's range checks let NaN through); the --report path must not
 /// name a file given as another argument (an input or another output), must
@@ -70,6 +87,11 @@ void check_parsed_arguments(const CLI::App& sub);
 /// report in the command's JSON report under "input_mesh" (to_json).
 LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const CommonOptions& opt,
                                  bool keep_polygons = false);
+
+/// Refuses the run if its estimate (geometry/work_budget.h) is over the
+/// memory budget or its exemplar over the method's size; otherwise prints
+/// the estimate in one "note:" line on stderr unless opt.quiet.
+void check_budget(const WorkEstimate& estimate, const CommonOptions& opt);
 
 struct Subcommand {
   std::string name;

@@ -17,29 +17,50 @@ namespace surftex {
 
 namespace {
 
-// Refuse absurd headers before allocating (a corrupt file may claim 10^6 x 10^6).
-constexpr long long kMaxPixels = 1LL << 28;  // 268M pixels
+ImageLimits g_limits;
+
+// Takes every pending OpenImageIO message (the reader's and the global
+// ones): OIIO prints those left unretrieved when the reader is destroyed, and
+// aborts once more than 16 MB accumulate (a TIFF claiming 2^31-1 rows that
+// fail one by one did). Returns the first line (the root cause).
+std::string take_errors(OIIO::ImageInput* in) {
+  std::string why = in ? in->geterror() : std::string();
+  const std::string global = OIIO::geterror();
+  if (why.empty()) why = global;
+  const auto nl = why.find('\n');
+  if (nl != std::string::npos) why.resize(nl);
+  if (why.size() > 200) why.resize(200);
+  return why;
+}
+
+void check_spec(const OIIO::ImageSpec& spec, const std::string& path, const ImageLimits& lim) {
+  const std::string dims = std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
+                           std::to_string(spec.nchannels) + " channels";
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    throw InvalidInputError("image '" + path + "' is empty (" + dims + ")");
+  if (spec.depth > 1)
+    throw InvalidInputError("image '" + path + "' is a volume (" + std::to_string(spec.depth) + " slices); only 2D images are read");
+  if (spec.deep) throw InvalidInputError("image '" + path + "' is a deep image; only flat images are read");
+  if (spec.nchannels > ImageLimits::kMaxChannels)
+    throw InvalidInputError("image '" + path + "' has " + std::to_string(spec.nchannels) + " channels (at most " +
+                            std::to_string(ImageLimits::kMaxChannels) + " are read)");
+  const long long w = spec.width, h = spec.height;
+  if (w > lim.max_side() || h > lim.max_side() || w * h > lim.max_pixels)
+    throw InvalidInputError("image '" + path + "' is " + dims + " (" + std::to_string(w * h * spec.nchannels * 4 / (1 << 20)) +
+                            " MiB decoded); the limit is " + std::to_string(lim.max_side()) + " px a side and " +
+                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
+                            " MiB decoded): pass --max-image-pixels to raise it");
+}
 
 Image read_current(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec& spec = in.spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-    throw InvalidInputError("image '" + path + "' is empty (" + std::to_string(spec.width) + "x" +
-                            std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
-                            " channels)");
-  if (static_cast<long long>(spec.width) * spec.height > kMaxPixels)
-    throw InvalidInputError("image '" + path + "' is too large (" + std::to_string(spec.width) +
-                            "x" + std::to_string(spec.height) + ")");
+  check_spec(spec, path, g_limits);
   Image img(spec.width, spec.height, spec.nchannels);
   if (!in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
                      img.data.data())) {
-    // Take every pending message now: OIIO prints the ones left unretrieved
-    // when the reader is destroyed, after our own error line.
-    std::string why = in.geterror();
+    std::string why = take_errors(&in);
     in.close();
-    (void)in.geterror();
-    (void)OIIO::geterror();
-    const auto nl = why.find('\n');
-    if (nl != std::string::npos) why.resize(nl);  // the first (root) cause
+    (void)take_errors(&in);
     throw IOError("cannot decode image '" + path + "' (truncated or corrupt): " + why);
   }
   for (float v : img.data)
@@ -67,6 +88,32 @@ std::uint32_t be32(const unsigned char* p) {
   return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
 }
 
+// The IHDR fields (PNG specification, section 11.2.2): libpng refuses
+// invalid ones by printing "libpng error: Invalid IHDR data" itself.
+void check_png_header(const unsigned char* d, std::uint32_t len, const std::string& what, const std::string& path,
+                      const ImageLimits& lim) {
+  if (len != 13) throw IOError(what + "the PNG header (IHDR) has " + std::to_string(len) + " bytes, not 13");
+  const std::uint32_t w = be32(d), h = be32(d + 4);
+  const int depth = d[8], type = d[9];
+  if (w == 0 || h == 0 || w > 0x7FFFFFFFu || h > 0x7FFFFFFFu)
+    throw IOError(what + "the PNG header claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
+  const bool ok_type = (type == 0 && (depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16)) ||
+                       (type == 3 && (depth == 1 || depth == 2 || depth == 4 || depth == 8)) ||
+                       ((type == 2 || type == 4 || type == 6) && (depth == 8 || depth == 16));
+  if (!ok_type)
+    throw IOError(what + "the PNG header's colour type " + std::to_string(type) + " with bit depth " +
+                  std::to_string(depth) + " is not a PNG format");
+  if (d[10] != 0 || d[11] != 0 || d[12] > 1)
+    throw IOError(what + "the PNG header's compression, filter or interlace method is unknown");
+  // Our limits before libpng's own (1,000,000 px a side, refused with its own text).
+  const long long side = std::min(lim.max_side(), 1000000LL);
+  if (w > side || h > side || static_cast<long long>(w) * h > lim.max_pixels)
+    throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) +
+                            " (PNG header); the limit is " + std::to_string(side) + " px a side and " +
+                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
+                            " MiB decoded): pass --max-image-pixels to raise it");
+}
+
 // A PNG file's chunk structure checked before libpng sees it: every chunk
 // inside the file with a matching CRC, IHDR first and IEND last (PNG
 // specification, sections 5.3-5.6). libpng reports a truncated or damaged
@@ -76,7 +123,7 @@ std::uint32_t be32(const unsigned char* p) {
 // offset instead. Damage inside the compressed pixel data with a valid CRC
 // (rare: the CRC covers it) still reaches libpng. Files that do not start
 // with the PNG signature are left to OpenImageIO.
-void check_png_structure(const std::string& path) {
+void check_png_structure(const std::string& path, const ImageLimits& lim) {
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::ifstream f(path, std::ios::binary);
   if (!f) return;  // OpenImageIO reports it
@@ -100,7 +147,6 @@ void check_png_structure(const std::string& path) {
                     " bytes)");
     if (first && type != "IHDR")
       throw IOError(what + "the first PNG chunk is '" + type + "', not IHDR");
-    first = false;
     buf.resize(static_cast<std::size_t>(len) + 4);
     f.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
     std::uint32_t crc = png_crc(head + 4, 4);
@@ -108,23 +154,26 @@ void check_png_structure(const std::string& path) {
     if (crc != be32(buf.data() + len))
       throw IOError(what + "PNG chunk '" + type + "' at byte " + std::to_string(at) +
                     " fails its CRC check");
+    if (first) check_png_header(buf.data(), len, what, path, lim);
+    first = false;
     at += 12 + static_cast<std::uintmax_t>(len);
     if (type == "IEND") return;
   }
 }
 
-std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path) {
+std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const ImageLimits& lim) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw IOError("image '" + path + "' does not exist");
   if (std::filesystem::is_directory(path, ec)) throw IOError("image '" + path + "' is a folder");
   if (std::filesystem::file_size(path, ec) == 0 && !ec)
     throw IOError("image '" + path + "' is empty (0 bytes)");
-  check_png_structure(path);
+  check_png_structure(path, lim);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
-    std::string why = OIIO::geterror();
+    const std::string why = take_errors(nullptr);
     throw IOError("cannot read image '" + path + "'" + (why.empty() ? "" : ": " + why));
   }
+  (void)take_errors(in.get());  // warnings of a header that opened
   return in;
 }
 
@@ -146,21 +195,52 @@ void check_writable(const Image& img, const std::string& path) {
 
 }  // namespace
 
+long long ImageLimits::max_side() const {
+  const auto s = static_cast<long long>(std::ceil(std::sqrt(static_cast<double>(std::max(0LL, max_pixels)))));
+  return std::max(16384LL, s);
+}
+
+void set_image_limits(const ImageLimits& limits) { g_limits = limits; }
+const ImageLimits& image_limits() { return g_limits; }
+
+ImageHeader read_image_header(const std::string& path, const ImageLimits& limits) {
+  auto in = open_input(path, limits);
+  const OIIO::ImageSpec spec = in->spec();
+  ImageHeader h;
+  h.width = spec.width;
+  h.height = spec.height;
+  h.channels = spec.nchannels;
+  h.format = in->format_name();
+  in->close();
+  (void)take_errors(in.get());
+  check_spec(spec, path, limits);
+  return h;
+}
+
 Image read_image(const std::string& path) {
-  auto in = open_input(path);
+  auto in = open_input(path, g_limits);
   Image img = read_current(*in, path);
   in->close();
   return img;
 }
 
 std::vector<Image> read_image_layers(const std::string& path) {
-  auto in = open_input(path);
+  auto in = open_input(path, g_limits);
   std::vector<Image> layers;
   int sub = 0;
+  long long bytes = 0;
   do {
+    const OIIO::ImageSpec& spec = in->spec();
+    check_spec(spec, path, g_limits);  // before the product below (no overflow)
+    bytes += static_cast<long long>(spec.width) * spec.height * spec.nchannels * 4;
+    if (bytes > 4 * g_limits.max_bytes())
+      throw InvalidInputError("image '" + path + "': its " + std::to_string(sub + 1) + " layers hold more than " +
+                              std::to_string(4 * g_limits.max_bytes() >> 20) +
+                              " MiB decoded (4 times the per-image limit; pass --max-image-pixels to raise it)");
     layers.push_back(read_current(*in, path));
     ++sub;
   } while (in->seek_subimage(sub, 0));
+  (void)take_errors(in.get());
   in->close();
   return layers;
 }

@@ -10,9 +10,44 @@
 
 namespace surftex {
 
+/// What an image file may hold before it is decoded (issue 21 item 4): its
+/// header (width, height, channels) is checked first, no pixel is read for
+/// a file over the limits. An Image holds 4-byte floats, so the decoded size
+/// is width * height * channels * 4 bytes.
+struct ImageLimits {
+  /// Most pixels (width * height). Default 16777216 (4096 x 4096), i.e.
+  /// 256 MiB decoded as 4-channel float; the CLI's --max-image-pixels.
+  long long max_pixels = 1LL << 24;
+  /// Longest side in pixels: 16384, or sqrt(max_pixels) when that is larger.
+  long long max_side() const;
+  /// Most decoded bytes: max_pixels * 16 (256 MiB by default).
+  long long max_bytes() const { return max_pixels * 16; }
+  /// Most channels.
+  static constexpr int kMaxChannels = 16;
+};
+
+/// The process-wide limits every read_image* call checks (the CLI sets them
+/// once from --max-image-pixels; library callers may too).
+void set_image_limits(const ImageLimits& limits);
+const ImageLimits& image_limits();
+
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0;
+  int subimages = 1;
+  std::string format;  ///< OpenImageIO's format name ("png", "tiff", ...)
+};
+
+/// Reads and checks only the header of the image at `path` (no pixel is
+/// decoded): refuses, naming the file, the sizes and the limit, an empty
+/// image, a volume or deep image, more than kMaxChannels channels, a side
+/// longer than max_side() or more than max_pixels pixels. Throws IOError
+/// (cannot open, not an image) or InvalidInputError (over a limit).
+ImageHeader read_image_header(const std::string& path, const ImageLimits& limits = image_limits());
+
 /// Reads the first subimage as floats. 8/16-bit integer formats map to [0,1].
+/// The header is checked against image_limits() before any pixel is decoded.
 /// Throws IOError naming the file if it cannot be opened or decoded, and
-/// InvalidInputError if it is empty or holds a non-finite value.
+/// InvalidInputError if it is empty, over the limits or holds a non-finite value.
 Image read_image(const std::string& path);
 
 struct WriteImageOptions {

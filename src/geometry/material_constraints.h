@@ -12,21 +12,26 @@
 //       {"faces": [12, 13, 40], "direction": [1, 0, 0]},   // faces by index, one 3D direction
 //       {"polyline": [[0, 0, 1], [0.1, 0, 1], [0.2, 0.05, 1]]}  // >= 2 points, mesh units
 //     ],
-//     "scale":    [{"point": [0, 0, 1], "value": 0.05}],  // texture period S > 0, mesh units
+//     "scale":    [{"point": [0, 0, 1], "value": 0.05}],  // texture period S, mesh units,
+//                                   // 1e-6..1e6 times half the mesh box's largest side
 //     "material": [{"point": [0, 1, 0], "value": 1.0}]    // m in [0, 1]
 //   }
-// A polyline is sampled along each segment (about one sample per mean edge
-// length, at least the segment midpoint); each sample's nearest face (the
+// Every point must lie within one box size of the mesh's bounding box. A
+// polyline is sampled along each segment (about one sample per mean edge
+// length, at least the segment midpoint, and at most two samples per mesh
+// face over all strokes together); each sample's nearest face (the
 // incident face, around the nearest vertex, whose centroid is nearest) gets
-// the segment's tangent as direction (projected on the face plane by the
-// direction field). A face constrained twice keeps its first direction. Scale
+// the segment's unit tangent as direction (projected on the face plane by the
+// direction field; a sample whose tangent is normal to its face is skipped, a
+// "faces" direction normal to one of its faces is refused). A face constrained twice keeps its first direction. Scale
 // and material points go to their nearest vertex (a later point on the same
 // vertex replaces the earlier one).
 //
-// Errors throw InvalidInputError with the file name, the line of the object
-// or field at fault and the field name (e.g. "c.json:7: strokes[1].faces[2]:
-// face 9000 out of range (5120 faces)"); malformed JSON reports its line and
-// column. read_material_constraints throws IOError if the file cannot be read.
+// Errors throw InvalidInputError "FILE: line L: field F: what" (e.g.
+// "c.json: line 7: field strokes[1].faces[2]: face 9000 out of range (5120
+// faces)"), also for malformed JSON, numbers beyond the double range and
+// nesting deeper than 32 (geometry/json_input.h). read_material_constraints
+// throws IOError if the file cannot be read or is larger than 16 MiB.
 
 #include <cstdint>
 #include <limits>

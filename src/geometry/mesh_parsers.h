@@ -34,6 +34,14 @@ PolygonSoup read_gltf(const std::string& path, std::string_view data, bool binar
 /// the OBJ's folder) into soup.materials (read_mtl.cpp).
 void read_obj_materials(const std::string& obj_path, PolygonSoup& soup);
 
+/// Length of a UTF-8 byte-order mark at the start of `data` (3 or 0). Text
+/// readers skip it (an editor on Windows may add one); without this the BOM
+/// glued to the first keyword made an OBJ's first `v` line an unknown
+/// keyword and shifted every face index (issue 21).
+inline std::size_t utf8_bom_length(std::string_view data) {
+  return data.substr(0, 3) == std::string_view("\xEF\xBB\xBF", 3) ? 3 : 0;
+}
+
 /// True if the 84-byte header's triangle count matches the file size exactly.
 bool looks_like_binary_stl(std::string_view data);
 

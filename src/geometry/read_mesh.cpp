@@ -22,6 +22,7 @@
 #include "geometry/mesh.h"
 #include "geometry/mesh_parsers.h"
 #include "geometry/properties.h"
+#include "geometry/split_pinched_polygons.h"
 
 namespace fs = std::filesystem;
 namespace PMP = CGAL::Polygon_mesh_processing;
@@ -169,8 +170,9 @@ bool is_off_keyword(std::string_view t) {
 
 Format sniff(std::string_view data) {
   if (data.substr(0, 4) == "glTF") return Format::Glb;
-  if (data.substr(0, 4) == "ply\n" || data.substr(0, 5) == "ply\r\n") return Format::Ply;
   if (looks_like_binary_stl(data)) return Format::Stl;
+  data.remove_prefix(utf8_bom_length(data));  // the text readers skip it too
+  if (data.substr(0, 4) == "ply\n" || data.substr(0, 5) == "ply\r\n") return Format::Ply;
   // First token of the first non-comment line.
   std::size_t pos = 0;
   int lines = 0;
@@ -388,8 +390,10 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
   c.duplicate_points_merged = PMP::merge_duplicate_points_in_polygon_soup(pts, polys);
   c.polygons_simplified = PMP::internal::simplify_polygons_in_polygon_soup(pts, polys, Kernel());
   std::size_t before_split = polys.size();
+  // Linear-time split first (CGAL's is quadratic in a polygon's corners).
+  split_pinched_polygons(polys, pts.size());  // a polygon left with no cycle is emptied: removed and counted below
   PMP::internal::split_pinched_polygons_in_polygon_soup(pts, polys, Kernel());
-  c.pinched_polygons_split = polys.size() - before_split;
+  c.pinched_polygons_split = polys.size() - std::min(before_split, polys.size());
   c.degenerate_polygons_removed = PMP::internal::remove_invalid_polygons_in_polygon_soup(pts, polys);
   c.duplicate_polygons_removed = PMP::merge_duplicate_polygons_in_polygon_soup(pts, polys);
   c.isolated_points_removed = PMP::remove_isolated_points_in_polygon_soup(pts, polys);

@@ -34,7 +34,7 @@ std::size_t resolve(const std::string& path, const std::string& where, std::stri
 
 PolygonSoup read_obj(const std::string& path, std::string_view data) {
   PolygonSoup soup;
-  TextLines lines(path, data);
+  TextLines lines(path, data, utf8_bom_length(data));
   std::string_view raw;
   std::string joined;  // for continued lines
   std::vector<std::string_view> tok;

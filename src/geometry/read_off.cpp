@@ -16,7 +16,7 @@ bool is_integer_token(std::string_view t) {
 }  // namespace
 
 PolygonSoup read_off(const std::string& path, std::string_view data) {
-  TextLines lines(path, data);
+  TextLines lines(path, data, utf8_bom_length(data));
   std::string_view line;
   std::vector<std::string_view> tok;
   auto next_content = [&]() -> bool {

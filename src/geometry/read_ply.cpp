@@ -136,10 +136,16 @@ class BodyReader {
 }  // namespace
 
 PolygonSoup read_ply(const std::string& path, std::string_view data) {
-  TextLines header(path, data);
+  TextLines header(path, data, utf8_bom_length(data));
   std::string_view line;
   std::vector<std::string_view> tok;
-  if (!header.next(line) || line != "ply") fail_io(path, at_line(1), "not a PLY file (no 'ply' magic)");
+  // The magic line, blanks around it allowed (an editor may leave them).
+  bool magic = header.next(line);
+  if (magic) {
+    split_blanks(line, tok);
+    magic = tok.size() == 1 && tok[0] == "ply";
+  }
+  if (!magic) fail_io(path, at_line(1), "not a PLY file (no 'ply' magic)");
   Encoding enc = Encoding::Ascii;
   bool have_format = false, ended = false;
   std::vector<Element> elements;

@@ -60,7 +60,7 @@ PolygonSoup read_binary(const std::string& path, std::string_view data) {
 PolygonSoup read_ascii(const std::string& path, std::string_view data) {
   PolygonSoup soup;
   Welder weld(soup);
-  TextLines lines(path, data);
+  TextLines lines(path, data, utf8_bom_length(data));
   std::string_view line;
   std::vector<std::string_view> tok;
   bool in_solid = false, in_facet = false, in_loop = false;
@@ -118,7 +118,7 @@ PolygonSoup read_ascii(const std::string& path, std::string_view data) {
 
 PolygonSoup read_stl(const std::string& path, std::string_view data) {
   if (looks_like_binary_stl(data)) return read_binary(path, data);
-  std::size_t i = 0;
+  std::size_t i = utf8_bom_length(data);
   while (i < data.size() && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n')) ++i;
   // "solid" and no NUL byte: ascii. With NUL bytes it is a binary file whose
   // header happens to start with "solid" and whose size is wrong.

@@ -4,32 +4,58 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
+#include "geometry/json_input.h"
 
 namespace surftex {
 
 namespace {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
+namespace ji = json_input;
 
-const nlohmann::json& field(const nlohmann::json& j, const char* name, const std::string& where) {
-  auto it = j.find(name);
-  if (it == j.end()) throw InvalidInputError(where + ": field '" + name + "' missing");
+// tile.json bounds: a layer is an image (image_limits() per layer); the tile
+// together may hold 4 times the per-image decoded limit; at most 4096 layers.
+constexpr long long kMaxLayers = 4096;
+
+struct TileJson {
+  std::string source;  // tile.json's path, for messages
+  const json& root;
+};
+
+const json& field(const TileJson& t, const json& obj, const char* name, const std::string& where) {
+  auto it = obj.find(name);
+  if (it == obj.end()) ji::fail(t.source, ji::line_of(obj), where.empty() ? name : where + "." + name, "missing");
   return *it;
 }
 
-long long int_field(const nlohmann::json& j, const char* name, const std::string& where, long long lo) {
-  const nlohmann::json& v = field(j, name, where);
-  if (!v.is_number_integer() || v.get<long long>() < lo)
-    throw InvalidInputError(where + ": field '" + name + "' must be an integer >= " + std::to_string(lo) +
-                            ", got " + v.dump());
+long long int_field(const TileJson& t, const json& obj, const char* name, long long lo, long long hi) {
+  const json& v = field(t, obj, name, "");
+  const bool ok = v.is_number_integer() &&
+                  (v.is_number_unsigned() ? v.get<unsigned long long>() <= static_cast<unsigned long long>(hi)
+                                          : (v.get<long long>() >= lo && v.get<long long>() <= hi));
+  if (!ok || v.get<long long>() < lo)
+    ji::fail(t.source, ji::line_of(obj, name), name,
+             "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + ji::describe(v));
   return v.get<long long>();
+}
+
+// A layer's file name: a plain name inside the tile folder.
+std::string layer_file(const TileJson& t, const json& l, const std::string& where) {
+  const json& file = field(t, l, "file", where);
+  const int line = ji::line_of(l, "file");
+  if (!file.is_string() || file.get_ref<const std::string&>().empty())
+    ji::fail(t.source, line, where + ".file", "must be a non-empty string, got " + ji::describe(file));
+  const std::string& name = file.get_ref<const std::string&>();
+  if (name.size() > 255 || name == "." || name == ".." || name.find('/') != std::string::npos ||
+      name.find('\\') != std::string::npos || name.find('\0') != std::string::npos)
+    ji::fail(t.source, line, where + ".file", "must be a file name inside the tile folder, got " + ji::describe(file));
+  return name;
 }
 
 }  // namespace
@@ -54,52 +80,64 @@ void validate_material_tile(const MaterialTile& tile) {
 
 MaterialTile read_material_tile(const std::string& dir) {
   const fs::path json_path = fs::path(dir) / "tile.json";
-  std::ifstream in(json_path, std::ios::binary);
-  if (!in) throw IOError("material tile '" + dir + "': cannot open '" + json_path.string() + "'");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  const std::string where = json_path.string();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(buf.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InvalidInputError(where + ": malformed JSON at byte " + std::to_string(e.byte) + ": " + e.what());
-  }
-  if (!j.is_object()) throw InvalidInputError(where + ": top level must be an object");
-  const nlohmann::json& fmt = field(j, "format", where);
-  if (!fmt.is_string() || fmt.get<std::string>() != "surftex material tile")
-    throw InvalidInputError(where + ": field 'format' must be \"surftex material tile\", got " + fmt.dump());
+  std::error_code ec;
+  if (!fs::is_regular_file(json_path, ec))
+    throw IOError("material tile '" + dir + "': cannot open '" + json_path.string() + "'");
+  const std::string src = json_path.string();
+  const json j = ji::parse(ji::read_file(src, "material tile description"), src);
+  const TileJson t{src, j};
+  if (!j.is_object()) ji::fail(src, 1, "(top level)", "must be an object, got " + ji::describe(j));
+  const json& fmt = field(t, j, "format", "");
+  if (!fmt.is_string() || fmt.get_ref<const std::string&>() != "surftex material tile")
+    ji::fail(src, ji::line_of(j, "format"), "format", "must be \"surftex material tile\", got " + ji::describe(fmt));
+  const ImageLimits& lim = image_limits();
   MaterialTile tile;
-  tile.size = static_cast<int>(int_field(j, "size", where, 1));
-  const int channels = static_cast<int>(int_field(j, "channels", where, 1));
-  const long long count = int_field(j, "layers", where, 1);
-  tile.layers_per_pair = static_cast<int>(int_field(j, "layers_per_pair", where, 0));
-  const nlohmann::json& list = field(j, "layer_list", where);
-  if (!list.is_array()) throw InvalidInputError(where + ": field 'layer_list' must be an array");
+  tile.size = static_cast<int>(int_field(t, j, "size", 1, lim.max_side()));
+  const int channels = static_cast<int>(int_field(t, j, "channels", 1, ImageLimits::kMaxChannels));
+  const long long count = int_field(t, j, "layers", 1, kMaxLayers);
+  tile.layers_per_pair = static_cast<int>(int_field(t, j, "layers_per_pair", 0, kMaxLayers));
+  const long long layer_bytes = static_cast<long long>(tile.size) * tile.size * channels * 4;
+  if (layer_bytes > lim.max_bytes() || layer_bytes * count > 4 * lim.max_bytes())
+    ji::fail(src, ji::line_of(j, "size"), "size",
+             std::to_string(count) + " layers of " + std::to_string(tile.size) + "x" + std::to_string(tile.size) + "x" +
+                 std::to_string(channels) + " hold " + std::to_string((layer_bytes * count) >> 20) +
+                 " MiB decoded; the limit is " + std::to_string(lim.max_bytes() >> 20) + " MiB a layer and " +
+                 std::to_string((4 * lim.max_bytes()) >> 20) + " MiB a tile (--max-image-pixels raises it)");
+  const json& list = field(t, j, "layer_list", "");
+  if (!list.is_array()) ji::fail(src, ji::line_of(j, "layer_list"), "layer_list", "must be an array, got " + ji::describe(list));
   if (static_cast<long long>(list.size()) != count)
-    throw InvalidInputError(where + ": 'layers' is " + std::to_string(count) + " but 'layer_list' has " +
-                            std::to_string(list.size()) + " entries");
+    ji::fail(src, ji::line_of(j, "layer_list"), "layer_list",
+             "has " + std::to_string(list.size()) + " entries but 'layers' is " + std::to_string(count));
+  // Every entry and every layer file's header is checked before any pixel is decoded.
+  std::vector<std::string> files;
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string lw = where + ": layer_list[" + std::to_string(i) + "]";
-    const nlohmann::json& l = list[i];
-    if (!l.is_object()) throw InvalidInputError(lw + " must be an object");
-    const nlohmann::json& file = field(l, "file", lw);
-    if (!file.is_string() || file.get<std::string>().empty())
-      throw InvalidInputError(lw + ": field 'file' must be a non-empty string");
-    const nlohmann::json& m = field(l, "m", lw);
-    if (!m.is_number()) throw InvalidInputError(lw + ": field 'm' must be a number, got " + m.dump());
-    const fs::path p = fs::path(dir) / file.get<std::string>();
-    std::error_code ec;
+    const std::string lw = "layer_list[" + std::to_string(i) + "]";
+    const json& l = list[i];
+    if (!l.is_object()) ji::fail(src, ji::element_line(j, "layer_list", i), lw, "must be an object, got " + ji::describe(l));
+    const std::string name = layer_file(t, l, lw);
+    const json& m = field(t, l, "m", lw);
+    if (!m.is_number() || !std::isfinite(m.get<double>()) || std::fabs(m.get<double>()) > 1e6)
+      ji::fail(src, ji::line_of(l, "m"), lw + ".m", "must be a finite number in [-1e6, 1e6], got " + ji::describe(m));
+    const fs::path p = fs::path(dir) / name;
     if (!fs::is_regular_file(p, ec))
-      throw IOError("material tile '" + dir + "': layer file '" + p.string() + "' missing");
-    Image img = read_image(p.string());
-    if (img.width != tile.size || img.height != tile.size || img.channels != channels)
+      throw IOError("material tile '" + dir + "': layer file '" + p.string() + "' missing (" + src + ": line " +
+                    std::to_string(ji::line_of(l, "file")) + ": field " + lw + ".file)");
+    const ImageHeader h = read_image_header(p.string());
+    if (h.width != tile.size || h.height != tile.size || h.channels != channels)
       throw InvalidInputError("material tile '" + dir + "': layer file '" + p.string() + "' is " +
-                              std::to_string(img.width) + "x" + std::to_string(img.height) + "x" +
-                              std::to_string(img.channels) + ", tile.json declares " + std::to_string(tile.size) +
+                              std::to_string(h.width) + "x" + std::to_string(h.height) + "x" +
+                              std::to_string(h.channels) + ", tile.json declares " + std::to_string(tile.size) +
                               "x" + std::to_string(tile.size) + "x" + std::to_string(channels));
-    tile.layers.push_back(std::move(img));
+    files.push_back(p.string());
     tile.material.push_back(m.get<double>());
+  }
+  for (const std::string& f : files) {
+    Image img = read_image(f);
+    if (img.width != tile.size || img.height != tile.size || img.channels != channels)
+      throw InvalidInputError("material tile '" + dir + "': layer file '" + f + "' decoded as " +
+                              std::to_string(img.width) + "x" + std::to_string(img.height) + "x" +
+                              std::to_string(img.channels) + ", unlike its header");
+    tile.layers.push_back(std::move(img));
   }
   validate_material_tile(tile);
   return tile;

@@ -32,12 +32,16 @@ struct MaterialTile {
   int layers_per_pair = 0;  ///< M
 };
 
-/// Reads `dir`/tile.json and every layer file it lists. Throws IOError (no
-/// tile.json, unreadable or missing layer file: names the file) and
-/// InvalidInputError (malformed JSON with its byte offset, wrong format tag, a
-/// missing or ill-typed field: names it, a layer whose size or channel count
-/// differs from the declared size/channels, a layer count that differs from
-/// "layers").
+/// Reads `dir`/tile.json and every layer file it lists. Every field and every
+/// layer file's header is checked before any pixel is decoded: "size" at
+/// most image_limits().max_side(), "channels" 1..16, "layers" 1..4096, a
+/// layer within the per-image decoded limit and the tile within 4 times it,
+/// layer files plain names inside `dir`. Throws IOError (no tile.json, larger
+/// than 16 MiB, unreadable or missing layer file: names the file) and
+/// InvalidInputError "tile.json: line L: field F: what" (malformed JSON,
+/// wrong format tag, a missing, ill-typed or out-of-range field, a layer
+/// whose size or channel count differs from the declared size/channels, a
+/// layer count that differs from "layers").
 MaterialTile read_material_tile(const std::string& dir);
 
 /// Checks a tile made in memory the same way (non-empty, square, equal sizes

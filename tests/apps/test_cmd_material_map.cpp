@@ -118,7 +118,7 @@ TEST(CmdMaterialMap, WritesEverythingAndUpdatesOnlyTheEffectArea) {
   std::ofstream(dir + "/bad.json") << "{\n \"strokes\": 3}";
   r = test::run_surftex(base + "--constraints '" + dir + "/bad.json' -o '" + dir + "/out4'");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("bad.json:2: strokes: must be an array"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad.json: line 2: field strokes: must be an array"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/out4/report.json"));
 }
 

@@ -123,7 +123,7 @@ TEST(MaterialTileIO, PreciseErrors) {
       read_material_tile(dir);
       FAIL() << "no throw";
     } catch (const InvalidInputError& e) {
-      EXPECT_NE(std::string(e.what()).find("layer_list[0]: field 'm' missing"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("tile.json: line 2: field layer_list[0].m: missing"), std::string::npos) << e.what();
     }
   }
   EXPECT_THROW(read_material_tile(test::temp_dir("tileio-none")), IOError);
