@@ -40,6 +40,7 @@
 #include "texture/material_tile_io.h"
 #include "texture/procedural_texture.h"
 #include "texture/render_material_space.h"
+#include "texture/surface_fidelity.h"
 
 namespace surftex::cli {
 namespace {
@@ -383,6 +384,7 @@ int run(const Args& a) {
   rep["distorted_faces"] = distorted;
   rep["mismatched_edges"] = mismatched;
   rep["singular_vertices"] = sv;
+  rep["fidelity"] = material_map_fidelity_report(mesh, sing.corners, tile, a.common.seed);  // issue 18 item 3
 
   ensure_directory(a.out);
   t = Timer();

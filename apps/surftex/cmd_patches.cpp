@@ -27,6 +27,7 @@
 #include "texture/patch_seam_ratio.h"
 #include "texture/patch_synthesis.h"
 #include "texture/procedural_texture.h"
+#include "texture/surface_fidelity.h"
 
 namespace fs = std::filesystem;
 
@@ -150,6 +151,8 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
                {"pairs_within", seam.pairs_within},
                {"step_texels", so.step_texels}};
   j["atlas"] = {{"width", atlas.image.width}, {"height", atlas.image.height}};
+  j["fidelity"] = atlas_fidelity_report(mesh, exemplars[0], atlas.image, r.flat.texel,  // issue 18 item 3
+                                        po.field != PatchField::None, seed);
   j["outputs"] = {"atlas.png", "mesh.obj", "mesh.mtl", "mesh.png", "mesh.glb", "render.png"};
   return j;
 }

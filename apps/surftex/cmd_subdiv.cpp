@@ -27,6 +27,7 @@
 #include "texture/displace_by_vertex_color.h"
 #include "texture/procedural_texture.h"
 #include "texture/subdivision_synthesis.h"
+#include "texture/surface_fidelity.h"
 
 namespace fs = std::filesystem;
 
@@ -99,7 +100,7 @@ Outputs output_paths(const std::string& dir) {
   return {p("surface.ply"), p("surface.glb"), p("surface_atlas.obj"), p("render.png")};
 }
 
-nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas_size) {
+nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas_size, double texel_size = 0) {
   nlohmann::json j;
   Timer t;
   WriteMeshOptions wo;
@@ -122,6 +123,9 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
   j["atlas"] = {{"charts", ar.num_charts}, {"size", atlas_size}, {"coverage", double(baked.covered) / (double(atlas_size) * atlas_size)},
                 {"mean_area_distortion", ar.mean_area_distortion}, {"flipped_faces", ar.flipped_faces},
                 {"seconds", t.seconds()}};
+  if (texel_size > 0)  // colour jumps across the baked atlas's chart seams (issue 18 item 3)
+    j["atlas"]["seam"] = to_json(surface_seam_ratio(tri, atlas_color_source(tri, baked.image),
+                                                    seam_edges_from_corner_uv(tri), texel_size));
   t.reset();
   ViewOptions view;
   view.colors = ViewOptions::Colors::VertexColors;
@@ -135,7 +139,17 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, int atlas
 
 nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const SubdivisionSynthesisOptions& o) {
   nlohmann::json j;
-  j["r_scale"] = o.r_scale;
+  const SubdivisionScale& sc = r.scale;
+  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"texels_per_edge", sc.texels_per_edge},
+                {"r_scale", sc.r_scale}, {"texel_size", sc.texel_size}, {"exemplar_scale", sc.exemplar_scale},
+                {"exemplar_size", {sc.exemplar_width, sc.exemplar_height}}, {"levels", sc.levels},
+                {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},
+                {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
+                {"predicted_vertices", sc.predicted_vertices}};
+  j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
+               {"bounded_levels", r.bounded_levels}};
+  j["repetition_penalty"] = o.repetition_penalty;
+  j["r_scale"] = sc.r_scale;
   j["object_unit"] = r.object_unit;
   j["stack_levels"] = r.stack_levels;
   j["pyramid"] = o.pyramid;
@@ -157,10 +171,67 @@ nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const Subdi
   return j;
 }
 
+// --texel-size: "Nx" = N exemplar widths across the longest bounding-box
+// side, "N/edge" = N exemplar texels per mean edge of the input mesh.
+void parse_texel_size(const std::string& spec, SubdivisionSynthesisOptions& o) {
+  if (spec.empty()) return;
+  auto number = [&](const std::string& t) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != t.size() || !(v > 0) || !std::isfinite(v))
+      throw InvalidInputError("--texel-size '" + spec +
+                              "' must be Nx (N > 0 exemplar widths across the object, e.g. 3x) or N/edge (N > 0 "
+                              "exemplar texels per mean edge of the mesh, e.g. 2/edge)");
+    return v;
+  };
+  const std::string edge = "/edge";
+  if (spec.size() > edge.size() && spec.compare(spec.size() - edge.size(), edge.size(), edge) == 0) {
+    o.texels_per_edge = number(spec.substr(0, spec.size() - edge.size()));
+  } else if (spec.size() > 1 && (spec.back() == 'x' || spec.back() == 'X')) {
+    o.repeats = number(spec.substr(0, spec.size() - 1));
+  } else {
+    number("");  // throws the explanation
+  }
+}
+
+void print_scale(const SubdivisionSynthesisResult& r) {
+  const SubdivisionScale& s = r.scale;
+  std::fprintf(stderr,
+               "subdiv: scale from %s: %.3g exemplar widths across (r_scale %.4g, %.3g texels per mean edge), "
+               "texel %.4g mesh units; %d uniform levels%s (vertex spacing %.2f texels, ~%zu vertices); exemplar "
+               "%dx%d%s; %s (wrap-seam ratio %.2f)\n",
+               s.scale_from, s.repeats, s.r_scale, s.texels_per_edge, s.texel_size, s.levels,
+               s.levels_chosen ? (s.budget_limited ? " (chosen, limited by --max-vertices)" : " (chosen)") : "",
+               s.spacing_texels, s.predicted_vertices, s.exemplar_width, s.exemplar_height,
+               s.exemplar_scale < 1 ? " (reduced to fit --max-vertices)" : "",
+               r.periodic ? "wrapped as periodic" : "not wrapped", r.wrap_seam_ratio);
+}
+
+// Issue 18 item 3: the vertex colours resampled in charts at the synthesis
+// texel, against the exemplar as synthesised.
+nlohmann::json subdiv_fidelity(const Mesh& mesh, const SubdivisionSynthesisResult& r, std::uint64_t seed) {
+  SurfaceFidelityOptions fo;
+  fo.texel_size = r.scale.texel_size;
+  fo.periodic_exemplar = r.periodic;
+  fo.seed = seed;
+  fo.source = vertex_source_coordinates(r.source);
+  try {
+    return to_json(surface_fidelity(mesh, r.exemplar, vertex_color_source(mesh), frames_from_vertex_directions(mesh), fo));
+  } catch (const InvalidInputError& e) {  // e.g. no chart fits a tiny or very thin mesh
+    return {{"error", e.what()}};
+  }
+}
+
 struct SubdivArgs {
-  std::string mesh, exemplar, outdir;
-  double rscale = 100, adaptive = 0, displace = 0, region = 9, sigma = 1;
-  int levels = 3, passes = 2, adaptive_steps = 4, atlas = 1024;
+  std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
+  double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
+  int levels = -1, passes = 2, adaptive_steps = 4, atlas = 1024;
+  std::size_t max_vertices = 150000;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
   CommonOptions common;
 };
@@ -180,7 +251,11 @@ int run_subdiv(const SubdivArgs& a) {
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;
+  parse_texel_size(a.texel_size, o);
   o.levels = a.levels;
+  o.max_vertices = a.max_vertices;
+  o.wrap = a.wrap == "periodic" ? ExemplarWrap::Periodic : a.wrap == "bounded" ? ExemplarWrap::Bounded : ExemplarWrap::Auto;
+  o.repetition_penalty = a.repetition;
   o.adaptive_factor = a.adaptive;
   o.adaptive_steps = a.adaptive_steps;
   o.passes = a.passes;
@@ -195,17 +270,20 @@ int run_subdiv(const SubdivArgs& a) {
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
+  if (!a.common.quiet) print_scale(r);
+  const nlohmann::json fidelity = subdiv_fidelity(mesh, r, a.common.seed);
   DisplaceResult disp;
   if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);
   ensure_directory(a.outdir);
   nlohmann::json rep = synthesis_report(r, o);
+  rep["fidelity"] = fidelity;
   if (a.displace != 0) rep["displace_offset_range"] = {disp.min_offset, disp.max_offset};
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
   rep["seconds_read"] = seconds_read;
-  rep["outputs"] = write_outputs(mesh, out, a.common.force, a.atlas);
+  rep["outputs"] = write_outputs(mesh, out, a.common.force, a.atlas, r.scale.texel_size);
   rep["seconds_total"] = total.seconds();
   CommonOptions ro = a.common;
   if (ro.report_path.empty()) {
@@ -214,8 +292,9 @@ int run_subdiv(const SubdivArgs& a) {
   }
   write_report(ro, "subdiv", rep);
   if (!a.common.quiet)
-    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, %.1f s -> %s\n", static_cast<std::size_t>(mesh.number_of_vertices()), a.levels,
-                 total.seconds(), a.outdir.c_str());
+    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, fidelity %.2fx graph-cut 2D, %.1f s -> %s\n",
+                 static_cast<std::size_t>(mesh.number_of_vertices()), r.scale.levels,
+                 fidelity.value("ratio", 0.0), total.seconds(), a.outdir.c_str());
   return 0;
 }
 
@@ -237,22 +316,42 @@ SubcommandRegistrar reg_subdiv{
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<SubdivArgs>();
        app.add_option("mesh", a->mesh, "Input mesh (OFF/OBJ/PLY/STL; polygons kept, any genus)")->required();
-       app.add_option("exemplar", a->exemplar, "Exemplar image (any format OpenImageIO reads; treated as periodic)")
+       app.add_option("exemplar", a->exemplar,
+                      "Exemplar image (any format OpenImageIO reads); wrapped around only if it tiles (see --wrap)")
            ->required();
        app.add_option("-o,--output", a->outdir,
                       "Output folder: surface.ply (vertex colours), surface.glb (COLOR_0), surface_atlas.obj/.mtl/.png "
                       "(baked texture atlas), render.png, report.json")
            ->required();
+       auto* ts = app.add_option("--texel-size", a->texel_size,
+                                 "Texture scale: Nx = N exemplar widths across the longest bounding-box side, or "
+                                 "N/edge = N exemplar texels per mean edge of the input mesh (default 3x)");
        app.add_option("--rscale", a->rscale,
-                      "r_scale: texels per object unit, the object unit being the longest bounding-box side; "
-                      "larger = smaller texture features; > 0 (default 100)")
-           ->check(CLI::Range(1e-3, 1e6));
-       app.add_option("--levels", a->levels, "Uniform sqrt(2)-subdivision steps after the base mesh, 0..12 (default 3); "
-                                             "each step about doubles the vertex count")
-           ->check(CLI::Range(0, 12));
+                      "The paper's r_scale instead of --texel-size: exemplar texels per object unit, the object "
+                      "unit being the longest bounding-box side; larger = smaller texture features; 1e-3..1e6 "
+                      "(default: from --texel-size)")
+           ->check(CLI::Range(1e-3, 1e6))
+           ->excludes(ts);
+       app.add_option("--levels", a->levels,
+                      "Uniform sqrt(2)-subdivision steps after the base mesh, 0..12, each about doubling the vertex "
+                      "count; -1 (default) = the fewest that bring the vertex spacing down to one texel")
+           ->check(CLI::Range(-1, 12));
+       app.add_option("--max-vertices", a->max_vertices,
+                      "With --levels -1: most vertices of the finest level, >= 1000 (default 150000); when the "
+                      "exemplar's resolution needs more, the synthesis texel grows (the exemplar is reduced, the "
+                      "scale kept)")
+           ->check(CLI::Range(std::size_t(1000), std::size_t(50000000)));
+       app.add_option("--wrap", a->wrap,
+                      "auto (default): wrap the exemplar around its edges only if its wrap-seam ratio is <= 1.3 "
+                      "(it tiles); periodic: always (a seamless tile, e.g. from `surftex tile`); bounded: never")
+           ->check(CLI::IsMember({"auto", "periodic", "bounded"}));
+       app.add_option("--repetition-penalty", a->repetition,
+                      "Weight of the penalty for matching exemplar areas that nearby regions already show more "
+                      "than average, >= 0 (default 0.3; 0 = off)")
+           ->check(CLI::Range(0.0, 100.0));
        app.add_option("--adaptive", a->adaptive,
                       "Adaptive subdivision threshold f (faces with area > f x mean are refined) before the "
-                      "hierarchy; 0 = off (default 0); the paper finds 1.5 good")
+                      "hierarchy; 0 = off (default 1.5, the paper's choice)")
            ->check(CLI::Range(0.0, 1e6));
        app.add_option("--adaptive-steps", a->adaptive_steps, "Adaptive steps when --adaptive > 0, 0..32 (default 4)")
            ->check(CLI::Range(0, 32));
