@@ -149,6 +149,7 @@ nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const Subdi
   j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
                {"bounded_levels", r.bounded_levels}};
   j["repetition_penalty"] = o.repetition_penalty;
+  j["exhaustive_levels"] = o.exhaustive_levels;
   j["r_scale"] = sc.r_scale;
   j["object_unit"] = r.object_unit;
   j["stack_levels"] = r.stack_levels;
@@ -230,7 +231,7 @@ nlohmann::json subdiv_fidelity(const Mesh& mesh, const SubdivisionSynthesisResul
 struct SubdivArgs {
   std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
   double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
-  int levels = -1, passes = 2, adaptive_steps = 4, atlas = 1024;
+  int levels = -1, passes = 1, adaptive_steps = 4, atlas = 1024, exhaustive_levels = 1;
   std::size_t max_vertices = 150000;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
   CommonOptions common;
@@ -256,6 +257,7 @@ int run_subdiv(const SubdivArgs& a) {
   o.max_vertices = a.max_vertices;
   o.wrap = a.wrap == "periodic" ? ExemplarWrap::Periodic : a.wrap == "bounded" ? ExemplarWrap::Bounded : ExemplarWrap::Auto;
   o.repetition_penalty = a.repetition;
+  o.exhaustive_levels = a.exhaustive_levels;
   o.adaptive_factor = a.adaptive;
   o.adaptive_steps = a.adaptive_steps;
   o.passes = a.passes;
@@ -349,6 +351,12 @@ SubcommandRegistrar reg_subdiv{
                       "Weight of the penalty for matching exemplar areas that nearby regions already show more "
                       "than average, >= 0 (default 0.3; 0 = off)")
            ->check(CLI::Range(0.0, 100.0));
+       app.add_option("--exhaustive-levels", a->exhaustive_levels,
+                      "Mesh levels from the base on that search the whole exemplar (the paper's Algorithm 1), "
+                      "0..13; later levels only try the exemplar positions their neighbours' sources imply "
+                      "(coherence search, far faster) and search exhaustively where none fits (default 1; 13 = "
+                      "exhaustive everywhere)")
+           ->check(CLI::Range(0, 13));
        app.add_option("--adaptive", a->adaptive,
                       "Adaptive subdivision threshold f (faces with area > f x mean are refined) before the "
                       "hierarchy; 0 = off (default 1.5, the paper's choice)")
@@ -359,7 +367,7 @@ SubcommandRegistrar reg_subdiv{
                       "Displace every vertex along its normal by H x its synthesised grey level (luminance in "
                       "[0, 1]), H in object units (longest bounding-box side = 1), in [-1, 1]; 0 = off (default 0)")
            ->check(CLI::Range(-1.0, 1.0));
-       app.add_option("--passes", a->passes, "Synthesis passes per level (fill passes not counted), 1..16 (default 2)")
+       app.add_option("--passes", a->passes, "Synthesis passes per level (fill passes not counted), 1..16 (default 1)")
            ->check(CLI::Range(1, 16));
        app.add_option("--region", a->region, "Neighbourhood size n in texels (n x n), > 0 (default 9; the paper's Table 1 uses 3, too small for structured textures)")
            ->check(CLI::Range(0.5, 64.0));

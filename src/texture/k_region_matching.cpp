@@ -257,6 +257,18 @@ std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
   return {p[0], p[1], p[2]};
 }
 
+std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const float ax = static_cast<float>(x - fx), ay = static_cast<float>(y - fy);
+  const auto a = texel(ex, level, x0, y0), b = texel(ex, level, x0 + 1, y0), c = texel(ex, level, x0, y0 + 1),
+             d = texel(ex, level, x0 + 1, y0 + 1);
+  std::array<float, 3> o{};
+  for (int k = 0; k < 3; ++k)
+    o[k] = (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
+  return o;
+}
+
 double naive_distance(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level, int qx,
                       int qy) {
   double d = 0;

@@ -261,6 +261,10 @@ class ExemplarIndex {
   std::vector<Level> levels_;
 };
 
+/// Bilinear colour of level l at continuous texel coordinates (x, y) (texel
+/// centres at integers), wrapping, or clamped at a bounded level.
+std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y);
+
 /// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level.
 std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y);
 

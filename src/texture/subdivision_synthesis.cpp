@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <string>
@@ -50,6 +51,7 @@ void validate(const SubdivisionSynthesisOptions& o) {
   if (!(o.wrap_threshold > 0) || !std::isfinite(o.wrap_threshold)) bad("wrap_threshold", o.wrap_threshold, "> 0");
   if (!(o.repetition_penalty >= 0) || !std::isfinite(o.repetition_penalty))
     bad("repetition_penalty", o.repetition_penalty, ">= 0");
+  if (o.exhaustive_levels < 0 || o.exhaustive_levels > 13) bad("exhaustive_levels", o.exhaustive_levels, "in 0..13");
 }
 
 // Mesh figures the scale needs: bounding box, area, element counts.
@@ -264,7 +266,49 @@ struct PassContext {
   double sigma2;                        ///< summed channel variance of level 0
   double r_scale;
   const SubdivisionSynthesisOptions& opt;
+  bool coherent;                        ///< coherence search (SubdivisionSynthesisOptions::exhaustive_levels)
 };
+
+// Coherence search (SubdivisionSynthesisOptions::exhaustive_levels): the best
+// of the centres implied by the region's sources. found = false when no
+// region vertex has a source implying a centre inside the box.
+MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, const MatchBox& box, JobScratch& s) {
+  MatchResult best;
+  const int W = c.ex.width(lp), H = c.ex.height(lp), sc = c.ex.scale(lp);
+  const bool bounded = !c.ex.wraps(lp);
+  std::array<std::array<int, 2>, 32> seen;
+  int nseen = 0;
+  double bd = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < reg.vertices.size() && nseen < 32; ++i) {
+    const std::size_t v = reg.vertices[i];
+    const auto& src = c.source[v];
+    if (src[0] < 0 || (i > 0 && !c.colored[v])) continue;
+    int qx = src[0] / sc - s.offsets[i][0], qy = src[1] / sc - s.offsets[i][1];
+    if (bounded) {
+      if (qx < box.x0 || qx > box.x1 || qy < box.y0 || qy > box.y1) continue;
+    } else {
+      qx = ((qx % W) + W) % W, qy = ((qy % H) + H) % H;
+    }
+    bool dup = false;
+    for (int k = 0; k < nseen && !dup; ++k) dup = seen[k][0] == qx && seen[k][1] == qy;
+    if (dup) continue;
+    seen[nseen++] = {qx, qy};
+    double d = box.bin_penalty ? box.bin_penalty[((qy * sc) / box.bin) * box.bins_x + (qx * sc) / box.bin] : 0.0;
+    for (const SampleGroup& g : s.groups) {
+      const auto t = texel(c.ex, g.level, qx + g.dx, qy + g.dy);
+      for (int k = 0; k < 3; ++k) d += g.weight * (double(t[k]) - g.color[k]) * (double(t[k]) - g.color[k]);
+      if (d >= bd) break;
+    }
+    if (d < bd || (d == bd && qy * W + qx < best.qy * W + best.qx)) {
+      bd = d;
+      best.found = true;
+      best.qx = qx, best.qy = qy, best.distance = d;
+    }
+  }
+  best.comparisons = s.groups.size();
+  best.candidates = static_cast<std::size_t>(nseen);
+  return best;
+}
 
 // Non-periodic exemplar: the region vertices whose offset lies within a
 // quarter of the level's size of the centre keep a texture (inside); the box
@@ -345,7 +389,8 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
     box.bin = c.grid->bin();
     box.bins_x = c.grid->bins_x();
   }
-  job.m = c.index.match(s.groups, lp, box);
+  job.m = c.coherent ? coherent_match(c, reg, lp, box, s) : MatchResult{};
+  if (!job.m.found) job.m = c.index.match(s.groups, lp, box);
   auto t2 = std::chrono::steady_clock::now();
   job.t_match = std::chrono::duration<double>(t2 - t1).count();
   if (!job.m.found) {  // nothing fits (cannot happen with the box above): leave the vertex
@@ -360,14 +405,19 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
     for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
       const std::size_t v = reg.vertices[i];
       RegionSample smp{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {}};
-      const auto& o = s.offsets[i];
       const int lv = c.ex.pyramid ? lp : c.level[v];
       TransferNode& n = s.nodes[i];
       n.colored = c.colored[v] != 0;
       const Color3f& col = c.color[v];
       n.surface = {col[0], col[1], col[2]};
       n.pinned = bounded && !s.inside[i];
-      n.texture = n.pinned ? n.surface : texel(c.ex, lv, job.m.qx + o[0], job.m.qy + o[1]);
+      // The texture at the vertex's exact offset (bilinear; the match compared
+      // rounded offsets): vertices about a texel apart then carry a resampled
+      // exemplar, not a nearest-texel one whose duplicated and skipped texels
+      // break its fine structure. Pinned vertices keep their colour.
+      const double lsc = c.ex.pyramid ? static_cast<double>(sc) : 1.0;  // as sample_offset
+      n.texture = n.pinned ? n.surface
+                           : texel_bilinear(c.ex, lv, job.m.qx + smp.du / lsc, job.m.qy - smp.dv / lsc);
       n.distance = std::sqrt(smp.du * smp.du + smp.dv * smp.dv);
       n.hops = reg.hops[i];
     }
@@ -468,7 +518,9 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
   bool any_colored = std::any_of(colored.begin(), colored.end(), [](char c) { return c != 0; });
   SynthesisPassStats st;
   st.seconds_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
-  const PassContext ctx{graph, fr, ex, index, level, colored, color, color_level, source, grid.get(), sigma2, r_scale, opt};
+  const bool coherent = source_io && geo.mesh_level >= opt.exhaustive_levels;
+  const PassContext ctx{graph, fr,     ex,        index,  level,   colored, color,
+                        color_level, source, grid.get(), sigma2, r_scale, opt, coherent};
   struct SourceChange {
     std::size_t vertex;
     std::array<int, 2> before, after;
@@ -674,7 +726,8 @@ void synthesize_level(Mesh& mesh, int level, const SubdivisionSynthesisOptions& 
                       SynthesisLevelStats& ls) {
   const std::vector<std::size_t> order = level_order(mesh, level, c.rng);
   const int hierarchy_level = c.levels - level;
-  const PassGeometry geo = make_pass_geometry(mesh);  // shared by every pass of the level
+  PassGeometry geo = make_pass_geometry(mesh);  // shared by every pass of the level
+  geo.mesh_level = level;
   for (int pass = 0; pass < opt.passes; ++pass) {
     report_progress(opt.progress, "synthesis level " + std::to_string(level),
                     double(level * opt.passes + pass) / double((c.levels + 1) * opt.passes));
