@@ -227,6 +227,19 @@ std::vector<Chart> place_charts(const std::vector<FanTriangle>& tris, const Text
   return charts;
 }
 
+// An object only a few dozen texels across holds no chart of the asked side:
+// halve it down to 16 (SurfaceFidelityOptions::chart_texels); o.chart_texels
+// is left at the side used.
+std::vector<Chart> place_fitting_charts(const std::vector<FanTriangle>& tris, const TextureFrames& fr,
+                                        SurfaceFidelityOptions& o) {
+  std::vector<Chart> charts = place_charts(tris, fr, o);
+  while (charts.empty() && o.chart_texels / 2 >= std::max(16, o.patch)) {
+    o.chart_texels /= 2;
+    charts = place_charts(tris, fr, o);
+  }
+  return charts;
+}
+
 Image as_rgb(const Image& in) {
   if (in.channels == 3) return in;
   Image out(in.width, in.height, 3);
@@ -492,8 +505,8 @@ SurfaceSeamRatio surface_seam_ratio(const Mesh& mesh, const SurfaceColorFn& colo
   co.chart_texels = o.chart_texels;
   co.max_charts = o.max_charts;
   co.seed = o.seed;
-  const std::vector<Chart> charts = place_charts(tris, fr, co);
-  const int C = o.chart_texels;
+  const std::vector<Chart> charts = place_fitting_charts(tris, fr, co);
+  const int C = co.chart_texels;
   double across[2] = {0, 0}, within[2] = {0, 0};
   std::size_t n_across[2] = {0, 0}, n_within[2] = {0, 0};
   std::vector<std::array<float, 3>> col(static_cast<std::size_t>(C) * C);
@@ -556,15 +569,16 @@ SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, 
          std::to_string(mesh.number_of_faces()) + " faces");
   const Image ex = as_rgb(exemplar);
   const std::vector<FanTriangle> tris = fan_triangles(mesh);
-  std::vector<Chart> charts = place_charts(tris, frames, o);
+  SurfaceFidelityOptions oc = o;
+  std::vector<Chart> charts = place_fitting_charts(tris, frames, oc);
   if (charts.empty())
-    fail("no chart of " + std::to_string(o.chart_texels) + " texels at texel size " + std::to_string(o.texel_size) +
+    fail("no chart of " + std::to_string(oc.chart_texels) + " texels at texel size " + std::to_string(o.texel_size) +
          " fits the surface with at least " + std::to_string(o.min_valid_share) + " of its pixels valid");
   SurfaceFidelityResult r;
   r.texel_size = o.texel_size;
-  r.chart_texels = o.chart_texels;
+  r.chart_texels = oc.chart_texels;
   r.charts = static_cast<int>(charts.size());
-  const int C = o.chart_texels, n = r.charts;
+  const int C = oc.chart_texels, n = r.charts;
   const int cols = static_cast<int>(std::ceil(std::sqrt(double(n)))), rows = (n + cols - 1) / cols;
   const int W = cols * (C + 1) - 1, H = rows * (C + 1) - 1;
   r.mosaic = Image(W, H, 3, 0.f);

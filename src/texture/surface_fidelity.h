@@ -140,7 +140,7 @@ std::vector<char> seam_edges_from_corner_uv(const Mesh& mesh);
 std::vector<char> seam_edges_from_face_ids(const Mesh& mesh, const std::vector<int>& face_id);
 
 struct SeamRatioSurfaceOptions {
-  int chart_texels = 64;  ///< chart side, texels, 16..1024
+  int chart_texels = 64;  ///< chart side, texels, 16..1024 (halved down to 16 when none fits)
   int max_charts = 48;    ///< 1..256
   std::uint64_t seed = 1;
 };
@@ -159,7 +159,9 @@ SurfaceSeamRatio surface_seam_ratio(const Mesh& mesh, const SurfaceColorFn& colo
 struct SurfaceFidelityOptions {
   /// Synthesis texel size: mesh units per exemplar texel, > 0 (required).
   double texel_size = 0;
-  /// Chart side in texels, 16..1024. Default 64.
+  /// Chart side in texels, 16..1024. Default 64. When no chart of this side
+  /// fits (an object a few dozen texels across), it is halved down to 16;
+  /// the result's chart_texels is the side used.
   int chart_texels = 64;
   /// Most charts, 1..256. Default 24 (about 100K texels at the default side).
   int max_charts = 24;
