@@ -18,7 +18,7 @@
 // has no scale option (its texel follows from the patch size and
 // --patch-res): its defaults are used and the texels across it got are
 // printed. material-map needs a material tile: one per texture is made first
-// (texture/material_tile.h, one key, 2 layers, side = the exemplar's shorter
+// (texture/material_tile.h, one key, one layer, side = the exemplar's shorter
 // side up to 256), its time is printed apart.
 //
 // Usage: bench_fidelity [WORK_DIR] [METHODS] [SURFACES] [TEXTURES] [THREADS]
@@ -95,7 +95,7 @@ void write_square(const std::string& path, int n) {
     }
 }
 
-// One key, 2 layers (same-mask mode), side = the exemplar's shorter side up to 256.
+// One key, one layer, side = the exemplar's shorter side up to 256.
 int make_tile(const std::string& texture, const std::string& dir, double& seconds) {
   const Image ex = read_image(texture);
   MaterialTileOptions o;
