@@ -217,11 +217,48 @@ TEST(SubdivisionSynthesis, BadInputErrors) {
   o.passes = 0;
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   o = {};
+  o.exhaustive_levels = 14;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
   EXPECT_THROW(synthesize_on_subdivision(m, Image(), o), InvalidInputError);
   o.keys = {{100000, {1, 0, 0}}};
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   Mesh empty;
   EXPECT_THROW(synthesize_on_subdivision(empty, ex, {}), InvalidInputError);
+}
+
+// The coherence search below the base level (exhaustive_levels, default 1)
+// gives the same colours for 1 and 2 threads, is really used (the result
+// differs from the exhaustive search on every level), and colours every
+// vertex from the exemplar.
+TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
+  const Image ex = make_cells(32, 3, 5);
+  auto run = [&](int threads, int exhaustive_levels) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    Mesh m;
+    make_icosphere(m, 1);
+    SubdivisionSynthesisOptions o;
+    o.r_scale = 40;
+    o.levels = 3;
+    o.adaptive_factor = 0;
+    o.exhaustive_levels = exhaustive_levels;
+    o.seed = 2;
+    synthesize_on_subdivision(m, ex, o);
+    std::vector<float> c;
+    auto col = find(m, kVertexColor).first;
+    for (VertexIndex v : m.vertices())
+      for (int k = 0; k < 3; ++k) c.push_back(col[v][k]);
+    return c;
+  };
+  const auto one = run(1, 1), two = run(2, 1), exhaustive = run(2, 13);
+  EXPECT_EQ(one, two);
+  ASSERT_EQ(one.size(), exhaustive.size());
+  EXPECT_NE(one, exhaustive);
+  float lo = 1, hi = 0;
+  for (float v : one) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_GE(lo, 0.f);
+  EXPECT_LE(hi, 1.f);
+  EXPECT_GT(hi - lo, 0.2f);
 }
 
 // The stencil matcher used by the passes returns exactly (bit for bit) what
