@@ -42,6 +42,7 @@
 #include "texture/material_mapping.h"
 #include "texture/pbr_maps.h"
 #include "texture/render_material_space.h"
+#include "texture/surface_fidelity.h"
 
 namespace surftex::cli {
 namespace {
@@ -224,6 +225,7 @@ int run(const Args& a) {
   sec["read_tile"] = s_tile;
   sec["read_mesh"] = s_mesh;
   const PgpSingularities& sing = mapping.result().singularities;
+  rep["fidelity"] = material_map_fidelity_report(mesh, sing.corners, tile, a.common.seed);  // issue 18 item 3
 
   ensure_directory(a.out);
   // Renders first: the bake replaces the corner uv by the atlas's.

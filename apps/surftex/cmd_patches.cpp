@@ -31,6 +31,7 @@
 #include "texture/patch_seam_ratio.h"
 #include "texture/patch_synthesis.h"
 #include "texture/procedural_texture.h"
+#include "texture/surface_fidelity.h"
 
 namespace fs = std::filesystem;
 
@@ -189,6 +190,8 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
                 {"normal_source", maps.normal.empty() ? "height" : "exemplar_normal"},
                 {"height_source", maps.height.empty() ? "luminance" : "exemplar_height"},
                 {"roughness", !maps.roughness.empty()}};
+  j["fidelity"] = atlas_fidelity_report(mesh, exemplars[0], atlas.image, r.flat.texel,  // issue 18 item 3
+                                        po.field != PatchField::None, seed);
   j["outputs"] = {"mesh.obj", "mesh.mtl", "mesh.png", "mesh_normal.png", "mesh_height.png", "mesh.glb", "render.png"};
   if (!maps.roughness.empty()) j["outputs"].push_back("mesh_roughness.png");
   return j;

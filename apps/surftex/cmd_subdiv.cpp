@@ -3,6 +3,7 @@
 // graph matching over a sqrt(2)-subdivision hierarchy (Bangay & Morkel 2006),
 // and its demo step.
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -28,6 +29,7 @@
 #include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
 #include "texture/subdivision_synthesis.h"
+#include "texture/surface_fidelity.h"
 
 namespace fs = std::filesystem;
 
@@ -113,6 +115,7 @@ struct PbrSettings {
   int atlas_size = 1024;
   double bump = 2;              ///< tilt per unit height slope, height per exemplar texel
   double texels_per_length = 0; ///< exemplar texels per mesh unit
+  double texel_size = 0;        ///< synthesis texel in mesh units: > 0 measures the atlas seams (issue 18 item 3)
 };
 
 // The vertex colours baked into a gutter atlas of a triangulated copy, with
@@ -156,6 +159,9 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
                 {"mean_area_distortion", ga.atlas.mean_area_distortion}, {"flipped_faces", ga.atlas.flipped_faces},
                 {"bump", pbr.bump}, {"atlas_texels_per_exemplar_texel", atlas_per_exemplar},
                 {"seconds", t.seconds()}};
+  if (pbr.texel_size > 0)  // colour jumps across the baked atlas's chart seams (issue 18 item 3)
+    j["atlas"]["seam"] = to_json(surface_seam_ratio(tri, atlas_color_source(tri, baked.image),
+                                                    seam_edges_from_corner_uv(tri), pbr.texel_size));
   t.reset();
   ViewOptions view;
   view.colors = ViewOptions::Colors::VertexColors;
@@ -170,7 +176,18 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
 
 nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const SubdivisionSynthesisOptions& o) {
   nlohmann::json j;
-  j["r_scale"] = o.r_scale;
+  const SubdivisionScale& sc = r.scale;
+  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"texels_per_edge", sc.texels_per_edge},
+                {"r_scale", sc.r_scale}, {"texel_size", sc.texel_size}, {"exemplar_scale", sc.exemplar_scale},
+                {"exemplar_size", {sc.exemplar_width, sc.exemplar_height}}, {"levels", sc.levels},
+                {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},
+                {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
+                {"predicted_vertices", sc.predicted_vertices}};
+  j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
+               {"bounded_levels", r.bounded_levels}};
+  j["repetition_penalty"] = o.repetition_penalty;
+  j["exhaustive_levels"] = o.exhaustive_levels;
+  j["r_scale"] = sc.r_scale;
   j["object_unit"] = r.object_unit;
   j["stack_levels"] = r.stack_levels;
   j["pyramid"] = o.pyramid;
@@ -192,10 +209,67 @@ nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const Subdi
   return j;
 }
 
+// --texel-size: "Nx" = N exemplar widths across the longest bounding-box
+// side, "N/edge" = N exemplar texels per mean edge of the input mesh.
+void parse_texel_size(const std::string& spec, SubdivisionSynthesisOptions& o) {
+  if (spec.empty()) return;
+  auto number = [&](const std::string& t) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != t.size() || !(v > 0) || !std::isfinite(v))
+      throw InvalidInputError("--texel-size '" + spec +
+                              "' must be Nx (N > 0 exemplar widths across the object, e.g. 3x) or N/edge (N > 0 "
+                              "exemplar texels per mean edge of the mesh, e.g. 2/edge)");
+    return v;
+  };
+  const std::string edge = "/edge";
+  if (spec.size() > edge.size() && spec.compare(spec.size() - edge.size(), edge.size(), edge) == 0) {
+    o.texels_per_edge = number(spec.substr(0, spec.size() - edge.size()));
+  } else if (spec.size() > 1 && (spec.back() == 'x' || spec.back() == 'X')) {
+    o.repeats = number(spec.substr(0, spec.size() - 1));
+  } else {
+    number("");  // throws the explanation
+  }
+}
+
+void print_scale(const SubdivisionSynthesisResult& r) {
+  const SubdivisionScale& s = r.scale;
+  std::fprintf(stderr,
+               "subdiv: scale from %s: %.3g exemplar widths across (r_scale %.4g, %.3g texels per mean edge), "
+               "texel %.4g mesh units; %d uniform levels%s (vertex spacing %.2f texels, ~%zu vertices); exemplar "
+               "%dx%d%s; %s (wrap-seam ratio %.2f)\n",
+               s.scale_from, s.repeats, s.r_scale, s.texels_per_edge, s.texel_size, s.levels,
+               s.levels_chosen ? (s.budget_limited ? " (chosen, limited by --max-vertices)" : " (chosen)") : "",
+               s.spacing_texels, s.predicted_vertices, s.exemplar_width, s.exemplar_height,
+               s.exemplar_scale < 1 ? " (reduced to fit --max-vertices)" : "",
+               r.periodic ? "wrapped as periodic" : "not wrapped", r.wrap_seam_ratio);
+}
+
+// Issue 18 item 3: the vertex colours resampled in charts at the synthesis
+// texel, against the exemplar as synthesised.
+nlohmann::json subdiv_fidelity(const Mesh& mesh, const SubdivisionSynthesisResult& r, std::uint64_t seed) {
+  SurfaceFidelityOptions fo;
+  fo.texel_size = r.scale.texel_size;
+  fo.periodic_exemplar = r.periodic;
+  fo.seed = seed;
+  fo.source = vertex_source_coordinates(r.source);
+  try {
+    return to_json(surface_fidelity(mesh, r.exemplar, vertex_color_source(mesh), frames_from_vertex_directions(mesh), fo));
+  } catch (const InvalidInputError& e) {  // e.g. no chart fits a tiny or very thin mesh
+    return {{"error", e.what()}};
+  }
+}
+
 struct SubdivArgs {
-  std::string mesh, exemplar, outdir;
-  double rscale = 100, adaptive = 0, displace = 0, region = 9, sigma = 1;
-  int levels = 3, passes = 2, adaptive_steps = 4, atlas = 1024;
+  std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
+  double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
+  int levels = -1, passes = 1, adaptive_steps = 4, atlas = 1024, exhaustive_levels = 1;
+  std::size_t max_vertices = 150000;
   double bump = 2;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
   CommonOptions common;
@@ -218,7 +292,12 @@ int run_subdiv(const SubdivArgs& a) {
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;
+  parse_texel_size(a.texel_size, o);
   o.levels = a.levels;
+  o.max_vertices = a.max_vertices;
+  o.wrap = a.wrap == "periodic" ? ExemplarWrap::Periodic : a.wrap == "bounded" ? ExemplarWrap::Bounded : ExemplarWrap::Auto;
+  o.repetition_penalty = a.repetition;
+  o.exhaustive_levels = a.exhaustive_levels;
   o.adaptive_factor = a.adaptive;
   o.adaptive_steps = a.adaptive_steps;
   o.passes = a.passes;
@@ -232,12 +311,22 @@ int run_subdiv(const SubdivArgs& a) {
   o.coordinates = a.projection ? LocalCoordinates::kTangentProjection : LocalCoordinates::kUnfolding;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
-  check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, a.levels, a.atlas), a.common);
+  // --levels -1 (chosen from the scale) is bounded by --max-vertices: the
+  // estimate takes the levels that reach it (each sqrt(2) level doubles the faces).
+  int est_levels = a.levels;
+  if (est_levels < 0) {
+    const double faces = std::max<double>(1.0, static_cast<double>(mesh.number_of_faces()));
+    est_levels = std::max(0, static_cast<int>(std::floor(std::log2(2.0 * static_cast<double>(a.max_vertices) / faces))));
+  }
+  check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, est_levels, a.atlas), a.common);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
+  if (!a.common.quiet) print_scale(r);
+  const nlohmann::json fidelity = subdiv_fidelity(mesh, r, a.common.seed);
   DisplaceResult disp;
   if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);
   ensure_directory(a.outdir);
   nlohmann::json rep = synthesis_report(r, o);
+  rep["fidelity"] = fidelity;
   if (a.displace != 0) rep["displace_offset_range"] = {disp.min_offset, disp.max_offset};
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
@@ -246,7 +335,8 @@ int run_subdiv(const SubdivArgs& a) {
   PbrSettings pbr;
   pbr.atlas_size = a.atlas;
   pbr.bump = a.bump;
-  pbr.texels_per_length = o.r_scale / r.object_unit;
+  pbr.texels_per_length = r.scale.r_scale / r.object_unit;
+  pbr.texel_size = r.scale.texel_size;
   nlohmann::json written = write_outputs(mesh, out, a.common.force, pbr);
   const RunFiles files{{a.mesh, a.exemplar}, written["files"].get<std::vector<std::string>>()};
   rep["seconds"] = {{"read", seconds_read},
@@ -263,8 +353,9 @@ int run_subdiv(const SubdivArgs& a) {
   }
   write_report(ro, "subdiv", rep, files);
   if (!a.common.quiet)
-    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, %.1f s -> %s\n", static_cast<std::size_t>(mesh.number_of_vertices()), a.levels,
-                 total.seconds(), a.outdir.c_str());
+    std::fprintf(stderr, "subdiv: %zu vertices after %d levels, fidelity %.2fx graph-cut 2D, %.1f s -> %s\n",
+                 static_cast<std::size_t>(mesh.number_of_vertices()), r.scale.levels,
+                 fidelity.value("ratio", 0.0), total.seconds(), a.outdir.c_str());
   return 0;
 }
 
@@ -286,23 +377,49 @@ SubcommandRegistrar reg_subdiv{
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<SubdivArgs>();
        app.add_option("mesh", a->mesh, "Input mesh (OFF/OBJ/PLY/STL; polygons kept, any genus)")->required();
-       app.add_option("exemplar", a->exemplar, "Exemplar image (any format OpenImageIO reads; treated as periodic)")
+       app.add_option("exemplar", a->exemplar,
+                      "Exemplar image (any format OpenImageIO reads); wrapped around only if it tiles (see --wrap)")
            ->required();
        app.add_option("-o,--output", a->outdir,
                       "Output folder: surface.ply (vertex colours), surface.glb (baked atlas as base colour, "
                       "normal map, vertex colours as _COLOR), surface_atlas.obj/.mtl/.png (baked atlas) with "
                       "surface_atlas_normal.png and surface_atlas_height.png (16-bit), render.png, report.json")
            ->required();
+       auto* ts = app.add_option("--texel-size", a->texel_size,
+                                 "Texture scale: Nx = N exemplar widths across the longest bounding-box side, or "
+                                 "N/edge = N exemplar texels per mean edge of the input mesh (default 3x)");
        app.add_option("--rscale", a->rscale,
-                      "r_scale: texels per object unit, the object unit being the longest bounding-box side; "
-                      "larger = smaller texture features; > 0 (default 100)")
-           ->check(CLI::Range(1e-3, 1e6));
-       app.add_option("--levels", a->levels, "Uniform sqrt(2)-subdivision steps after the base mesh, 0..12 (default 3); "
-                                             "each step about doubles the vertex count")
-           ->check(CLI::Range(0, 12));
+                      "The paper's r_scale instead of --texel-size: exemplar texels per object unit, the object "
+                      "unit being the longest bounding-box side; larger = smaller texture features; 1e-3..1e6 "
+                      "(default: from --texel-size)")
+           ->check(CLI::Range(1e-3, 1e6))
+           ->excludes(ts);
+       app.add_option("--levels", a->levels,
+                      "Uniform sqrt(2)-subdivision steps after the base mesh, 0..12, each about doubling the vertex "
+                      "count; -1 (default) = the fewest that bring the vertex spacing down to one texel")
+           ->check(CLI::Range(-1, 12));
+       app.add_option("--max-vertices", a->max_vertices,
+                      "With --levels -1: most vertices of the finest level, >= 1000 (default 150000); when the "
+                      "exemplar's resolution needs more, the synthesis texel grows (the exemplar is reduced, the "
+                      "scale kept)")
+           ->check(CLI::Range(std::size_t(1000), std::size_t(50000000)));
+       app.add_option("--wrap", a->wrap,
+                      "auto (default): wrap the exemplar around its edges only if its wrap-seam ratio is <= 1.3 "
+                      "(it tiles); periodic: always (a seamless tile, e.g. from `surftex tile`); bounded: never")
+           ->check(CLI::IsMember({"auto", "periodic", "bounded"}));
+       app.add_option("--repetition-penalty", a->repetition,
+                      "Weight of the penalty for matching exemplar areas that nearby regions already show more "
+                      "than average, >= 0 (default 0.3; 0 = off)")
+           ->check(CLI::Range(0.0, 100.0));
+       app.add_option("--exhaustive-levels", a->exhaustive_levels,
+                      "Mesh levels from the base on that search the whole exemplar (the paper's Algorithm 1), "
+                      "0..13; later levels only try the exemplar positions their neighbours' sources imply "
+                      "(coherence search, far faster) and search exhaustively where none fits (default 1; 13 = "
+                      "exhaustive everywhere)")
+           ->check(CLI::Range(0, 13));
        app.add_option("--adaptive", a->adaptive,
                       "Adaptive subdivision threshold f (faces with area > f x mean are refined) before the "
-                      "hierarchy; 0 = off (default 0); the paper finds 1.5 good")
+                      "hierarchy; 0 = off (default 1.5, the paper's choice)")
            ->check(CLI::Range(0.0, 1e6));
        app.add_option("--adaptive-steps", a->adaptive_steps, "Adaptive steps when --adaptive > 0, 0..32 (default 4)")
            ->check(CLI::Range(0, 32));
@@ -310,7 +427,7 @@ SubcommandRegistrar reg_subdiv{
                       "Displace every vertex along its normal by H x its synthesised grey level (luminance in "
                       "[0, 1]), H in object units (longest bounding-box side = 1), in [-1, 1]; 0 = off (default 0)")
            ->check(CLI::Range(-1.0, 1.0));
-       app.add_option("--passes", a->passes, "Synthesis passes per level (fill passes not counted), 1..16 (default 2)")
+       app.add_option("--passes", a->passes, "Synthesis passes per level (fill passes not counted), 1..16 (default 1)")
            ->check(CLI::Range(1, 16));
        app.add_option("--region", a->region, "Neighbourhood size n in texels (n x n), > 0 (default 9; the paper's Table 1 uses 3, too small for structured textures)")
            ->check(CLI::Range(0.5, 64.0));

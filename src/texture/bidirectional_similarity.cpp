@@ -22,13 +22,32 @@ struct Patches {
   const float* row(std::size_t i) const { return v.data() + i * dim; }
 };
 
-Patches extract(const Image& img, int k, bool wrap, int stride) {
+// Patches of `img` at every stride-th position; with `valid` (width*height),
+// only those whose k*k pixels are all valid.
+Patches extract(const Image& img, int k, bool wrap, int stride, const std::vector<char>* valid = nullptr) {
   Patches p;
   p.dim = k * k * img.channels;
   const int nx = wrap ? img.width : img.width - k + 1;
   const int ny = wrap ? img.height : img.height - k + 1;
+  // Valid patch corners: a summed-area table of invalid pixels.
+  std::vector<int> bad;
+  if (valid) {
+    const int W = img.width, H = img.height;
+    bad.assign(static_cast<std::size_t>(W + 1) * (H + 1), 0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        bad[static_cast<std::size_t>(y + 1) * (W + 1) + x + 1] =
+            ((*valid)[static_cast<std::size_t>(y) * W + x] ? 0 : 1) + bad[static_cast<std::size_t>(y) * (W + 1) + x + 1] +
+            bad[static_cast<std::size_t>(y + 1) * (W + 1) + x] - bad[static_cast<std::size_t>(y) * (W + 1) + x];
+  }
+  auto all_valid = [&](int x, int y) {
+    if (!valid) return true;
+    const std::size_t W1 = img.width + 1;
+    return bad[(y + k) * W1 + x + k] - bad[y * W1 + x + k] - bad[(y + k) * W1 + x] + bad[y * W1 + x] == 0;
+  };
   for (int y = 0; y < ny; y += stride)
     for (int x = 0; x < nx; x += stride) {
+      if (!all_valid(x, y)) continue;
       for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
           const int sx = (x + i) % img.width, sy = (y + j) % img.height;
@@ -193,6 +212,7 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
         std::to_string(exemplar.channels));
   if (opt.patch < 1 || opt.patch > 31) bad("patch " + std::to_string(opt.patch) + " outside 1..31");
   if (opt.stride < 1) bad("stride " + std::to_string(opt.stride) + " < 1");
+  if (opt.exemplar_stride < 1) bad("exemplar_stride " + std::to_string(opt.exemplar_stride) + " < 1");
   if (opt.max_candidates < 0) bad("max_candidates " + std::to_string(opt.max_candidates) + " < 0");
   if (opt.pca_dims < 1) bad("pca_dims " + std::to_string(opt.pca_dims) + " < 1");
   if (output.width < opt.patch || output.height < opt.patch)
@@ -201,20 +221,31 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
   if (!opt.periodic_exemplar && (exemplar.width < opt.patch || exemplar.height < opt.patch))
     bad("patch " + std::to_string(opt.patch) + " larger than the exemplar (" +
         std::to_string(exemplar.width) + "x" + std::to_string(exemplar.height) + ")");
-  const Patches out = extract(output, opt.patch, false, opt.stride);
+  const bool masked = !opt.output_valid.empty();
+  if (masked && opt.output_valid.size() != static_cast<std::size_t>(output.width) * output.height)
+    bad("output_valid has " + std::to_string(opt.output_valid.size()) + " entries for a " +
+        std::to_string(output.width) + "x" + std::to_string(output.height) + " output");
+  const Patches out = extract(output, opt.patch, false, opt.stride, masked ? &opt.output_valid : nullptr);
+  if (out.count == 0) bad("the output mask leaves no valid " + std::to_string(opt.patch) + "x" +
+                          std::to_string(opt.patch) + " patch");
   const Patches ex = extract(exemplar, opt.patch, opt.periodic_exemplar, 1);
   BidirectionalResult r;
   r.output_patches = out.count;
   r.exemplar_patches = ex.count;
+  // Completeness queries: every exemplar_stride-th exemplar patch.
+  const Patches exq = opt.exemplar_stride > 1 ? extract(exemplar, opt.patch, opt.periodic_exemplar, opt.exemplar_stride)
+                                              : Patches{};
+  const Patches& queries = opt.exemplar_stride > 1 ? exq : ex;
   if (opt.brute_force) {
     std::vector<double> none;
     r.coherence = mean_nearest(out, ex, nullptr, none, none, 0);
-    r.completeness = mean_nearest(ex, out, nullptr, none, none, 0);
+    r.completeness = mean_nearest(queries, out, nullptr, none, none, 0);
   } else {
     const Pca pca = fit_pca(ex, out, std::min(opt.pca_dims, ex.dim));
     const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
     r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates);
-    r.completeness = mean_nearest(ex, out, &pca, pex, pout, opt.max_candidates);
+    const std::vector<double> pq = opt.exemplar_stride > 1 ? project(queries, pca) : std::vector<double>();
+    r.completeness = mean_nearest(queries, out, &pca, opt.exemplar_stride > 1 ? pq : pex, pout, opt.max_candidates);
   }
   r.total = r.coherence + r.completeness;
   return r;

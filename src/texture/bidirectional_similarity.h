@@ -22,9 +22,11 @@
 // best full distance found so far cannot hold the nearest patch and is pruned.
 //
 // Throws InvalidInputError on empty images, different channel counts,
-// patch outside 1..31 or larger than an image, or stride < 1.
+// patch outside 1..31 or larger than an image, stride < 1, or a mask of the
+// wrong size or without any valid patch.
 
 #include <cstddef>
+#include <vector>
 
 #include "geometry/image.h"
 
@@ -39,6 +41,10 @@ struct BidirectionalOptions {
   /// Step between output patch positions (1 = every patch), >= 1. Larger
   /// steps subsample big outputs.
   int stride = 1;
+  /// Step between the exemplar patches that query the output for
+  /// completeness (1 = every patch), >= 1; coherence always searches every
+  /// exemplar patch. Larger steps subsample big exemplars.
+  int exemplar_stride = 1;
   /// Dimensions kept by the PCA projection for the kd-tree (1..k*k*channels,
   /// clamped), default 16. Affects speed only, not the result.
   int pca_dims = 16;
@@ -50,6 +56,12 @@ struct BidirectionalOptions {
   int max_candidates = 0;
   /// Brute-force search instead of the kd-tree (reference; slow).
   bool brute_force = false;
+  /// Optional validity mask of the output (width*height, row-major; empty =
+  /// every pixel valid): only output patches whose k*k pixels are all valid
+  /// are compared, in both directions (an output made of several charts laid
+  /// side by side with invalid gaps, texture/surface_fidelity.h). At least
+  /// one valid patch is required.
+  std::vector<char> output_valid{};
 };
 
 struct BidirectionalResult {

@@ -13,7 +13,7 @@ namespace surftex {
 namespace {
 
 double mismatch(const TransferNode& n) {
-  if (!n.colored) return 0.0;
+  if (!n.colored || n.pinned) return 0.0;
   double s = 0;
   for (int c = 0; c < 3; ++c) s += (double(n.surface[c]) - n.texture[c]) * (double(n.surface[c]) - n.texture[c]);
   return std::sqrt(s);
@@ -81,7 +81,10 @@ GraphCutTransferResult graph_cut_transfer(const std::vector<TransferNode>& nodes
   paste.assign(n, 1);
   for (int i = 0; i < n; ++i) {
     const TransferNode& a = nodes[i];
-    if (i == center || !a.colored) {
+    if (a.pinned && i != center) {
+      gc.add_terminal(i, 0, GraphCut::kInfinity);
+      paste[i] = 0;
+    } else if (i == center || !a.colored) {
       gc.add_terminal(i, GraphCut::kInfinity, 0);
     } else if (a.hops >= border_hops) {
       gc.add_terminal(i, 0, GraphCut::kInfinity);

@@ -13,6 +13,9 @@
 //     surface terminal, infinite (it keeps its colour);
 //   - every uncoloured vertex -> texture terminal, infinite (it has no colour
 //     to keep; documented choice, the paper only discusses coloured ones);
+//   - a `pinned` vertex (the matched neighbourhood has no texel for it: it
+//     falls outside a non-periodic exemplar) -> surface terminal, infinite;
+//     its mismatch term is 0 (it keeps its colour, or stays uncoloured);
 //   - every region edge (A, B): W(A,B) = M(A,B) exp(-(x_A^2 + x_B^2) / (sigma r^2))
 //     both ways, with M(A,B) = |C_s(A) - C_t(A)| + |C_s(B) - C_t(B)| (Euclidean
 //     RGB norms; a term is 0 for an uncoloured vertex), x = the vertex's
@@ -41,6 +44,7 @@ struct TransferNode {
   std::array<float, 3> texture{};  ///< C_t
   double distance = 0;             ///< x: texels from the target
   int hops = 0;                    ///< edges from the target
+  bool pinned = false;             ///< no texture for it: keeps its colour (or none)
 };
 
 struct GraphCutTransferOptions {

@@ -199,8 +199,9 @@ int region_k(double region_texels, int level, bool pyramid, double r_scale, doub
   return std::clamp(static_cast<int>(std::ceil(k - 1e-9)), 1, max_k);
 }
 
-ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int levels) {
+ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int levels, int bounded_levels) {
   if (exemplar.empty()) throw InvalidInputError("make_exemplar_levels: the exemplar image is empty");
+  if (bounded_levels < 0) throw InvalidInputError("make_exemplar_levels: bounded_levels must be >= 0");
   Image rgb(exemplar.width, exemplar.height, 3);
   for (int y = 0; y < exemplar.height; ++y)
     for (int x = 0; x < exemplar.width; ++x)
@@ -208,16 +209,23 @@ ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int lev
         rgb.at(x, y, c) = exemplar.at(x, y, exemplar.channels >= 3 ? c : 0);
   ExemplarLevels ex;
   ex.pyramid = pyramid;
-  if (pyramid) {
-    PyramidOptions po;
-    po.levels = levels;
-    po.toroidal = true;
-    ex.levels = gaussian_pyramid(rgb, po);
-  } else {
+  auto build = [&](bool toroidal) {
+    if (pyramid) {
+      PyramidOptions po;
+      po.levels = levels;
+      po.toroidal = toroidal;
+      return gaussian_pyramid(rgb, po);
+    }
     StackOptions so;
     so.levels = levels;
-    so.toroidal = true;
-    ex.levels = gaussian_stack(rgb, so);
+    so.toroidal = toroidal;
+    return gaussian_stack(rgb, so);
+  };
+  ex.levels = build(true);
+  ex.bounded_levels = std::min<int>(bounded_levels, static_cast<int>(ex.levels.size()));
+  if (ex.bounded_levels > 0) {  // the bounded levels from the clamped stack
+    std::vector<Image> clamped = build(false);
+    for (int l = 0; l < ex.bounded_levels; ++l) ex.levels[l] = std::move(clamped[l]);
   }
   return ex;
 }
@@ -244,8 +252,21 @@ std::vector<SampleGroup> group_samples(const ExemplarLevels& ex, const std::vect
 
 std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
   const Image& im = ex.levels[level];
-  const float* p = im.pixel(wrap(x, im.width), wrap(y, im.height));
+  const float* p = ex.wraps(level) ? im.pixel(wrap(x, im.width), wrap(y, im.height))
+                               : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
   return {p[0], p[1], p[2]};
+}
+
+std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const float ax = static_cast<float>(x - fx), ay = static_cast<float>(y - fy);
+  const auto a = texel(ex, level, x0, y0), b = texel(ex, level, x0 + 1, y0), c = texel(ex, level, x0, y0 + 1),
+             d = texel(ex, level, x0 + 1, y0 + 1);
+  std::array<float, 3> o{};
+  for (int k = 0; k < 3; ++k)
+    o[k] = (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
+  return o;
 }
 
 double naive_distance(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level, int qx,
@@ -363,6 +384,46 @@ void group_into(const ExemplarLevels& ex, const std::vector<RegionSample>& sampl
   }
 }
 
+MatchBox candidate_box(int w, int h, int min_dx, int max_dx, int min_dy, int max_dy) {
+  MatchBox b;
+  b.restricted = true;
+  b.x0 = -min_dx;
+  b.x1 = w - 1 - max_dx;
+  b.y0 = -min_dy;
+  b.y1 = h - 1 - max_dy;
+  return b;
+}
+
+namespace {
+
+// The box a match searches: clipped `box` if restricted, else the whole
+// level (wrapping) or the box keeping every group inside (bounded).
+MatchBox search_box(const ExemplarLevels& ex, const std::vector<SampleGroup>& groups, int W, int H,
+                    const MatchBox& box, int center_level) {
+  const bool wraps = ex.wraps(center_level);
+  MatchBox b = box;
+  if (!b.restricted) {
+    if (wraps) {
+      b.x0 = b.y0 = 0, b.x1 = W - 1, b.y1 = H - 1;
+    } else {
+      int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+      for (const SampleGroup& g : groups)
+        x0 = std::min(x0, g.dx), x1 = std::max(x1, g.dx), y0 = std::min(y0, g.dy), y1 = std::max(y1, g.dy);
+      const MatchBox c = candidate_box(W, H, x0, x1, y0, y1);
+      b.x0 = c.x0, b.x1 = c.x1, b.y0 = c.y0, b.y1 = c.y1;
+    }
+  }
+  b.x0 = std::max(b.x0, 0), b.y0 = std::max(b.y0, 0), b.x1 = std::min(b.x1, W - 1), b.y1 = std::min(b.y1, H - 1);
+  if (!wraps && b.x0 <= b.x1 && b.y0 <= b.y1)
+    for (const SampleGroup& g : groups)
+      if (b.x0 + g.dx < 0 || b.x1 + g.dx >= W || b.y0 + g.dy < 0 || b.y1 + g.dy >= H)
+        throw InvalidInputError("ExemplarIndex::match: the candidate box lets group (" + std::to_string(g.dx) + "," +
+                                std::to_string(g.dy) + ") leave a bounded level");
+  return b;
+}
+
+}  // namespace
+
 MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
                          const MatchOptions& opt) {
   if (center_level < 0 || center_level >= static_cast<int>(ex.levels.size()))
@@ -376,15 +437,17 @@ MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSampl
   const int W = ex.width(center_level), H = ex.height(center_level);
   GroupTable tab;
   group_table(ex, groups, W, H, tab);
+  const MatchBox box = search_box(ex, groups, W, H, MatchBox{}, center_level);
+  if (box.x1 < box.x0 || box.y1 < box.y0) return res;  // the region does not fit the exemplar
   const int blocks = (H + opt.rows_per_block - 1) / opt.rows_per_block;
   std::vector<float> best_d(blocks, std::numeric_limits<float>::infinity());
   std::vector<int> best_i(blocks, -1);
   tbb::parallel_for(0, blocks, [&](int b) {
     float bd = std::numeric_limits<float>::infinity();
     int bi = -1;
-    const int y0 = b * opt.rows_per_block, y1 = std::min(H, y0 + opt.rows_per_block);
+    const int y0 = std::max(box.y0, b * opt.rows_per_block), y1 = std::min(box.y1 + 1, (b + 1) * opt.rows_per_block);
     for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < W; ++x) {
+      for (int x = box.x0; x <= box.x1; ++x) {
         const float d = score(groups, tab, W, H, x, y, bd);
         if (d < bd) bd = d, bi = y * W + x;  // row-major: the first of equal minima is kept
       }
@@ -395,7 +458,7 @@ MatchResult match_region(const ExemplarLevels& ex, const std::vector<RegionSampl
   int bi = -1;
   for (int b = 0; b < blocks; ++b)
     if (best_i[b] >= 0 && best_d[b] < bd) bd = best_d[b], bi = best_i[b];
-  if (bi < 0) bi = 0, bd = 0;  // only NaN colours: degenerate, take texel 0
+  if (bi < 0) bi = box.y0 * W + box.x0, bd = 0;  // only NaN colours: degenerate, take the first candidate
   res.found = true;
   res.qx = bi % W;
   res.qy = bi / W;
@@ -431,6 +494,10 @@ inline void accumulate(float* d, const float* r, const float* g, const float* b,
 }  // namespace
 
 MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int center_level) const {
+  return match(groups, center_level, MatchBox{});
+}
+
+MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int center_level, const MatchBox& box_in) const {
   const ExemplarLevels& ex = *ex_;
   if (center_level < 0 || center_level >= static_cast<int>(ex.levels.size()))
     throw InvalidInputError("ExemplarIndex::match: centre level " + std::to_string(center_level) + " out of range");
@@ -440,34 +507,47 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
     if (g.level < 0 || g.level >= static_cast<int>(ex.levels.size()))
       throw InvalidInputError("ExemplarIndex::match: group level " + std::to_string(g.level) + " out of range");
   const int W = ex.width(center_level), H = ex.height(center_level);
+  const MatchBox box = search_box(ex, groups, W, H, box_in, center_level);
+  if (box.x1 < box.x0 || box.y1 < box.y0) return res;  // no candidate keeps the region inside
+  const int x0 = box.x0, nx = box.x1 - box.x0 + 1;
+  const bool wraps = ex.wraps(center_level);
+  const int sc = ex.scale(center_level);
   const std::size_t G = groups.size();
   thread_local std::vector<float> d;
   thread_local std::vector<int> gx, gy;
-  d.resize(W);
+  d.resize(nx);
   gx.resize(G);
   gy.resize(G);
-  for (std::size_t g = 0; g < G; ++g) gx[g] = wrap(groups[g].dx, W), gy[g] = wrap(groups[g].dy, H);
+  // Periodic: offsets wrapped into [0, W); non-periodic: as they are (the box keeps them inside).
+  for (std::size_t g = 0; g < G; ++g)
+    gx[g] = wraps ? wrap(groups[g].dx, W) : groups[g].dx, gy[g] = wraps ? wrap(groups[g].dy, H) : groups[g].dy;
   thread_local std::vector<int> alive;
   thread_local std::vector<const float*> rowp;
-  alive.resize(W);
+  alive.resize(nx);
   rowp.resize(3 * G);
   float bd = std::numeric_limits<float>::infinity();
   int bi = -1;
   std::size_t scored = 0;
   // Row by row, the region as a sparse stencil. Phase 1 (vectorised): the
-  // heaviest groups add their terms to all W candidates of the row from one
-  // contiguous (wrapped in two pieces) run of their level's planes; the row is
-  // dropped as soon as every partial sum reaches the best distance so far
-  // (terms are >= 0, and a later candidate must be strictly better to win).
-  // Phase 2 (once few candidates of the row survive): each survivor alone
-  // adds the remaining terms and is abandoned as soon as its partial sum
-  // reaches the best distance. Both phases add the same terms in the same
+  // heaviest groups add their terms to all candidates of the row from one
+  // contiguous (periodic: wrapped in two pieces) run of their level's planes;
+  // the row is dropped as soon as every partial sum reaches the best distance
+  // so far (terms are >= 0, and a later candidate must be strictly better to
+  // win). Phase 2 (once few candidates of the row survive): each survivor
+  // alone adds the remaining terms and is abandoned as soon as its partial
+  // sum reaches the best distance. Both phases add the same terms in the same
   // order with the same arithmetic, so every finished sum equals the full
-  // scan's, bit for bit, and so does the argmin (first of equal minima).
-  for (int y = 0; y < H; ++y) {
-    std::fill(d.begin(), d.end(), 0.0f);
+  // scan's, bit for bit, and so does the argmin (first of equal minima). A
+  // repetition penalty is the starting value of each sum (>= 0).
+  for (int y = box.y0; y <= box.y1; ++y) {
+    if (box.bin_penalty) {
+      const float* prow = box.bin_penalty + static_cast<std::size_t>((y * sc) / box.bin) * box.bins_x;
+      for (int x = 0; x < nx; ++x) d[x] = prow[((x0 + x) * sc) / box.bin];
+    } else {
+      std::fill(d.begin(), d.end(), 0.0f);
+    }
     bool dropped = false;
-    int na = W;
+    int na = nx;
     std::size_t g = 0, next_check = 1;
     while (g < G) {
       const Level& L = levels_[groups[g].level];
@@ -477,31 +557,38 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
       const float* r = L.plane[0].data() + row;
       const float* gg = L.plane[1].data() + row;
       const float* b = L.plane[2].data() + row;
-      const int s = gx[g];  // candidate x reads texel x + s (mod W)
-      accumulate(d.data(), r + s, gg + s, b + s, W - s, groups[g]);
-      accumulate(d.data() + (W - s), r, gg, b, s, groups[g]);
+      if (wraps) {
+        int s = x0 + gx[g];  // candidate x0 + i reads texel x0 + i + dx (mod W)
+        if (s >= W) s -= W;
+        const int first = std::min(nx, W - s);
+        accumulate(d.data(), r + s, gg + s, b + s, first, groups[g]);
+        accumulate(d.data() + first, r, gg, b, nx - first, groups[g]);
+      } else {
+        const int s = x0 + gx[g];
+        accumulate(d.data(), r + s, gg + s, b + s, nx, groups[g]);
+      }
       ++g;
       if (g == next_check && g < G) {
         next_check *= 2;
         na = 0;
-        for (int x = 0; x < W; ++x) na += d[x] < bd ? 1 : 0;
+        for (int x = 0; x < nx; ++x) na += d[x] < bd ? 1 : 0;
         if (na == 0) {
           dropped = true;
           break;
         }
-        if (8 * na <= W) break;  // few survivors: phase 2
+        if (8 * na <= nx) break;  // few survivors: phase 2
       }
     }
     if (dropped) continue;
     if (g >= G) {  // every term added over the whole row
-      for (int x = 0; x < W; ++x)
-        if (d[x] < bd) bd = d[x], bi = y * W + x;  // row-major: the first of equal minima is kept
-      scored += static_cast<std::size_t>(W);
+      for (int x = 0; x < nx; ++x)
+        if (d[x] < bd) bd = d[x], bi = y * W + x0 + x;  // row-major: the first of equal minima is kept
+      scored += static_cast<std::size_t>(nx);
       continue;
     }
     // Phase 2: survivors one by one over the remaining groups.
     na = 0;
-    for (int x = 0; x < W; ++x)
+    for (int x = 0; x < nx; ++x)
       if (d[x] < bd) alive[na++] = x;
     for (std::size_t h = g; h < G; ++h) {
       const Level& L = levels_[groups[h].level];
@@ -518,8 +605,8 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
       std::size_t h = g;
       for (; h < G; ++h) {
         const SampleGroup& grp = groups[h];
-        int xx = x + gx[h];
-        if (xx >= W) xx -= W;
+        int xx = x0 + x + gx[h];
+        if (wraps && xx >= W) xx -= W;
         const float e0 = rowp[3 * h][xx] - grp.color[0], e1 = rowp[3 * h + 1][xx] - grp.color[1],
                     e2 = rowp[3 * h + 2][xx] - grp.color[2];
         dx += grp.weight * (e0 * e0 + e1 * e1 + e2 * e2);
@@ -527,10 +614,10 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
       }
       if (h < G) continue;  // abandoned
       ++scored;
-      if (dx < bd) bd = dx, bi = y * W + x;  // x increasing: the first of equal minima is kept
+      if (dx < bd) bd = dx, bi = y * W + x0 + x;  // x increasing: the first of equal minima is kept
     }
   }
-  if (bi < 0) bi = 0, bd = 0;  // only NaN colours: degenerate, take texel 0
+  if (bi < 0) bi = box.y0 * W + x0, bd = 0;  // only NaN colours: degenerate, take the box's first texel
   res.found = true;
   res.qx = bi % W;
   res.qy = bi / W;

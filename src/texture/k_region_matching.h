@@ -115,10 +115,19 @@ void k_region(const Mesh& mesh, const SurfaceFrames& frames, std::size_t center,
 /// level_relative_region).
 int region_k(double region_texels, int level, bool pyramid, double r_scale, double mean_edge, int max_k = 32);
 
-/// The exemplar as a Gaussian stack (default, toroidal) or pyramid, RGB.
+/// The exemplar as a Gaussian stack (default) or pyramid, RGB. Levels below
+/// `bounded_levels` are "bounded" (issue 18 item 2: a non-periodic exemplar's
+/// wrap seams must not be copied): blurred with clamped borders, read
+/// clamped, and a match at such a level may only take candidates whose whole
+/// region lies inside the level (MatchBox). The other levels are blurred
+/// toroidally and read wrapping around (all of them for a periodic
+/// exemplar, bounded_levels = 0; for a non-periodic one the coarse, blurred
+/// levels whose regions would not fit in half the exemplar).
 struct ExemplarLevels {
   std::vector<Image> levels;  ///< level 0 = the (RGB) exemplar
   bool pyramid = false;
+  int bounded_levels = 0;
+  bool wraps(int l) const { return l >= bounded_levels; }
   int width(int l) const { return levels[l].width; }
   int height(int l) const { return levels[l].height; }
   /// a^l: level-0 texels per texel of level l (1 for a stack).
@@ -128,7 +137,7 @@ struct ExemplarLevels {
 /// Builds the stack (or pyramid) of `exemplar` (1, 3 or 4 channels; grey is
 /// expanded, alpha dropped). levels = 0: 1 + floor(log2(min(w, h))). Throws
 /// InvalidInputError on an empty image.
-ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int levels = 0);
+ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int levels = 0, int bounded_levels = 0);
 
 /// Stack level for a vertex with mean edge length e (section 3.3.4).
 int antialias_level(const ExemplarLevels& ex, double r_scale, double mean_edge);
@@ -170,6 +179,28 @@ struct MatchOptions {
   /// Rows per parallel block (fixed so results do not depend on threads).
   int rows_per_block = 8;
 };
+
+/// What a match may choose besides the SSD (issue 18 item 2):
+/// - the candidate box: with `restricted`, only texels x0..x1, y0..y1
+///   (inclusive, at the centre's level; clipped to the level) may be taken.
+///   Not restricted: every texel of a wrapping level, and at a bounded
+///   level the box in which every group lies inside the level.
+///   A caller that also copies other region vertices (graph-cut transfer)
+///   gives the box of all their offsets (candidate_box).
+/// - a repetition penalty per exemplar bin: d(Q) starts at
+///   bin_penalty[(y s / bin) * bins_x + (x s / bin)] (s = level-0 texels per
+///   texel of the centre's level) instead of 0; null = none. Values >= 0.
+struct MatchBox {
+  bool restricted = false;
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  const float* bin_penalty = nullptr;
+  int bin = 1, bins_x = 0;
+};
+
+/// The box of candidates Q for which Q + o stays inside a w x h level for
+/// every offset o in [min_dx, max_dx] x [min_dy, max_dy] (restricted; empty,
+/// x1 < x0 or y1 < y0, when the offsets span more than the level).
+MatchBox candidate_box(int w, int h, int min_dx, int max_dx, int min_dy, int max_dy);
 
 struct MatchResult {
   bool found = false;   ///< false when there is no sample
@@ -217,6 +248,10 @@ class ExemplarIndex {
   /// `groups` as from prepare_groups (heaviest first). Throws
   /// InvalidInputError for a level out of range.
   MatchResult match(const std::vector<SampleGroup>& groups, int center_level) const;
+  /// The same restricted to `box` (and with its penalty). An empty box gives
+  /// found = false. At a bounded level the box must
+  /// keeps every group inside the level (InvalidInputError otherwise).
+  MatchResult match(const std::vector<SampleGroup>& groups, int center_level, const MatchBox& box) const;
 
  private:
   const ExemplarLevels* ex_;
@@ -226,7 +261,11 @@ class ExemplarIndex {
   std::vector<Level> levels_;
 };
 
-/// Texel colour of level l at (x, y), wrapping.
+/// Bilinear colour of level l at continuous texel coordinates (x, y) (texel
+/// centres at integers), wrapping, or clamped at a bounded level.
+std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y);
+
+/// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level.
 std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y);
 
 }  // namespace surftex

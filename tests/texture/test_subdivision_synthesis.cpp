@@ -20,6 +20,7 @@
 #include "texture/k_region_matching.h"
 #include "texture/procedural_texture.h"
 #include "texture/subdivision_synthesis.h"
+#include "texture/wrap_seam_ratio.h"
 
 using namespace surftex;
 
@@ -198,10 +199,25 @@ TEST(SubdivisionSynthesis, BadInputErrors) {
   make_icosphere(m, 0);
   const Image ex = make_cells(16, 2, 1);
   SubdivisionSynthesisOptions o;
-  o.r_scale = 0;
+  o.r_scale = -1;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.repeats = 0;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.levels = -2;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.max_vertices = 10;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.repetition_penalty = std::nan("");
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   o = {};
   o.passes = 0;
+  EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
+  o = {};
+  o.exhaustive_levels = 14;
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   o = {};
   EXPECT_THROW(synthesize_on_subdivision(m, Image(), o), InvalidInputError);
@@ -209,6 +225,40 @@ TEST(SubdivisionSynthesis, BadInputErrors) {
   EXPECT_THROW(synthesize_on_subdivision(m, ex, o), InvalidInputError);
   Mesh empty;
   EXPECT_THROW(synthesize_on_subdivision(empty, ex, {}), InvalidInputError);
+}
+
+// The coherence search below the base level (exhaustive_levels, default 1)
+// gives the same colours for 1 and 2 threads, is really used (the result
+// differs from the exhaustive search on every level), and colours every
+// vertex from the exemplar.
+TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
+  const Image ex = make_cells(32, 3, 5);
+  auto run = [&](int threads, int exhaustive_levels) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    Mesh m;
+    make_icosphere(m, 1);
+    SubdivisionSynthesisOptions o;
+    o.r_scale = 40;
+    o.levels = 3;
+    o.adaptive_factor = 0;
+    o.exhaustive_levels = exhaustive_levels;
+    o.seed = 2;
+    synthesize_on_subdivision(m, ex, o);
+    std::vector<float> c;
+    auto col = find(m, kVertexColor).first;
+    for (VertexIndex v : m.vertices())
+      for (int k = 0; k < 3; ++k) c.push_back(col[v][k]);
+    return c;
+  };
+  const auto one = run(1, 1), two = run(2, 1), exhaustive = run(2, 13);
+  EXPECT_EQ(one, two);
+  ASSERT_EQ(one.size(), exhaustive.size());
+  EXPECT_NE(one, exhaustive);
+  float lo = 1, hi = 0;
+  for (float v : one) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_GE(lo, 0.f);
+  EXPECT_LE(hi, 1.f);
+  EXPECT_GT(hi - lo, 0.2f);
 }
 
 // The stencil matcher used by the passes returns exactly (bit for bit) what
@@ -560,7 +610,9 @@ TEST(SubdivisionSynthesis, DeepHierarchyKeepsTheExemplarsFeatureSize) {
   o.r_scale = n;                      // one texel per final edge
   o.keys = {{0, {1, 0, 0}}};
   o.seed = 1;
-  synthesize_on_subdivision(m, img, o);
+  const SubdivisionSynthesisResult res = synthesize_on_subdivision(m, img, o);
+  EXPECT_FALSE(res.periodic);  // make_cells does not tile (wrap-seam ratio 1.59): its fine levels are bounded
+  EXPECT_GE(res.bounded_levels, 1);
   // Vertex grey binned on the final grid (vertices near the border are moved
   // off the lattice by the smoothing, so bin rather than pick lattice points).
   std::vector<double> sum(n * n, 0.0), cnt(n * n, 0.0), all;
@@ -589,4 +641,133 @@ TEST(SubdivisionSynthesis, DeepHierarchyKeepsTheExemplarsFeatureSize) {
   EXPECT_GT(ratio, 0.8) << "features too large (edge density " << jump << " per texel)";
   EXPECT_LT(ratio, 1.25) << "features too small or noisy (edge density " << jump << " per texel)";
   EXPECT_GT(grey_std(all), 0.8 * grey_std(ex_grey)) << "result close to uniform";
+}
+
+// Issue 18 item 1: the default scale is given in exemplar widths across the
+// object, so a mesh 100 units across and the same mesh 0.01 units across get
+// the same number of exemplar repeats, the same depth and the same texel in
+// object units; the depth is the fewest levels whose vertex spacing is at
+// most one texel (the actual final mesh is measured), and several repeats
+// show on the object.
+TEST(SubdivisionSynthesis, DefaultScaleGivesTheSameRepeatsWhateverTheMeshUnits) {
+  const Image ex = make_cells(16, 2, 2);  // small, so that 3 repeats need few vertices
+  SubdivisionSynthesisOptions o;          // defaults: 3 repeats, chosen levels
+  o.passes = 1;
+  SubdivisionSynthesisResult r[2];
+  double longest[2] = {100.0, 0.01}, mean_edge[2] = {0, 0};
+  for (int i = 0; i < 2; ++i) {
+    Mesh m;
+    make_icosphere(m, 2, longest[i] / 2);  // bounding box about `longest` across
+    r[i] = synthesize_on_subdivision(m, ex, o);
+    double s = 0;
+    for (EdgeIndex e : m.edges()) s += std::sqrt((m.point(m.vertex(e, 0)) - m.point(m.vertex(e, 1))).squared_length());
+    mean_edge[i] = s / m.number_of_edges();
+  }
+  EXPECT_NEAR(r[0].scale.repeats, r[1].scale.repeats, 1e-9 * r[0].scale.repeats);
+  EXPECT_NEAR(r[0].scale.repeats, 3.0, 1e-9);
+  EXPECT_EQ(r[0].scale.levels, r[1].scale.levels);
+  EXPECT_NEAR(r[0].scale.texel_size / r[0].object_unit, r[1].scale.texel_size / r[1].object_unit, 1e-9);
+  EXPECT_EQ(r[0].levels.back().vertices, r[1].levels.back().vertices);
+  for (int i = 0; i < 2; ++i) {
+    const SubdivisionScale& sc = r[i].scale;
+    EXPECT_TRUE(sc.levels_chosen);
+    EXPECT_FALSE(sc.budget_limited);
+    EXPECT_EQ(sc.exemplar_scale, 1.0);
+    EXPECT_LE(mean_edge[i] / sc.texel_size, 1.1) << "final vertex spacing above one texel";
+    // the fewest levels: one level less would leave the spacing above a texel
+    EXPECT_GT(mean_edge[i] * std::sqrt(2.0) / sc.texel_size, 1.0);
+  }
+  // The same in texels per mean edge.
+  o.texels_per_edge = 2;
+  Mesh a, b;
+  make_icosphere(a, 2, 50);
+  make_icosphere(b, 2, 0.005);
+  const double e = 50 * 0.3, f = 0.005 * 0.3;  // any mean edge in the same proportion
+  const SubdivisionScale sa = choose_subdivision_scale(a, 16, 16, e, o), sb = choose_subdivision_scale(b, 16, 16, f, o);
+  EXPECT_NEAR(sa.repeats, sb.repeats, 1e-9 * sa.repeats);
+  EXPECT_EQ(sa.levels, sb.levels);
+  EXPECT_STREQ(sa.scale_from, "texels_per_edge");
+}
+
+// The vertex budget: when one texel per vertex would need more vertices, the
+// depth stays within max_vertices and the exemplar is reduced so that a
+// synthesis texel is the final vertex spacing (the repeats are kept).
+TEST(SubdivisionSynthesis, VertexBudgetCoarsensTheTexelNotTheScale) {
+  Mesh m;
+  make_icosphere(m, 2, 1.0);
+  SubdivisionSynthesisOptions o;
+  o.repeats = 4;
+  o.max_vertices = 20000;
+  const SubdivisionScale s = choose_subdivision_scale(m, 64, 64, 0.1, o);
+  EXPECT_TRUE(s.budget_limited);
+  EXPECT_LE(s.predicted_vertices, 20000u);
+  o.max_vertices = 2 * s.predicted_vertices + 2000;  // one level more fits: deeper, finer texel
+  const SubdivisionScale s2 = choose_subdivision_scale(m, 64, 64, 0.1, o);
+  EXPECT_EQ(s2.levels, s.levels + 1);
+  EXPECT_GT(s2.exemplar_scale, s.exemplar_scale);
+  EXPECT_LT(s.exemplar_scale, 1.0);
+  EXPECT_NEAR(s.repeats, 4.0, 1e-9);
+  EXPECT_NEAR(s.spacing_texels, 1.0, 1e-9);
+  EXPECT_EQ(s.exemplar_width, static_cast<int>(std::lround(64 * s.exemplar_scale)));
+}
+
+namespace {
+
+// A non-periodic exemplar with a strong edge at its wrap: a left-to-right
+// ramp from dark to bright with a fine random texture on top.
+Image ramp_exemplar(int w, int h, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(-0.06f, 0.06f);
+  Image im(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float g = 0.1f + 0.8f * float(x) / float(w - 1) + u(rng);
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = g;
+    }
+  return im;
+}
+
+// Mesh edges whose two vertices were copied from opposite sides of the
+// exemplar's left-right wrap (sources within 2 texels of the two borders,
+// rows within 3): the wrap seam pasted onto the surface.
+int edges_across_the_wrap(const Mesh& m, const std::vector<std::array<int, 2>>& src, int w) {
+  int n = 0;
+  for (EdgeIndex e : m.edges()) {
+    const auto& a = src[m.vertex(e, 0).idx()];
+    const auto& b = src[m.vertex(e, 1).idx()];
+    if (a[0] < 0 || b[0] < 0 || std::abs(a[1] - b[1]) > 3) continue;
+    if ((a[0] >= w - 2 && b[0] <= 1) || (b[0] >= w - 2 && a[0] <= 1)) ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+// Issue 18 item 2, done-when test: a non-periodic exemplar with a strong edge
+// at its wrap is not copied across it. Forced to wrap (the old behaviour),
+// the synthesis pastes the exemplar's right border next to its left border.
+TEST(SubdivisionSynthesis, NonPeriodicExemplarIsNotCopiedAcrossItsWrap) {
+  const Image ex = ramp_exemplar(40, 40, 3);
+  EXPECT_GT(wrap_seam_ratio(ex), 1.3);
+  auto run = [&](ExemplarWrap wrap) {
+    Mesh m;
+    make_quad_plane(m, 10, 0.1);  // a unit square
+    SubdivisionSynthesisOptions o;
+    o.repeats = 2.5;  // 100 texels across: the exemplar has to be left and re-entered
+    o.wrap = wrap;
+    o.passes = 1;
+    o.keys = {{0, {1, 0, 0}}};
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+    EXPECT_EQ(r.source.size(), m.number_of_vertices());
+    std::size_t with_source = 0;
+    for (const auto& s : r.source) with_source += s[0] >= 0;
+    EXPECT_GT(with_source, m.number_of_vertices() * 9 / 10);
+    return std::make_pair(r.periodic, edges_across_the_wrap(m, r.source, ex.width));
+  };
+  const auto automatic = run(ExemplarWrap::Auto);
+  const auto forced = run(ExemplarWrap::Periodic);
+  EXPECT_FALSE(automatic.first);
+  EXPECT_TRUE(forced.first);
+  EXPECT_EQ(automatic.second, 0);
+  EXPECT_GT(forced.second, 10) << "the test does not see wrap copies";
 }
