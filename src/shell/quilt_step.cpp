@@ -14,6 +14,7 @@
 #include "geometry/errors.h"
 #include "geometry/timer.h"
 #include "shell/element_correspondence.h"
+#include "shell/element_clearance.h"
 #include "shell/element_deformation.h"
 #include "shell/element_merging.h"
 
@@ -48,6 +49,11 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   in_added += o.in_added;
   in_cut_added += o.in_cut_added;
   in_cut_components += o.in_cut_components;
+  crossing_hits += o.crossing_hits;
+  crossing_dropped += o.crossing_dropped;
+  crossing_trimmed += o.crossing_trimmed;
+  crossing_pieces += o.crossing_pieces;
+  seconds_resolve += o.seconds_resolve;
   seconds_match += o.seconds_match;
   seconds_correspond += o.seconds_correspond;
   seconds_deform += o.seconds_deform;
@@ -114,11 +120,52 @@ std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& cor
   corr.pairs.swap(pairs);
   return keep;
 }
+// QuiltStepOptions::resolve_crossings: of the elements about to be added,
+// those that hit an element already there (or one added before them) are
+// dropped or trimmed; returns what is to be added.
+std::vector<ElementMesh> resolve_crossings(const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
+                                           std::vector<ElementMesh> adds, const QuiltStepOptions& opt,
+                                           QuiltStepStats& stats) {
+  ElementCollider old(elements, alive);
+  std::vector<ElementMesh> keep;
+  for (ElementMesh& m : adds) {
+    const std::vector<char> hit = old.hits(m, -1, opt.clearance);
+    const std::size_t nhit = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), 1));
+    if (nhit == 0) {
+      old.add(m, -2);
+      keep.push_back(std::move(m));
+      continue;
+    }
+    ++stats.crossing_hits;
+    std::vector<ElementMesh> pieces;
+    if (!is_compact_element(m)) pieces = trim_and_cap(m, hit, opt.trim_rings, std::max<std::size_t>(24, m.tris.size() / 10));
+    // A piece is kept only if it is clear of the others itself (its cap may reach them).
+    std::size_t kept = 0;
+    for (ElementMesh& p : pieces) {
+      const std::vector<char> h2 = old.hits(p, -1, opt.clearance);
+      if (std::find(h2.begin(), h2.end(), 1) != h2.end()) continue;
+      old.add(p, -2);
+      keep.push_back(std::move(p));
+      ++kept;
+    }
+    if (kept == 0) {
+      ++stats.crossing_dropped;
+    } else {
+      ++stats.crossing_trimmed;
+      stats.crossing_pieces += kept;
+    }
+  }
+  return keep;
+}
 }  // namespace
 
 QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& swatch_tree, const QuiltGrid& grid,
                                   const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
                                   std::mt19937_64& rng, const QuiltStepOptions& opt, const QuiltPlacement* near) {
+  if (!std::isfinite(opt.clearance))
+    throw InvalidInputError("quilt_step: clearance must be finite (" + std::to_string(opt.clearance) + ")");
+  if (opt.trim_rings < 0 || opt.trim_rings > 16)
+    throw InvalidInputError("quilt_step: trim_rings must be in [0, 16] (" + std::to_string(opt.trim_rings) + ")");
   if (opt.subcell_levels < 0 || opt.subcell_levels > 8)
     throw InvalidInputError("quilt_step: subcell_levels must be in [0, 8] (" + std::to_string(opt.subcell_levels) + ")");
   if (opt.max_match_vertices < 1)
@@ -438,13 +485,21 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
     t_merge += tm.seconds();
   }
   for (auto& [e, m] : replacements) elements[e] = std::move(m);
+  std::vector<ElementMesh> adds;
   for (int e = 0; e < ni; ++e)
     if (add_in[e]) {
-      elements.push_back(std::move(placed[e]));
-      alive.push_back(1);
+      adds.push_back(std::move(placed[e]));
       ++stats.in_added;
     }
-  for (ElementMesh& m : cut_inputs) {
+  for (ElementMesh& m : cut_inputs) adds.push_back(std::move(m));
+  if (opt.resolve_crossings) {
+    Timer tr;
+    QuiltStepOptions ro = opt;
+    if (ro.clearance < 0) ro.clearance = 0.5 * swatch.min_gap;
+    adds = resolve_crossings(elements, alive, std::move(adds), ro, stats);
+    stats.seconds_resolve += tr.seconds();
+  }
+  for (ElementMesh& m : adds) {
     elements.push_back(std::move(m));
     alive.push_back(1);
   }
