@@ -281,6 +281,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
   SurfaceQuilt q;
   Timer tq;
   const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
@@ -318,7 +319,10 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_hits", r.stats.crossing_hits},
          {"crossing_dropped", r.stats.crossing_dropped},
          {"crossing_trimmed", r.stats.crossing_trimmed},
+         {"crossing_pushed", r.stats.crossing_pushed},
          {"crossings_resolved", r.crossings_resolved},
+         {"crossing_elements_embedded", er.crossing_elements},
+         {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},
          {"faces_refilled", r.faces_refilled},

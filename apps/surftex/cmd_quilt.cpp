@@ -21,6 +21,7 @@
 #include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
@@ -120,6 +121,7 @@ void write_stitch_stats(nlohmann::json& rep, const QuiltStepStats& st) {
   rep["crossing_hits"] = st.crossing_hits;  // new elements that would have passed through placed ones
   rep["crossing_dropped"] = st.crossing_dropped;
   rep["crossing_trimmed"] = st.crossing_trimmed;
+  rep["crossing_pushed"] = st.crossing_pushed;
 }
 
 // Mean and largest element length of a planar quilt: each element's larger
@@ -316,6 +318,8 @@ int run_quilt(QuiltArgs& a) {
     rep["elements_stretched"] = r.elements_stretched;
     rep["edge_stretch_max"] = r.edge_stretch_max;
     rep["crossings_resolved"] = r.crossings_resolved;
+    rep["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
+    rep["fragments_removed"] = r.fragments_removed;
     rep["faces_refilled"] = r.faces_refilled;
     rep["bare_fraction"] = r.bare_fraction;
     write_stitch_stats(rep, r.stats);
@@ -377,7 +381,14 @@ int run_quilt(QuiltArgs& a) {
   if (!a.render.empty()) {
     WriteImageOptions io;
     io.overwrite = a.common.force;
-    write_image(a.render, render_preview(scene), io);
+    // The render stands the mesh on the axis nearest --up (+Y by default, as
+    // glTF viewers do); a plane lies in xy and is seen from above (+Z).
+    ViewOptions vo;
+    vo.size = 800;
+    vo.elevation_deg = 35.f;
+    const bool y_up = a.plane.empty() && std::abs(a.up[1]) >= std::abs(a.up[2]);
+    vo.up = y_up ? ViewOptions::Up::Y : ViewOptions::Up::Z;
+    write_image(a.render, render_view(scene, vo), io);
     rep["render"] = a.render;
   }
   rep["files"] = outputs;

@@ -33,7 +33,16 @@ struct Batch {
     if (tris.empty()) return;
     tree.insert(tris.cbegin(), tris.cend());
     tree.build();
-    tree.accelerate_distance_queries();
+  }
+  // Squared distance from p to the nearest triangle if it is below c2 (the
+  // box of half-side c around p meets some triangle's box first), else c2.
+  // (No kd-tree of distance hints: most points are far from every triangle,
+  // and the box test settles them; the hint is a corner of a triangle the box meets.)
+  double near2(const Point3& p, double c, double c2) const {
+    const CGAL::Bbox_3 box(p.x() - c, p.y() - c, p.z() - c, p.x() + c, p.y() + c, p.z() + c);
+    const auto hit = tree.any_intersected_primitive(box);
+    if (!hit) return c2;
+    return std::min(c2, CGAL::squared_distance(p, tree.closest_point(p, (*hit)->vertex(0))));
   }
   void push(const ElementMesh& m, int id) {
     for (const Tri& t : m.tris) {
@@ -77,7 +86,7 @@ double ElementCollider::nearest_distance(const std::vector<P3>& points, double l
   double best = limit * limit;
   for (const P3& p : points)
     for (const auto& b : impl_->batches)
-      if (!b->tris.empty()) best = std::min(best, CGAL::squared_distance(pt(p), b->tree.closest_point(pt(p))));
+      if (!b->tris.empty()) best = b->near2(pt(p), std::sqrt(best), best);
   return std::sqrt(best);
 }
 
@@ -98,7 +107,7 @@ std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double c
     for (std::size_t v = 0; v < m.points.size(); ++v)
       for (const auto& b : impl_->batches) {
         if (b->tris.empty()) continue;
-        if (CGAL::squared_distance(pt(m.points[v]), b->tree.closest_point(pt(m.points[v]))) < clearance * clearance) {
+        if (b->near2(pt(m.points[v]), clearance, clearance * clearance) < clearance * clearance) {
           near[v] = 1;
           break;
         }

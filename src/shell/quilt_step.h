@@ -99,6 +99,11 @@ struct QuiltStepOptions {
   double clearance = -1;
   /// Rings of triangles removed around the hits of a trimmed element, >= 0. Default 2.
   int trim_rings = 2;
+  /// With resolve_crossings: a thread (not compact) that hits is first pushed
+  /// over or under each crossing by a smooth bump in z (as a woven thread
+  /// passes the one it crosses); kept so if that clears it, else trimmed.
+  /// Default true.
+  bool push_over_under = true;
 };
 
 /// Where quilt_step put the swatch: its bbox min at the corner of cell
@@ -147,6 +152,7 @@ struct QuiltStepStats {
   /// old one, and of them those dropped and those trimmed (into
   /// crossing_pieces pieces).
   std::size_t crossing_hits = 0, crossing_dropped = 0, crossing_trimmed = 0, crossing_pieces = 0;
+  std::size_t crossing_pushed = 0;  ///< of crossing_hits, threads pushed over or under instead (push_over_under)
   double seconds_resolve = 0;
   double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
   void add(const QuiltStepStats& o);

@@ -489,6 +489,7 @@ class SurfaceQuilter {
   void mark(int f);
   void drift(const Patch& p);
   P3 lifted(const SurfaceQuiltVertex& v) const;
+  void fit_z(Element& el);
   void settle_and_trim();
   void resolve_crossings_lifted();
   std::vector<char> bare_faces() const;
@@ -524,6 +525,7 @@ class SurfaceQuilter {
   std::vector<P3> face_dir_;
   int done_ = 0;
   bool refilling_ = false;
+  double stretch_bound2_ = 0;  // squared (mesh units); 0 = none (settle_and_trim)
   SurfaceQuiltResult res_;
 };
 
@@ -1171,7 +1173,7 @@ void SurfaceQuilter::add_new(const ElementMesh& m, const PatchLocator& loc, cons
     return;
   }
   ++res_.dropped_new;
-  if (!opt_.trim_new_to_patch && !refilling_) return;
+  if ((!opt_.trim_new_to_patch && !refilling_) || el.compact) return;  // (a cut ring or pebble is no element)
   std::vector<char> off(m.points.size(), 0);
   for (std::size_t v = 0; v < m.points.size(); ++v) off[v] = loc.locate({m.points[v][0], m.points[v][1]}, w) < 0;
   std::vector<char> drop(m.tris.size(), 0);
@@ -1298,6 +1300,24 @@ void grow_drop(const std::vector<Tri>& tris, std::size_t nv, std::vector<char>& 
 }
 }  // namespace
 
+// The element shifted in z into the output's z range (the swatch's, widened
+// by max_z_growth swatch heights), squeezed if taller than it: the
+// deformations and stitches of sections 2.6-2.7 move vertices a little past it.
+void SurfaceQuilter::fit_z(Element& el) {
+  const double lim_lo = swatch_.bbox_min[2] - opt_.max_z_growth * swatch_h_, lim_hi = swatch_.bbox_max[2] + opt_.max_z_growth * swatch_h_;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  if (!(lo < lim_lo || hi > lim_hi)) return;
+  ++res_.z_fitted_elements;
+  res_.z_fitted_vertices += el.loc.size();
+  if (hi - lo <= lim_hi - lim_lo) {
+    const double shift = lo < lim_lo ? lim_lo - lo : lim_hi - hi;
+    for (SurfaceQuiltVertex& v : el.loc) v.z = std::clamp(v.z + shift, lim_lo, lim_hi);
+  } else {
+    for (SurfaceQuiltVertex& v : el.loc) v.z = std::clamp(lim_lo + (v.z - lo) * (lim_hi - lim_lo) / (hi - lo), lim_lo, lim_hi);
+  }
+}
+
 // Finish, first part: every location moved onto the base face containing it;
 // elements past a border of the base mesh trimmed there (or removed), and
 // stretched triangles (an edge longer, lifted, than max_edge_stretch times
@@ -1311,10 +1331,12 @@ void SurfaceQuilter::settle_and_trim() {
       max_edge = std::max(max_edge, norm3(sub3(swatch_.mesh.points[static_cast<std::size_t>(t[k])],
                                                swatch_.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])])));
   const double bound = opt_.max_edge_stretch * max_edge * S_, cap_max = 2 * swatch_h_ * S_;
+  stretch_bound2_ = opt_.max_edge_stretch > 0 ? bound * bound : 0.0;
   const std::size_t n = elements_.size();
   for (std::size_t e = 0; e < n; ++e) {
     if (!elements_[e].alive || elements_[e].mesh.tris.empty()) continue;
     Element& el = elements_[e];
+    fit_z(el);
     std::vector<char> past_v(el.loc.size(), 0);
     std::size_t past = 0;
     for (std::size_t i = 0; i < el.loc.size(); ++i) {
@@ -1402,7 +1424,7 @@ void SurfaceQuilter::resolve_crossings_lifted() {
     std::vector<char> drop = hit;
     grow_drop(el.mesh.tris, el.loc.size(), drop, opt_.step.trim_rings);
     std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>> pieces;
-    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, 0.0, pieces);
+    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, stretch_bound2_, pieces);
     for (auto& [tris, locs] : pieces) {
       ElementMesh m;
       m.tris = tris;
@@ -1489,36 +1511,33 @@ std::size_t SurfaceQuilter::refill() {
   return n;
 }
 
-// The output: every live element fitted into the output's z range
-// (SurfaceQuiltOptions::max_z_growth: shifted, or squeezed if taller than
-// it), appended; the z range widened to the vertices' heights.
+// The output: every live element (fitted into the z range by finish)
+// appended, fragments left out; the z range widened to the vertices' heights.
 void SurfaceQuilter::emit(SurfaceQuilt& out) {
   out = SurfaceQuilt{};
   out.scale = S_;
   out.z_min = swatch_.bbox_min[2];
   out.z_max = swatch_.bbox_max[2];
-  const double lim_lo = swatch_.bbox_min[2] - opt_.max_z_growth * swatch_h_, lim_hi = swatch_.bbox_max[2] + opt_.max_z_growth * swatch_h_;
+  // Fragments (pieces of cut elements, outer parts split off at a broken
+  // seam) smaller than a tenth of the swatch's smallest element are no
+  // elements: they are left out (counted).
+  std::size_t min_faces = std::numeric_limits<std::size_t>::max();
+  for (const SwatchElement& e : swatch_.elements) min_faces = std::min(min_faces, e.faces);
+  min_faces = std::max<std::size_t>(4, min_faces / 10);
   for (Element& el : elements_) {
     if (!el.alive || el.mesh.tris.empty()) continue;
-    std::vector<SurfaceQuiltVertex>& settled = el.loc;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const SurfaceQuiltVertex& v : settled) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
-    if (lo < lim_lo || hi > lim_hi) {
-      ++res_.z_fitted_elements;
-      res_.z_fitted_vertices += settled.size();
-      if (hi - lo <= lim_hi - lim_lo) {
-        const double shift = lo < lim_lo ? lim_lo - lo : lim_hi - hi;
-        for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(v.z + shift, lim_lo, lim_hi);
-      } else {
-        for (SurfaceQuiltVertex& v : settled) v.z = std::clamp(lim_lo + (v.z - lo) * (lim_hi - lim_lo) / (hi - lo), lim_lo, lim_hi);
-      }
+    if (el.mesh.tris.size() < min_faces) {
+      ++res_.fragments_removed;
+      continue;
     }
+    const std::vector<SurfaceQuiltVertex>& settled = el.loc;
     const int base_index = static_cast<int>(out.vertices.size());
     for (const SurfaceQuiltVertex& v : settled) out.vertices.push_back(v);
     for (const Tri& t : el.mesh.tris) {
       out.tris.push_back({t[0] + base_index, t[1] + base_index, t[2] + base_index});
       out.tri_element.push_back(out.elements);
     }
+    out.element_compact.push_back(el.compact ? 1 : 0);
     ++out.elements;
   }
   double lo = out.z_min, hi = out.z_max;

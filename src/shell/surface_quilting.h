@@ -135,9 +135,9 @@ struct SurfaceQuiltOptions {
   /// patch by extrapolation, on a curved rim or across a gap); such triangles
   /// (and one ring) are cut out of threads and the pieces capped, compact
   /// elements with one are removed, and the space is refilled (refill_rounds).
-  /// >= 0; 0 = no bound. Default 2 (SurfaceQuiltResult::edge_stretch_max
-  /// reports what is left; see docs/decisions/102-quilt-shards.md).
-  double max_edge_stretch = 2.0;
+  /// >= 0; 0 = no bound. Default 3 (SurfaceQuiltResult::edge_stretch_max
+  /// reports what is left; docs/decisions/102-quilt-crossings-shards-coverage.md).
+  double max_edge_stretch = 3.0;
   /// Interpenetration (issue 17 item 1): after the loop, the elements are
   /// lifted to their heights and tested against each other exactly; of two
   /// that cross, the later yields (compact ones removed, threads cut at the
@@ -148,8 +148,8 @@ struct SurfaceQuiltOptions {
   /// Rounds of refilling (issue 17 items 2 and 4): after the loop and the
   /// finish, the base faces left bare (no element vertex within half the
   /// swatch's element spacing, swatch_element_spacing) are quilted again, new
-  /// elements off their patch kept trimmed to it. In [0, 8]; 0 = none. Default 2.
-  int refill_rounds = 2;
+  /// elements off their patch kept trimmed to it. In [0, 8]; 0 = none. Default 3.
+  int refill_rounds = 3;
   /// The output's z range is the swatch's widened to the heights the quilt
   /// reached, by at most this many swatch heights on each side; an element
   /// reaching beyond is shifted in z into it (squeezed if taller). In [0, 10];
@@ -194,6 +194,8 @@ struct SurfaceQuilt {
   std::vector<Tri> tris;
   std::vector<int> tri_element;  ///< element id per triangle, 0..elements-1
   int elements = 0;
+  /// Per element: compact (a ring, a pebble: is_compact_element in its frame), not a thread.
+  std::vector<char> element_compact;
   double scale = 0;              ///< mesh units per swatch unit
   /// The output's z range (swatch units): the swatch's, widened to the
   /// vertices' heights (SurfaceQuiltOptions::max_z_growth); every vertex's z
@@ -255,6 +257,8 @@ struct SurfaceQuiltResult {
   std::size_t elements_not_expressed = 0;
   /// Elements that crossed an earlier one when lifted and yielded (SurfaceQuiltOptions::resolve_crossings).
   std::size_t crossings_resolved = 0;
+  /// Output pieces left out for being smaller than a tenth of the swatch's smallest element.
+  std::size_t fragments_removed = 0;
   /// Base faces reopened by the refill rounds, and the bare area fraction at the end (SurfaceQuiltOptions::refill_rounds).
   std::size_t faces_refilled = 0;
   double bare_fraction = 0;
