@@ -490,7 +490,7 @@ class SurfaceQuilter {
   void drift(const Patch& p);
   P3 lifted(const SurfaceQuiltVertex& v) const;
   void fit_z(Element& el);
-  void settle_and_trim();
+  void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
   std::vector<char> bare_faces() const;
 
@@ -1324,7 +1324,7 @@ void SurfaceQuilter::fit_z(Element& el) {
 // the swatch's longest edge, scaled: a shard) cut out of non-compact
 // elements, whose pieces are capped (trim_element), and compact elements
 // with one removed (issue 17 item 2: their space is refilled, refill()).
-void SurfaceQuilter::settle_and_trim() {
+void SurfaceQuilter::settle_and_trim(std::size_t from) {
   double max_edge = 0;
   for (const Tri& t : swatch_.mesh.tris)
     for (int k = 0; k < 3; ++k)
@@ -1332,8 +1332,9 @@ void SurfaceQuilter::settle_and_trim() {
                                                swatch_.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])])));
   const double bound = opt_.max_edge_stretch * max_edge * S_, cap_max = 2 * swatch_h_ * S_;
   stretch_bound2_ = opt_.max_edge_stretch > 0 ? bound * bound : 0.0;
-  const std::size_t n = elements_.size();
-  for (std::size_t e = 0; e < n; ++e) {
+  // (The pieces appended are checked in turn: a cap's edges, lifted along
+  // the vertex normals, may pass the bound where they diverge, at a rim.)
+  for (std::size_t e = from; e < elements_.size(); ++e) {
     if (!elements_[e].alive || elements_[e].mesh.tris.empty()) continue;
     Element& el = elements_[e];
     fit_z(el);
@@ -1444,8 +1445,12 @@ void SurfaceQuilter::resolve_crossings_lifted() {
 
 void SurfaceQuilter::finish() {
   Timer t;
-  settle_and_trim();
-  if (opt_.resolve_crossings) resolve_crossings_lifted();
+  settle_and_trim(0);
+  if (opt_.resolve_crossings) {
+    const std::size_t n = elements_.size();
+    resolve_crossings_lifted();
+    settle_and_trim(n);  // the pieces it cut, against the stretch bound
+  }
   res_.seconds_finish += t.seconds();
 }
 
@@ -1520,10 +1525,11 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
   out.z_max = swatch_.bbox_max[2];
   // Fragments (pieces of cut elements, outer parts split off at a broken
   // seam) smaller than a tenth of the swatch's smallest element are no
-  // elements: they are left out (counted).
-  std::size_t min_faces = std::numeric_limits<std::size_t>::max();
-  for (const SwatchElement& e : swatch_.elements) min_faces = std::min(min_faces, e.faces);
-  min_faces = std::max<std::size_t>(4, min_faces / 10);
+  // elements: they are left out (counted). At least 4 faces, never more
+  // than the smallest element has (a one-triangle swatch's elements stay).
+  std::size_t smallest = std::numeric_limits<std::size_t>::max();
+  for (const SwatchElement& e : swatch_.elements) smallest = std::min(smallest, e.faces);
+  const std::size_t min_faces = std::min(smallest, std::max<std::size_t>(4, smallest / 10));
   for (Element& el : elements_) {
     if (!el.alive || el.mesh.tris.empty()) continue;
     if (el.mesh.tris.size() < min_faces) {
