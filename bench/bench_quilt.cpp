@@ -276,12 +276,14 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.max_edge_stretch = 12;
   }
   // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS,
-  // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1).
+  // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
+  // BENCH_CLEARANCE (swatch units; negative = automatic).
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
   SurfaceQuilt q;
   Timer tq;
   const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
