@@ -21,6 +21,7 @@
 #include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
@@ -43,15 +44,21 @@ std::string render_path_for(const std::string& out) {
 }
 
 struct QuiltArgs {
-  std::string base, swatch, output, plane, render, field = "up";
+  std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto";
   bool no_render = false, no_check = false, no_align = false, smooth_field = false;
   double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0;
-  std::vector<double> up{0, 0, 1};
+  std::vector<double> up{0, 1, 0};
   int subpatch = 0, stretch_iterations = 20;
   CommonOptions common;
 };
 
-bool is_generated_swatch(const std::string& s) { return s == "chainmail" || s == "weave" || s == "scatter"; }
+bool is_generated_swatch(const std::string& s) {
+  return s == "chainmail" || s == "weave" || s == "scatter" || s == "tori";
+}
+
+SwatchAxis swatch_axis(const std::string& s) {
+  return s == "x" ? SwatchAxis::kX : s == "y" ? SwatchAxis::kY : s == "z" ? SwatchAxis::kZ : SwatchAxis::kAuto;
+}
 
 // The swatch: a file, or one the project generates (seeded by --seed).
 Mesh load_or_generate_swatch(const std::string& name, std::uint64_t seed) {
@@ -68,6 +75,10 @@ Mesh load_or_generate_swatch(const std::string& name, std::uint64_t seed) {
     ScatterOptions o;
     o.seed = seed;
     make_scatter_swatch(sm, o);
+  } else if (name == "tori") {
+    ToriOptions o;
+    o.seed = seed;
+    make_tori_swatch(sm, o);
   } else {
     read_mesh(name, sm);
   }
@@ -107,6 +118,10 @@ void write_stitch_stats(nlohmann::json& rep, const QuiltStepStats& st) {
   rep["inputs_added"] = st.in_added;
   rep["inputs_dropped"] = st.in_dropped;
   rep["inputs_kept_cut"] = st.in_cut_added;
+  rep["crossing_hits"] = st.crossing_hits;  // new elements that would have passed through placed ones
+  rep["crossing_dropped"] = st.crossing_dropped;
+  rep["crossing_trimmed"] = st.crossing_trimmed;
+  rep["crossing_pushed"] = st.crossing_pushed;
 }
 
 // Mean and largest element length of a planar quilt: each element's larger
@@ -158,7 +173,7 @@ int run_quilt(QuiltArgs& a) {
   if (!a.plane.empty() && !a.base.empty())
     throw InvalidInputError("quilt: give either a base MESH or --plane WxH, not both");
   if (a.plane.empty() && a.base.empty()) throw InvalidInputError("quilt: missing MESH (or --plane WxH)");
-  if (a.swatch.empty()) throw InvalidInputError("quilt: missing SWATCH (a mesh file or chainmail|weave|scatter)");
+  if (a.swatch.empty()) throw InvalidInputError("quilt: missing SWATCH (a mesh file or chainmail|weave|scatter|tori)");
   if (!is_generated_swatch(a.swatch)) require_input_file(a.swatch, "swatch");
   std::vector<std::string> inputs;
   if (!is_generated_swatch(a.swatch)) inputs.push_back(a.swatch);
@@ -209,7 +224,7 @@ int run_quilt(QuiltArgs& a) {
       const Point3 p = sm.point(v);
       sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
     }
-    const Swatch s = make_swatch(sm);
+    const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
     check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
     check_budget(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())), a.common);
     PlanarQuiltOptions o;
@@ -242,7 +257,7 @@ int run_quilt(QuiltArgs& a) {
     rep["input_mesh"] = to_json(load_method_mesh(a.base, base, a.common));
     base.collect_garbage();
     const double read_seconds = t.seconds();
-    const Swatch s = make_swatch(sm);
+    const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
     SurfaceQuiltOptions o;
     o.relative_size = a.scale > 0 ? a.scale : 0.25;
     if (!(o.relative_size <= 10)) throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
@@ -289,6 +304,8 @@ int run_quilt(QuiltArgs& a) {
     rep["base_faces"] = base.number_of_faces();
     rep["swatch_faces"] = s.mesh.tris.size();
     rep["swatch_elements"] = s.elements.size();
+    rep["swatch_up"] = axis_name(s.up_axis);
+    rep["up"] = a.up;
     rep["scale"] = o.relative_size;
     rep["field"] = a.field;
     rep["elements"] = r.elements;
@@ -303,6 +320,12 @@ int run_quilt(QuiltArgs& a) {
     rep["patches_turned"] = r.patches_turned;
     rep["elements_past_border"] = r.elements_past_border;
     rep["elements_stretched"] = r.elements_stretched;
+    rep["edge_stretch_max"] = r.edge_stretch_max;
+    rep["crossings_resolved"] = r.crossings_resolved;
+    rep["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
+    rep["fragments_removed"] = r.fragments_removed;
+    rep["faces_refilled"] = r.faces_refilled;
+    rep["bare_fraction"] = r.bare_fraction;
     write_stitch_stats(rep, r.stats);
     rep["charts"] = er.atlas.num_charts;
     rep["tets"] = er.tets;
@@ -312,6 +335,7 @@ int run_quilt(QuiltArgs& a) {
     rep["stretch_after"] = er.stretch.stretch_after;
     rep["outside_vertices"] = er.embed.outside;
     rep["elements_not_expressible"] = r.elements_not_expressible;
+    rep["elements_not_expressed"] = r.elements_not_expressed;
     rep["elements_partial"] = r.elements_partial;
     rep["seams_broken"] = r.seams_broken;
     rep["z_fitted_elements"] = r.z_fitted_elements;
@@ -342,6 +366,8 @@ int run_quilt(QuiltArgs& a) {
                       {"correspond", r.stats.seconds_correspond},
                       {"deform", r.stats.seconds_deform},
                       {"merge", r.stats.seconds_merge},
+                      {"resolve", r.stats.seconds_resolve},
+                      {"finish", r.seconds_finish},
                       {"atlas", er.seconds_atlas},
                       {"shell", er.seconds_shell},
                       {"stretch", er.seconds_stretch},
@@ -359,7 +385,14 @@ int run_quilt(QuiltArgs& a) {
   if (!a.render.empty()) {
     WriteImageOptions io;
     io.overwrite = a.common.force;
-    write_image(a.render, render_preview(scene), io);
+    // The render stands the mesh on the axis nearest --up (+Y by default, as
+    // glTF viewers do); a plane lies in xy and is seen from above (+Z).
+    ViewOptions vo;
+    vo.size = 800;
+    vo.elevation_deg = 35.f;
+    const bool y_up = a.plane.empty() && std::abs(a.up[1]) >= std::abs(a.up[2]);
+    vo.up = y_up ? ViewOptions::Up::Y : ViewOptions::Up::Z;
+    write_image(a.render, render_view(scene, vo), io);
     rep["render"] = a.render;
   }
   rep["seconds"]["write"] = t.seconds();
@@ -388,8 +421,13 @@ SubcommandRegistrar reg_quilt{
        auto a = std::make_shared<QuiltArgs>();
        app.add_option("mesh", a->base, "Base mesh (OFF/OBJ/PLY/STL) or, with --plane, the swatch");
        app.add_option("swatch", a->swatch,
-                      "Swatch: a mesh file (elements = connected components, z = thin axis) or chainmail, "
-                      "weave or scatter to generate one (seeded by --seed)");
+                      "Swatch: a mesh file (elements = connected components; its thin axis, see --swatch-up, "
+                      "becomes the height over the surface) or chainmail, weave, scatter or tori to generate one "
+                      "(seeded by --seed)");
+       app.add_option("--swatch-up", a->swatch_up,
+                      "The swatch's thin axis, which stands on the surface normal: auto (the axis of the smallest "
+                      "bounding-box extent, z on ties), x, y or z (default auto)")
+           ->check(CLI::IsMember({"auto", "x", "y", "z"}));
        app.add_option("--plane", a->plane, "Quilt over a plane of W x H swatch sizes, e.g. 4x4, instead of a mesh (runs that would build more than 5e7 faces, here or on a mesh, are refused)");
        app.add_option("-o,--output", a->output,
                       "Output mesh; format by extension: .obj, .ply (binary), .off, .glb; element colours as vertex "
@@ -406,7 +444,10 @@ SubcommandRegistrar reg_quilt{
                       "Guidance field aligning the swatch's +y on a mesh: up (the projected --up vector) or none "
                       "(each patch's own flattening) (default up)")
            ->check(CLI::IsMember({"up", "none"}));
-       app.add_option("--up", a->up, "The up vector of --field up, three numbers (default 0 0 1)")->expected(3);
+       app.add_option("--up", a->up,
+                      "The up vector of --field up in the mesh's own coordinates, three numbers; the swatch's +y "
+                      "follows its projection on the surface (default 0 1 0: the mesh's +Y, glTF's up axis)")
+           ->expected(3);
        app.add_option("--shell-height", a->shell_height,
                       "Shell thickness in scaled swatch heights, > 0 (default 1); clamped locally where the "
                       "shell would fold")

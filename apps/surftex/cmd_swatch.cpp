@@ -33,6 +33,11 @@ int run_swatch(const SwatchArgs& a) {
     if (a.size) o.threads_x = o.threads_y = a.size;
     o.seed = a.common.seed;
     make_weave_swatch(m, o);
+  } else if (a.kind == "tori") {
+    ToriOptions o;
+    if (a.size) o.tori_x = o.tori_y = a.size;
+    o.seed = a.common.seed;
+    make_tori_swatch(m, o);
   } else {
     ScatterOptions o;
     if (a.size) o.size = a.size;
@@ -59,16 +64,16 @@ int run_swatch(const SwatchArgs& a) {
 }
 
 SubcommandRegistrar reg{
-    {"swatch", "Generate a mesh swatch for quilting: chain mail, weave or scattered blobs",
+    {"swatch", "Generate a mesh swatch for quilting: chain mail, weave, scattered blobs or tilted tori",
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<SwatchArgs>();
-       app.add_option("kind", a->kind, "chainmail | weave | scatter")
+       app.add_option("kind", a->kind, "chainmail | weave | scatter | tori")
            ->required()
-           ->check(CLI::IsMember({"chainmail", "weave", "scatter"}));
+           ->check(CLI::IsMember({"chainmail", "weave", "scatter", "tori"}));
        app.add_option("-o,--output", a->output, "Output mesh (.obj, .ply, .off, .glb)")->required();
        app.add_option("--size", a->size,
                       "chainmail: rings per side (1..64, default 4); weave: threads per direction "
-                      "(1..64, default 6); scatter: side of the square (5..64, default 10); 0 = default")
+                      "(1..64, default 6); scatter: side of the square (5..64, default 10); tori: rings per side (1..64, default 4); 0 = default")
            ->check(CLI::Range(0, 64));
        add_common_options(app, a->common);
        return [a] { return run_swatch(*a); };

@@ -1,15 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/base_mesh_atlas.h"
 
-#ifndef CGAL_EIGEN3_ENABLED
-#define CGAL_EIGEN3_ENABLED  // LSCM's default solver is the Eigen one
-#endif
-
-#include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/compute_normal.h>
-#include <CGAL/Surface_mesh_parameterization/Error_code.h>
-#include <CGAL/Surface_mesh_parameterization/LSCM_parameterizer_3.h>
-#include <CGAL/Surface_mesh_parameterization/parameterize.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +10,7 @@
 #include <numeric>
 #include <string>
 
+#include "geometry/disc_chart.h"
 #include "geometry/errors.h"
 #include "geometry/properties.h"
 
@@ -25,7 +18,6 @@ namespace surftex {
 
 namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
-namespace SMP = CGAL::Surface_mesh_parameterization;
 constexpr double kPi = 3.14159265358979323846;
 
 struct Chart {
@@ -36,51 +28,22 @@ struct Chart {
   double area3d = 0;
 };
 
-// Greedy region growing into disc charts (see header, step 1).
+// Greedy region growing into disc charts (see header, step 1; the growth is
+// geometry/disc_chart.h's, shared with mesh quilting's surface patches).
 std::vector<int> grow_charts(const Mesh& mesh, const BaseMeshAtlasOptions& opt, int& num_charts) {
   const double cos_max = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
   std::vector<Vector3> normal(mesh.num_faces());
-  for (FaceIndex f : mesh.faces()) {
-    Vector3 n = PMP::compute_face_normal(f, mesh);
-    normal[f.idx()] = n;
-  }
+  for (FaceIndex f : mesh.faces()) normal[f.idx()] = PMP::compute_face_normal(f, mesh);
   std::vector<int> chart_of(mesh.num_faces(), -1);
-  std::vector<int> vertex_stamp(mesh.num_vertices(), -1);  // last chart touching the vertex
+  DiscGrowthState state(mesh);
   num_charts = 0;
   for (FaceIndex seed : mesh.faces()) {
     if (chart_of[seed.idx()] != -1) continue;
     const int c = num_charts++;
     const Vector3 n0 = normal[seed.idx()];
-    std::size_t size = 0;
-    auto add = [&](FaceIndex f, std::deque<FaceIndex>& q) {
-      chart_of[f.idx()] = c;
-      ++size;
-      for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
-        vertex_stamp[mesh.target(h).idx()] = c;
-        FaceIndex g = mesh.face(mesh.opposite(h));
-        if (g != Mesh::null_face() && chart_of[g.idx()] == -1) q.push_back(g);
-      }
-    };
-    std::deque<FaceIndex> queue;
-    add(seed, queue);
-    while (!queue.empty() && size < opt.max_chart_faces) {
-      FaceIndex f = queue.front();
-      queue.pop_front();
-      if (chart_of[f.idx()] != -1) continue;
-      if (normal[f.idx()] * n0 < cos_max) continue;
-      int shared = 0;
-      VertexIndex opposite_vertex;
-      for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
-        FaceIndex g = mesh.face(mesh.opposite(h));
-        if (g != Mesh::null_face() && chart_of[g.idx()] == c) {
-          ++shared;
-          opposite_vertex = mesh.target(mesh.next(h));
-        }
-      }
-      // Disc invariant: one shared edge with a new apex, or two shared edges.
-      bool ok = (shared == 2) || (shared == 1 && vertex_stamp[opposite_vertex.idx()] != c);
-      if (ok) add(f, queue);
-    }
+    auto accept = [&](int f) { return chart_of[static_cast<std::size_t>(f)] == -1 && normal[static_cast<std::size_t>(f)] * n0 >= cos_max; };
+    for (int f : grow_disc_chart(mesh, static_cast<int>(seed.idx()), accept, opt.max_chart_faces, state))
+      chart_of[static_cast<std::size_t>(f)] = c;
   }
   return chart_of;
 }
@@ -113,66 +76,20 @@ double signed_area(const std::array<double, 2>& a, const std::array<double, 2>& 
   return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
 }
 
-// Copies the chart into its own mesh, checks it is a disc, flattens it with LSCM.
-void flatten_chart(const Mesh& mesh, Chart& ch, int chart_id, std::vector<int>& local) {
-  Mesh sub;
-  for (FaceIndex f : ch.faces) {
-    for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) {
-      if (local[v.idx()] < 0) {
-        local[v.idx()] = static_cast<int>(ch.vertices.size());
-        ch.vertices.push_back(v);
-        sub.add_vertex(mesh.point(v));
-      }
-    }
-  }
-  for (FaceIndex f : ch.faces) {
-    std::vector<VertexIndex> vs;
-    for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f)))
-      vs.push_back(VertexIndex(static_cast<Mesh::size_type>(local[v.idx()])));
-    if (sub.add_face(vs) == Mesh::null_face())
-      throw TopologyError("base mesh atlas: chart " + std::to_string(chart_id) +
-                          " is not a manifold surface (non-manifold base mesh?)");
-    ch.area3d += std::sqrt(CGAL::squared_area(mesh.point(mesh.target(mesh.halfedge(f))),
-                                              mesh.point(mesh.target(mesh.next(mesh.halfedge(f)))),
-                                              mesh.point(mesh.source(mesh.halfedge(f)))));
-  }
-  // Disc check: Euler characteristic 1 and one border loop.
-  std::vector<HalfedgeIndex> borders;
-  PMP::extract_boundary_cycles(sub, std::back_inserter(borders));
-  const long chi = static_cast<long>(sub.number_of_vertices()) - static_cast<long>(sub.number_of_edges()) +
-                   static_cast<long>(sub.number_of_faces());
-  if (chi != 1 || borders.size() != 1)
-    throw TopologyError("base mesh atlas: chart " + std::to_string(chart_id) + " is not a disc (Euler " +
-                        std::to_string(chi) + ", " + std::to_string(borders.size()) + " border loops)");
-
-  auto uvmap = sub.add_property_map<VertexIndex, Point2>("v:lscm_uv", Point2(0, 0)).first;
-  using Parameterizer = SMP::LSCM_parameterizer_3<Mesh>;
-  SMP::Error_code err = SMP::parameterize(sub, Parameterizer(), borders.front(), uvmap);
-  if (err != SMP::OK)
-    throw SolverError("base mesh atlas: LSCM failed on chart " + std::to_string(chart_id) + " (" +
-                      std::to_string(sub.number_of_faces()) + " faces): " + SMP::get_error_message(err));
-  ch.uv.resize(ch.vertices.size());
-  for (VertexIndex v : sub.vertices()) {
-    const Point2& p = uvmap[v];
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
-      throw SolverError("base mesh atlas: LSCM gave non-finite uv on chart " + std::to_string(chart_id));
-    ch.uv[v.idx()] = {p.x(), p.y()};
-  }
-  // Orientation and scale: total signed uv area positive and equal to the 3D area.
-  double auv = 0;
-  for (FaceIndex f : sub.faces()) {
-    HalfedgeIndex h = sub.halfedge(f);
-    auv += signed_area(ch.uv[sub.source(h).idx()], ch.uv[sub.target(h).idx()],
-                       ch.uv[sub.target(sub.next(h)).idx()]);
-  }
-  if (auv < 0)
-    for (auto& p : ch.uv) p[0] = -p[0];
-  if (!(std::abs(auv) > 0))
-    throw SolverError("base mesh atlas: LSCM gave a degenerate (zero-area) chart " + std::to_string(chart_id));
-  const double s = std::sqrt(ch.area3d / std::abs(auv));
-  for (auto& p : ch.uv) p = {p[0] * s, p[1] * s};
+// Flattens the chart (geometry/disc_chart.h: disc check, LSCM, oriented and
+// scaled to its 3D area) and turns it to its smallest bounding box.
+void flatten_chart(const Mesh& mesh, Chart& ch, int chart_id) {
+  std::vector<int> faces;
+  for (FaceIndex f : ch.faces) faces.push_back(static_cast<int>(f.idx()));
+  DiscChartFlattening fl = flatten_disc_chart(mesh, faces);
+  const std::string what = "base mesh atlas: chart " + std::to_string(chart_id) + " (" + std::to_string(ch.faces.size()) + " faces): ";
+  if (fl.status == DiscChartFlattening::Status::kTopology) throw TopologyError(what + fl.error + " (non-manifold base mesh?)");
+  if (fl.status != DiscChartFlattening::Status::kOk) throw SolverError(what + fl.error);
+  ch.vertices.clear();
+  for (int v : fl.vertices) ch.vertices.push_back(VertexIndex(static_cast<Mesh::size_type>(v)));
+  ch.uv = std::move(fl.uv);
+  ch.area3d = fl.area3d;
   rotate_to_small_box(ch);
-  for (VertexIndex v : ch.vertices) local[v.idx()] = -1;
 }
 }  // namespace
 
@@ -196,7 +113,7 @@ BaseMeshAtlasResult compute_base_mesh_atlas(Mesh& mesh, const BaseMeshAtlasOptio
   for (FaceIndex f : mesh.faces()) charts[chart_of[f.idx()]].faces.push_back(f);
 
   std::vector<int> local(mesh.num_vertices(), -1);
-  for (int c = 0; c < res.num_charts; ++c) flatten_chart(mesh, charts[c], c, local);
+  for (int c = 0; c < res.num_charts; ++c) flatten_chart(mesh, charts[c], c);
 
   // Shelf packing (see header, step 3), in 3D length units.
   double box_area = 0, max_w = 0;

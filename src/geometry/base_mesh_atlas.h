@@ -5,7 +5,7 @@
 // low-distortion multi-chart atlas of the bunny). The paper does not say how
 // the atlas is made; this is a careful, simple choice:
 //
-// 1. Segmentation: greedy region growing. Seeds are taken in face-index order
+// 1. Segmentation (geometry/disc_chart.h): greedy region growing. Seeds are taken in face-index order
 //    (the first face not yet in a chart); a chart grows breadth-first over
 //    edges and accepts a face when (a) its normal is within
 //    `max_normal_angle_deg` of the seed face's normal, (b) the chart has fewer
@@ -16,7 +16,7 @@
 //    every chart is verified to be a disc (Euler characteristic V-E+F = 1 and
 //    exactly one border loop); a chart that fails throws TopologyError (this
 //    is an internal invariant and does not happen on manifold input).
-// 2. Flattening: each chart is copied into its own Surface_mesh and flattened
+// 2. Flattening (geometry/disc_chart.h): each chart is copied into its own Surface_mesh and flattened
 //    with CGAL's LSCM (Surface_mesh_parameterization::LSCM_parameterizer_3,
 //    two pinned vertices chosen by CGAL). A chart whose flattening comes out
 //    with negative total signed area is mirrored. The chart is then scaled so

@@ -13,12 +13,62 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/self_intersections.h"
+#include "shell/element_clearance.h"
 #include "geometry/timer.h"
 #include "shell/element_mesh.h"
 #include "shell/shell_map.h"
 #include "shell/shell_space.h"
 
 namespace surftex {
+
+namespace {
+// EmbedSurfaceQuiltOptions::resolve_crossings: the face pairs of the embedded
+// mesh that intersect (exact); of two elements the later yields its faces,
+// an element crossing itself both; a compact element with such faces is
+// removed, another has them (and one ring) cut out and its pieces capped
+// (trim_and_cap). `out` is rebuilt.
+void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact,
+                                std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+  std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
+  for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
+  auto element_of = [&](std::uint32_t f) {
+    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
+  };
+  std::vector<std::vector<char>> bad(els.size());
+  auto mark = [&](std::size_t e, std::uint32_t f) {
+    if (bad[e].empty()) bad[e].assign(els[e].tris.size(), 0);
+    bad[e][f - first[e]] = 1;
+  };
+  for (const FacePair& p : pairs) {
+    const std::size_t a = element_of(p[0]), b = element_of(p[1]);
+    if (a == b) {
+      mark(a, p[0]);
+      mark(a, p[1]);
+    } else {
+      mark(std::max(a, b), a > b ? p[0] : p[1]);
+    }
+  }
+  std::vector<ElementMesh> kept;
+  std::vector<char> kept_compact;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const bool c = e < compact.size() && compact[e];
+    if (bad[e].empty()) {
+      kept.push_back(std::move(els[e]));
+      kept_compact.push_back(c);
+      continue;
+    }
+    ++res.crossing_elements;
+    if (c) continue;
+    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
+      kept.push_back(std::move(piece));
+      kept_compact.push_back(0);
+    }
+  }
+  els.swap(kept);
+  compact.swap(kept_compact);
+  mesh_from_elements(els, out);
+}
+}  // namespace
 
 EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt& quilt, Mesh& out,
                                             const EmbedSurfaceQuiltOptions& opt) {
@@ -162,8 +212,22 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     else
       ++res.outside_uv;
   }
+  // Resolution rounds (a cut piece's cap may meet another element), each
+  // reusing the exact check that the count below reports.
+  std::vector<FacePair> pairs;
+  bool checked = false;
+  if (opt.resolve_crossings) {
+    std::vector<char> compact = quilt.element_compact;
+    for (int round = 0; round < 3; ++round) {
+      pairs = self_intersecting_faces(out);
+      checked = true;
+      if (pairs.empty()) break;
+      resolve_embedded_crossings(pairs, compact, els, out, res);
+      checked = false;
+    }
+  }
   if (opt.check_self_intersections) {
-    const std::vector<FacePair> pairs = self_intersecting_faces(out);
+    if (!checked) pairs = self_intersecting_faces(out);
     auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
     for (const FacePair& fp : pairs) {
       if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])

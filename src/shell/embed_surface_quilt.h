@@ -62,6 +62,14 @@ struct EmbedSurfaceQuiltOptions {
   MinimizeStretchOptions stretch;
   /// Run the exact self-intersection count on the embedded mesh.
   bool check_self_intersections = true;
+  /// Issue 17 item 1, the last stage: the faces of the embedded mesh that
+  /// still intersect (exact; the shell map bends elements a little otherwise
+  /// than quilt_surface's lifted check assumed) are resolved before the
+  /// count: of two elements the later yields; a compact element
+  /// (SurfaceQuilt::element_compact) with such faces is removed, another has
+  /// them and one ring cut out and its pieces capped. The count then reports
+  /// what is left. Default true.
+  bool resolve_crossings = true;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
   OutsideShellOptions outside_shell;
@@ -89,6 +97,8 @@ struct EmbedSurfaceQuiltResult {
   /// (what the swatch's elements may already have, and deformation adds) and
   /// faces of two different elements (overlapping elements: a quilting defect).
   std::size_t self_intersections_within = 0, self_intersections_between = 0;
+  /// Elements cut or removed by EmbedSurfaceQuiltOptions::resolve_crossings.
+  std::size_t crossing_elements = 0;
   /// Embedded vertices outside the geometric shell (the union of the shell's
   /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;

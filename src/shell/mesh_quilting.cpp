@@ -20,11 +20,8 @@ QuiltResult quilt_plane(const Swatch& swatch, double width, double height, Mesh&
   Timer timer;
   QuiltResult res;
   const double c = opt.cell_size > 0 ? opt.cell_size : std::max(swatch.length(), swatch.width()) / 10.0;
-  const int sx = static_cast<int>(std::ceil(swatch.length() / c - 1e-9));
-  const int sy = static_cast<int>(std::ceil(swatch.width() / c - 1e-9));
-  if (std::min(sx, sy) < 3)
-    throw InvalidInputError("quilt_plane: the swatch covers only " + std::to_string(sx) + "x" + std::to_string(sy) +
-                            " cells of size " + std::to_string(c) + " (need >= 3)");
+  int sx = 0, sy = 0;
+  swatch_cells(swatch, c, "quilt_plane", sx, sy);
   const int r = opt.subpatch_radius > 0 ? opt.subpatch_radius : std::max(1, std::min(sx, sy) / 4);
   if (2 * r + 1 > std::min(sx, sy))
     throw InvalidInputError("quilt_plane: subpatch_radius " + std::to_string(r) + " too large for a swatch of " +

@@ -14,6 +14,7 @@
 #include "geometry/errors.h"
 #include "geometry/timer.h"
 #include "shell/element_correspondence.h"
+#include "shell/element_clearance.h"
 #include "shell/element_deformation.h"
 #include "shell/element_merging.h"
 
@@ -48,6 +49,12 @@ void QuiltStepStats::add(const QuiltStepStats& o) {
   in_added += o.in_added;
   in_cut_added += o.in_cut_added;
   in_cut_components += o.in_cut_components;
+  crossing_hits += o.crossing_hits;
+  crossing_dropped += o.crossing_dropped;
+  crossing_trimmed += o.crossing_trimmed;
+  crossing_pieces += o.crossing_pieces;
+  crossing_pushed += o.crossing_pushed;
+  seconds_resolve += o.seconds_resolve;
   seconds_match += o.seconds_match;
   seconds_correspond += o.seconds_correspond;
   seconds_deform += o.seconds_deform;
@@ -114,11 +121,123 @@ std::vector<std::pair<int, int>> strongest_relations(ElementCorrespondences& cor
   corr.pairs.swap(pairs);
   return keep;
 }
+// A thread that crosses old elements at about the same height is pushed over
+// or under each crossing (issue 17: a weave's threads from two placements
+// passing through each other; the paper's elements do not, and a woven thread
+// goes over or under the one it crosses). Per connected cluster of hit
+// triangles: its centre c (xy mean of their corners) and xy radius rc; the new
+// thread's height z_n and half-thickness r_n there (mean and half the z
+// extent of its vertices within rc of c), the old ones' z_o and r_o likewise;
+// the thread's vertices within `reach` = rc + 3 (r_n + r_o) of c move in z by
+// dz (1 - (d / reach)^2)^2, dz taking z_n to z_o +- (r_n + r_o + clearance) on
+// the side it already lies on (our simplification of a Laplacian deformation
+// with those heights as constraints, section 2.6). Returns false if a
+// cluster has no old vertex near it.
+bool push_over_under(ElementMesh& m, const std::vector<char>& hit, const std::vector<ElementMesh>& elements,
+                     const std::vector<char>& alive, double clearance) {
+  std::vector<int> ht;
+  for (std::size_t t = 0; t < hit.size(); ++t)
+    if (hit[t]) ht.push_back(static_cast<int>(t));
+  const ElementMesh hm = extract_triangles(m, ht);
+  std::vector<int> comp;
+  const int nc = triangle_components(hm, comp);
+  std::vector<std::vector<int>> verts(static_cast<std::size_t>(nc));
+  for (std::size_t t = 0; t < hm.tris.size(); ++t)
+    for (int v : hm.tris[t]) verts[static_cast<std::size_t>(comp[t])].push_back(v);
+  std::vector<double> dz(m.points.size(), 0.0);
+  for (const std::vector<int>& vs : verts) {
+    double cx = 0, cy = 0;
+    for (int v : vs) cx += hm.points[static_cast<std::size_t>(v)][0] / static_cast<double>(vs.size()), cy += hm.points[static_cast<std::size_t>(v)][1] / static_cast<double>(vs.size());
+    double rc = 0;
+    for (int v : vs) rc = std::max(rc, std::hypot(hm.points[static_cast<std::size_t>(v)][0] - cx, hm.points[static_cast<std::size_t>(v)][1] - cy));
+    // Mean and half extent in z of points within rc of c.
+    auto near_z = [&](const std::vector<P3>& pts, double& sum, double& lo, double& hi, std::size_t& n) {
+      for (const P3& q : pts)
+        if (std::hypot(q[0] - cx, q[1] - cy) <= rc) sum += q[2], lo = std::min(lo, q[2]), hi = std::max(hi, q[2]), ++n;
+    };
+    double so = 0, lo_o = 1e300, hi_o = -1e300, sn = 0, lo_n = 1e300, hi_n = -1e300;
+    std::size_t no = 0, nn = 0;
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      if (alive[e]) near_z(elements[e].points, so, lo_o, hi_o, no);
+    near_z(m.points, sn, lo_n, hi_n, nn);
+    if (no == 0 || nn == 0) return false;
+    const double zo = so / static_cast<double>(no), zn = sn / static_cast<double>(nn);
+    const double ro = 0.5 * (hi_o - lo_o), rn = 0.5 * (hi_n - lo_n), need = ro + rn + clearance;
+    const double side = zn >= zo ? 1.0 : -1.0;
+    const double shift = zo + side * need - zn;
+    if (side * shift <= 0) continue;  // already clear in height
+    const double reach = rc + 3 * (rn + ro);
+    for (std::size_t v = 0; v < m.points.size(); ++v) {
+      const double d = std::hypot(m.points[v][0] - cx, m.points[v][1] - cy);
+      if (d >= reach) continue;
+      const double w = 1 - (d / reach) * (d / reach);
+      const double add = shift * w * w;
+      if (std::abs(add) > std::abs(dz[v])) dz[v] = add;  // the larger push where two bumps meet
+    }
+  }
+  for (std::size_t v = 0; v < m.points.size(); ++v) m.points[v][2] += dz[v];
+  return true;
+}
+
+// QuiltStepOptions::resolve_crossings: of the elements about to be added,
+// those that hit an element already there (or one added before them) are
+// dropped or trimmed; returns what is to be added.
+std::vector<ElementMesh> resolve_crossings(const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
+                                           std::vector<ElementMesh> adds, const QuiltStepOptions& opt,
+                                           QuiltStepStats& stats) {
+  ElementCollider old(elements, alive);
+  std::vector<ElementMesh> keep;
+  for (ElementMesh& m : adds) {
+    const std::vector<char> hit = old.hits(m, -1, opt.clearance);
+    const std::size_t nhit = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), 1));
+    if (nhit == 0) {
+      old.add(m, -2);
+      keep.push_back(std::move(m));
+      continue;
+    }
+    ++stats.crossing_hits;
+    const bool compact = is_compact_element(m);
+    if (!compact && opt.push_over_under) {  // over or under the crossing threads, if that clears them
+      ElementMesh pushed = m;
+      if (push_over_under(pushed, hit, elements, alive, opt.clearance)) {
+        const std::vector<char> h2 = old.hits(pushed, -1, opt.clearance);
+        if (std::find(h2.begin(), h2.end(), 1) == h2.end()) {
+          ++stats.crossing_pushed;
+          old.add(pushed, -2);
+          keep.push_back(std::move(pushed));
+          continue;
+        }
+      }
+    }
+    std::vector<ElementMesh> pieces;
+    if (!compact) pieces = trim_and_cap(m, hit, opt.trim_rings, std::max<std::size_t>(24, m.tris.size() / 10));
+    // A piece is kept only if it is clear of the others itself (its cap may reach them).
+    std::size_t kept = 0;
+    for (ElementMesh& p : pieces) {
+      const std::vector<char> h2 = old.hits(p, -1, opt.clearance);
+      if (std::find(h2.begin(), h2.end(), 1) != h2.end()) continue;
+      old.add(p, -2);
+      keep.push_back(std::move(p));
+      ++kept;
+    }
+    if (kept == 0) {
+      ++stats.crossing_dropped;
+    } else {
+      ++stats.crossing_trimmed;
+      stats.crossing_pieces += kept;
+    }
+  }
+  return keep;
+}
 }  // namespace
 
 QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& swatch_tree, const QuiltGrid& grid,
                                   const std::vector<ElementMesh>& elements, const std::vector<char>& alive,
                                   std::mt19937_64& rng, const QuiltStepOptions& opt, const QuiltPlacement* near) {
+  if (!std::isfinite(opt.clearance))
+    throw InvalidInputError("quilt_step: clearance must be finite (" + std::to_string(opt.clearance) + ")");
+  if (opt.trim_rings < 0 || opt.trim_rings > 16)
+    throw InvalidInputError("quilt_step: trim_rings must be in [0, 16] (" + std::to_string(opt.trim_rings) + ")");
   if (opt.subcell_levels < 0 || opt.subcell_levels > 8)
     throw InvalidInputError("quilt_step: subcell_levels must be in [0, 8] (" + std::to_string(opt.subcell_levels) + ")");
   if (opt.max_match_vertices < 1)
@@ -438,13 +557,21 @@ QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_t
     t_merge += tm.seconds();
   }
   for (auto& [e, m] : replacements) elements[e] = std::move(m);
+  std::vector<ElementMesh> adds;
   for (int e = 0; e < ni; ++e)
     if (add_in[e]) {
-      elements.push_back(std::move(placed[e]));
-      alive.push_back(1);
+      adds.push_back(std::move(placed[e]));
       ++stats.in_added;
     }
-  for (ElementMesh& m : cut_inputs) {
+  for (ElementMesh& m : cut_inputs) adds.push_back(std::move(m));
+  if (opt.resolve_crossings) {
+    Timer tr;
+    QuiltStepOptions ro = opt;
+    if (ro.clearance < 0) ro.clearance = 0.5 * swatch.min_gap;
+    adds = resolve_crossings(elements, alive, std::move(adds), ro, stats);
+    stats.seconds_resolve += tr.seconds();
+  }
+  for (ElementMesh& m : adds) {
     elements.push_back(std::move(m));
     alive.push_back(1);
   }

@@ -79,6 +79,31 @@ struct QuiltStepOptions {
   /// (planar default weave 2x2: 28 merges stitched / 55 refused without, 101
   /// / 34 with). [0, 8].
   int subcell_levels = 3;
+  /// No interpenetration by construction (issue 17; the paper's elements do
+  /// not pass through each other, sections 2.5-2.7 merge those that
+  /// correspond): before an input element that was not merged (2.7's "added
+  /// directly", or a refused one's kept part) is added, its triangles are
+  /// tested against every element already there (exact triangle-triangle
+  /// intersection, element_clearance.h) and against a clearance of
+  /// `clearance` (vertex to triangle). One that hits is dropped if it is
+  /// compact (a ring, a pebble: is_compact_element) or too little of it
+  /// would be left, else trimmed at the hits (trim_rings rings more) and
+  /// its cuts capped (a thread crossing an old one at the same height
+  /// stops short of it on both sides; the hole is refilled by a later
+  /// patch where there is room). false = added as before.
+  bool resolve_crossings = true;
+  /// Swatch units; the distance under which a new element counts as
+  /// touching an old one. Negative = automatic (default): half the swatch's
+  /// smallest gap between elements (Swatch::min_gap), so that disjoint
+  /// elements keep about their spacing; 0 = intersections only.
+  double clearance = -1;
+  /// Rings of triangles removed around the hits of a trimmed element, >= 0. Default 2.
+  int trim_rings = 2;
+  /// With resolve_crossings: a thread (not compact) that hits is first pushed
+  /// over or under each crossing by a smooth bump in z (as a woven thread
+  /// passes the one it crosses); kept so if that clears it, else trimmed.
+  /// Default true.
+  bool push_over_under = true;
 };
 
 /// Where quilt_step put the swatch: its bbox min at the corner of cell
@@ -123,6 +148,12 @@ struct QuiltStepStats {
   /// (QuiltStepOptions::keep_cut_refused_inputs; not counted in in_dropped),
   /// and the elements (components) this added.
   std::size_t in_cut_added = 0, in_cut_components = 0;
+  /// QuiltStepOptions::resolve_crossings: elements that would have hit an
+  /// old one, and of them those dropped and those trimmed (into
+  /// crossing_pieces pieces).
+  std::size_t crossing_hits = 0, crossing_dropped = 0, crossing_trimmed = 0, crossing_pieces = 0;
+  std::size_t crossing_pushed = 0;  ///< of crossing_hits, threads pushed over or under instead (push_over_under)
+  double seconds_resolve = 0;
   double seconds_match = 0, seconds_correspond = 0, seconds_deform = 0, seconds_merge = 0;
   void add(const QuiltStepStats& o);
 };

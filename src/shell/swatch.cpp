@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
@@ -11,6 +12,7 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "shell/element_clearance.h"
 
 namespace surftex {
 
@@ -65,7 +67,80 @@ Swatch make_swatch(const Mesh& mesh) {
   if (!(s.length() > 0) || !(s.width() > 0))
     throw InvalidInputError("swatch: zero extent in x or y (" + std::to_string(s.length()) + " x " +
                             std::to_string(s.width()) + ")");
+  if (n > 1) {
+    std::vector<ElementMesh> els;
+    for (int e = 0; e < n; ++e) els.push_back(extract_triangles(s.mesh, tris[e]));
+    s.min_gap = smallest_element_gap(els, std::max(s.length(), s.width()));
+  }
   return s;
+}
+
+int swatch_thin_axis(const Mesh& mesh) {
+  if (mesh.number_of_vertices() == 0) throw InvalidInputError("swatch: the mesh has no vertices");
+  P3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    const P3 q{p.x(), p.y(), p.z()};
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+  }
+  const P3 ext{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  int axis = 2;
+  for (int d : {1, 0})
+    if (ext[d] < 0.99 * ext[axis]) axis = d;
+  return axis;
+}
+
+void orient_swatch_up(Mesh& mesh, int axis) {
+  if (axis == 2) return;
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3 p = mesh.point(v);
+    mesh.point(v) = axis == 0 ? Point3(p.y(), p.z(), p.x()) : Point3(p.z(), p.x(), p.y());
+  }
+}
+
+double swatch_element_spacing(const Swatch& s) {
+  if (s.elements.size() < 2) return std::max(s.length(), s.width());
+  std::vector<double> d;
+  for (const SwatchElement& a : s.elements) {
+    double best = 1e300;
+    for (const SwatchElement& b : s.elements)
+      if (&a != &b) best = std::min(best, std::hypot(a.centroid[0] - b.centroid[0], a.centroid[1] - b.centroid[1]));
+    d.push_back(best);
+  }
+  std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+const char* axis_name(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+
+Swatch make_swatch(const Mesh& mesh, SwatchAxis up) {
+  if (mesh.number_of_faces() == 0) throw InvalidInputError("swatch: the mesh has no faces");
+  const int axis = up == SwatchAxis::kAuto ? swatch_thin_axis(mesh) : up == SwatchAxis::kX ? 0 : up == SwatchAxis::kY ? 1 : 2;
+  if (axis == 2) return make_swatch(mesh);
+  Mesh turned = mesh;
+  orient_swatch_up(turned, axis);
+  Swatch s = make_swatch(turned);
+  s.up_axis = axis;
+  return s;
+}
+
+void swatch_cells(const Swatch& s, double c, const std::string& who, int& sx, int& sy) {
+  sx = static_cast<int>(std::ceil(s.length() / c - 1e-9));
+  sy = static_cast<int>(std::ceil(s.width() / c - 1e-9));
+  if (std::min(sx, sy) >= 3) return;
+  // The input's axes that became x and y (orient_swatch_up's cyclic turn).
+  const int ax = (s.up_axis + 1) % 3, ay = (s.up_axis + 2) % 3;
+  auto num = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return std::string(buf);
+  };
+  throw InvalidInputError(who + ": the swatch covers only " + std::to_string(sx) + "x" + std::to_string(sy) +
+                          " cells of size " + num(c) + " along its " + axis_name(ax) + " and " + axis_name(ay) +
+                          " axes (extent " + num(s.length()) + " x " + num(s.width()) + "; its thin axis " +
+                          axis_name(s.up_axis) + ", extent " + num(s.height()) +
+                          ", is the height); need >= 3 along each: give a smaller cell (--cell, at most " +
+                          num(std::min(s.length(), s.width()) / 3) + ") or the swatch's thin axis (--swatch-up x|y|z)");
 }
 
 Swatch load_swatch(const std::string& path) {

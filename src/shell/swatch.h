@@ -4,9 +4,9 @@
 // triangle mesh; its geometric elements are its connected components. The
 // swatch's 2D domain is its xy bounding rectangle (l_in x w_in) and its height
 // h_in the z extent. The paper defines h_in as the smallest bounding-box
-// dimension; we require the caller to give swatches with z as the thin axis
-// (the shipped generators do) and do not reorient: a swatch whose z extent is
-// not the smallest is accepted, it is simply quilted in xy.
+// dimension: make_swatch(mesh, SwatchAxis::kAuto) finds that thin axis and
+// turns the swatch so that it becomes z (swatch_thin_axis, orient_swatch_up);
+// make_swatch(mesh) takes z as given (the shipped generators make z thin).
 #include <string>
 #include <vector>
 
@@ -22,12 +22,22 @@ struct SwatchElement {
   std::size_t faces = 0;
 };
 
+/// The swatch axis that is its thickness (h_in) and becomes the height over
+/// the surface: detected (kAuto) or given (x, y, z).
+enum class SwatchAxis { kAuto, kX, kY, kZ };
+
 struct Swatch {
   ElementMesh mesh;                   ///< all triangles of the swatch
   std::vector<int> face_element;      ///< element id per triangle (kFaceElement), 0..elements-1
   std::vector<SwatchElement> elements;
   P3 bbox_min{0, 0, 0}, bbox_max{0, 0, 0};
   double mean_edge_length = 0;
+  /// The smallest distance between two elements (vertex to triangle; 0 for
+  /// a single element or elements that touch), at most max(l_in, w_in): the
+  /// clearance quilting keeps between elements (QuiltStepOptions::clearance).
+  double min_gap = 0;
+  /// The input's axis that became z (0 = x, 1 = y, 2 = z; see make_swatch).
+  int up_axis = 2;
   double length() const { return bbox_max[0] - bbox_min[0]; }  ///< l_in (x)
   double width() const { return bbox_max[1] - bbox_min[1]; }   ///< w_in (y)
   double height() const { return bbox_max[2] - bbox_min[2]; }  ///< h_in (z)
@@ -41,6 +51,30 @@ struct Swatch {
 /// needs a shell of positive thickness and refuses it there
 /// (embed_surface_quilt).
 Swatch make_swatch(const Mesh& mesh);
+/// As above, with the thin axis `up` turned onto z first (kAuto: the axis of
+/// the smallest bounding-box extent, swatch_thin_axis); Swatch::up_axis says
+/// which it was. The turn is a cyclic permutation of the axes (x up: (y, z,
+/// x); y up: (z, x, y)), so orientation and handedness are kept.
+Swatch make_swatch(const Mesh& mesh, SwatchAxis up);
+/// The axis (0, 1, 2) of the smallest bounding-box extent of `mesh` (the
+/// paper's h_in, section 2.1); z unless another extent is smaller by more than
+/// 1%, then y before x. Throws InvalidInputError for an empty mesh.
+int swatch_thin_axis(const Mesh& mesh);
+/// Permutes the coordinates of every vertex cyclically so that `axis` (0, 1,
+/// 2) becomes z; axis 2 leaves the mesh unchanged.
+void orient_swatch_up(Mesh& mesh, int axis);
+/// The grid of section 2.3 over the swatch's xy rectangle for cells of side
+/// `cell` (swatch units): sx x sy cells. Throws InvalidInputError, with `who`
+/// leading, if either is below 3, naming the swatch's axes as the input had
+/// them (its thin axis, Swatch::up_axis, is the height), the cell size and
+/// the CLI's --cell and --swatch-up.
+void swatch_cells(const Swatch& swatch, double cell, const std::string& who, int& sx, int& sy);
+/// The swatch's element spacing (swatch units): the median, over its
+/// elements, of the xy distance from an element's vertex centroid to the
+/// nearest other's; for a single element its larger xy side.
+double swatch_element_spacing(const Swatch& swatch);
+/// "x", "y" or "z".
+const char* axis_name(int axis);
 /// read_mesh + make_swatch (any format read_mesh reads). Throws as both.
 Swatch load_swatch(const std::string& path);
 /// The triangles of element `e` as their own ElementMesh.

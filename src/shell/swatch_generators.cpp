@@ -205,4 +205,27 @@ void make_scatter_swatch(Mesh& out, const ScatterOptions& o) {
   mesh_from_elements(blobs, out);
 }
 
+void make_tori_swatch(Mesh& out, const ToriOptions& o) {
+  check(o.tori_x >= 1 && o.tori_x <= 64, "tori_x", o.tori_x);
+  check(o.tori_y >= 1 && o.tori_y <= 64, "tori_y", o.tori_y);
+  check(o.major_radius > 0 && std::isfinite(o.major_radius), "major_radius", o.major_radius);
+  check(o.minor_radius > 0 && o.minor_radius <= 0.5 * o.major_radius, "minor_radius", o.minor_radius);
+  check(std::isfinite(o.spacing) && 0.94 * o.spacing > 2 * (o.major_radius + o.minor_radius), "spacing", o.spacing);
+  check(o.tilt_max_deg >= 0 && o.tilt_max_deg <= 80, "tilt_max_deg", o.tilt_max_deg);
+  check(o.segments >= 6 && o.segments <= 256, "segments", o.segments);
+  check(o.sides >= 3 && o.sides <= 64, "sides", o.sides);
+  std::mt19937_64 g(o.seed);
+  std::vector<ElementMesh> rings;
+  for (int j = 0; j < o.tori_y; ++j)
+    for (int i = 0; i < o.tori_x; ++i) {
+      const P3 c{(i + uniform(g, -0.03, 0.03)) * o.spacing, (j + uniform(g, -0.03, 0.03)) * o.spacing, 0};
+      // The ring's plane: xy turned by `tilt` about the horizontal axis at angle `az`.
+      const double az = uniform(g, 0, kPi), tilt = uniform(g, 0, o.tilt_max_deg) * kPi / 180.0;
+      const P3 a{std::cos(az), std::sin(az), 0}, b0{-std::sin(az), std::cos(az), 0};
+      const P3 b{b0[0] * std::cos(tilt), b0[1] * std::cos(tilt), std::sin(tilt)};
+      rings.push_back(torus(c, a, b, o.major_radius, o.minor_radius, o.segments, o.sides, uniform(g, 0, kPi)));
+    }
+  mesh_from_elements(rings, out);
+}
+
 }  // namespace surftex

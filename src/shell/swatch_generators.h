@@ -61,4 +61,23 @@ struct ScatterOptions {
 };
 void make_scatter_swatch(Mesh& out, const ScatterOptions& opt = {});
 
+/// Separate tilted rings: a tori_x x tori_y grid of tori (major radius R,
+/// minor radius r) at spacing `spacing`, each centre moved by up to 3% of the
+/// spacing and each ring's plane tilted away from xy by an angle in
+/// [0, tilt_max_deg] about a random horizontal axis (a layer of scattered
+/// rings or washers: a disjoint-element swatch for Zhou et al. 2006, whose
+/// elements must keep their spacing). The rings never touch: spacing must
+/// exceed 2 (R + r) + 0.06 spacing. Faces: 2 * segments * sides per torus.
+struct ToriOptions {
+  int tori_x = 4, tori_y = 4;   ///< rings per row / column, 1..64
+  double spacing = 3.0;         ///< centre spacing, > 2 (R + r) / 0.94
+  double major_radius = 1.0;    ///< R, > 0
+  double minor_radius = 0.25;   ///< r, in (0, 0.5 R]
+  double tilt_max_deg = 35.0;   ///< in [0, 80]
+  int segments = 24;            ///< around the ring, 6..256
+  int sides = 8;                ///< around the tube, 3..64
+  std::uint64_t seed = 1;
+};
+void make_tori_swatch(Mesh& out, const ToriOptions& opt = {});
+
 }  // namespace surftex

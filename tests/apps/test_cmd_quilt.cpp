@@ -112,3 +112,43 @@ TEST(CmdQuilt, BadInputExitsTwoAndWritesNothing) {
   EXPECT_NE(r.exit_code, 0);
   for (const char* f : {"/o.ply", "/o.glb", "/o_render.png"}) EXPECT_FALSE(fs::exists(dir + f)) << f;
 }
+
+// Issue 17 item 3 / issue 16 item 6: the swatch's thin axis is detected (a
+// ring modelled thin along y, like shared/data/swatches/torus_ring.obj) and
+// reported, up defaults to +Y, and a swatch too small for the grid is refused
+// naming its axes, --cell and --swatch-up.
+TEST(CmdQuilt, SwatchThinAxisIsDetectedUpIsYAndTheCellErrorNamesAxes) {
+  const std::string dir = test::temp_dir("quilt-axis");
+  Mesh ring;
+  make_torus(ring, 1.0, 0.25, 16, 6);  // in xy, thin along z
+  for (VertexIndex v : ring.vertices()) {
+    const Point3 p = ring.point(v);
+    ring.point(v) = Point3(p.y(), p.z(), p.x());  // thin along y
+  }
+  write_mesh(dir + "/ring_y.obj", ring);
+  Mesh base;
+  make_icosphere(base, 1);
+  write_mesh(dir + "/sphere.off", base);
+  test::RunResult r = test::run_surftex("quilt '" + dir + "/sphere.off' '" + dir + "/ring_y.obj' -o '" + dir +
+                                        "/q.ply' --scale 0.4 --stretch-iterations 2 --no-check --no-render --report '" + dir +
+                                        "/r.json' --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = read_json(dir + "/r.json");
+  EXPECT_EQ(j["swatch_up"].get<std::string>(), "y");
+  EXPECT_EQ(j["up"], nlohmann::json::parse("[0.0, 1.0, 0.0]"));
+  for (const char* k : {"edge_stretch_max", "crossings_resolved", "crossing_hits", "bare_fraction", "faces_refilled"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  // Taken as z-thin, the ring's xy extent is 2.5 x 0.5: 10 x 2 cells, refused with the axes named.
+  r = test::run_surftex("quilt '" + dir + "/sphere.off' '" + dir + "/ring_y.obj' -o '" + dir +
+                        "/z.ply' --swatch-up z --no-render --quiet");
+  EXPECT_EQ(r.exit_code, 2);
+  for (const char* w : {"along its x and y axes", "thin axis z", "--cell", "--swatch-up"})
+    EXPECT_NE(r.err.find(w), std::string::npos) << w << " in " << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/z.ply"));
+  // The generated tori swatch.
+  r = test::run_surftex("swatch tori -o '" + dir + "/t.obj' --size 2 --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Mesh t;
+  read_mesh(dir + "/t.obj", t);
+  EXPECT_GT(t.number_of_faces(), 4u * 100u);
+}

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Disc charts: a topological disc of faces grown breadth-first from a seed
+// face, and its LSCM flattening. One routine for the two places that need
+// it: the base mesh's texture atlas (base_mesh_atlas.h; Zhou et al. 2006,
+// section 3.2) and the surface patches of mesh quilting (shell/
+// surface_quilting.h, section 3.1: "growing the region using breadth-first
+// traversal", "flattened ... using LSCM").
+//
+// Growth: a queue of the faces across the edges of every accepted face (in
+// halfedges_around_face order); a face is accepted when accept(f) holds, the
+// chart has fewer than max_faces faces and the chart stays a disc: the face
+// shares exactly one edge with the chart and its opposite vertex is not yet
+// in the chart, or it shares two edges (fills a notch). Sharing three edges
+// (closing the chart into a sphere) is refused.
+// Flattening: the chart copied into its own Surface_mesh, checked to be a
+// disc (one border loop, Euler characteristic 1), flattened by CGAL's
+// LSCM_parameterizer_3 (two vertices pinned by CGAL), mirrored if its signed
+// uv area is negative and scaled so that its uv area equals its 3D area.
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+/// Stamps shared by successive growths (no clearing between charts).
+struct DiscGrowthState {
+  std::vector<int> face, vertex;  ///< last growth id that took the face / touched the vertex
+  int next_id = 0;
+  explicit DiscGrowthState(const Mesh& mesh);
+};
+
+/// Grows a disc chart from face index `seed` (always in it); see the header.
+/// Returns its face indices in the order they were accepted. max_faces >= 1.
+std::vector<int> grow_disc_chart(const Mesh& mesh, int seed, const std::function<bool(int)>& accept,
+                                 std::size_t max_faces, DiscGrowthState& state);
+
+struct DiscChartFlattening {
+  std::vector<int> vertices;                  ///< chart vertex -> mesh vertex index
+  std::vector<std::array<double, 2>> uv;      ///< per chart vertex (3D length units)
+  double area3d = 0;                          ///< the chart's 3D area
+  enum class Status { kOk, kTopology, kSolver } status = Status::kOk;
+  std::string error;                          ///< why not, when status != kOk
+};
+
+/// Flattens the disc chart `faces` (triangles); see the header. Never throws
+/// for a bad chart: the result's status and error say what went wrong (a
+/// non-manifold chart or not a disc: kTopology; LSCM failed, non-finite or
+/// zero-area uv: kSolver).
+DiscChartFlattening flatten_disc_chart(const Mesh& mesh, const std::vector<int>& faces);
+
+}  // namespace surftex

@@ -1,0 +1,237 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/element_clearance.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <vector>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+
+namespace surftex {
+namespace {
+using Triangle3 = Kernel::Triangle_3;
+using Iterator = std::vector<Triangle3>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+Point3 pt(const P3& p) { return Point3(p[0], p[1], p[2]); }
+
+// One batch of triangles (a tree is built once; later additions get their own).
+struct Batch {
+  std::vector<Triangle3> tris;
+  std::vector<int> element;
+  Tree tree;
+  void build() {
+    if (tris.empty()) return;
+    tree.insert(tris.cbegin(), tris.cend());
+    tree.build();
+  }
+  // Squared distance from p to the nearest triangle if it is below c2 (the
+  // box of half-side c around p meets some triangle's box first), else c2.
+  // (No kd-tree of distance hints: most points are far from every triangle,
+  // and the box test settles them; the hint is a corner of a triangle the box meets.)
+  double near2(const Point3& p, double c, double c2) const {
+    const CGAL::Bbox_3 box(p.x() - c, p.y() - c, p.z() - c, p.x() + c, p.y() + c, p.z() + c);
+    const auto hit = tree.any_intersected_primitive(box);
+    if (!hit) return c2;
+    return std::min(c2, CGAL::squared_distance(p, tree.closest_point(p, (*hit)->vertex(0))));
+  }
+  void push(const ElementMesh& m, int id) {
+    for (const Tri& t : m.tris) {
+      const Point3 a = pt(m.points[static_cast<std::size_t>(t[0])]), b = pt(m.points[static_cast<std::size_t>(t[1])]),
+                   c = pt(m.points[static_cast<std::size_t>(t[2])]);
+      if (CGAL::collinear(a, b, c)) continue;
+      tris.emplace_back(a, b, c);
+      element.push_back(id);
+    }
+  }
+};
+}  // namespace
+
+struct ElementCollider::Impl {
+  std::vector<std::unique_ptr<Batch>> batches;
+};
+
+ElementCollider::ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use)
+    : impl_(std::make_unique<Impl>()) {
+  if (!use.empty() && use.size() != elements.size())
+    throw InvalidInputError("ElementCollider: use has " + std::to_string(use.size()) + " entries for " +
+                            std::to_string(elements.size()) + " elements");
+  auto b = std::make_unique<Batch>();
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (use.empty() || use[e]) b->push(elements[e], static_cast<int>(e));
+  b->build();
+  impl_->batches.push_back(std::move(b));
+}
+ElementCollider::~ElementCollider() = default;
+ElementCollider::ElementCollider(ElementCollider&&) noexcept = default;
+ElementCollider& ElementCollider::operator=(ElementCollider&&) noexcept = default;
+
+void ElementCollider::add(const ElementMesh& m, int id) {
+  auto b = std::make_unique<Batch>();
+  b->push(m, id);
+  b->build();
+  if (!b->tris.empty()) impl_->batches.push_back(std::move(b));
+}
+
+double ElementCollider::nearest_distance(const std::vector<P3>& points, double limit) const {
+  double best = limit * limit;
+  for (const P3& p : points)
+    for (const auto& b : impl_->batches)
+      if (!b->tris.empty()) best = b->near2(pt(p), std::sqrt(best), best);
+  return std::sqrt(best);
+}
+
+bool ElementCollider::empty() const {
+  for (const auto& b : impl_->batches)
+    if (!b->tris.empty()) return false;
+  return true;
+}
+
+std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead) const {
+  auto counts = [&](int tag) {
+    if (tag == skip && skip >= 0) return false;
+    return !(dead && tag >= 0 && static_cast<std::size_t>(tag) < dead->size() && (*dead)[static_cast<std::size_t>(tag)]);
+  };
+  std::vector<char> hit(m.tris.size(), 0);
+  std::vector<char> near(m.points.size(), 0);
+  if (clearance > 0 && skip < 0 && !dead)
+    for (std::size_t v = 0; v < m.points.size(); ++v)
+      for (const auto& b : impl_->batches) {
+        if (b->tris.empty()) continue;
+        if (b->near2(pt(m.points[v]), clearance, clearance * clearance) < clearance * clearance) {
+          near[v] = 1;
+          break;
+        }
+      }
+  std::vector<Tree::Primitive_id> ids;
+  for (std::size_t t = 0; t < m.tris.size(); ++t) {
+    const Tri& tr = m.tris[t];
+    for (int v : tr)
+      if (v < 0 || static_cast<std::size_t>(v) >= m.points.size())
+        throw InvalidInputError("ElementCollider::hits: vertex index " + std::to_string(v) + " out of range");
+    if (near[static_cast<std::size_t>(tr[0])] || near[static_cast<std::size_t>(tr[1])] || near[static_cast<std::size_t>(tr[2])]) {
+      hit[t] = 1;
+      continue;
+    }
+    const Point3 a = pt(m.points[static_cast<std::size_t>(tr[0])]), b = pt(m.points[static_cast<std::size_t>(tr[1])]),
+                 c = pt(m.points[static_cast<std::size_t>(tr[2])]);
+    if (CGAL::collinear(a, b, c)) continue;
+    const Triangle3 q(a, b, c);
+    for (const auto& bt : impl_->batches) {
+      if (bt->tris.empty()) continue;
+      if (skip < 0 && !dead) {
+        if (bt->tree.do_intersect(q)) {
+          hit[t] = 1;
+          break;
+        }
+        continue;
+      }
+      ids.clear();
+      bt->tree.all_intersected_primitives(q, std::back_inserter(ids));
+      for (const auto& id : ids)
+        if (counts(bt->element[static_cast<std::size_t>(id - bt->tris.cbegin())])) {
+          hit[t] = 1;
+          break;
+        }
+      if (hit[t]) break;
+    }
+  }
+  return hit;
+}
+
+std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<char>& drop, int rings, std::size_t min_faces) {
+  std::vector<ElementMesh> out;
+  if (drop.size() != m.tris.size())
+    throw InvalidInputError("trim_and_cap: drop has " + std::to_string(drop.size()) + " entries for " +
+                            std::to_string(m.tris.size()) + " triangles");
+  if (count_border_edges(m) != 0) return out;
+  std::vector<char> gone = drop;
+  for (int r = 0; r < rings; ++r) {
+    std::vector<char> vgone(m.points.size(), 0);
+    for (std::size_t t = 0; t < m.tris.size(); ++t)
+      if (gone[t])
+        for (int v : m.tris[t]) vgone[static_cast<std::size_t>(v)] = 1;
+    for (std::size_t t = 0; t < m.tris.size(); ++t)
+      for (int v : m.tris[t]) gone[t] = gone[t] || vgone[static_cast<std::size_t>(v)];
+  }
+  std::vector<int> kept;
+  for (std::size_t t = 0; t < m.tris.size(); ++t)
+    if (!gone[t]) kept.push_back(static_cast<int>(t));
+  if (kept.empty()) return out;
+  const ElementMesh part = extract_triangles(m, kept);
+  std::vector<int> comp;
+  const int nc = triangle_components(part, comp);
+  std::vector<std::vector<int>> by(static_cast<std::size_t>(nc));
+  for (std::size_t t = 0; t < comp.size(); ++t) by[static_cast<std::size_t>(comp[t])].push_back(static_cast<int>(t));
+  for (const auto& ct : by) {
+    if (ct.size() < std::max<std::size_t>(min_faces, 1)) continue;
+    ElementMesh e = extract_triangles(part, ct);
+    std::vector<std::vector<int>> loops;
+    if (!boundary_loops(e, loops)) continue;
+    bool ok = true;
+    for (const std::vector<int>& l : loops) {
+      if (l.size() < 3) {
+        ok = false;
+        break;
+      }
+      P3 c{0, 0, 0};
+      for (int v : l)
+        for (int d = 0; d < 3; ++d) c[d] += e.points[static_cast<std::size_t>(v)][d] / static_cast<double>(l.size());
+      const int cv = static_cast<int>(e.points.size());
+      e.points.push_back(c);
+      for (std::size_t k = 0; k < l.size(); ++k) e.tris.push_back({l[(k + 1) % l.size()], l[k], cv});
+    }
+    if (ok && is_closed_oriented(e)) out.push_back(std::move(e));
+  }
+  return out;
+}
+
+bool is_compact_element(const ElementMesh& m, double ratio) {
+  if (m.points.empty()) return true;
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const P3& p : m.points)
+    for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
+  const double a = hi[0] - lo[0], b = hi[1] - lo[1];
+  return std::max(a, b) <= ratio * std::min(a, b);
+}
+
+double smallest_element_gap(const std::vector<ElementMesh>& elements, double limit) {
+  if (elements.size() < 2) return 0;
+  std::vector<std::array<double, 6>> box(elements.size());
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    box[e] = {1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
+    for (const P3& p : elements[e].points)
+      for (int d = 0; d < 3; ++d) box[e][d] = std::min(box[e][d], p[d]), box[e][3 + d] = std::max(box[e][3 + d], p[d]);
+  }
+  double best = limit;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    // The other elements whose boxes come within `best` of this one's.
+    std::vector<char> use(elements.size(), 0);
+    bool any = false;
+    for (std::size_t f = 0; f < elements.size(); ++f) {
+      if (f == e) continue;
+      bool near = true;
+      for (int d = 0; d < 3; ++d)
+        near = near && box[f][d] <= box[e][3 + d] + best && box[e][d] <= box[f][3 + d] + best;
+      if (near) use[f] = 1, any = true;
+    }
+    if (!any) continue;
+    const ElementCollider others(elements, use);
+    if (others.empty()) continue;
+    const std::vector<char> h = others.hits(elements[e], -1, 0.0);
+    if (std::find(h.begin(), h.end(), 1) != h.end()) return 0;
+    best = std::min(best, others.nearest_distance(elements[e].points, best));
+  }
+  return best;
+}
+
+}  // namespace surftex

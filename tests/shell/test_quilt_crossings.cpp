@@ -1,0 +1,369 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Issue 17: quilted elements that do not pass through each other (element
+// clearance, quilt_step's resolve_crossings, quilt_surface's finish), that
+// stand on the base surface's normal whatever the swatch's and the mesh's
+// axes (swatch thin axis, up default), and that do not stretch into shards;
+// the shared disc-chart routine.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "geometry/disc_chart.h"
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/self_intersections.h"
+#include "shell/element_clearance.h"
+#include "shell/element_mesh.h"
+#include "shell/embed_surface_quilt.h"
+#include "shell/mesh_quilting.h"
+#include "shell/surface_quilting.h"
+#include "shell/swatch.h"
+#include "shell/swatch_generators.h"
+#include "shell_test_util.h"
+
+namespace surftex {
+namespace {
+
+Swatch small_tori(int n = 3, std::uint64_t seed = 1) {
+  ToriOptions o;
+  o.tori_x = o.tori_y = n;
+  o.segments = 16;
+  o.sides = 6;
+  o.seed = seed;
+  Mesh m;
+  make_tori_swatch(m, o);
+  return make_swatch(m);
+}
+
+TEST(ElementClearance, CrossingTubesHitDisjointOnesDoNotClearanceCounts) {
+  Mesh tor;
+  make_torus(tor, 1.0, 0.3, 24, 12);
+  ElementMesh a = element_mesh_from(tor);
+  ElementMesh b = a, c = a;
+  for (P3& p : b.points) p = {p[0] + 1.0, p[2], p[1]};  // turned onto xz through a's hole: linked, 0.4 apart
+  for (P3& p : c.points) p = {p[0] + 3.0, p[1], p[2]};  // beside a, gap 3 - 2.6 = 0.4
+  const ElementCollider coll({a}, {});
+  auto any = [](const std::vector<char>& h) { return std::find(h.begin(), h.end(), 1) != h.end(); };
+  EXPECT_FALSE(any(coll.hits(b, -1, 0.0)));
+  EXPECT_FALSE(any(coll.hits(c, -1, 0.0)));
+  EXPECT_FALSE(any(coll.hits(c, -1, 0.35)));
+  EXPECT_TRUE(any(coll.hits(c, -1, 0.45)));  // within the clearance
+  ElementMesh d = a;
+  for (P3& p : d.points) p = {p[0] + 1.5, p[1], p[2]};  // overlapping tubes
+  const std::vector<char> h = coll.hits(d, -1, 0.0);
+  EXPECT_TRUE(any(h));
+  EXPECT_LT(std::count(h.begin(), h.end(), 1), static_cast<long>(d.tris.size() / 2));
+  // The element itself is skipped by its tag; dead tags are ignored.
+  const ElementCollider two({a, d}, {});
+  EXPECT_TRUE(any(two.hits(d, 1, 0.0)));
+  const std::vector<char> dead{1, 0};
+  EXPECT_FALSE(any(two.hits(d, 1, 0.0, &dead)));
+  EXPECT_NEAR(smallest_element_gap({a, c}, 10.0), 0.4, 0.05);
+  EXPECT_EQ(smallest_element_gap({a, d}, 10.0), 0.0);
+}
+
+TEST(ElementClearance, TrimAndCapLeavesClosedPiecesAwayFromTheHits) {
+  Mesh tor;
+  make_torus(tor, 2.0, 0.3, 48, 8);
+  const ElementMesh ring = element_mesh_from(tor);
+  ASSERT_TRUE(is_closed_oriented(ring));
+  // Cut the ring through its tube at two places (around the +x and -x
+  // directions, 0.15 rad each way): two closed arcs.
+  std::vector<char> drop(ring.tris.size(), 0);
+  for (std::size_t t = 0; t < ring.tris.size(); ++t) {
+    double cx = 0, cy = 0;
+    for (int v : ring.tris[t]) cx += ring.points[static_cast<std::size_t>(v)][0] / 3, cy += ring.points[static_cast<std::size_t>(v)][1] / 3;
+    drop[t] = std::abs(std::atan2(cy, std::abs(cx))) < 0.15;
+  }
+  const std::vector<ElementMesh> pieces = trim_and_cap(ring, drop, 1, 20);
+  ASSERT_EQ(pieces.size(), 2u);
+  for (const ElementMesh& p : pieces) {
+    EXPECT_TRUE(is_closed_oriented(p));
+    for (const P3& q : p.points) EXPECT_GT(std::abs(std::atan2(q[1], std::abs(q[0]))), 0.15);
+  }
+  EXPECT_TRUE(is_compact_element(ring));
+  Mesh cyl;
+  make_cylinder(cyl, 0.1, 3.0, 8, 12);
+  ElementMesh thread = element_mesh_from(cyl);
+  for (P3& p : thread.points) p = {p[2], p[1], p[0]};  // along x
+  EXPECT_FALSE(is_compact_element(thread));
+  EXPECT_THROW(trim_and_cap(ring, std::vector<char>(3, 0), 1, 1), InvalidInputError);
+}
+
+TEST(SwatchAxis, ThinAxisIsDetectedAndTurnedOntoZ) {
+  Mesh m;
+  ScatterOptions so;
+  so.size = 6;
+  so.subdivisions = 1;
+  make_scatter_swatch(m, so);  // thin in z
+  EXPECT_EQ(swatch_thin_axis(m), 2);
+  // The same swatch modelled Y-thin (y <- z, z <- -y would mirror; the cyclic turn (x, y, z) -> (z, x, y) inverted).
+  Mesh y_thin = m;
+  for (VertexIndex v : y_thin.vertices()) {
+    const Point3 p = y_thin.point(v);
+    y_thin.point(v) = Point3(p.y(), p.z(), p.x());  // old z -> y
+  }
+  EXPECT_EQ(swatch_thin_axis(y_thin), 1);
+  const Swatch z = make_swatch(m), y = make_swatch(y_thin, SwatchAxis::kAuto);
+  EXPECT_EQ(y.up_axis, 1);
+  EXPECT_NEAR(y.height(), z.height(), 1e-9);
+  EXPECT_NEAR(y.length() * y.width(), z.length() * z.width(), 1e-9);
+  const Swatch forced = make_swatch(y_thin, SwatchAxis::kZ);
+  EXPECT_EQ(forced.up_axis, 2);
+  EXPECT_GT(forced.height(), 3 * y.height());
+  // The too-small error names the axes, the cell and the options.
+  try {
+    int sx = 0, sy = 0;
+    swatch_cells(forced, std::max(forced.length(), forced.width()) / 10, "quilt_surface", sx, sy);
+    FAIL() << "no error";
+  } catch (const InvalidInputError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("along its x and y axes"), std::string::npos) << w;
+    EXPECT_NE(w.find("--cell"), std::string::npos) << w;
+    EXPECT_NE(w.find("--swatch-up"), std::string::npos) << w;
+    EXPECT_NE(w.find("thin axis z"), std::string::npos) << w;
+  }
+}
+
+TEST(DiscChart, GrowsADiscWithinTheAcceptedFacesAndFlattensToItsArea) {
+  Mesh s;
+  make_icosphere(s, 3);
+  DiscGrowthState st(s);
+  std::vector<char> inside(s.number_of_faces(), 0);
+  for (FaceIndex f : s.faces()) {
+    Point3 c(0, 0, 0);
+    int k = 0;
+    for (VertexIndex v : s.vertices_around_face(s.halfedge(f))) c = c + (s.point(v) - CGAL::ORIGIN) / 3.0, ++k;
+    inside[f.idx()] = c.z() > -0.2;  // a cap of the sphere larger than a hemisphere
+  }
+  const std::vector<int> chart = grow_disc_chart(s, 0, [&](int f) { return inside[static_cast<std::size_t>(f)] != 0; }, 100000, st);
+  ASSERT_GT(chart.size(), 100u);
+  for (int f : chart) EXPECT_TRUE(inside[static_cast<std::size_t>(f)] || f == 0);
+  const DiscChartFlattening fl = flatten_disc_chart(s, chart);
+  ASSERT_EQ(fl.status, DiscChartFlattening::Status::kOk) << fl.error;
+  double auv = 0;
+  std::vector<int> local(s.number_of_vertices(), -1);
+  for (std::size_t i = 0; i < fl.vertices.size(); ++i) local[static_cast<std::size_t>(fl.vertices[i])] = static_cast<int>(i);
+  for (int fi : chart) {
+    std::array<std::array<double, 2>, 3> t;
+    int k = 0;
+    for (VertexIndex v : s.vertices_around_face(s.halfedge(FaceIndex(static_cast<Mesh::size_type>(fi)))))
+      t[static_cast<std::size_t>(k++)] = fl.uv[static_cast<std::size_t>(local[v.idx()])];
+    const double a = 0.5 * ((t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]));
+    EXPECT_GT(a, 0);
+    auv += a;
+  }
+  EXPECT_NEAR(auv, fl.area3d, 1e-9 * fl.area3d);
+  // The whole sphere cannot be a disc: growth stops short of closing it.
+  DiscGrowthState st2(s);
+  const std::vector<int> all = grow_disc_chart(s, 0, [](int) { return true; }, 100000, st2);
+  EXPECT_LT(all.size(), s.number_of_faces());
+  EXPECT_EQ(flatten_disc_chart(s, all).status, DiscChartFlattening::Status::kOk);
+}
+
+TEST(ToriSwatch, RingsAreDisjointClosedAndTilted) {
+  const Swatch s = small_tori(4);
+  EXPECT_EQ(s.elements.size(), 16u);
+  for (const SwatchElement& e : s.elements) EXPECT_TRUE(e.closed);
+  EXPECT_GT(s.min_gap, 0.1);
+  EXPECT_GT(s.height(), 2 * 0.25 + 0.1);  // tilted rings stand up above a flat ring's 0.5
+  EXPECT_NEAR(swatch_element_spacing(s), 3.0, 0.3);
+  Mesh m;
+  ToriOptions bad;
+  bad.spacing = 2.0;
+  EXPECT_THROW(make_tori_swatch(m, bad), InvalidInputError);
+}
+
+// The planar quilt of disjoint tilted rings and of the demo's chain mail
+// keeps its elements apart with the crossing check on (on the plane the
+// placements are exact, and it finds nearly nothing to do: it must not cost
+// elements there).
+TEST(QuiltStepCrossings, PlanarToriAndChainmailHaveNoIntersectingElements) {
+  for (int kind = 0; kind < 2; ++kind) {
+    const Swatch s = kind == 0 ? small_tori(3) : test::small_chainmail_swatch(1, 12, 6);
+    auto run = [&](bool resolve) {
+      PlanarQuiltOptions o;
+      o.step.resolve_crossings = resolve;
+      Mesh out;
+      const QuiltResult r = quilt_plane(s, 2 * s.length(), 2 * s.width(), out, o);
+      const std::vector<FacePair> pairs = self_intersecting_faces(out);
+      auto el = find(out, kFaceElement).first;
+      std::size_t between = 0;
+      for (const FacePair& p : pairs)
+        if (el[FaceIndex(p[0])] != el[FaceIndex(p[1])]) ++between;
+      std::cout << "[ plane " << (kind ? "chainmail" : "tori") << " ] resolve " << resolve << ": " << r.elements
+                << " elements, " << between << " pairs between, hits " << r.stats.crossing_hits << "\n";
+      return std::make_pair(between, r);
+    };
+    const auto [off, roff] = run(false);
+    const auto [on, ron] = run(true);
+    EXPECT_EQ(on, 0u) << kind;
+    EXPECT_LE(on, off) << kind;
+    EXPECT_GE(ron.elements + 2, roff.elements) << kind;
+  }
+}
+
+// Issue 17's "done when": a disjoint-tori swatch on a sphere, 0 intersecting pairs.
+TEST(SurfaceQuiltingCrossings, DisjointToriOnASphereHaveNoIntersectingPairs) {
+  Mesh base;
+  make_icosphere(base, 2);
+  const Swatch s = small_tori(3);
+  auto run = [&](bool resolve) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.3;  // (at 0.3 the placements overlap enough to cross: 1,938 pairs without the fix)
+    o.resolve_crossings = resolve;
+    o.step.resolve_crossings = resolve;
+    o.refill_rounds = resolve ? 2 : 0;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    EmbedSurfaceQuiltOptions eo;
+    eo.stretch.iterations = 4;
+    eo.measure_outside_shell = false;
+    eo.resolve_crossings = resolve;
+    Mesh out;
+    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+    std::cout << "[ sphere tori ] resolve " << resolve << ": " << r.elements << " elements, " << out.number_of_faces()
+              << " faces, pairs between " << er.self_intersections_between << ", within " << er.self_intersections_within
+              << ", bare " << r.bare_fraction << ", hits " << r.stats.crossing_hits << ", resolved " << r.crossings_resolved
+              << "\n";
+    return std::make_pair(er, r);
+  };
+  const auto [eoff, roff] = run(false);
+  EXPECT_GT(eoff.self_intersections_between, 0u);
+  const auto [eon, ron] = run(true);
+  EXPECT_EQ(eon.self_intersections_between, 0u);
+  EXPECT_EQ(eon.self_intersections_within, 0u);
+  EXPECT_GT(ron.elements, 20);
+  EXPECT_LT(ron.bare_fraction, 0.08);
+}
+
+// A +Y-up mesh (an ellipsoid standing on y) and a swatch modelled Y-thin
+// (flattened blobs lying in xz): with the thin axis detected every element
+// lies flat on the surface (its own thin axis along the base normal).
+TEST(SurfaceQuiltingUpright, ElementsOfAYThinSwatchStandOnTheNormalOfAYUpMesh) {
+  Mesh base;
+  make_icosphere(base, 2);
+  for (VertexIndex v : base.vertices()) {
+    const Point3 p = base.point(v);
+    base.point(v) = Point3(p.x(), 1.6 * p.y(), p.z());
+  }
+  Mesh blobs;
+  ScatterOptions so;
+  so.size = 6;
+  so.subdivisions = 1;
+  make_scatter_swatch(blobs, so);
+  for (VertexIndex v : blobs.vertices()) {
+    const Point3 p = blobs.point(v);
+    blobs.point(v) = Point3(p.y(), p.z(), p.x());  // the blobs' thin z becomes y
+  }
+  auto alignment = [&](SwatchAxis axis) {
+    const Swatch s = make_swatch(blobs, axis);
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.4;
+    SurfaceQuilt q;
+    quilt_surface(base, s, q, o);
+    Mesh disp;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, disp);
+    // Per element: the smallest principal axis of its vertices against the
+    // base normal under its centroid (the nearest base vertex's normal).
+    const ElementMesh em = element_mesh_from(disp);
+    std::vector<int> comp;
+    const int n = triangle_components(em, comp);
+    std::vector<std::vector<int>> verts(static_cast<std::size_t>(n));
+    for (std::size_t t = 0; t < em.tris.size(); ++t)
+      for (int v : em.tris[t]) verts[static_cast<std::size_t>(comp[t])].push_back(v);
+    double sum = 0;
+    int count = 0;
+    for (auto& vs : verts) {
+      std::sort(vs.begin(), vs.end());
+      vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+      if (vs.size() < 10) continue;
+      P3 c{0, 0, 0};
+      for (int v : vs)
+        for (int d = 0; d < 3; ++d) c[d] += em.points[static_cast<std::size_t>(v)][d] / static_cast<double>(vs.size());
+      double cov[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+      for (int v : vs)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            cov[i][j] += (em.points[static_cast<std::size_t>(v)][i] - c[i]) * (em.points[static_cast<std::size_t>(v)][j] - c[j]);
+      // Smallest eigenvector by inverse power iteration on cov + eps I.
+      P3 x{0.3, 0.5, 0.8};
+      for (int it = 0; it < 60; ++it) {
+        // Solve (cov + eps I) y = x by Cramer's rule.
+        double a[3][3];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) a[i][j] = cov[i][j] + (i == j ? 1e-12 : 0);
+        const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                           a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+        if (!(std::abs(det) > 0)) break;
+        P3 y;
+        for (int k = 0; k < 3; ++k) {
+          double m2[3][3];
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) m2[i][j] = j == k ? x[i] : a[i][j];
+          y[k] = (m2[0][0] * (m2[1][1] * m2[2][2] - m2[1][2] * m2[2][1]) - m2[0][1] * (m2[1][0] * m2[2][2] - m2[1][2] * m2[2][0]) +
+                  m2[0][2] * (m2[1][0] * m2[2][1] - m2[1][1] * m2[2][0])) / det;
+        }
+        const double l = std::sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+        x = {y[0] / l, y[1] / l, y[2] / l};
+      }
+      // The ellipsoid's normal at the centroid's direction: grad of x^2 + (y/1.6)^2 + z^2.
+      P3 nrm{c[0], c[1] / (1.6 * 1.6), c[2]};
+      const double nl = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+      sum += std::abs(x[0] * nrm[0] + x[1] * nrm[1] + x[2] * nrm[2]) / nl;
+      ++count;
+    }
+    return count ? sum / count : 0.0;
+  };
+  const double detected = alignment(SwatchAxis::kAuto);
+  std::cout << "[ upright ] mean |cos(thin axis, normal)|: detected " << detected << "\n";
+  EXPECT_GT(detected, 0.9);
+  // Taken as z (the state before), the swatch is a 6 x 0.8 wall of blobs 6
+  // high: refused at the default cell, with its axes named.
+  EXPECT_THROW(alignment(SwatchAxis::kZ), InvalidInputError);
+}
+
+// A rim (a thin slab's sharp edges): threads placed over it by extrapolation
+// stretched into shards; with the bound none is longer than max_edge_stretch
+// swatch edges (lifted), and the space is refilled.
+TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
+  Mesh base;
+  make_icosphere(base, 2);
+  for (VertexIndex v : base.vertices()) {
+    const Point3 p = base.point(v);
+    base.point(v) = Point3(p.x(), p.y(), 0.08 * p.z());  // a lens: two faces meeting at a sharp rim
+  }
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 6;
+  wo.sides = 5;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  const Swatch s = make_swatch(wm);
+  auto run = [&](double bound) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.4;
+    o.max_edge_stretch = bound;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    std::cout << "[ rim ] bound " << bound << ": edge stretch max " << r.edge_stretch_max << ", stretched "
+              << r.elements_stretched << ", elements " << r.elements << ", bare " << r.bare_fraction << "\n";
+    return r;
+  };
+  const SurfaceQuiltResult loose = run(0);
+  EXPECT_GT(loose.edge_stretch_max, 2.0);  // the rim makes shards without the bound
+  const SurfaceQuiltResult tight = run(2.0);
+  EXPECT_LE(tight.edge_stretch_max, 2.0 + 1e-9);
+  EXPECT_GT(tight.elements_stretched, 0u);
+  EXPECT_GT(tight.elements, 10);
+}
+
+}  // namespace
+}  // namespace surftex
+
