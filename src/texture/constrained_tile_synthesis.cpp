@@ -16,7 +16,8 @@
 //    neighbourhoods already match exactly (the paper's I_0 = identity);
 //  - the coarsest level runs layer after layer (each starts from the previous
 //    one); the finer levels of different layers are independent and run in
-//    parallel, each with its own seeded random stream;
+//    parallel, each with its own seeded random stream; the exemplar's levels
+//    (PCA, feature vectors, kd-tree) are built in parallel too;
 //  - speed: at the finer levels only the first `fine_ann_passes` passes query
 //    the kd-tree; later passes choose among the current and coherent
 //    candidates (the map is already mask-consistent after the first pass).
@@ -313,7 +314,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
   std::vector<std::vector<Image>> tmask_pyr(K);
   tbb::parallel_for(0, K, [&](int k) { tmask_pyr[k] = pyramid(first_channel(target_masks[k]), levels); });
   std::vector<ExemplarLevel> ex(levels);
-  for (int r = 0; r < levels; ++r) build_exemplar_level(ex[r], col_pyr[r], emask_pyr[r], opt);
+  tbb::parallel_for(0, levels, [&](int r) { build_exemplar_level(ex[r], col_pyr[r], emask_pyr[r], opt); });
   report_progress(opt.progress, "tile synthesis", 0.05);
 
   ConstrainedSynthesisResult res;
