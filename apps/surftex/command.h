@@ -3,7 +3,7 @@
 // The subcommand registry of the `surftex` command. Each apps/surftex/cmd_*.cpp
 // defines one subcommand and registers it with a static SubcommandRegistrar;
 // main.cpp needs no edit when a subcommand is added. Apps are thin: parse,
-// validate, call the library, report (STYLE.md 7).
+// validate, call the library, report (docs/STYLE.md 7).
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

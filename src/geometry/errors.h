@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// The error policy of surftex (STYLE.md 6): library code throws one of these,
+// The error policy of surftex (docs/STYLE.md 6): library code throws one of these,
 // with the offending parameter or file and value in the message; it never exits.
 // The CLI turns them into "error: <message>" and exit code 2.
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// The one s-t min-cut / max-flow wrapper of surftex (DESIGN.md: "Boost.Graph for
+// The one s-t min-cut / max-flow wrapper of surftex (docs/DESIGN.md: "Boost.Graph for
 // every max-flow / graph cut"). Every graph cut in the project (graph-cut
 // textures, tileable tiles, mesh quilting, subdivision graph matching) goes
 // through this class; it runs Boost.Graph's boykov_kolmogorov_max_flow

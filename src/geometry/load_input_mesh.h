@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Loading a user's mesh for a texturing method (DESIGN.md data flow step 1:
+// Loading a user's mesh for a texturing method (docs/DESIGN.md data flow step 1:
 // "load -> validate -> repair (or refuse with a precise error)").
 //
 // Every method subcommand (patches, material-map, subdiv, quilt) reads its

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Small meshes built in code: for unit tests (STYLE.md 9), for the demo, and
+// Small meshes built in code: for unit tests (docs/STYLE.md 9), for the demo, and
 // as base shapes. All are triangle meshes with outward (counter-clockwise seen
 // from outside) orientation. Units are arbitrary; sizes are documented per shape.
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Every property map surftex puts on a Mesh, in one place (STYLE.md 4): its
+// Every property map surftex puts on a Mesh, in one place (docs/STYLE.md 4): its
 // name, the element it lives on and its value type. Algorithms take the maps
 // they read and write as arguments; nothing picks up a map just because a name
 // is present. Include in .cpp files only (it pulls in CGAL through mesh.h).

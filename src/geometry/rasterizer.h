@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// A small software rasterizer for previews and validation renders (DESIGN.md:
+// A small software rasterizer for previews and validation renders (docs/DESIGN.md:
 // "a software rasterizer renders results to images, no GPU needed").
 //
 // Pipeline: vertices -> camera frame -> homogeneous clip coordinates; triangles

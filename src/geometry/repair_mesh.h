@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Repair of degenerate input meshes (DESIGN.md data flow step 1: "load ->
+// Repair of degenerate input meshes (docs/DESIGN.md data flow step 1: "load ->
 // validate -> repair (or refuse with a precise error)"), built from CGAL 5.5
 // Polygon Mesh Processing steps:
 //   0. triangulate non-triangle faces (PMP::triangulate_faces; faces it
