@@ -10,9 +10,13 @@ endfunction()
 
 # A module library built from every .cpp in its folder: one algorithm per
 # header/source pair, so adding an algorithm needs no CMake edit.
+# EXCLUDE names sources of the folder that are built elsewhere.
 function(surftex_add_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE" ${ARGN})
   file(GLOB _srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  foreach(_x ${ARG_EXCLUDE})
+    list(REMOVE_ITEM _srcs "${CMAKE_CURRENT_SOURCE_DIR}/${_x}")
+  endforeach()
   if(_srcs)
     add_library(surftex_${name} STATIC ${_srcs})
     target_include_directories(surftex_${name} PUBLIC "${PROJECT_SOURCE_DIR}/src")

@@ -112,28 +112,37 @@ struct NearestByBound : KdIndex<double>::Visitor {
 };
 
 // Mean over `queries` of the distance to the nearest patch of `base`.
+// `subset`: the query indices to average over (empty = all).
 double mean_nearest(const Patches& queries, const Patches& base, const PcaBasis* pca,
                     const std::vector<double>& qproj, const std::vector<double>& bproj,
-                    std::size_t max_candidates) {
-  std::vector<double> best(queries.count);
+                    std::size_t max_candidates, const std::vector<std::size_t>& subset = {}) {
+  std::vector<std::size_t> all;
+  if (subset.empty()) {
+    all.resize(queries.count);
+    for (std::size_t i = 0; i < queries.count; ++i) all[i] = i;
+  }
+  const std::vector<std::size_t>& qs = subset.empty() ? all : subset;
+  std::vector<double> best(qs.size());
   if (!pca) {
-    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
+    tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
+      const std::size_t i = qs[k];
       double b = std::numeric_limits<double>::infinity();
       for (std::size_t j = 0; j < base.count; ++j) b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
-      best[i] = b;
+      best[k] = b;
     });
   } else {
     const int d = pca->dims;
     const KdIndex<double> tree(bproj, d);
-    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
+    tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
+      const std::size_t i = qs[k];
       NearestByBound r(queries.row(i), &base, max_candidates);
       tree.search(qproj.data() + i * d, r);
-      best[i] = r.best;
+      best[k] = r.best;
     });
   }
   double sum = 0;
   for (double v : best) sum += v;
-  return sum / static_cast<double>(queries.count) / base.dim;
+  return sum / static_cast<double>(qs.size()) / base.dim;
 }
 
 }  // namespace
@@ -148,6 +157,7 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
         std::to_string(exemplar.channels));
   if (opt.patch < 1 || opt.patch > 31) bad("patch " + std::to_string(opt.patch) + " outside 1..31");
   if (opt.stride < 1) bad("stride " + std::to_string(opt.stride) + " < 1");
+  if (opt.exemplar_stride < 1) bad("exemplar_stride " + std::to_string(opt.exemplar_stride) + " < 1");
   if (opt.max_candidates < 0) bad("max_candidates " + std::to_string(opt.max_candidates) + " < 0");
   if (opt.pca_dims < 1) bad("pca_dims " + std::to_string(opt.pca_dims) + " < 1");
   if (output.width < opt.patch || output.height < opt.patch)
@@ -161,15 +171,22 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
   BidirectionalResult r;
   r.output_patches = out.count;
   r.exemplar_patches = ex.count;
+  // Completeness over a regular subsample of the exemplar positions.
+  std::vector<std::size_t> ex_subset;
+  if (opt.exemplar_stride > 1) {
+    const int nx = opt.periodic_exemplar ? exemplar.width : exemplar.width - opt.patch + 1;
+    for (std::size_t i = 0; i < ex.count; ++i)
+      if ((i % nx) % opt.exemplar_stride == 0 && (i / nx) % opt.exemplar_stride == 0) ex_subset.push_back(i);
+  }
   if (opt.brute_force) {
     std::vector<double> none;
     r.coherence = mean_nearest(out, ex, nullptr, none, none, 0);
-    r.completeness = mean_nearest(ex, out, nullptr, none, none, 0);
+    r.completeness = mean_nearest(ex, out, nullptr, none, none, 0, ex_subset);
   } else {
     const PcaBasis pca = fit_patch_pca(ex, out, std::min(opt.pca_dims, ex.dim));
     const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
     r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates);
-    r.completeness = mean_nearest(ex, out, &pca, pex, pout, opt.max_candidates);
+    r.completeness = mean_nearest(ex, out, &pca, pex, pout, opt.max_candidates, ex_subset);
   }
   r.total = r.coherence + r.completeness;
   return r;

@@ -39,6 +39,12 @@ struct BidirectionalOptions {
   /// Step between output patch positions (1 = every patch), >= 1. Larger
   /// steps subsample big outputs.
   int stride = 1;
+  /// Step between the exemplar patch positions whose nearest output patch
+  /// the completeness term averages (>= 1; default 1 = all). Coherence still
+  /// searches every exemplar patch. Larger steps bound the cost on big
+  /// exemplars (the completeness mean is then estimated from a regular
+  /// subsample).
+  int exemplar_stride = 1;
   /// Dimensions kept by the PCA projection for the kd-tree (1..k*k*channels,
   /// clamped), default 16. Affects speed only, not the result.
   int pca_dims = 16;

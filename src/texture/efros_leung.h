@@ -139,8 +139,9 @@ struct ElOptions {
   /// Approximate search: kd-tree neighbours per pixel, 1..256. Default 16.
   int ann_candidates = 16;
   /// Approximate search: PCA coefficients of the first-pass neighbourhood,
-  /// 1..first_pass_window^2 * channels (clamped). Default 10.
-  int ann_pca_dims = 10;
+  /// 1..first_pass_window^2 * channels (clamped). Default 4 (the kd-tree
+  /// stays shallow; pass 1 re-ranks the hits exactly).
+  int ann_pca_dims = 4;
   /// Approximate search: (1 + eps)-approximate kd-tree distances, >= 0. Default 1.
   double ann_eps = 1.0;
   /// Reference mode: Efros-Leung's original single exhaustive pass with the
