@@ -12,7 +12,11 @@
 // Measurement history: docs/decisions/50N-*.md.
 //
 // Usage: bench_material_tile [cli_defaults|paper|all] [threads]
-// BENCH_OUT=DIR writes the cli_defaults tile there.
+// BENCH_OUT=DIR writes the cli_defaults tile there. Tuning:
+// SURFTEX_BENCH_MT_SET="pca_dims=5,ann_eps=4,candidates=2,fine_ann_passes=1,
+// fine_ann_only_mismatched=1,coarse_passes=20,fine_passes=3" overrides those
+// synthesis options (cases
+// then say "tuned").
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -21,6 +25,7 @@
 #include <ctime>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "geometry/image_io.h"
@@ -45,6 +50,26 @@ void run_case(const std::string& name, int crop_side, int layers, int levels) {
   MaterialTileOptions opt;
   if (layers > 0) opt.layers = layers;
   opt.synthesis.levels = levels;
+  std::string tuned;
+  if (const char* set = std::getenv("SURFTEX_BENCH_MT_SET")) {
+    std::stringstream ss(set);
+    for (std::string kv; std::getline(ss, kv, ',');) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos) continue;
+      const std::string k = kv.substr(0, eq);
+      const double v = std::atof(kv.c_str() + eq + 1);
+      ConstrainedSynthesisOptions& so = opt.synthesis;
+      if (k == "pca_dims") so.pca_dims = int(v);
+      else if (k == "ann_eps") so.ann_eps = v;
+      else if (k == "candidates") so.candidates = int(v);
+      else if (k == "fine_ann_passes") so.fine_ann_passes = int(v);
+      else if (k == "fine_ann_only_mismatched") so.fine_ann_only_mismatched = v != 0;
+      else if (k == "coarse_passes") so.coarse_passes = int(v);
+      else if (k == "fine_passes") so.fine_passes = int(v);
+      else continue;
+      tuned += (tuned.empty() ? "" : ",") + kv;
+    }
+  }
   Timer t;
   const std::clock_t c0 = std::clock();
   MaterialTileResult r = make_material_tile(keys, opt);
@@ -59,6 +84,7 @@ void run_case(const std::string& name, int crop_side, int layers, int levels) {
   nlohmann::json j;
   j["bench"] = "material_tile_" + name;
   j["sets"] = name == "paper" ? "layers 7, levels 3 (the paper's table)" : "nothing (CLI defaults)";
+  if (!tuned.empty()) j["tuned"] = tuned;
   j["inputs"] = {a, b};
   j["exemplar_side"] = ia.width;
   j["layers"] = r.layers.size();

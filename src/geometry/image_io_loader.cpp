@@ -66,7 +66,9 @@ const ImageIoTable& table() {
 
 // The module calls output_file.h's functions in the executable: this
 // reference keeps them linked into every executable that does image IO.
-void (AtomicOutputFile::*const image_io_module_needs_commit)() = &AtomicOutputFile::commit;
+// (Non-const: a const object at namespace scope would have internal linkage
+// and be dropped with the reference.)
+void (AtomicOutputFile::*image_io_module_needs_commit)() = &AtomicOutputFile::commit;
 
 Image read_image(const std::string& path) { return table().read_image(path); }
 

@@ -19,8 +19,10 @@
 //    parallel, each with its own seeded random stream; the exemplar's levels
 //    (PCA, feature vectors, kd-tree) are built in parallel too;
 //  - speed: at the finer levels only the first `fine_ann_passes` passes query
-//    the kd-tree; later passes choose among the current and coherent
-//    candidates (the map is already mask-consistent after the first pass).
+//    the kd-tree, and (fine_ann_only_mismatched) only for the texels whose
+//    current exemplar pixel's 3x3 mask disagrees with the target's; other
+//    texels and later passes choose among the current and coherent
+//    candidates (the upsampled map follows the mask away from its edges).
 #include "texture/constrained_tile_synthesis.h"
 
 #include <tbb/parallel_for.h>
@@ -151,10 +153,23 @@ void build_exemplar_level(ExemplarLevel& L, const Image& colour, const Image& ma
   L.tree = std::make_unique<KdIndex<float>>(std::move(pts), L.D);
 }
 
+// True when the 3x3 feature mask around texel (i, j)'s current exemplar pixel
+// differs (thresholded at 0.5) from the target mask around (i, j).
+bool mask_mismatch(const IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int i, int j) {
+  const int w = map.width, h = map.height;
+  const int cx = map.x(i, j), cy = map.y(i, j);
+  for (int dy = -kMaskR; dy <= kMaskR; ++dy)
+    for (int dx = -kMaskR; dx <= kMaskR; ++dx)
+      if ((L.mask.at(wrap(cx + dx, L.w), wrap(cy + dy, L.h)) > 0.5f) !=
+          (target_mask.at(wrap(i + dx, w), wrap(j + dy, h)) > 0.5f))
+        return true;
+  return false;
+}
+
 // Optimises one indirection map in place at one level (section 1.2 "Optimization").
 void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int passes,
                   std::uint64_t seed, const ConstrainedSynthesisOptions& opt, double exclude,
-                  int ann_passes) {
+                  int ann_passes, bool ann_only_mismatched) {
   const int w = map.width, h = map.height;
   const std::size_t n_out = std::size_t(w) * h;
   const int raw = (2 * kColR + 1) * (2 * kColR + 1) * L.C;
@@ -191,7 +206,7 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
           mv[k] = static_cast<float>(opt.mask_weight) * target_mask.at(wrap(i + dx, w), wrap(j + dy, h));
       L.mask_pca.project(mv, q.data() + L.d);
       std::size_t found = 0;
-      if (pass < ann_passes)
+      if (pass < ann_passes && (!ann_only_mismatched || mask_mismatch(map, L, target_mask, i, j)))
         found = L.tree->knn(q.data(), k_ann, static_cast<float>(opt.ann_eps), nn_idx.data(), nn_d2.data());
       // Candidates: ANN results, the current pixel, the coherent ones.
       std::uint32_t cand[32];
@@ -338,7 +353,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
     }
     if (k > 0 || opt.random_first_layer)
       optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt,
-                   opt.exclude_radius * ex[0].w / W, opt.coarse_passes);
+                   opt.exclude_radius * ex[0].w / W, opt.coarse_passes, false);
     report_progress(opt.progress, "tile synthesis", 0.05 + 0.25 * (k + 1) / K);
   }
   // Finer levels: layers are independent.
@@ -352,7 +367,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
       }
       m = upsample_map(res.maps[k][r - 1], ex[r].w, ex[r].h);
       optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt,
-                   opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes);
+                   opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes, opt.fine_ann_only_mismatched);
     }
     int d = ++done;
     report_progress(opt.progress, "tile synthesis", 0.3 + 0.7 * d / K);

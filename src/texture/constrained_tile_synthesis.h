@@ -50,6 +50,10 @@ struct ConstrainedSynthesisOptions {
   /// others only compare the current and coherent candidates. The coarsest
   /// level always queries it in every pass.
   int fine_ann_passes = 1;
+  /// At the finer levels, query the kd-tree only for texels whose current
+  /// exemplar pixel's 3x3 feature mask differs from the target's (the others
+  /// compare the current and coherent candidates only). Default on.
+  bool fine_ann_only_mismatched = true;
   int pca_dims = 8;        ///< PCA coefficients of the 5x5 colour neighbourhood (1..25*channels)
   double mask_weight = 2;  ///< scale of the 3x3 mask entries in the vector (>= 0)
   /// PCA coefficients kept of the (weighted) 3x3 mask neighbourhood (0..9,

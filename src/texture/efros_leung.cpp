@@ -227,6 +227,22 @@ struct SearchImage {
   std::vector<std::pair<int, int>> blocks;
   int max_span = 0;
   std::vector<std::uint8_t> is_candidate;  // per buffer position: 1 = a candidate centre
+  // Periodic exemplars: the candidate centres are one period, [margin,
+  // margin + core_w) x [margin, margin + core_h); positions outside it are
+  // the same neighbourhoods shifted by a period.
+  bool periodic = false;
+  int margin = 0, core_w = 0, core_h = 0;
+  /// The candidate centre equivalent to buffer position c, or -1.
+  int candidate_at(long long c) const {
+    if (periodic) {
+      if (c < 0 || c >= static_cast<long long>(pw) * ph) return -1;
+      int x = static_cast<int>(c % pw) - margin, y = static_cast<int>(c / pw) - margin;
+      x = ((x % core_w) + core_w) % core_w;
+      y = ((y % core_h) + core_h) % core_h;
+      return (y + margin) * pw + x + margin;
+    }
+    return c >= 0 && c < static_cast<long long>(is_candidate.size()) && is_candidate[c] ? static_cast<int>(c) : -1;
+  }
   std::unique_ptr<PartialNeighbourhoodIndex> ann;  // approximate search only
 
   const float* plane(int c) const { return planes.data() + static_cast<std::size_t>(c) * pw * ph; }
@@ -280,6 +296,10 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
   }
   s.is_candidate.assign(n, 0);
   for (int id : s.ids) s.is_candidate[id] = 1;
+  s.periodic = periodic;
+  s.margin = margin;
+  s.core_w = core_w;
+  s.core_h = core_h;
   // Blocks of spans for pass 1 (the partition does not affect the result).
   const int want = std::max(1, tbb::this_task_arena::max_concurrency());
   const int per = std::max<int>(1, (static_cast<int>(s.ids.size()) + want - 1) / want);
@@ -577,9 +597,8 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
           p1_slot_.push_back((dy - flo) * first_ + (dx - flo));
           // Coherent candidate: q's source shifted back by q's offset (same search image only).
           if (src_[q] >= 0 && key_[q] == key_[p]) {
-            const long long c = static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx);
-            if (c >= 0 && c < static_cast<long long>(s.is_candidate.size()) && s.is_candidate[c])
-              short_.push_back(static_cast<int>(c));
+            const int c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
+            if (c >= 0) short_.push_back(c);
           }
         }
       }
