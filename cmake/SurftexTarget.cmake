@@ -30,3 +30,11 @@ function(surftex_add_module name)
     add_library(surftex::${name} ALIAS surftex_${name})
   endif()
 endfunction()
+
+# SURFTEX_PCH: one precompiled header per target, made of the headers most of
+# its sources include (docs/decisions/504-first-build.md).
+function(surftex_precompile target)
+  if(SURFTEX_PCH)
+    target_precompile_headers(${target} PRIVATE ${ARGN})
+  endif()
+endfunction()
