@@ -19,6 +19,8 @@
 // One JSON line per texture, then a summary line (how many within 5%).
 // SURFTEX_BENCH_EL_ANN="K,D,EPS;K,D,EPS..." also runs these settings of
 // (ann_candidates, ann_pca_dims, ann_eps) (tuning; "settings" in the lines).
+// SURFTEX_BENCH_EL_REFERENCE=FILE takes the exhaustive figures from an
+// earlier run's output instead of recomputing them.
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
@@ -28,6 +30,8 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -97,6 +101,19 @@ int main(int argc, char** argv) {
       if (std::sscanf(item.c_str(), "%d,%d,%lf", &st.candidates, &st.dims, &st.eps) == 3) settings.push_back(st);
     }
   }
+  // SURFTEX_BENCH_EL_REFERENCE=FILE: exhaustive figures from an earlier run's
+  // JSON lines (same size; the exhaustive search is deterministic).
+  std::map<std::string, std::pair<double, double>> reference;
+  if (const char* ref = std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
+    std::ifstream in(ref);
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] != '{') continue;
+      const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+      if (j.is_discarded() || !j.contains("texture") || j.value("output", 0) != size) continue;
+      reference[j["texture"].get<std::string>()] = {j["bds_exhaustive"].get<double>(),
+                                                    j["cpu_seconds"]["exhaustive"].get<double>()};
+    }
+  }
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().extension() == ".png") files.push_back(e.path());
@@ -108,7 +125,13 @@ int main(int argc, char** argv) {
       const std::string name = f.stem().string();
       if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
       const Image ex = read_image(f.string());
-      const Run a = synthesize(ex, size, ElSearch::Exhaustive);
+      Run a;
+      if (reference.count(name)) {
+        a.bds = reference[name].first;
+        a.cpu = reference[name].second;
+      } else {
+        a = synthesize(ex, size, ElSearch::Exhaustive);
+      }
       const Run b = synthesize(ex, size, ElSearch::Approximate);
       nlohmann::json tried = nlohmann::json::array();
       for (const AnnSetting& st : settings) {

@@ -322,6 +322,9 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
     bad("window " + std::to_string(opt.window) + " outside 3..51");
   if (opt.rotations < 1 || opt.rotations > 128)
     bad("rotations " + std::to_string(opt.rotations) + " outside 1..128");
+  if (opt.ann_stride < 1 || opt.ann_stride > 4)
+    bad("ann_stride " + std::to_string(opt.ann_stride) + " outside 1..4");
+  if (opt.ann_pca_dims < 1) bad("ann_pca_dims " + std::to_string(opt.ann_pca_dims) + " < 1");
   if (exemplars.empty()) bad("exemplars: none given");
   for (std::size_t e = 0; e < exemplars.size(); ++e) {
     const Image& ex = exemplars[e];
@@ -346,7 +349,7 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
 // so different slots build concurrently); a built slot never changes.
 struct ElPreparedExemplars {
   std::vector<Image> exemplars;
-  int window = 0, first_window = 0, rotations = 1, ann_pca_dims = 0;
+  int window = 0, first_window = 0, rotations = 1, ann_pca_dims = 0, ann_stride = 1;
   bool periodic = false;
   ElSearch search = ElSearch::Approximate;
   mutable std::unique_ptr<std::once_flag[]> once;
@@ -371,7 +374,8 @@ struct ElPreparedExemplars {
                               "periodic_exemplar");
     if (search == ElSearch::Approximate)
       s->ann = std::make_unique<PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
-                                                           s->pw, s->channels, s->ids, first_window, ann_pca_dims);
+                                                           s->pw, s->channels, s->ids, first_window, ann_pca_dims,
+                                                           ann_stride);
     return s;
   }
 };
@@ -389,6 +393,7 @@ std::shared_ptr<ElPreparedExemplars> prepare(const std::vector<Image>& exemplars
   p->periodic = opt.periodic_exemplar;
   p->search = opt.search;
   p->ann_pca_dims = opt.ann_pca_dims;
+  p->ann_stride = opt.ann_stride;
   const std::size_t n = exemplars.size() * static_cast<std::size_t>(opt.rotations);
   p->once = std::make_unique<std::once_flag[]>(n);
   p->slots = std::make_unique<std::unique_ptr<SearchImage>[]>(n);
@@ -465,6 +470,8 @@ void Synthesizer::validate() {
   if (opt_.ann_candidates < 1 || opt_.ann_candidates > 256)
     bad("ann_candidates " + std::to_string(opt_.ann_candidates) + " outside 1..256");
   if (opt_.ann_pca_dims < 1) bad("ann_pca_dims " + std::to_string(opt_.ann_pca_dims) + " < 1");
+  if (opt_.ann_stride < 1 || opt_.ann_stride > 4)
+    bad("ann_stride " + std::to_string(opt_.ann_stride) + " outside 1..4");
   if (!(opt_.ann_eps >= 0.0) || !std::isfinite(opt_.ann_eps))
     bad("ann_eps " + std::to_string(opt_.ann_eps) + " must be finite and >= 0");
   if (!(opt_.gaussian_sigma >= 0.0) || !std::isfinite(opt_.gaussian_sigma))
@@ -493,9 +500,11 @@ void Synthesizer::validate() {
           " differs from the prepared exemplars'");
     if (p.search != opt_.search) bad("search differs from the prepared exemplars'");
     if (p.search == ElSearch::Approximate &&
-        (p.first_window != el_first_pass_window(opt_) || p.ann_pca_dims != opt_.ann_pca_dims))
-      bad("first_pass_window / ann_pca_dims differ from the prepared exemplars' (" +
-          std::to_string(p.first_window) + " / " + std::to_string(p.ann_pca_dims) + ")");
+        (p.first_window != el_first_pass_window(opt_) || p.ann_pca_dims != opt_.ann_pca_dims ||
+         p.ann_stride != opt_.ann_stride))
+      bad("first_pass_window / ann_pca_dims / ann_stride differ from the prepared exemplars' (" +
+          std::to_string(p.first_window) + " / " + std::to_string(p.ann_pca_dims) + " / " +
+          std::to_string(p.ann_stride) + ")");
     prep_ = in_.prepared;
   } else {
     prep_ = prepare(in_.exemplars, opt_);

@@ -14,10 +14,11 @@ namespace surftex {
 
 PartialNeighbourhoodIndex::PartialNeighbourhoodIndex(const float* planes, std::size_t plane_size, int pitch,
                                                      int channels, const std::vector<int>& ids, int window,
-                                                     int pca_dims)
-    : f_(window), C_(channels), ids_(ids) {
+                                                     int pca_dims, int stride)
+    : f_(window), C_(channels), pitch_(pitch), stride_(stride) {
   const std::string fn = "PartialNeighbourhoodIndex: ";
   if (ids.empty()) throw InvalidInputError(fn + "no candidate position");
+  if (stride < 1) throw InvalidInputError(fn + "stride " + std::to_string(stride) + " < 1");
   if (window < 1 || channels < 1 || pitch < window)
     throw InvalidInputError(fn + "window " + std::to_string(window) + ", channels " + std::to_string(channels) +
                             ", pitch " + std::to_string(pitch));
@@ -58,12 +59,19 @@ PartialNeighbourhoodIndex::PartialNeighbourhoodIndex(const float* planes, std::s
       for (int i = 0; i < d_; ++i)
         for (int j = 0; j < d_; ++j) g[i * d_ + j] += b[i] * b[j];
     }
-  // Coefficients of every candidate.
-  std::vector<float> pts(N * d_);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, N, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+  // Coefficients of every indexed candidate (all, or those on the stride grid).
+  for (int id : ids)
+    if ((id % pitch) % stride == 0 && (id / pitch) % stride == 0) ids_.push_back(id);
+  if (stride > 1) {
+    member_.assign(plane_size, 0);
+    for (int id : ids) member_[id] = 1;
+  }
+  const std::size_t M = ids_.size();
+  std::vector<float> pts(M * d_);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, M, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     std::vector<float> rv(raw);
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
-      raw_vec(ids[i], rv.data());
+      raw_vec(ids_[i], rv.data());
       pca_.project(rv.data(), &pts[i * d_]);
     }
   });
@@ -117,12 +125,25 @@ std::size_t PartialNeighbourhoodIndex::query(const int* slot, const float* value
   s.hits.resize(k);
   s.d2.resize(k);
   const std::size_t r = tree_->knn(s.c.data(), k, eps, s.hits.data(), s.d2.data());
-  for (std::size_t i = 0; i < r; ++i) out.push_back(ids_[s.hits[i]]);
-  return r;
+  const std::size_t before = out.size();
+  for (std::size_t i = 0; i < r; ++i) {
+    const int id = ids_[s.hits[i]];
+    if (stride_ == 1) {
+      out.push_back(id);
+      continue;
+    }
+    for (int dy = 0; dy < stride_; ++dy)
+      for (int dx = 0; dx < stride_; ++dx) {
+        const std::size_t c = static_cast<std::size_t>(id) + static_cast<std::size_t>(dy) * pitch_ + dx;
+        if (c < member_.size() && member_[c]) out.push_back(static_cast<int>(c));
+      }
+  }
+  return out.size() - before;
 }
 
 std::size_t PartialNeighbourhoodIndex::bytes() const {
-  return tree_->bytes() + ids_.size() * sizeof(int) + (slot_gram_.size() + basis_t_.size()) * sizeof(double);
+  return tree_->bytes() + ids_.size() * sizeof(int) + member_.size() +
+         (slot_gram_.size() + basis_t_.size()) * sizeof(double);
 }
 
 }  // namespace surftex

@@ -20,6 +20,7 @@
 // search), independent of the number of candidates but for the tree's depth.
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -34,8 +35,12 @@ class PartialNeighbourhoodIndex {
   /// window (offsets -f/2 .. f-1-f/2) lies in the buffer; f = `window` >= 1;
   /// pca_dims in 1..f*f*channels (clamped). Throws InvalidInputError on
   /// empty ids or bad sizes, SolverError if the PCA fails.
+  /// `stride` >= 1: only the candidates at buffer positions whose x and y
+  /// are multiples of it go in the kd-tree (stride^2 times fewer points); a
+  /// query then returns, for each hit, the candidates of its stride x stride
+  /// block.
   PartialNeighbourhoodIndex(const float* planes, std::size_t plane_size, int pitch, int channels,
-                            const std::vector<int>& ids, int window, int pca_dims);
+                            const std::vector<int>& ids, int window, int pca_dims, int stride = 1);
   ~PartialNeighbourhoodIndex();
 
   /// Per-caller scratch (queries are const and thread-safe with one scratch each).
@@ -45,8 +50,9 @@ class PartialNeighbourhoodIndex {
     std::vector<std::uint32_t> hits;
   };
   /// The known pixels of the query: slot[i] = (dy - lo) * f + (dx - lo) for
-  /// window offset (dx, dy), lo = -f/2, values[i * channels + c]. Appends up
-  /// to k candidate centres (from `ids`) to `out`; returns how many.
+  /// window offset (dx, dy), lo = -f/2, values[i * channels + c]. Appends
+  /// the candidate centres (from `ids`) of up to k kd-tree hits to `out`
+  /// (stride^2 per hit at most); returns how many were appended.
   std::size_t query(const int* slot, const float* values, int known, std::size_t k, float eps,
                     std::vector<int>& out, Scratch& scratch) const;
 
@@ -55,7 +61,8 @@ class PartialNeighbourhoodIndex {
   std::size_t bytes() const;
 
  private:
-  int f_ = 0, C_ = 0, d_ = 0;
+  int f_ = 0, C_ = 0, d_ = 0, pitch_ = 0, stride_ = 1;
+  std::vector<std::uint8_t> member_;  // per buffer position: 1 = one of `ids`
   PcaBasis pca_;
   std::vector<double> slot_gram_;   // per slot: d x d sum over its channels of b b^T
   std::vector<double> basis_t_;     // per raw entry r: its d basis coefficients

@@ -432,6 +432,9 @@ TEST(EfrosLeung, InvalidOptionsThrowNamingTheOption) {
   o = ElOptions();
   o.ann_eps = -1;
   expect_named(o, "ann_eps");
+  o = ElOptions();
+  o.ann_stride = 5;
+  expect_named(o, "ann_stride");
   o = {};
   o.rotations = 0;
   expect_named(o, "rotations");
@@ -488,8 +491,8 @@ TEST(EfrosLeung, EvenWindowsAndDefaultFirstPass) {
 TEST(EfrosLeung, ApproximateSearchRanksAShortListWhateverTheExemplarSize) {
   // The exhaustive pass 1 ranks every candidate position for every pixel;
   // the approximate one a short list of at most ann_candidates kd-tree hits
-  // plus one coherent candidate per known first-pass neighbour, whatever the
-  // exemplar's size.
+  // (ann_stride^2 candidates each) plus one coherent candidate per known
+  // first-pass neighbour, whatever the exemplar's size.
   const Image src = read_image(test::shared_data("textures/pebbles_256.png"));
   const int size = sanitized() ? 24 : 40;
   for (int side : {64, 160}) {
@@ -502,7 +505,7 @@ TEST(EfrosLeung, ApproximateSearchRanksAShortListWhateverTheExemplarSize) {
     const ElResult ap = efros_leung_synthesize(in, opt);
     const int f = el_first_pass_window(opt);
     const double per_pixel = double(ap.pass1_candidates) / ap.synthesized;
-    EXPECT_LE(per_pixel, opt.ann_candidates + f * f - 1) << "exemplar " << side;
+    EXPECT_LE(per_pixel, opt.ann_candidates * opt.ann_stride * opt.ann_stride + f * f - 1) << "exemplar " << side;
     EXPECT_GT(per_pixel, 1.0);
     opt.search = ElSearch::Exhaustive;
     const ElResult ex_r = efros_leung_synthesize(in, opt);
@@ -570,5 +573,8 @@ TEST(EfrosLeung, ApproximateSearchSameBytesForOneAndTwoThreadsAndPrepared) {
   EXPECT_THROW(efros_leung_synthesize(prep, other), InvalidInputError);
   other = opt;
   other.search = ElSearch::Exhaustive;
+  EXPECT_THROW(efros_leung_synthesize(prep, other), InvalidInputError);
+  other = opt;
+  other.ann_stride = 1;
   EXPECT_THROW(efros_leung_synthesize(prep, other), InvalidInputError);
 }
