@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "geometry/errors.h"
@@ -124,45 +125,54 @@ TEST(PartialNeighbourhoodIndex, HalfKnownQueriesReturnTopRankedCandidates) {
   std::vector<int> ids;
   for (int y = 2; y < side - 2; ++y)
     for (int x = 2; x < side - 2; ++x) ids.push_back(y * pw + x);
-  const PartialNeighbourhoodIndex index(planes.data(), ps, pw, C, ids, f, 4);
-  EXPECT_EQ(index.pca_dims(), 4);
-  PartialNeighbourhoodIndex::Scratch scratch;
-  std::mt19937_64 rng(6);
-  const int trials = 100;
-  int good = 0;
-  std::vector<int> slot, offset;
-  std::vector<float> val;
-  for (int t = 0; t < trials; ++t) {
-    const int id = ids[rng() % ids.size()];
-    slot.clear();
-    offset.clear();
-    val.clear();
-    for (int dy = lo; dy <= 2; ++dy)
-      for (int dx = lo; dx <= 2; ++dx) {
-        if (dy > 0 || (dy == 0 && dx >= 0)) continue;
-        slot.push_back((dy - lo) * f + (dx - lo));
-        offset.push_back(dy * pw + dx);
-        for (int c = 0; c < C; ++c) val.push_back(planes[c * ps + id + dy * pw + dx]);
-      }
-    auto known_ssd = [&](int cand) {
-      double e = 0;
-      for (std::size_t k = 0; k < offset.size(); ++k)
-        for (int c = 0; c < C; ++c) {
-          const double d = planes[c * ps + cand + offset[k]] - val[k * C + c];
-          e += d * d;
+  // stride 2 (the Efros-Leung default): a quarter of the positions in the
+  // tree, each hit standing for its 2x2 block of candidates.
+  for (int stride : {1, 2}) {
+    SCOPED_TRACE("stride " + std::to_string(stride));
+    std::vector<char> is_id(ps, 0);
+    for (int c : ids) is_id[c] = 1;
+    const PartialNeighbourhoodIndex index(planes.data(), ps, pw, C, ids, f, 4, stride);
+    EXPECT_EQ(index.pca_dims(), 4);
+    PartialNeighbourhoodIndex::Scratch scratch;
+    std::mt19937_64 rng(6);
+    const int trials = 100;
+    int good = 0;
+    std::vector<int> slot, offset;
+    std::vector<float> val;
+    for (int t = 0; t < trials; ++t) {
+      const int id = ids[rng() % ids.size()];
+      slot.clear();
+      offset.clear();
+      val.clear();
+      for (int dy = lo; dy <= 2; ++dy)
+        for (int dx = lo; dx <= 2; ++dx) {
+          if (dy > 0 || (dy == 0 && dx >= 0)) continue;
+          slot.push_back((dy - lo) * f + (dx - lo));
+          offset.push_back(dy * pw + dx);
+          for (int c = 0; c < C; ++c) val.push_back(planes[c * ps + id + dy * pw + dx]);
         }
-      return e;
-    };
-    std::vector<int> out;
-    index.query(slot.data(), val.data(), static_cast<int>(slot.size()), 16, 0.f, out, scratch);
-    ASSERT_FALSE(out.empty());
-    EXPECT_LE(out.size(), 16u);
-    double best = 1e300;
-    for (int c : out) best = std::min(best, known_ssd(c));
-    std::size_t better = 0;
-    for (int c : ids) better += known_ssd(c) < best;
-    good += better < ids.size() / 100;
+      auto known_ssd = [&](int cand) {
+        double e = 0;
+        for (std::size_t k = 0; k < offset.size(); ++k)
+          for (int c = 0; c < C; ++c) {
+            const double d = planes[c * ps + cand + offset[k]] - val[k * C + c];
+            e += d * d;
+          }
+        return e;
+      };
+      std::vector<int> out;
+      index.query(slot.data(), val.data(), static_cast<int>(slot.size()), 16, 0.f, out, scratch);
+      ASSERT_FALSE(out.empty());
+      EXPECT_LE(out.size(), 16u * stride * stride);
+      for (int c : out) ASSERT_TRUE(c >= 0 && std::size_t(c) < ps && is_id[c]) << c;
+      double best = 1e300;
+      for (int c : out) best = std::min(best, known_ssd(c));
+      std::size_t better = 0;
+      for (int c : ids) better += known_ssd(c) < best;
+      good += better < ids.size() / 100;
+    }
+    EXPECT_GT(good, trials * 7 / 10) << good << " of " << trials;
   }
-  EXPECT_GT(good, trials * 7 / 10) << good << " of " << trials;
+  EXPECT_THROW(PartialNeighbourhoodIndex(planes.data(), ps, pw, C, ids, f, 4, 0), InvalidInputError);
   EXPECT_THROW(PartialNeighbourhoodIndex(planes.data(), ps, pw, C, {}, f, 4), InvalidInputError);
 }
