@@ -62,7 +62,11 @@ PartialNeighbourhoodIndex::PartialNeighbourhoodIndex(const float* planes, std::s
   // Coefficients of every indexed candidate (all, or those on the stride grid).
   for (int id : ids)
     if ((id % pitch) % stride == 0 && (id / pitch) % stride == 0) ids_.push_back(id);
-  if (stride > 1) {
+  if (ids_.empty()) {  // no candidate on the grid (a tiny exemplar): index them all
+    ids_ = ids;
+    stride_ = 1;
+  }
+  if (stride_ > 1) {
     member_.assign(plane_size, 0);
     for (int id : ids) member_[id] = 1;
   }

@@ -174,5 +174,16 @@ TEST(PartialNeighbourhoodIndex, HalfKnownQueriesReturnTopRankedCandidates) {
     EXPECT_GT(good, trials * 7 / 10) << good << " of " << trials;
   }
   EXPECT_THROW(PartialNeighbourhoodIndex(planes.data(), ps, pw, C, ids, f, 4, 0), InvalidInputError);
+  {  // no candidate on the stride grid (odd x and y): all of them are indexed
+    const std::vector<int> odd = {3 * pw + 3, 3 * pw + 5, 5 * pw + 3};
+    const PartialNeighbourhoodIndex small(planes.data(), ps, pw, C, odd, f, 2, 2);
+    PartialNeighbourhoodIndex::Scratch sc;
+    const int slot0[1] = {0};
+    std::vector<float> v(C, 0.5f);
+    std::vector<int> got;
+    EXPECT_EQ(small.query(slot0, v.data(), 1, 3, 0.f, got, sc), 3u);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, odd);
+  }
   EXPECT_THROW(PartialNeighbourhoodIndex(planes.data(), ps, pw, C, {}, f, 4), InvalidInputError);
 }
