@@ -18,7 +18,8 @@
 // Usage: bench_el_search [TEXTURE_DIR] [NAME,NAME,...|-] [threads]
 // One JSON line per texture, then a summary line (how many within 5%).
 // SURFTEX_BENCH_EL_ANN="K,D,EPS;K,D,EPS..." also runs these settings of
-// (ann_candidates, ann_pca_dims, ann_eps) (tuning; "settings" in the lines).
+// (ann_candidates, ann_pca_dims, ann_eps[, ann_stride]) (tuning; "settings" in
+// the lines; ann_stride defaults to the library's).
 // SURFTEX_BENCH_EL_REFERENCE=FILE takes the exhaustive figures from an
 // earlier run's output instead of recomputing them.
 #include <nlohmann/json.hpp>
@@ -51,10 +52,12 @@ struct Run {
   double bds = 0, cpu = 0, wall = 0;
 };
 
-// One approximate-search setting (ann_candidates, ann_pca_dims, ann_eps).
+// One approximate-search setting (ann_candidates, ann_pca_dims, ann_eps,
+// ann_stride; stride 0 = the library's default).
 struct AnnSetting {
   int candidates, dims;
   double eps;
+  int stride = 0;
 };
 
 Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann = nullptr) {
@@ -64,6 +67,7 @@ Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann
     o.ann_candidates = ann->candidates;
     o.ann_pca_dims = ann->dims;
     o.ann_eps = ann->eps;
+    if (ann->stride > 0) o.ann_stride = ann->stride;
   }
   o.seed = 1;
   Run r;
@@ -97,8 +101,9 @@ int main(int argc, char** argv) {
   if (const char* t = std::getenv("SURFTEX_BENCH_EL_ANN")) {
     std::stringstream ss(t);
     for (std::string item; std::getline(ss, item, ';');) {
-      AnnSetting st{16, 10, 1.0};
-      if (std::sscanf(item.c_str(), "%d,%d,%lf", &st.candidates, &st.dims, &st.eps) == 3) settings.push_back(st);
+      AnnSetting st{16, 10, 1.0, 0};
+      if (std::sscanf(item.c_str(), "%d,%d,%lf,%d", &st.candidates, &st.dims, &st.eps, &st.stride) >= 3)
+        settings.push_back(st);
     }
   }
   // SURFTEX_BENCH_EL_REFERENCE=FILE: exhaustive figures from an earlier run's
@@ -136,7 +141,7 @@ int main(int argc, char** argv) {
       nlohmann::json tried = nlohmann::json::array();
       for (const AnnSetting& st : settings) {
         const Run c = synthesize(ex, size, ElSearch::Approximate, &st);
-        tried.push_back({{"ann", {st.candidates, st.dims, st.eps}},
+        tried.push_back({{"ann", {st.candidates, st.dims, st.eps, st.stride}},
                          {"ratio", c.bds / std::max(a.bds, 1e-12)},
                          {"cpu_seconds", c.cpu}});
       }
