@@ -1,32 +1,30 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Patch-based oriented surface synthesis speed and seams (Gorla et al. 2003,
 // section 4 / Table 1: about 1,600 synthesised texels per second on a
-// Pentium III 933 MHz, 96-99% of the time in synthesis): CGAL's
-// triceratops.off (extracted with tar from SURFTEX_CGAL_DATA_TARBALL into a
-// temporary folder), a stochastic texture from the shared data, 128x128
-// texels per patch, "up" field, window 9, preselect = exemplar width (one
-// scanline). Prints one JSON line.
+// Pentium III 933 MHz, 96-99% of the time in synthesis), at the CLI's
+// defaults (`surftex patches MESH EXEMPLAR`: PatchSynthesisOptions{}, i.e.
+// field up, 128 texels per patch side, at most 200 faces per patch, window
+// 11, preselect = exemplar width, 64 rotations, the approximate search).
+// Sets nothing else. Cases (one JSON line each):
+//  - triceratops: CGAL's triceratops.off (5,660 triangles) with leather_64
+//    (the paper's 64 x 64 sample size, Table 1);
+//  - bear: CGAL's bear.off (27.6K triangles) with pebbles_256 (issue 19's
+//    goal: a 256 px exemplar at defaults in <= 60 s on 2 threads).
+// Meshes are extracted with tar from SURFTEX_CGAL_DATA_TARBALL into a
+// temporary folder. Measurement history: docs/decisions/501-*.md.
 //
-// Measured (2 cores shared with other builds, load average 15, so wall times
-// are inflated about 2-3x; the same binary pair back to back):
-//   before (sequential patches, rotations per patch, nth_element pass 1):
-//     synthesis 49.4 s wall, 18.1 s user for the whole run, 9,077 texels/s, seam 0.966
-//   now: synthesis 27.3 s wall, 11.2 s user for the whole run (pipeline CPU
-//     9.5 s), 16,424 texels/s under that load, seam 0.964; 664 patches,
-//     448,593 texels; the patch dependency graph allows up to 8x parallelism
-//     (critical path 55,951 texels), so on a quiet 2-core machine the wall
-//     time should be about half the pipeline CPU time.
-//
-// Usage: bench_patches [texture.png] [out_dir] [patch_res] [max_patch_faces] [threads]
-// (default leather_64.png, no file output, 128, 120, all cores; "" keeps a
-// default). out_dir receives atlas.png and render.png. texels_per_second is
-// texels over the synthesis wall time; synthesis_cpu_seconds is the process
-// CPU time (all threads) of the whole pipeline call, which is load-independent.
+// Usage: bench_patches [case|all] [out_dir] [threads]
+// (default all, no file output, all cores). out_dir receives
+// CASE_atlas.png and CASE_render.png. texels_per_second is texels over the
+// synthesis wall time; pipeline_cpu_seconds is the process CPU time (all
+// threads) of the pipeline call, which is load-independent.
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include <ctime>
+#include <stdexcept>
+#include <unistd.h>
 #include <memory>
 #include <cstdio>
 #include <cstdlib>
@@ -45,43 +43,35 @@
 using namespace surftex;
 namespace fs = std::filesystem;
 
-int main(int argc, char** argv) {
-  const std::string tex = argc > 1 && argv[1][0] ? argv[1]
-                                                 : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/leather_64.png";
-  const std::string out = argc > 2 ? argv[2] : "";
-  const int res = argc > 3 && argv[3][0] ? std::atoi(argv[3]) : 128;
-  const int max_faces = argc > 4 && argv[4][0] ? std::atoi(argv[4]) : 120;
-  std::unique_ptr<tbb::global_control> limit;
-  if (argc > 5 && std::atoi(argv[5]) > 0)
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  std::atoi(argv[5]));
+namespace {
+
+Mesh cgal_mesh(const std::string& name) {
   const fs::path tmp = fs::temp_directory_path() / ("surftex_bench_patches_" + std::to_string(::getpid()));
   fs::create_directories(tmp);
   const std::string cmd = std::string("tar xzf '") + SURFTEX_CGAL_DATA_TARBALL + "' -C '" + tmp.string() +
-                          "' data/meshes/triceratops.off";
-  if (std::system(cmd.c_str()) != 0) {
-    std::fprintf(stderr, "cannot extract triceratops.off from %s\n", SURFTEX_CGAL_DATA_TARBALL);
-    return 1;
-  }
+                          "' data/meshes/" + name;
+  if (std::system(cmd.c_str()) != 0)
+    throw std::runtime_error("cannot extract " + name + " from " + SURFTEX_CGAL_DATA_TARBALL);
   Mesh mesh;
-  read_mesh((tmp / "data/meshes/triceratops.off").string(), mesh);
+  read_mesh((tmp / "data/meshes" / name).string(), mesh);
   fs::remove_all(tmp);
-  Image ex = read_image(tex);
-  if (ex.channels != 3) {
-    Image rgb(ex.width, ex.height, 3);
-    for (int y = 0; y < ex.height; ++y)
-      for (int x = 0; x < ex.width; ++x)
-        for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = ex.at(x, y, ex.channels >= 3 ? c : 0);
-    ex = rgb;
-  }
-  PatchSynthesisOptions po;
-  po.flatten.resolution = res;
-  po.flatten.margin = std::max(2, res / 32);
-  po.partition.max_faces = max_faces;
-  po.field = PatchField::Constant;
-  po.el.window = 9;
-  po.el.preselect = ex.width;
-  po.seed = 1;
+  return mesh;
+}
+
+Image rgb(const Image& ex) {  // as the CLI: grey replicated, alpha dropped
+  if (ex.channels == 3) return ex;
+  Image out(ex.width, ex.height, 3);
+  for (int y = 0; y < ex.height; ++y)
+    for (int x = 0; x < ex.width; ++x)
+      for (int c = 0; c < 3; ++c) out.at(x, y, c) = ex.at(x, y, ex.channels >= 3 ? c : 0);
+  return out;
+}
+
+void run_case(const std::string& name, const std::string& mesh_file, const std::string& texture,
+              const std::string& out) {
+  Mesh mesh = cgal_mesh(mesh_file);
+  const Image ex = rgb(read_image(std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/" + texture));
+  PatchSynthesisOptions po;  // the CLI's defaults
   Timer total;
   const std::clock_t c0 = std::clock();
   PatchSynthesisResult r = synthesize_patches(mesh, {ex}, po);
@@ -91,20 +81,26 @@ int main(int argc, char** argv) {
   const double all = total.seconds();
   if (!out.empty()) {
     fs::create_directories(out);
-    write_image(out + "/atlas.png", at.image);
+    write_image(out + "/" + name + "_atlas.png", at.image);
     ViewOptions view;
     view.size = 1024;
     view.azimuth_deg = 60.f;
     view.elevation_deg = 15.f;
     view.texture = &at.image;
-    write_image(out + "/render.png", render_view(mesh, view));
+    write_image(out + "/" + name + "_render.png", render_view(mesh, view));
   }
   nlohmann::json j;
-  j["bench"] = "patches_triceratops";
+  j["bench"] = "patches_" + name;
+  j["sets"] = "nothing (CLI defaults)";
+  j["mesh"] = mesh_file;
   j["faces"] = mesh.number_of_faces();
-  j["texture"] = fs::path(tex).filename().string();
+  j["texture"] = texture;
   j["exemplar"] = std::to_string(ex.width) + "x" + std::to_string(ex.height);
-  j["patch_res"] = res;
+  j["patch_res"] = po.flatten.resolution;
+  j["window"] = po.el.window;
+  j["preselect"] = po.el.preselect > 0 ? po.el.preselect : ex.width;
+  j["rotations"] = po.el.rotations;
+  j["search"] = po.el.search == ElSearch::Approximate ? "approximate" : "exhaustive";
   j["patches"] = r.flat.patches.size();
   j["texels_synthesized"] = r.texels;
   j["texels_per_second"] = r.texels / r.seconds_synthesis;
@@ -116,8 +112,25 @@ int main(int argc, char** argv) {
   j["synthesis_share"] = r.seconds_synthesis / r.seconds_total;
   j["seam_ratio"] = s.ratio;
   j["seam_pairs_across"] = s.pairs_across;
-  j["window"] = po.el.window;
-  j["preselect"] = po.el.preselect;
   std::printf("%s\n", j.dump().c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string which = argc > 1 && argv[1][0] ? argv[1] : "all";
+  const std::string out = argc > 2 ? argv[2] : "";
+  std::unique_ptr<tbb::global_control> limit;
+  if (argc > 3 && std::atoi(argv[3]) > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  std::atoi(argv[3]));
+  try {
+    if (which == "all" || which == "triceratops") run_case("triceratops", "triceratops.off", "leather_64.png", out);
+    if (which == "all" || which == "bear") run_case("bear", "bear.off", "pebbles_256.png", out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
   return 0;
 }

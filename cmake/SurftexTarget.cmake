@@ -10,9 +10,13 @@ endfunction()
 
 # A module library built from every .cpp in its folder: one algorithm per
 # header/source pair, so adding an algorithm needs no CMake edit.
+# EXCLUDE names sources of the folder that are built elsewhere.
 function(surftex_add_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE" ${ARGN})
   file(GLOB _srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  foreach(_x ${ARG_EXCLUDE})
+    list(REMOVE_ITEM _srcs "${CMAKE_CURRENT_SOURCE_DIR}/${_x}")
+  endforeach()
   if(_srcs)
     add_library(surftex_${name} STATIC ${_srcs})
     target_include_directories(surftex_${name} PUBLIC "${PROJECT_SOURCE_DIR}/src")
@@ -24,5 +28,13 @@ function(surftex_add_module name)
     target_include_directories(surftex_${name} INTERFACE "${PROJECT_SOURCE_DIR}/src")
     target_link_libraries(surftex_${name} INTERFACE ${ARG_DEPS})
     add_library(surftex::${name} ALIAS surftex_${name})
+  endif()
+endfunction()
+
+# SURFTEX_PCH: one precompiled header per target, made of the headers most of
+# its sources include (docs/decisions/504-first-build.md).
+function(surftex_precompile target)
+  if(SURFTEX_PCH)
+    target_precompile_headers(${target} PRIVATE ${ARGN})
   endif()
 endfunction()

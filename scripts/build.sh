@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Configures and builds surftex into build/ (or $SURFTEX_BUILD_DIR).
 # Usage: scripts/build.sh [extra cmake -D options]
+# SURFTEX_BUILD_TARGETS="surftex ..." builds only these targets (default: all,
+# i.e. the command, every test suite and every benchmark); SURFTEX_JOBS sets
+# the parallel jobs (default: the number of cores).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${SURFTEX_BUILD_DIR:-$root/build}"
@@ -13,4 +16,6 @@ else
   cmake -S "$root" -B "$build" "$@" >/dev/null
 fi
 jobs="${SURFTEX_JOBS:-$(nproc)}"
-cmake --build "$build" -j "$jobs"
+targets=()
+for t in ${SURFTEX_BUILD_TARGETS:-}; do targets+=(--target "$t"); done
+cmake --build "$build" -j "$jobs" "${targets[@]}"

@@ -41,7 +41,7 @@ namespace {
 struct PatchArgs {
   std::string exemplar_normal, exemplar_height, exemplar_roughness;
   std::string mesh, exemplar, outdir, field = "up", order = "random", resynth, exemplar2,
-                                     multi = "none", fill = "onion";
+                                     multi = "none", fill = "onion", search = "approximate";
   int patch_res = 128, max_faces = 200, window = 11, preselect = 0, rotations = 64,
       exemplar_size = 0;
   double max_angle = 30.0, bump = 2.0;
@@ -253,6 +253,7 @@ int run(const PatchArgs& a) {
   po.el.window = a.window;
   po.el.preselect = a.preselect;
   po.el.rotations = a.rotations;
+  po.el.search = a.search == "exhaustive" ? ElSearch::Exhaustive : ElSearch::Approximate;
   po.el.order = a.fill == "direction" ? FillOrder::Direction : FillOrder::OnionPeel;
   po.seed = a.common.seed;
   po.progress = terminal_progress(a.common.quiet);
@@ -266,6 +267,7 @@ int run(const PatchArgs& a) {
   rep["field"] = a.field;
   rep["order"] = a.order;
   rep["fill"] = a.fill;
+  rep["search"] = a.search;
   rep["multi"] = a.multi;
   rep["resynthesized"] = po.resynthesize;
   rep["faces"] = mesh.number_of_faces();
@@ -346,6 +348,11 @@ SubcommandRegistrar reg{
            ->check(CLI::NonNegativeNumber);
        app.add_option("--rotations", a->rotations, "Pre-rotated exemplars, 1..128 (default 64)")
            ->check(CLI::Range(1, 128));
+       app.add_option("--search", a->search,
+                      "First-pass search: approximate (coherent and kd-tree candidates, cost independent "
+                      "of the exemplar size) or exhaustive (every exemplar position, Gorla 2003 as "
+                      "published; slow on large exemplars) (default approximate)")
+           ->check(CLI::IsMember({"approximate", "exhaustive"}));
        app.add_option("--exemplar-size", a->exemplar_size,
                       "Resize exemplars so the longer side is this many pixels, 0 = as is, "
                       "16..1024 (default 0)")

@@ -25,6 +25,7 @@ struct SynthArgs {
   std::string exemplar, output, size = "256x256", method = "el2pass", angle_field;
   int window = 11, first_window = 0, preselect = 0, rotations = 64;
   double angle_deg = 0.0;
+  std::string search = "approximate";
   bool has_angle = false, periodic = false;
   CommonOptions common;
 };
@@ -74,6 +75,7 @@ ElResult run_el2pass(const SynthArgs& a, const Image& exemplar, int w, int h) {
   opt.first_pass_window = a.first_window;
   opt.preselect = a.preselect;
   opt.rotations = a.rotations;
+  opt.search = a.search == "exhaustive" ? ElSearch::Exhaustive : ElSearch::Approximate;
   opt.periodic_exemplar = a.periodic;
   opt.seed = a.common.seed;
   opt.progress = terminal_progress(a.common.quiet);
@@ -114,6 +116,9 @@ int run(const SynthArgs& a) {
   bo.periodic_exemplar = a.periodic;
   bo.stride = std::max(1, std::min(w, h) / 128);  // subsample big outputs
   bo.max_candidates = 256;                         // approximate (upper bound), bounded time
+  // Completeness from at most ~16K exemplar positions (a regular subsample).
+  const double ex_patches = double(exemplar.width) * exemplar.height;
+  bo.exemplar_stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(ex_patches / 16384.0))));
   const BidirectionalResult bs = bidirectional_similarity(r.image, exemplar, bo);
   const double chi = histogram_chi_square(r.image, exemplar);
   nlohmann::json rep;
@@ -128,11 +133,13 @@ int run(const SynthArgs& a) {
     rep["preselect"] = a.preselect > 0 ? a.preselect : exemplar.width;
     rep["orientations_searched"] = r.rotations_used;
     rep["seeded_pixels"] = r.seeded;
+    rep["search"] = a.search;
   }
   rep["seconds"] = {{"synthesis", seconds}};
   rep["texels_per_second"] = (w * static_cast<double>(h)) / std::max(seconds, 1e-9);
   rep["bidirectional_similarity"] = {{"patch", bo.patch},
                                      {"stride", bo.stride},
+                                     {"exemplar_stride", bo.exemplar_stride},
                                      {"approximate_max_candidates", bo.max_candidates},
                                      {"coherence", bs.coherence},
                                      {"completeness", bs.completeness},
@@ -184,6 +191,11 @@ SubcommandRegistrar reg{
        app.add_option("--rotations", a->rotations,
                       "Number of pre-rotated exemplars for oriented synthesis, 1..128 (default 64)")
            ->check(CLI::Range(1, 128));
+       app.add_option("--search", a->search,
+                      "First-pass search: approximate (coherent and kd-tree candidates, cost independent "
+                      "of the exemplar size) or exhaustive (every exemplar position, Gorla 2003 as "
+                      "published; slow on large exemplars) (default approximate)")
+           ->check(CLI::IsMember({"approximate", "exhaustive"}));
        app.add_flag("--periodic", a->periodic,
                     "The exemplar tiles seamlessly: neighbourhoods wrap around its edges "
                     "(default off)");

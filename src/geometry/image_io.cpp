@@ -17,8 +17,6 @@ namespace surftex {
 
 namespace {
 
-ImageLimits g_limits;
-
 // Takes every pending OpenImageIO message (the reader's and the global
 // ones): OIIO prints those left unretrieved when the reader is destroyed, and
 // aborts once more than 16 MB accumulate (a TIFF claiming 2^31-1 rows that
@@ -54,7 +52,7 @@ void check_spec(const OIIO::ImageSpec& spec, const std::string& path, const Imag
 
 Image read_current(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec& spec = in.spec();
-  check_spec(spec, path, g_limits);
+  check_spec(spec, path, image_limits());
   Image img(spec.width, spec.height, spec.nchannels);
   if (!in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
                      img.data.data())) {
@@ -195,14 +193,6 @@ void check_writable(const Image& img, const std::string& path) {
 
 }  // namespace
 
-long long ImageLimits::max_side() const {
-  const auto s = static_cast<long long>(std::ceil(std::sqrt(static_cast<double>(std::max(0LL, max_pixels)))));
-  return std::max(16384LL, s);
-}
-
-void set_image_limits(const ImageLimits& limits) { g_limits = limits; }
-const ImageLimits& image_limits() { return g_limits; }
-
 ImageHeader read_image_header(const std::string& path, const ImageLimits& limits) {
   auto in = open_input(path, limits);
   const OIIO::ImageSpec spec = in->spec();
@@ -218,24 +208,24 @@ ImageHeader read_image_header(const std::string& path, const ImageLimits& limits
 }
 
 Image read_image(const std::string& path) {
-  auto in = open_input(path, g_limits);
+  auto in = open_input(path, image_limits());
   Image img = read_current(*in, path);
   in->close();
   return img;
 }
 
 std::vector<Image> read_image_layers(const std::string& path) {
-  auto in = open_input(path, g_limits);
+  auto in = open_input(path, image_limits());
   std::vector<Image> layers;
   int sub = 0;
   long long bytes = 0;
   do {
     const OIIO::ImageSpec& spec = in->spec();
-    check_spec(spec, path, g_limits);  // before the product below (no overflow)
+    check_spec(spec, path, image_limits());  // before the product below (no overflow)
     bytes += static_cast<long long>(spec.width) * spec.height * spec.nchannels * 4;
-    if (bytes > 4 * g_limits.max_bytes())
+    if (bytes > 4 * image_limits().max_bytes())
       throw InvalidInputError("image '" + path + "': its " + std::to_string(sub + 1) + " layers hold more than " +
-                              std::to_string(4 * g_limits.max_bytes() >> 20) +
+                              std::to_string(4 * image_limits().max_bytes() >> 20) +
                               " MiB decoded (4 times the per-image limit; pass --max-image-pixels to raise it)");
     layers.push_back(read_current(*in, path));
     ++sub;

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/bidirectional_similarity.h"
 
-#include <Eigen/Dense>
-#include <nanoflann.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 #include <vector>
 
 #include "geometry/errors.h"
+#include "texture/pca_kdtree.h"
 
 namespace surftex {
 namespace {
@@ -88,63 +87,22 @@ double ssd_bounded(const float* a, const float* b, int dim, double bound) {
   return s;
 }
 
-struct Cloud {
-  const std::vector<double>* pts;
-  int dim;
-  std::size_t n;
-  std::size_t kdtree_get_point_count() const { return n; }
-  double kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i * dim + d]; }
-  template <class B>
-  bool kdtree_get_bbox(B&) const {
-    return false;
-  }
-};
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud,
-                                                 -1, std::uint32_t>;
-
-// PCA basis (dim x d, orthonormal columns) and mean from a sample of patches.
-struct Pca {
-  Eigen::VectorXd mean;
-  Eigen::MatrixXd basis;
-};
-
-Pca fit_pca(const Patches& a, const Patches& b, int d) {
-  const int dim = a.dim;
-  Pca pca;
-  pca.mean = Eigen::VectorXd::Zero(dim);
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(dim, dim);
-  std::size_t used = 0;
+// PCA (dims directions) fitted on a sample of the patches of both images.
+PcaBasis fit_patch_pca(const Patches& a, const Patches& b, int d) {
+  PcaFit fit(a.dim);
   auto add = [&](const Patches& p) {
     const std::size_t step = std::max<std::size_t>(1, p.count / 8000);
-    for (std::size_t i = 0; i < p.count; i += step) {
-      Eigen::Map<const Eigen::VectorXf> r(p.row(i), dim);
-      Eigen::VectorXd x = r.cast<double>();
-      pca.mean += x;
-      cov.selfadjointView<Eigen::Lower>().rankUpdate(x);
-      ++used;
-    }
+    for (std::size_t i = 0; i < p.count; i += step) fit.add(p.row(i));
   };
   add(a);
   add(b);
-  pca.mean /= static_cast<double>(used);
-  cov = cov.selfadjointView<Eigen::Lower>();
-  cov /= static_cast<double>(used);
-  cov -= pca.mean * pca.mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(cov);
-  if (es.info() != Eigen::Success)
-    throw SolverError("bidirectional_similarity: PCA eigen decomposition failed");
-  pca.basis = es.eigenvectors().rightCols(d);  // eigenvalues ascend: keep the largest
-  return pca;
+  return fit.fit(d, "bidirectional_similarity");
 }
 
-std::vector<double> project(const Patches& p, const Pca& pca) {
-  const int d = static_cast<int>(pca.basis.cols());
+std::vector<double> project(const Patches& p, const PcaBasis& pca) {
+  const int d = pca.dims;
   std::vector<double> out(p.count * d);
-  tbb::parallel_for(std::size_t(0), p.count, [&](std::size_t i) {
-    Eigen::Map<const Eigen::VectorXf> r(p.row(i), p.dim);
-    Eigen::VectorXd c = pca.basis.transpose() * (r.cast<double>() - pca.mean);
-    std::copy(c.data(), c.data() + d, out.begin() + i * d);
-  });
+  tbb::parallel_for(std::size_t(0), p.count, [&](std::size_t i) { pca.project(p.row(i), out.data() + i * d); });
   return out;
 }
 
@@ -155,19 +113,17 @@ std::vector<double> project(const Patches& p, const Pca& pca) {
 // tree offers is re-ranked with the full SSD. The result is the exact minimum
 // (the visiting order only changes the speed). With max_candidates > 0 the
 // search stops after that many full evaluations (approximate, an upper bound).
-struct NearestByBound {
+struct NearestByBound : KdIndex<double>::Visitor {
   const float* query;
   const Patches* base;
   std::size_t max_candidates;
   double best = std::numeric_limits<double>::infinity();
   std::size_t evaluated = 0;
-  std::size_t size() const { return evaluated; }
-  bool full() const { return true; }
-  // Slack for the float rounding of the projection (the bound is exact in
-  // exact arithmetic).
-  double worstDist() const { return best * (1.0 + 1e-9); }
-  bool addPoint(double lower_bound, std::uint32_t index) {
-    if (lower_bound > worstDist()) return true;
+  NearestByBound(const float* q, const Patches* b, std::size_t m) : query(q), base(b), max_candidates(m) {}
+  // Slack for the rounding of the projection (the bound is exact in exact
+  // arithmetic).
+  double bound() const override { return best * (1.0 + 1e-9); }
+  bool add(double, std::uint32_t index) override {
     best = std::min(best, ssd_bounded(query, base->row(index), base->dim, best));
     ++evaluated;
     return max_candidates == 0 || evaluated < max_candidates;
@@ -175,29 +131,37 @@ struct NearestByBound {
 };
 
 // Mean over `queries` of the distance to the nearest patch of `base`.
-double mean_nearest(const Patches& queries, const Patches& base, const Pca* pca,
+// `subset`: the query indices to average over (empty = all).
+double mean_nearest(const Patches& queries, const Patches& base, const PcaBasis* pca,
                     const std::vector<double>& qproj, const std::vector<double>& bproj,
-                    std::size_t max_candidates) {
-  std::vector<double> best(queries.count);
+                    std::size_t max_candidates, const std::vector<std::size_t>& subset = {}) {
+  std::vector<std::size_t> all;
+  if (subset.empty()) {
+    all.resize(queries.count);
+    for (std::size_t i = 0; i < queries.count; ++i) all[i] = i;
+  }
+  const std::vector<std::size_t>& qs = subset.empty() ? all : subset;
+  std::vector<double> best(qs.size());
   if (!pca) {
-    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
+    tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
+      const std::size_t i = qs[k];
       double b = std::numeric_limits<double>::infinity();
       for (std::size_t j = 0; j < base.count; ++j) b = std::min(b, ssd(queries.row(i), base.row(j), base.dim));
-      best[i] = b;
+      best[k] = b;
     });
   } else {
-    const int d = static_cast<int>(pca->basis.cols());
-    Cloud cloud{&bproj, d, base.count};
-    Tree tree(d, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    tbb::parallel_for(std::size_t(0), queries.count, [&](std::size_t i) {
-      NearestByBound r{queries.row(i), &base, max_candidates};
-      tree.findNeighbors(r, qproj.data() + i * d, nanoflann::SearchParams());
-      best[i] = r.best;
+    const int d = pca->dims;
+    const KdIndex<double> tree(bproj, d);
+    tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
+      const std::size_t i = qs[k];
+      NearestByBound r(queries.row(i), &base, max_candidates);
+      tree.search(qproj.data() + i * d, r);
+      best[k] = r.best;
     });
   }
   double sum = 0;
   for (double v : best) sum += v;
-  return sum / static_cast<double>(queries.count) / base.dim;
+  return sum / static_cast<double>(qs.size()) / base.dim;
 }
 
 }  // namespace
@@ -241,7 +205,7 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
     r.coherence = mean_nearest(out, ex, nullptr, none, none, 0);
     r.completeness = mean_nearest(queries, out, nullptr, none, none, 0);
   } else {
-    const Pca pca = fit_pca(ex, out, std::min(opt.pca_dims, ex.dim));
+    const PcaBasis pca = fit_patch_pca(ex, out, std::min(opt.pca_dims, ex.dim));
     const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
     r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates);
     const std::vector<double> pq = opt.exemplar_stride > 1 ? project(queries, pca) : std::vector<double>();

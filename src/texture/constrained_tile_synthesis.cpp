@@ -16,14 +16,15 @@
 //    neighbourhoods already match exactly (the paper's I_0 = identity);
 //  - the coarsest level runs layer after layer (each starts from the previous
 //    one); the finer levels of different layers are independent and run in
-//    parallel, each with its own seeded random stream;
+//    parallel, each with its own seeded random stream; the exemplar's levels
+//    (PCA, feature vectors, kd-tree) are built in parallel too;
 //  - speed: at the finer levels only the first `fine_ann_passes` passes query
-//    the kd-tree; later passes choose among the current and coherent
-//    candidates (the map is already mask-consistent after the first pass).
+//    the kd-tree, and (fine_ann_only_mismatched) only for the texels whose
+//    current exemplar pixel's 3x3 mask disagrees with the target's; other
+//    texels and later passes choose among the current and coherent
+//    candidates (the upsampled map follows the mask away from its edges).
 #include "texture/constrained_tile_synthesis.h"
 
-#include <Eigen/Dense>
-#include <nanoflann.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -36,6 +37,7 @@
 
 #include "geometry/errors.h"
 #include "texture/gaussian_pyramid.h"
+#include "texture/pca_kdtree.h"
 
 namespace surftex {
 
@@ -67,79 +69,32 @@ Image first_channel(const Image& m) {
 constexpr int kColR = 2;  // 5x5 colour window
 constexpr int kMaskR = 1; // 3x3 mask window
 
-// Flat row-major point cloud for nanoflann.
-struct FeatureCloud {
-  std::vector<float> pts;
-  int dim = 0;
-  std::size_t kdtree_get_point_count() const { return dim ? pts.size() / dim : 0; }
-  float kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i * dim + d]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FeatureCloud>,
-                                                   FeatureCloud, -1, std::uint32_t>;
-
 // Everything about the exemplar at one level.
 struct ExemplarLevel {
   Image colour, mask;
   int w = 0, h = 0, C = 0, d = 0, D = 0;
-  int dm = 0;                // mask coefficients
-  std::vector<float> mean;   // 25 C
-  std::vector<float> basis;  // d x 25C row-major
-  std::vector<float> mmean;  // 9 (weighted mask neighbourhood mean)
-  std::vector<float> mbasis; // dm x 9 (identity when the mask is not reduced)
-  FeatureCloud cloud;        // n x D
-  std::unique_ptr<KdTree> tree;
-  double scale = 0;          // V: mean squared norm of centred feature vectors
+  int dm = 0;                  // mask coefficients
+  PcaBasis colour_pca;         // 25 C -> d
+  PcaBasis mask_pca;           // 9 (weighted mask neighbourhood) -> dm
+  std::unique_ptr<KdIndex<float>> tree;  // n x D feature vectors
+  double scale = 0;            // V: mean squared norm of centred feature vectors
+  const float* feature(std::size_t i) const { return tree->point(i); }
 };
 
-void project(const std::vector<float>& basis, int d, int raw, const float* centred, float* out) {
-  for (int k = 0; k < d; ++k) {
-    const float* b = &basis[std::size_t(k) * raw];
-    float s = 0;
-    for (int i = 0; i < raw; ++i) s += b[i] * centred[i];
-    out[k] = s;
-  }
-}
-
 // PCA of the `raw`-dimensional vectors vec(x, y) over a regular subsample (at
-// most ~16k) of the w x h pixels: mean and the top-d eigenvectors (rows),
-// sign-normalised so the largest entry is positive (deterministic basis).
+// most ~16k) of the w x h pixels (texture/pca_kdtree.h).
 template <class VecFn>
-void fit_pca(int raw, int d, int w, int h, VecFn vec, std::vector<float>& mean_out,
-             std::vector<float>& basis_out) {
+PcaBasis fit_pca(int raw, int d, int w, int h, VecFn vec) {
   int stride = 1;
   while ((std::size_t(w) * h) / (std::size_t(stride) * stride) > 16384) ++stride;
   std::vector<float> v(raw);
-  Eigen::VectorXd mean = Eigen::VectorXd::Zero(raw);
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(raw, raw);
-  long long cnt = 0;
+  PcaFit fit(raw);
   for (int y = 0; y < h; y += stride)
     for (int x = 0; x < w; x += stride) {
       vec(x, y, v.data());
-      Eigen::VectorXd ed = Eigen::Map<const Eigen::VectorXf>(v.data(), raw).cast<double>();
-      mean += ed;
-      cov.selfadjointView<Eigen::Lower>().rankUpdate(ed);
-      ++cnt;
+      fit.add(v.data());
     }
-  mean /= double(cnt);
-  cov = cov.selfadjointView<Eigen::Lower>();
-  cov = cov / double(cnt) - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
-  if (eig.info() != Eigen::Success)
-    throw SolverError("constrained tile synthesis: PCA eigen-decomposition failed (" +
-                      std::to_string(raw) + " dimensions, level " + std::to_string(w) + "x" +
-                      std::to_string(h) + ")");
-  mean_out.assign(raw, 0.f);
-  for (int i = 0; i < raw; ++i) mean_out[i] = static_cast<float>(mean[i]);
-  basis_out.assign(std::size_t(d) * raw, 0.f);
-  for (int k = 0; k < d; ++k) {  // eigenvalues ascending: take the last d
-    Eigen::VectorXd ev = eig.eigenvectors().col(raw - 1 - k);
-    int big = 0;
-    ev.cwiseAbs().maxCoeff(&big);
-    if (ev[big] < 0) ev = -ev;
-    for (int i = 0; i < raw; ++i) basis_out[std::size_t(k) * raw + i] = static_cast<float>(ev[i]);
-  }
+  return fit.fit(d, "constrained tile synthesis (level " + std::to_string(w) + "x" + std::to_string(h) + ")");
 }
 
 void build_exemplar_level(ExemplarLevel& L, const Image& colour, const Image& mask,
@@ -163,48 +118,58 @@ void build_exemplar_level(ExemplarLevel& L, const Image& colour, const Image& ma
         for (int c = 0; c < L.C; ++c) out[k++] = p[c];
       }
   };
-  fit_pca(raw, L.d, L.w, L.h, raw_vec, L.mean, L.basis);
+  L.colour_pca = fit_pca(raw, L.d, L.w, L.h, raw_vec);
   auto mask_vec = [&](int x, int y, float* out) {
     int k = 0;
     for (int dy = -kMaskR; dy <= kMaskR; ++dy)
       for (int dx = -kMaskR; dx <= kMaskR; ++dx)
         out[k++] = static_cast<float>(opt.mask_weight) * mask.at(wrap(x + dx, L.w), wrap(y + dy, L.h));
   };
-  fit_pca(mask_n, L.dm, L.w, L.h, mask_vec, L.mmean, L.mbasis);
+  L.mask_pca = fit_pca(mask_n, L.dm, L.w, L.h, mask_vec);
   // Feature vectors of every exemplar pixel.
-  L.cloud.dim = L.D;
-  L.cloud.pts.assign(n * L.D, 0.f);
+  std::vector<float> pts(n * L.D, 0.f);
   tbb::parallel_for(0, L.h, [&](int y) {
     std::vector<float> rv(raw);
     float mv[9];
     for (int x = 0; x < L.w; ++x) {
       raw_vec(x, y, rv.data());
-      float* f = &L.cloud.pts[(std::size_t(y) * L.w + x) * L.D];
-      for (int i = 0; i < raw; ++i) rv[i] -= L.mean[i];
-      project(L.basis, L.d, raw, rv.data(), f);
+      float* f = &pts[(std::size_t(y) * L.w + x) * L.D];
+      L.colour_pca.project(rv.data(), f);
       mask_vec(x, y, mv);
-      for (int i = 0; i < mask_n; ++i) mv[i] -= L.mmean[i];
-      project(L.mbasis, L.dm, mask_n, mv, f + L.d);
+      L.mask_pca.project(mv, f + L.d);
     }
   });
   std::vector<double> fmean(L.D, 0.0);
   for (std::size_t i = 0; i < n; ++i)
-    for (int k = 0; k < L.D; ++k) fmean[k] += L.cloud.pts[i * L.D + k];
+    for (int k = 0; k < L.D; ++k) fmean[k] += pts[i * L.D + k];
   for (double& m : fmean) m /= double(n);
   double var = 0;
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < L.D; ++k) {
-      double e = L.cloud.pts[i * L.D + k] - fmean[k];
+      double e = pts[i * L.D + k] - fmean[k];
       var += e * e;
     }
   L.scale = std::max(var / double(n), 1e-12);
-  L.tree = std::make_unique<KdTree>(L.D, L.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  L.tree = std::make_unique<KdIndex<float>>(std::move(pts), L.D);
+}
+
+// True when the 3x3 feature mask around texel (i, j)'s current exemplar pixel
+// differs (thresholded at 0.5) from the target mask around (i, j).
+bool mask_mismatch(const IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int i, int j) {
+  const int w = map.width, h = map.height;
+  const int cx = map.x(i, j), cy = map.y(i, j);
+  for (int dy = -kMaskR; dy <= kMaskR; ++dy)
+    for (int dx = -kMaskR; dx <= kMaskR; ++dx)
+      if ((L.mask.at(wrap(cx + dx, L.w), wrap(cy + dy, L.h)) > 0.5f) !=
+          (target_mask.at(wrap(i + dx, w), wrap(j + dy, h)) > 0.5f))
+        return true;
+  return false;
 }
 
 // Optimises one indirection map in place at one level (section 1.2 "Optimization").
 void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& target_mask, int passes,
                   std::uint64_t seed, const ConstrainedSynthesisOptions& opt, double exclude,
-                  int ann_passes) {
+                  int ann_passes, bool ann_only_mismatched) {
   const int w = map.width, h = map.height;
   const std::size_t n_out = std::size_t(w) * h;
   const int raw = (2 * kColR + 1) * (2 * kColR + 1) * L.C;
@@ -217,12 +182,10 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
   const std::size_t k_ann = static_cast<std::size_t>(opt.candidates);
   std::vector<std::uint32_t> nn_idx(k_ann);
   std::vector<float> nn_d2(k_ann), rv(raw), q(L.D);
-  const int mask_n = (2 * kMaskR + 1) * (2 * kMaskR + 1);
   float mv[9];
   std::vector<std::uint32_t> order(n_out);
   std::iota(order.begin(), order.end(), 0u);
   std::mt19937_64 rng(seed);
-  nanoflann::SearchParams sp(32, static_cast<float>(opt.ann_eps));
   for (int pass = 0; pass < passes; ++pass) {
     std::shuffle(order.begin(), order.end(), rng);
     for (std::uint32_t t : order) {
@@ -233,23 +196,18 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
         for (int dx = -kColR; dx <= kColR; ++dx) {
           std::size_t tt = std::size_t(wrap(j + dy, h)) * w + wrap(i + dx, w);
           const float* p = L.colour.pixel(map.coords[2 * tt], map.coords[2 * tt + 1]);
-          for (int c = 0; c < L.C; ++c, ++k) rv[k] = p[c] - L.mean[k];
+          for (int c = 0; c < L.C; ++c, ++k) rv[k] = p[c];
         }
-      project(L.basis, L.d, raw, rv.data(), q.data());
+      L.colour_pca.project(rv.data(), q.data());
       // ... followed by the target mask around (i,j), projected likewise.
       k = 0;
       for (int dy = -kMaskR; dy <= kMaskR; ++dy)
         for (int dx = -kMaskR; dx <= kMaskR; ++dx, ++k)
-          mv[k] = static_cast<float>(opt.mask_weight) * target_mask.at(wrap(i + dx, w), wrap(j + dy, h)) -
-                  L.mmean[k];
-      project(L.mbasis, L.dm, mask_n, mv, q.data() + L.d);
+          mv[k] = static_cast<float>(opt.mask_weight) * target_mask.at(wrap(i + dx, w), wrap(j + dy, h));
+      L.mask_pca.project(mv, q.data() + L.d);
       std::size_t found = 0;
-      if (pass < ann_passes) {
-        nanoflann::KNNResultSet<float, std::uint32_t> rs(k_ann);
-        rs.init(nn_idx.data(), nn_d2.data());
-        L.tree->findNeighbors(rs, q.data(), sp);
-        found = rs.size();
-      }
+      if (pass < ann_passes && (!ann_only_mismatched || mask_mismatch(map, L, target_mask, i, j)))
+        found = L.tree->knn(q.data(), k_ann, static_cast<float>(opt.ann_eps), nn_idx.data(), nn_d2.data());
       // Candidates: ANN results, the current pixel, the coherent ones.
       std::uint32_t cand[32];
       int nc = 0;
@@ -272,7 +230,7 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
           dy = std::min(dy, L.h - dy);
           if (double(dx) * dx + double(dy) * dy < exclude * exclude) continue;
         }
-        const float* f = &L.cloud.pts[c * L.D];
+        const float* f = L.feature(c);
         double d2 = 0;
         for (int b = 0; b < L.D; ++b) {
           double e = double(q[b]) - f[b];
@@ -371,7 +329,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
   std::vector<std::vector<Image>> tmask_pyr(K);
   tbb::parallel_for(0, K, [&](int k) { tmask_pyr[k] = pyramid(first_channel(target_masks[k]), levels); });
   std::vector<ExemplarLevel> ex(levels);
-  for (int r = 0; r < levels; ++r) build_exemplar_level(ex[r], col_pyr[r], emask_pyr[r], opt);
+  tbb::parallel_for(0, levels, [&](int r) { build_exemplar_level(ex[r], col_pyr[r], emask_pyr[r], opt); });
   report_progress(opt.progress, "tile synthesis", 0.05);
 
   ConstrainedSynthesisResult res;
@@ -395,7 +353,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
     }
     if (k > 0 || opt.random_first_layer)
       optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt,
-                   opt.exclude_radius * ex[0].w / W, opt.coarse_passes);
+                   opt.exclude_radius * ex[0].w / W, opt.coarse_passes, false);
     report_progress(opt.progress, "tile synthesis", 0.05 + 0.25 * (k + 1) / K);
   }
   // Finer levels: layers are independent.
@@ -409,7 +367,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
       }
       m = upsample_map(res.maps[k][r - 1], ex[r].w, ex[r].h);
       optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt,
-                   opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes);
+                   opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes, opt.fine_ann_only_mismatched);
     }
     int d = ++done;
     report_progress(opt.progress, "tile synthesis", 0.3 + 0.7 * d / K);

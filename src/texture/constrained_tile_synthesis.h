@@ -15,7 +15,7 @@
 // (3) above; each pass visits the texels in a seeded random order and replaces
 // I(p) by the exemplar pixel whose neighbourhood vector is nearest, where the
 // vector is the 5x5 colour neighbourhood reduced by PCA (Eigen) to `pca_dims`
-// (8) coefficients, followed by the 3x3 feature mask scaled by `mask_weight` (2).
+// (5) coefficients, followed by the 3x3 feature mask scaled by `mask_weight` (2).
 // Nearest neighbours: a kd-tree (nanoflann) approximate search for `candidates`
 // neighbours, plus the current and the four coherent candidates (I(p+o) - o);
 // each candidate is penalised by how many output texels already use it, which
@@ -50,12 +50,19 @@ struct ConstrainedSynthesisOptions {
   /// others only compare the current and coherent candidates. The coarsest
   /// level always queries it in every pass.
   int fine_ann_passes = 1;
-  int pca_dims = 8;        ///< PCA coefficients of the 5x5 colour neighbourhood (1..25*channels)
+  /// At the finer levels, query the kd-tree only for texels whose current
+  /// exemplar pixel's 3x3 feature mask differs from the target's (the others
+  /// compare the current and coherent candidates only). Default on.
+  bool fine_ann_only_mismatched = true;
+  /// PCA coefficients of the 5x5 colour neighbourhood (1..25*channels).
+  /// Default 5, the paper's timing setting (section 4: "5x5 patch size for
+  /// colors (reduced to a 5 dimensions vector)"; section 1.2 mentions 8).
+  int pca_dims = 5;
   double mask_weight = 2;  ///< scale of the 3x3 mask entries in the vector (>= 0)
   /// PCA coefficients kept of the (weighted) 3x3 mask neighbourhood (0..9,
   /// 0 = all 9 raw entries). Default 3, the paper's figure (section 4,
   /// "3x3 patch size for feature (reduced to a 3 dimensions vector)"); it keeps
-  /// the kd-tree low-dimensional (11 instead of 17), which is what makes it fast.
+  /// the kd-tree low-dimensional (8 instead of 14), which is what makes it fast.
   int mask_pca_dims = 3;
   /// Reuse penalty: a candidate used u times (by other texels) costs
   /// reuse_penalty * u * V more, V the mean squared norm of the centred

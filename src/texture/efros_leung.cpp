@@ -20,6 +20,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/timer.h"
+#include "texture/partial_neighbourhood_index.h"
 #include "texture/rotated_exemplars.h"
 
 namespace surftex {
@@ -225,6 +226,24 @@ struct SearchImage {
   // Span blocks of roughly equal size for the parallel pass 1.
   std::vector<std::pair<int, int>> blocks;
   int max_span = 0;
+  std::vector<std::uint8_t> is_candidate;  // per buffer position: 1 = a candidate centre
+  // Periodic exemplars: the candidate centres are one period, [margin,
+  // margin + core_w) x [margin, margin + core_h); positions outside it are
+  // the same neighbourhoods shifted by a period.
+  bool periodic = false;
+  int margin = 0, core_w = 0, core_h = 0;
+  /// The candidate centre equivalent to buffer position c, or -1.
+  int candidate_at(long long c) const {
+    if (periodic) {
+      if (c < 0 || c >= static_cast<long long>(pw) * ph) return -1;
+      int x = static_cast<int>(c % pw) - margin, y = static_cast<int>(c / pw) - margin;
+      x = ((x % core_w) + core_w) % core_w;
+      y = ((y % core_h) + core_h) % core_h;
+      return (y + margin) * pw + x + margin;
+    }
+    return c >= 0 && c < static_cast<long long>(is_candidate.size()) && is_candidate[c] ? static_cast<int>(c) : -1;
+  }
+  std::unique_ptr<PartialNeighbourhoodIndex> ann;  // approximate search only
 
   const float* plane(int c) const { return planes.data() + static_cast<std::size_t>(c) * pw * ph; }
 };
@@ -275,6 +294,12 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
     s.max_span = std::max(s.max_span, sp.x1 - sp.x0);
     for (int x = sp.x0; x < sp.x1; ++x) s.ids.push_back(sp.y * s.pw + x);
   }
+  s.is_candidate.assign(n, 0);
+  for (int id : s.ids) s.is_candidate[id] = 1;
+  s.periodic = periodic;
+  s.margin = margin;
+  s.core_w = core_w;
+  s.core_h = core_h;
   // Blocks of spans for pass 1 (the partition does not affect the result).
   const int want = std::max(1, tbb::this_task_arena::max_concurrency());
   const int per = std::max<int>(1, (static_cast<int>(s.ids.size()) + want - 1) / want);
@@ -297,6 +322,9 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
     bad("window " + std::to_string(opt.window) + " outside 3..51");
   if (opt.rotations < 1 || opt.rotations > 128)
     bad("rotations " + std::to_string(opt.rotations) + " outside 1..128");
+  if (opt.ann_stride < 1 || opt.ann_stride > 4)
+    bad("ann_stride " + std::to_string(opt.ann_stride) + " outside 1..4");
+  if (opt.ann_pca_dims < 1) bad("ann_pca_dims " + std::to_string(opt.ann_pca_dims) + " < 1");
   if (exemplars.empty()) bad("exemplars: none given");
   for (std::size_t e = 0; e < exemplars.size(); ++e) {
     const Image& ex = exemplars[e];
@@ -317,36 +345,38 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
 }  // namespace
 
 // Search images built on first use: slot e * rotations + k holds exemplar e
-// rotated by 2 pi k / rotations. A slot, once built, never changes, so
-// readers only need the acquire load of its pointer.
+// rotated by 2 pi k / rotations. Each slot is built once (its own once_flag,
+// so different slots build concurrently); a built slot never changes.
 struct ElPreparedExemplars {
   std::vector<Image> exemplars;
-  int window = 0, rotations = 1;
+  int window = 0, first_window = 0, rotations = 1, ann_pca_dims = 0, ann_stride = 1;
   bool periodic = false;
-  mutable std::mutex build_mutex;
-  mutable std::vector<std::unique_ptr<SearchImage>> storage;
-  mutable std::unique_ptr<std::atomic<const SearchImage*>[]> slots;
+  ElSearch search = ElSearch::Approximate;
+  mutable std::unique_ptr<std::once_flag[]> once;
+  mutable std::unique_ptr<std::unique_ptr<SearchImage>[]> slots;
 
   const SearchImage& get(int e, int k) const {
     const std::size_t i = static_cast<std::size_t>(e) * rotations + k;
-    if (const SearchImage* s = slots[i].load(std::memory_order_acquire)) return *s;
-    std::lock_guard<std::mutex> lock(build_mutex);
-    if (const SearchImage* s = slots[i].load(std::memory_order_relaxed)) return *s;
+    std::call_once(once[i], [&] { slots[i] = build(e, k); });
+    return *slots[i];
+  }
+
+  std::unique_ptr<SearchImage> build(int e, int k) const {
     const Image& ex = exemplars[e];
     const int margin = std::max(-lo_of(window), hi_of(window));
     RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
-    auto s = std::make_unique<SearchImage>(
-        make_search_image(r, window, periodic, margin, ex.width, ex.height));
+    auto s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));
     if (s->ids.empty())
       throw InvalidInputError("efros_leung: exemplar " + std::to_string(e) + " rotated by " +
                               std::to_string(360.0 * k / rotations) +
-                              " degrees has no position where the whole window " +
-                              std::to_string(window) +
+                              " degrees has no position where the whole window " + std::to_string(window) +
                               " fits; use a larger exemplar, a smaller window or "
                               "periodic_exemplar");
-    storage.push_back(std::move(s));
-    slots[i].store(storage.back().get(), std::memory_order_release);
-    return *storage.back();
+    if (search == ElSearch::Approximate)
+      s->ann = std::make_unique<PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
+                                                           s->pw, s->channels, s->ids, first_window, ann_pca_dims,
+                                                           ann_stride);
+    return s;
   }
 };
 
@@ -358,11 +388,15 @@ std::shared_ptr<ElPreparedExemplars> prepare(const std::vector<Image>& exemplars
   auto p = std::make_shared<ElPreparedExemplars>();
   p->exemplars = exemplars;
   p->window = opt.window;
+  p->first_window = el_first_pass_window(opt);
   p->rotations = opt.rotations;
   p->periodic = opt.periodic_exemplar;
+  p->search = opt.search;
+  p->ann_pca_dims = opt.ann_pca_dims;
+  p->ann_stride = opt.ann_stride;
   const std::size_t n = exemplars.size() * static_cast<std::size_t>(opt.rotations);
-  p->slots = std::make_unique<std::atomic<const SearchImage*>[]>(n);
-  for (std::size_t i = 0; i < n; ++i) p->slots[i].store(nullptr, std::memory_order_relaxed);
+  p->once = std::make_unique<std::once_flag[]>(n);
+  p->slots = std::make_unique<std::unique_ptr<SearchImage>[]>(n);
   return p;
 }
 
@@ -377,6 +411,7 @@ class Synthesizer {
   int search_key(int p) const { return key_[p]; }
   void gather_known(int p, const SearchImage& s);
   int pass1(const SearchImage& s, std::size_t n);
+  void pass1_short_list(const SearchImage& s, std::size_t n);
   void select_smallest(const SearchImage& s, std::size_t n);
   void score_full(const SearchImage& s, const std::vector<int>& ids, std::vector<Scored>& out);
   void synthesize_pixel(int p);
@@ -411,12 +446,19 @@ class Synthesizer {
   std::vector<float> err_, sample_, p2_err_;
   std::vector<int> pre_;
   std::vector<Scored> scored_, collect_;
-  std::size_t synthesized_ = 0, seeded_ = 0;
+  std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0;
   std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
   std::vector<ElSource> source_;         // per pixel: where its value came from
   void record_source(int q, int p, int id, const SearchImage& s) {
     source_[q] = {pair_of_[p] / opt_.rotations, pair_of_[p] % opt_.rotations, id % s.pw, id / s.pw};
   }
+  // Approximate search: source position (buffer offset in the pixel's own
+  // search image) of every synthesised pixel, -1 for the others; the known
+  // first-pass neighbours' window slots; the short list.
+  std::vector<int> src_;
+  std::vector<int> p1_slot_;
+  std::vector<int> short_;
+  PartialNeighbourhoodIndex::Scratch ann_scratch_;
 };
 
 void Synthesizer::validate() {
@@ -428,6 +470,15 @@ void Synthesizer::validate() {
     bad("first_pass_window " + std::to_string(opt_.first_pass_window) + " outside 3..window (" +
         std::to_string(opt_.window) + ") or 0");
   if (opt_.preselect < 0) bad("preselect " + std::to_string(opt_.preselect) + " < 0");
+  if (opt_.search != ElSearch::Approximate && opt_.search != ElSearch::Exhaustive)
+    bad("search holds an unknown value " + std::to_string(static_cast<int>(opt_.search)));
+  if (opt_.ann_candidates < 1 || opt_.ann_candidates > 256)
+    bad("ann_candidates " + std::to_string(opt_.ann_candidates) + " outside 1..256");
+  if (opt_.ann_pca_dims < 1) bad("ann_pca_dims " + std::to_string(opt_.ann_pca_dims) + " < 1");
+  if (opt_.ann_stride < 1 || opt_.ann_stride > 4)
+    bad("ann_stride " + std::to_string(opt_.ann_stride) + " outside 1..4");
+  if (!(opt_.ann_eps >= 0.0) || !std::isfinite(opt_.ann_eps))
+    bad("ann_eps " + std::to_string(opt_.ann_eps) + " must be finite and >= 0");
   if (!(opt_.gaussian_sigma >= 0.0) || !std::isfinite(opt_.gaussian_sigma))
     bad("gaussian_sigma " + std::to_string(opt_.gaussian_sigma) + " must be finite and >= 0");
   if (!(opt_.pick_fraction >= 0.0 && opt_.pick_fraction <= 1.0))
@@ -452,6 +503,13 @@ void Synthesizer::validate() {
     if (p.periodic != opt_.periodic_exemplar)
       bad(std::string("periodic_exemplar ") + (opt_.periodic_exemplar ? "true" : "false") +
           " differs from the prepared exemplars'");
+    if (p.search != opt_.search) bad("search differs from the prepared exemplars'");
+    if (p.search == ElSearch::Approximate &&
+        (p.first_window != el_first_pass_window(opt_) || p.ann_pca_dims != opt_.ann_pca_dims ||
+         p.ann_stride != opt_.ann_stride))
+      bad("first_pass_window / ann_pca_dims / ann_stride differ from the prepared exemplars' (" +
+          std::to_string(p.first_window) + " / " + std::to_string(p.ann_pca_dims) + " / " +
+          std::to_string(p.ann_stride) + ")");
     prep_ = in_.prepared;
   } else {
     prep_ = prepare(in_.exemplars, opt_);
@@ -531,6 +589,8 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   weight_.clear();
   p1_delta_.clear();
   p1_value_.clear();
+  p1_slot_.clear();
+  short_.clear();
   const int px = p % W, py = p / W;
   const int lo = lo_of(window_), hi = hi_of(window_);
   const int flo = lo_of(first_), fhi = hi_of(first_);
@@ -549,6 +609,14 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
       if (dx >= flo && dx <= fhi && dy >= flo && dy <= fhi) {
         p1_delta_.push_back(dy * s.pw + dx);
         p1_value_.insert(p1_value_.end(), v, v + C);
+        if (s.ann) {
+          p1_slot_.push_back((dy - flo) * first_ + (dx - flo));
+          // Coherent candidate: q's source shifted back by q's offset (same search image only).
+          if (src_[q] >= 0 && key_[q] == key_[p]) {
+            const int c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
+            if (c >= 0) short_.push_back(c);
+          }
+        }
       }
       delta_.push_back(dy * s.pw + dx);
       weight_.push_back(gauss_[g]);
@@ -595,6 +663,7 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
       }
     }
   };
+  pass1_candidates_ += N;
   const std::size_t work = N * static_cast<std::size_t>(nk) * C;
   if (nb > 1 && opt_.parallel_pixel_search && work > 40000)
     tbb::parallel_for(0, nb, run_block);
@@ -604,6 +673,38 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
   pre_.clear();
   for (const auto& v : scored_) pre_.push_back(v.second);
   return static_cast<int>(pre_.size());
+}
+
+// Approximate pass 1 (ElSearch::Approximate): the short list -- the coherent
+// candidates gathered with the known neighbours and the kd-tree's nearest
+// first-pass neighbourhoods -- deduplicated and ranked exactly by the
+// first-pass SSD; the n best (by (error, position)) go to pre_.
+void Synthesizer::pass1_short_list(const SearchImage& s, std::size_t n) {
+  const int nk = static_cast<int>(p1_slot_.size());
+  s.ann->query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
+               static_cast<float>(opt_.ann_eps), short_, ann_scratch_);
+  std::sort(short_.begin(), short_.end());
+  short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
+  pre_.clear();
+  pass1_candidates_ += short_.size();
+  if (short_.size() <= n) {
+    pre_ = short_;
+    return;
+  }
+  const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
+  const float* P = s.planes.data();
+  scored_.clear();
+  for (int id : short_) {
+    float e = 0;
+    for (int k = 0; k < nk; ++k)
+      for (int c = 0; c < C; ++c) {
+        const float d = P[c * ps + id + p1_delta_[k]] - p1_value_[k * C + c];
+        e += d * d;
+      }
+    scored_.push_back({e, id});
+  }
+  std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
+  for (std::size_t i = 0; i < n; ++i) pre_.push_back(scored_[i].second);
 }
 
 // The n smallest (err_[i], ids[i]) into scored_ (in no particular order:
@@ -707,6 +808,7 @@ void Synthesizer::seed_patch(int p) {
       if (state_[q] != PixelState::Fill || known_[q] || key_[q] != key_[p]) continue;
       for (int c = 0; c < C; ++c) out_.at(x, y, c) = s.plane(c)[id + dy * s.pw + dx];
       record_source(q, p, id + dy * s.pw + dx, s);
+      src_[q] = id + dy * s.pw + dx;
       mark_filled(q);
       ++seeded_;
     }
@@ -729,7 +831,10 @@ void Synthesizer::synthesize_pixel(int p) {
     if (!in_.exemplar_index.empty())
       n = opt_.preselect > 0 ? n : static_cast<std::size_t>(ex[in_.exemplar_index[p]].width);
     n = std::min(n, total);
-    pass1(s, n);
+    if (s.ann && !p1_slot_.empty())
+      pass1_short_list(s, n);
+    else
+      pass1(s, n);
     score_full(s, pre_, scored_);
   }
   const std::size_t m = scored_.size();
@@ -748,6 +853,7 @@ void Synthesizer::synthesize_pixel(int p) {
   const int px = p % W, py = p / W;
   for (int c = 0; c < C; ++c) out_.at(px, py, c) = s.plane(c)[id];
   record_source(p, p, id, s);
+  src_[p] = id;
   mark_filled(p);
   ++synthesized_;
 }
@@ -765,6 +871,7 @@ ElResult Synthesizer::run() {
   state_ = in_.state.empty() ? std::vector<PixelState>(n, PixelState::Fill) : in_.state;
   out_ = in_.target;
   known_.assign(n, 0);
+  src_.assign(n, -1);
   std::size_t any_known = 0, to_fill = 0;
   for (std::size_t p = 0; p < n; ++p) {
     if (state_[p] == PixelState::Known) {
@@ -872,6 +979,7 @@ ElResult Synthesizer::run() {
   res.source = std::move(source_);
   res.synthesized = synthesized_;
   res.seeded = seeded_;
+  res.pass1_candidates = pass1_candidates_;
   res.seconds = timer.seconds();
   return res;
 }

@@ -6,10 +6,13 @@
 // exemplar (multi-texturing, section 5).
 //
 // Each pixel to fill is synthesised from the already known pixels around it:
-//  - pass 1: exhaustive search over every candidate position of the (rotated)
-//    exemplar with a small UNWEIGHTED square neighbourhood, comparing only
-//    the known neighbours (SSD over all channels); the `preselect` best are
-//    kept (ties broken by candidate position, so the set is unique);
+//  - pass 1: a small UNWEIGHTED square neighbourhood compared over the
+//    known neighbours only (SSD over all channels), on every candidate
+//    position of the (rotated) exemplar (ElSearch::Exhaustive, the paper) or
+//    on a short list of coherent and approximate-nearest candidates
+//    (ElSearch::Approximate, the default: its cost does not grow with the
+//    exemplar); the `preselect` best are kept (ties broken by candidate
+//    position, so the set is unique);
 //  - pass 2: the preselected candidates are scored with the full window,
 //    Gaussian-weighted (Efros & Leung 1999), weights renormalised over the
 //    known neighbours;
@@ -42,12 +45,12 @@
 // pixel further up/left than down/right.
 //
 // Determinism: every random choice comes from std::mt19937_64(seed),
-// consumed in the (deterministic) fill order. The candidate search of one
-// pixel is split over TBB tasks, each keeping its own best list; the lists
+// consumed in the (deterministic) fill order. The exhaustive candidate
+// search of one pixel is split over TBB tasks, each keeping its own best list; the lists
 // are merged under the total order (error, candidate position), so the result
 // is the same bytes for any thread count.
 //
-// Speed (exact, no approximation): pass 1 computes every candidate's error
+// Speed of the exhaustive pass 1: it computes every candidate's error
 // over channel planes, 8 consecutive candidates per vector register; the n
 // best are then found without sorting thousands of candidates: a threshold
 // guessed from every 8th error keeps about 2n of them (checked: if fewer
@@ -73,6 +76,22 @@ enum class PixelState : std::uint8_t {
   Fill = 0,     ///< to synthesise
   Known = 1,    ///< boundary condition: read, never changed
   Outside = 2,  ///< not part of the domain: never read or written
+};
+
+/// How pass 1 finds its candidates.
+enum class ElSearch {
+  /// A short list whose size does not grow with the exemplar: the coherent
+  /// candidates (each known neighbour's source position shifted by its
+  /// offset, Ashikhmin 2001; same exemplar and orientation only) and the
+  /// `ann_candidates` nearest first-pass neighbourhoods by a kd-tree over
+  /// their PCA coefficients (texture/partial_neighbourhood_index.h: the
+  /// unknown part of the query estimated from the known part), per
+  /// (exemplar, orientation). Pass 1 ranks the short list exactly and keeps
+  /// the `preselect` best for pass 2 as in the exhaustive search.
+  Approximate,
+  /// Every candidate position (Gorla's pass 1 as published; cost grows with
+  /// the exemplar area). The reference.
+  Exhaustive,
 };
 
 enum class FillOrder {
@@ -115,6 +134,22 @@ struct ElOptions {
   /// so every exemplar pixel is a candidate (else only positions whose whole
   /// window lies inside the exemplar).
   bool periodic_exemplar = false;
+  /// Pass-1 candidate search (see ElSearch). Default Approximate.
+  ElSearch search = ElSearch::Approximate;
+  /// Approximate search: kd-tree neighbours per pixel, 1..256. Default 16.
+  int ann_candidates = 16;
+  /// Approximate search: PCA coefficients of the first-pass neighbourhood,
+  /// 1..first_pass_window^2 * channels (clamped). Default 4 (the kd-tree
+  /// stays shallow; pass 1 re-ranks the hits exactly).
+  int ann_pca_dims = 4;
+  /// Approximate search: (1 + eps)-approximate kd-tree distances, >= 0. Default 1.
+  double ann_eps = 1.0;
+  /// Approximate search: the kd-tree holds the candidates on every
+  /// ann_stride-th row and column, each hit standing for its ann_stride^2
+  /// block (all of which pass 1 ranks), 1..4. Default 2: a quarter of the
+  /// points, so building the index of each of 64 rotations of a 512 px
+  /// exemplar costs a quarter as much.
+  int ann_stride = 2;
   /// Reference mode: Efros-Leung's original single exhaustive pass with the
   /// full Gaussian-weighted window (no preselection). Slow; for tests and
   /// comparisons.
@@ -143,8 +178,9 @@ struct ElInput {
   /// empty when `prepared` is given (the prepared exemplars are used).
   std::vector<Image> exemplars;
   /// Alternative to `exemplars`: exemplars prepared once for many runs
-  /// (el_prepare_exemplars with the same window, rotations and
-  /// periodic_exemplar as the run's options, else InvalidInputError).
+  /// (el_prepare_exemplars with the same window, first-pass window,
+  /// rotations, periodic_exemplar, search, ann_pca_dims and ann_stride as
+  /// the run's options, else InvalidInputError).
   std::shared_ptr<const ElPreparedExemplars> prepared;
   /// Output canvas: size and channels of the result (channels must match the
   /// exemplars); values at Known pixels are the boundary conditions.
@@ -180,6 +216,10 @@ struct ElResult {
   int window = 0;              ///< effective full window
   int first_pass_window = 0;   ///< effective first-pass window
   int rotations_used = 0;      ///< distinct (exemplar, orientation) pairs searched
+  /// Candidates ranked by pass 1, summed over the pixels: the exemplar's
+  /// candidate count per pixel for the exhaustive search, the short list's
+  /// length for the approximate one.
+  std::size_t pass1_candidates = 0;
   double seconds = 0.0;
 };
 
@@ -191,9 +231,11 @@ Image efros_leung_synthesize(const Image& exemplar, int width, int height,
                              const ElOptions& opt = {});
 
 /// Validates `exemplars` (as efros_leung_synthesize does) and prepares them
-/// for runs with opt.window, opt.rotations and opt.periodic_exemplar (other
-/// options are not read). Rotations are built on first use. Throws
-/// InvalidInputError.
+/// for runs with opt.window, first_pass_window, rotations,
+/// periodic_exemplar, search, ann_pca_dims and ann_stride (other options
+/// are not read).
+/// Rotations (and their search index) are built on first use, each once,
+/// concurrently for different rotations. Throws InvalidInputError.
 std::shared_ptr<const ElPreparedExemplars> el_prepare_exemplars(const std::vector<Image>& exemplars,
                                                                 const ElOptions& opt);
 

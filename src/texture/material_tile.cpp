@@ -69,6 +69,39 @@ KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTil
   return k;
 }
 
+// One pair of consecutive keys (a, b), p its index among the K - 1 pairs:
+// morph F_a into F_b (section 1.1), then the two constrained syntheses
+// (section 1.2) side by side. Seeds depend on p only.
+struct PairTile {
+  MaskMorphResult morph;
+  ConstrainedSynthesisResult ra, rb;
+  double seconds_morph = 0, seconds_synthesis = 0;
+};
+
+PairTile make_pair_tile(const KeyTile& a, const KeyTile& b, std::size_t p, std::size_t K,
+                        const MaterialTileOptions& opt) {
+  PairTile pt;
+  Timer t;
+  MaskMorphOptions mo = opt.morph;
+  mo.progress = nullptr;
+  pt.morph = morph_feature_masks(a.mask, b.mask, opt.layers, mo);
+  pt.seconds_morph = t.seconds();
+  report_progress(opt.progress, "material tile: morph", double(p + 1) / (K - 1));
+  t.reset();
+  std::vector<Image> reversed(pt.morph.masks.rbegin(), pt.morph.masks.rend());
+  ConstrainedSynthesisOptions sa = opt.synthesis, sb = opt.synthesis;
+  sa.seed = derive_seed(opt.seed, 10 * p + 1);
+  sb.seed = derive_seed(opt.seed, 10 * p + 2);
+  sa.progress = [&opt, p, K](std::string_view, double f) {
+    report_progress(opt.progress, "material tile: synthesis", (p + f) / (K - 1));
+  };
+  sb.progress = nullptr;
+  tbb::parallel_invoke([&] { pt.ra = synthesize_constrained_tiles(a.tile, a.mask, pt.morph.masks, sa); },
+                       [&] { pt.rb = synthesize_constrained_tiles(b.tile, b.mask, reversed, sb); });
+  pt.seconds_synthesis = t.seconds();
+  return pt;
+}
+
 }  // namespace
 
 Image square_resample(const Image& img, int size) {
@@ -155,38 +188,27 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
     return res;
   }
 
+  // Pairs of consecutive keys are independent: each morphs its masks and
+  // runs its two syntheses (in parallel); the layers are assembled in order.
+  std::vector<PairTile> pairs(K - 1);
+  tbb::parallel_for(std::size_t(0), K - 1, [&](std::size_t p) {
+    pairs[p] = make_pair_tile(tiles[p], tiles[p + 1], p, K, opt);
+  });
   for (std::size_t p = 0; p + 1 < K; ++p) {
-    t.reset();
-    MaskMorphOptions mo = opt.morph;
-    mo.progress = nullptr;
-    MaskMorphResult morph = morph_feature_masks(tiles[p].mask, tiles[p + 1].mask, M, mo);
-    res.seconds_morph += t.seconds();
-    report_progress(opt.progress, "material tile: morph", double(p + 1) / (K - 1));
-    t.reset();
-    std::vector<Image> reversed(morph.masks.rbegin(), morph.masks.rend());
-    ConstrainedSynthesisResult ra, rb;
-    ConstrainedSynthesisOptions sa = opt.synthesis, sb = opt.synthesis;
-    sa.seed = derive_seed(opt.seed, 10 * p + 1);
-    sb.seed = derive_seed(opt.seed, 10 * p + 2);
-    sa.progress = [&](std::string_view, double f) {
-      report_progress(opt.progress, "material tile: synthesis", (p + f) / (K - 1));
-    };
-    sb.progress = nullptr;
-    tbb::parallel_invoke(
-        [&] { ra = synthesize_constrained_tiles(tiles[p].tile, tiles[p].mask, morph.masks, sa); },
-        [&] { rb = synthesize_constrained_tiles(tiles[p + 1].tile, tiles[p + 1].mask, reversed, sb); });
-    res.seconds_synthesis += t.seconds();
+    const PairTile& pt = pairs[p];
+    res.seconds_morph += pt.seconds_morph;
+    res.seconds_synthesis += pt.seconds_synthesis;
     for (int m = (p == 0 ? 0 : 1); m <= M; ++m) {
-      const Image& A = ra.layers[m];
-      const Image& B = rb.layers[M - m];
+      const Image& A = pt.ra.layers[m];
+      const Image& B = pt.rb.layers[M - m];
       const float wb = static_cast<float>(double(m) / M), wa = 1.f - wb;
       Image out(A.width, A.height, A.channels);
       for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] = wa * A.data[i] + wb * B.data[i];
       res.layers.push_back(std::move(out));
-      res.masks.push_back(morph.masks[m]);
+      res.masks.push_back(pt.morph.masks[m]);
       res.material.push_back(double(p) + double(m) / M);
-      res.sign_changes.push_back(m == 0 ? 0 : morph.sign_changes[m - 1]);
-      res.mask_agreement.push_back(std::min(ra.mask_agreement[m], rb.mask_agreement[M - m]));
+      res.sign_changes.push_back(m == 0 ? 0 : pt.morph.sign_changes[m - 1]);
+      res.mask_agreement.push_back(std::min(pt.ra.mask_agreement[m], pt.rb.mask_agreement[M - m]));
     }
   }
   res.seconds_total = total.seconds();

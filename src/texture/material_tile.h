@@ -66,6 +66,8 @@ struct MaterialTileResult {
   std::vector<long long> sign_changes;  ///< per layer: texels changing sign since the previous layer (0 for the first)
   std::vector<double> mask_agreement;   ///< per layer: min over the two syntheses of the mask agreement
   std::vector<Image> key_tiles, key_masks;  ///< T and F of every key
+  /// Wall seconds per stage; morph and synthesis are summed over the key
+  /// pairs, which run in parallel (so their sum may exceed seconds_total).
   double seconds_keys = 0, seconds_morph = 0, seconds_synthesis = 0, seconds_total = 0;
 };
 

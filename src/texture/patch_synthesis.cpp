@@ -2,6 +2,7 @@
 // Patch-based oriented surface synthesis (Gorla et al. 2003, 3-5).
 #include "texture/patch_synthesis.h"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -451,8 +452,10 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   }
   res.seconds_synthesis = t.seconds();
 
-  // 7. Boundary pixels of every image from the neighbour's texture.
-  for (int p = 0; p < P; ++p) {
+  // 7. Boundary pixels of every image from the neighbour's texture. Patch p
+  // writes only its own Boundary pixels and reads only Inside pixels of
+  // others, so the patches run in parallel.
+  tbb::parallel_for(0, P, [&](int p) {
     const FlatPatch& fp = patches[p];
     for (std::size_t i = 0; i < N; ++i) {
       if (fp.pixel[i] != PatchPixel::Boundary) continue;
@@ -466,7 +469,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
       const auto pq = fq.to_pixel(u, v);
       sample_inside(fq, res.images[q], pq[0], pq[1], &res.images[p].data[i * C]);
     }
-  }
+  });
   res.seconds_total = total.seconds();
   return res;
 }

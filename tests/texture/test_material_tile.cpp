@@ -189,17 +189,30 @@ TEST(MaterialTile, SameMaskModeGivesDifferentTilesWithOneMask) {
 }
 
 TEST(MaterialTile, SameSeedSameBytesWhateverTheThreads) {
+  // Parallel stages: the keys, the key pairs (three keys: two pairs), the two
+  // syntheses of a pair, the exemplar levels and the finer levels' layers.
   MaterialTileOptions o = small_options();
   o.layers = 2;
-  MaterialTileResult a = make_material_tile(cells_to_stripes(o.size), o);
+  auto keys = cells_to_stripes(o.size);
+  keys.push_back({make_checker(o.size, 4), {}, "checker"});
+  MaterialTileResult a;
+  {
+    tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+    a = make_material_tile(keys, o);
+  }
   MaterialTileResult b;
   {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    b = make_material_tile(cells_to_stripes(o.size), o);
+    b = make_material_tile(keys, o);
   }
-  for (std::size_t m = 0; m < a.layers.size(); ++m) EXPECT_EQ(a.layers[m].data, b.layers[m].data);
+  ASSERT_EQ(a.layers.size(), 5u);
+  ASSERT_EQ(a.layers.size(), b.layers.size());
+  for (std::size_t m = 0; m < a.layers.size(); ++m) EXPECT_EQ(a.layers[m].data, b.layers[m].data) << "layer " << m;
+  EXPECT_EQ(a.sign_changes, b.sign_changes);
+  EXPECT_EQ(a.mask_agreement, b.mask_agreement);
+  keys.pop_back();
   o.seed = 6;
-  MaterialTileResult c = make_material_tile(cells_to_stripes(o.size), o);
+  MaterialTileResult c = make_material_tile(keys, o);
   EXPECT_NE(a.layers[1].data, c.layers[1].data);
 }
 

@@ -1,0 +1,181 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Quality and cost of the approximate Efros-Leung first pass against the
+// exhaustive one (efros_leung.h, ElSearch), on every texture of
+// ../shared/data/textures: the same 2D synthesis at the `surftex synth`
+// defaults (window 11, first-pass window 5, preselect = exemplar width,
+// pick 10 / 10%, epsilon 0.1, seed 1; library defaults for everything else,
+// the approximate search's included) run once with ElSearch::Exhaustive
+// (the published method, as before issue 19) and once with
+// ElSearch::Approximate (the default). Sets: the output size (default 128 x
+// 128, the cost of the exhaustive reference grows with exemplar area times
+// output area; SURFTEX_BENCH_EL_SIZE=256 is the CLI's own default size).
+//
+// Similarity: bidirectional_similarity with bench_graphcut's setting (7x7
+// patches, output patches at stride 2, exact nearest neighbours); lower is
+// better; `ratio` = approximate / exhaustive. Times are process CPU seconds
+// (load-independent) and wall seconds.
+//
+// Usage: bench_el_search [TEXTURE_DIR] [NAME,NAME,...|-] [threads]
+// One JSON line per texture, then a summary line (how many within 5%).
+// SURFTEX_BENCH_EL_ANN="K,D,EPS;K,D,EPS..." also runs these settings of
+// (ann_candidates, ann_pca_dims, ann_eps[, ann_stride]) (tuning; "settings" in
+// the lines; ann_stride defaults to the library's).
+// SURFTEX_BENCH_EL_REFERENCE=FILE takes the exhaustive figures from an
+// earlier run's output instead of recomputing them.
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "geometry/image_io.h"
+#include "geometry/timer.h"
+#include "texture/bidirectional_similarity.h"
+#include "texture/efros_leung.h"
+
+using namespace surftex;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  double bds = 0, cpu = 0, wall = 0;
+};
+
+// One approximate-search setting (ann_candidates, ann_pca_dims, ann_eps,
+// ann_stride; stride 0 = the library's default).
+struct AnnSetting {
+  int candidates, dims;
+  double eps;
+  int stride = 0;
+};
+
+Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann = nullptr) {
+  ElOptions o;  // the `surftex synth` defaults are the library's
+  o.search = search;
+  if (ann) {
+    o.ann_candidates = ann->candidates;
+    o.ann_pca_dims = ann->dims;
+    o.ann_eps = ann->eps;
+    if (ann->stride > 0) o.ann_stride = ann->stride;
+  }
+  o.seed = 1;
+  Run r;
+  Timer t;
+  const std::clock_t c0 = std::clock();
+  const Image out = efros_leung_synthesize(ex, size, size, o);
+  r.cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  r.wall = t.seconds();
+  BidirectionalOptions bo;
+  bo.patch = 7;
+  bo.stride = 2;
+  r.bds = bidirectional_similarity(out, ex, bo).total;
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string dir = argc > 1 && argv[1][0] ? argv[1] : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures";
+  std::vector<std::string> only;
+  if (argc > 2 && std::string(argv[2]) != "-") {
+    std::stringstream ss(argv[2]);
+    for (std::string n; std::getline(ss, n, ',');) only.push_back(n);
+  }
+  std::unique_ptr<tbb::global_control> limit;
+  if (argc > 3 && std::atoi(argv[3]) > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::atoi(argv[3]));
+  const char* env = std::getenv("SURFTEX_BENCH_EL_SIZE");
+  const int size = env && std::atoi(env) > 0 ? std::atoi(env) : 128;
+  std::vector<AnnSetting> settings;
+  if (const char* t = std::getenv("SURFTEX_BENCH_EL_ANN")) {
+    std::stringstream ss(t);
+    for (std::string item; std::getline(ss, item, ';');) {
+      AnnSetting st{16, 10, 1.0, 0};
+      if (std::sscanf(item.c_str(), "%d,%d,%lf,%d", &st.candidates, &st.dims, &st.eps, &st.stride) >= 3)
+        settings.push_back(st);
+    }
+  }
+  // SURFTEX_BENCH_EL_REFERENCE=FILE: exhaustive figures from an earlier run's
+  // JSON lines (same size; the exhaustive search is deterministic).
+  std::map<std::string, std::pair<double, double>> reference;
+  if (const char* ref = std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
+    std::ifstream in(ref);
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] != '{') continue;
+      const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+      if (j.is_discarded() || !j.contains("texture") || j.value("output", 0) != size) continue;
+      reference[j["texture"].get<std::string>()] = {j["bds_exhaustive"].get<double>(),
+                                                    j["cpu_seconds"]["exhaustive"].get<double>()};
+    }
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".png") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  int n = 0, within = 0;
+  double worst = 0, cpu_ex = 0, cpu_ap = 0, log_sum = 0;
+  try {
+    for (const fs::path& f : files) {
+      const std::string name = f.stem().string();
+      if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
+      const Image ex = read_image(f.string());
+      Run a;
+      if (reference.count(name)) {
+        a.bds = reference[name].first;
+        a.cpu = reference[name].second;
+      } else {
+        a = synthesize(ex, size, ElSearch::Exhaustive);
+      }
+      const Run b = synthesize(ex, size, ElSearch::Approximate);
+      nlohmann::json tried = nlohmann::json::array();
+      for (const AnnSetting& st : settings) {
+        const Run c = synthesize(ex, size, ElSearch::Approximate, &st);
+        tried.push_back({{"ann", {st.candidates, st.dims, st.eps, st.stride}},
+                         {"ratio", c.bds / std::max(a.bds, 1e-12)},
+                         {"cpu_seconds", c.cpu}});
+      }
+      const double ratio = b.bds / std::max(a.bds, 1e-12);
+      ++n;
+      within += ratio <= 1.05;
+      worst = std::max(worst, ratio);
+      log_sum += std::log(ratio);
+      cpu_ex += a.cpu;
+      cpu_ap += b.cpu;
+      nlohmann::json j;
+      j["texture"] = name;
+      j["exemplar"] = std::to_string(ex.width) + "x" + std::to_string(ex.height);
+      j["output"] = size;
+      j["bds_exhaustive"] = a.bds;
+      j["bds_approximate"] = b.bds;
+      j["ratio"] = ratio;
+      j["cpu_seconds"] = {{"exhaustive", a.cpu}, {"approximate", b.cpu}};
+      j["wall_seconds"] = {{"exhaustive", a.wall}, {"approximate", b.wall}};
+      if (!settings.empty()) j["settings"] = tried;
+      std::printf("%s\n", j.dump().c_str());
+      std::fflush(stdout);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+  nlohmann::json s;
+  s["summary"] = "el_search";
+  s["textures"] = n;
+  s["within_5_percent"] = within;
+  s["worst_ratio"] = worst;
+  s["geometric_mean_ratio"] = n ? std::exp(log_sum / n) : 0.0;
+  s["cpu_seconds"] = {{"exhaustive", cpu_ex}, {"approximate", cpu_ap}};
+  std::printf("%s\n", s.dump().c_str());
+  return 0;
+}

@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "texture/pca_kdtree.h"
+
+#include <Eigen/Dense>
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include "geometry/errors.h"
+
+namespace surftex {
+
+void PcaBasis::project(const float* v, float* out) const {
+  for (int k = 0; k < dims; ++k) {
+    const float* b = &basis[static_cast<std::size_t>(k) * dim];
+    float s = 0;
+    for (int i = 0; i < dim; ++i) s += b[i] * (v[i] - mean[i]);
+    out[k] = s;
+  }
+}
+
+void PcaBasis::project(const float* v, double* out) const {
+  for (int k = 0; k < dims; ++k) {
+    const double* b = &basis_d[static_cast<std::size_t>(k) * dim];
+    double s = 0;
+    for (int i = 0; i < dim; ++i) s += b[i] * (static_cast<double>(v[i]) - mean_d[i]);
+    out[k] = s;
+  }
+}
+
+struct PcaFit::Sums {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd cov;  // lower triangle of sum x x^T
+};
+
+PcaFit::PcaFit(int dim) : dim_(dim), sums_(std::make_unique<Sums>()) {
+  if (dim < 1) throw InvalidInputError("PcaFit: dim " + std::to_string(dim) + " < 1");
+  sums_->mean = Eigen::VectorXd::Zero(dim);
+  sums_->cov = Eigen::MatrixXd::Zero(dim, dim);
+}
+
+PcaFit::~PcaFit() = default;
+
+void PcaFit::add(const float* v) {
+  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXf>(v, dim_).cast<double>();
+  sums_->mean += x;
+  sums_->cov.selfadjointView<Eigen::Lower>().rankUpdate(x);
+  ++count_;
+}
+
+PcaBasis PcaFit::fit(int dims, const std::string& what) const {
+  if (count_ == 0) throw InvalidInputError(what + ": PCA of no sample");
+  if (dims < 1 || dims > dim_)
+    throw InvalidInputError(what + ": PCA dims " + std::to_string(dims) + " outside 1.." + std::to_string(dim_));
+  const double n = static_cast<double>(count_);
+  const Eigen::VectorXd mean = sums_->mean / n;
+  Eigen::MatrixXd cov = sums_->cov.selfadjointView<Eigen::Lower>();
+  cov = cov / n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
+  if (eig.info() != Eigen::Success)
+    throw SolverError(what + ": PCA eigen-decomposition failed (" + std::to_string(dim_) + " dimensions, " +
+                      std::to_string(count_) + " samples)");
+  PcaBasis b;
+  b.dim = dim_;
+  b.dims = dims;
+  b.mean.resize(dim_);
+  b.mean_d.resize(dim_);
+  for (int i = 0; i < dim_; ++i) {
+    b.mean_d[i] = mean[i];
+    b.mean[i] = static_cast<float>(mean[i]);
+  }
+  b.eigenvalues.resize(dim_);
+  for (int i = 0; i < dim_; ++i) b.eigenvalues[i] = std::max(0.0, eig.eigenvalues()[dim_ - 1 - i]);
+  b.basis.assign(static_cast<std::size_t>(dims) * dim_, 0.f);
+  b.basis_d.assign(static_cast<std::size_t>(dims) * dim_, 0.0);
+  for (int k = 0; k < dims; ++k) {  // eigenvalues ascend: take the last dims
+    Eigen::VectorXd ev = eig.eigenvectors().col(dim_ - 1 - k);
+    int big = 0;
+    ev.cwiseAbs().maxCoeff(&big);
+    if (ev[big] < 0) ev = -ev;
+    for (int i = 0; i < dim_; ++i) {
+      b.basis_d[static_cast<std::size_t>(k) * dim_ + i] = ev[i];
+      b.basis[static_cast<std::size_t>(k) * dim_ + i] = static_cast<float>(ev[i]);
+    }
+  }
+  return b;
+}
+
+namespace {
+
+template <class T>
+struct Cloud {
+  const std::vector<T>* pts;
+  int dim;
+  std::size_t kdtree_get_point_count() const { return dim ? pts->size() / dim : 0; }
+  T kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i * dim + d]; }
+  template <class B>
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
+};
+
+// Adapts a KdIndex visitor to nanoflann's result-set interface.
+template <class T>
+struct VisitorSet {
+  typename KdIndex<T>::Visitor* v;
+  std::size_t n = 0;
+  std::size_t size() const { return n; }
+  bool full() const { return true; }
+  T worstDist() const { return v->bound(); }
+  bool addPoint(T d, std::uint32_t i) {
+    if (d > v->bound()) return true;
+    ++n;
+    return v->add(d, i);
+  }
+};
+
+}  // namespace
+
+template <class T>
+struct KdIndex<T>::Tree {
+  Cloud<T> cloud;
+  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<T, Cloud<T>>, Cloud<T>, -1, std::uint32_t>
+      index;
+  Tree(const std::vector<T>* pts, int dims)
+      : cloud{pts, dims}, index(dims, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
+};
+
+template <class T>
+KdIndex<T>::KdIndex(std::vector<T> points, int dims) : points_(std::move(points)), dims_(dims) {
+  if (dims < 1) throw InvalidInputError("KdIndex: dims " + std::to_string(dims) + " < 1");
+  if (points_.size() % static_cast<std::size_t>(dims) != 0)
+    throw InvalidInputError("KdIndex: " + std::to_string(points_.size()) + " coordinates are not a multiple of " +
+                            std::to_string(dims));
+  tree_ = std::make_unique<Tree>(&points_, dims);
+}
+
+template <class T>
+KdIndex<T>::~KdIndex() = default;
+
+template <class T>
+std::size_t KdIndex<T>::size() const {
+  return points_.size() / dims_;
+}
+
+template <class T>
+std::size_t KdIndex<T>::knn(const T* q, std::size_t k, float eps, std::uint32_t* index, T* d2) const {
+  if (k == 0 || size() == 0) return 0;
+  nanoflann::KNNResultSet<T, std::uint32_t> rs(k);
+  rs.init(index, d2);
+  tree_->index.findNeighbors(rs, q, nanoflann::SearchParams(32, eps));
+  return rs.size();
+}
+
+template <class T>
+void KdIndex<T>::search(const T* q, Visitor& v, float eps) const {
+  if (size() == 0) return;
+  VisitorSet<T> rs{&v};
+  tree_->index.findNeighbors(rs, q, nanoflann::SearchParams(32, eps));
+}
+
+template <class T>
+std::size_t KdIndex<T>::bytes() const {
+  // Points, the permutation and about 2 n / 16 nodes of ~ (2 dims + 4) words.
+  const std::size_t n = size();
+  return points_.size() * sizeof(T) + n * sizeof(std::uint32_t) +
+         (2 * n / 16 + 1) * (2 * dims_ * sizeof(T) + 32);
+}
+
+template class KdIndex<float>;
+template class KdIndex<double>;
+
+}  // namespace surftex
