@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
       if (sub->parsed()) {
         surftex::cli::sweep_stale_outputs_of_arguments(*sub);
         surftex::cli::check_parsed_arguments(*sub);
+        // `batch` is not staged: it keeps its state in OUT as it goes (lock,
+        // Snakefile, per-job results) so that an interrupted batch resumes,
+        // and each of its jobs is staged by surftex-job itself.
+        if (sub->get_name() == "batch") return run();
         surftex::OutputStaging staging;
         const int rc = run();
         if (rc != 0) return rc;  // the staging is abandoned: nothing is written

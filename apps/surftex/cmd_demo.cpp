@@ -66,13 +66,15 @@ std::vector<std::string> demo_outputs(const DemoContext& ctx, const std::string&
   std::vector<std::string> out;
   auto add = [&](const fs::path& p) {
     std::error_code ec;
-    if (p.filename() == kMarker || same_file(p.string(), report_path) || !fs::is_regular_file(p, ec)) return;
+    // (a file of this run is still in its staging folder: geometry/output_file.h)
+    if (p.filename() == kMarker || same_file(p.string(), report_path) || !fs::is_regular_file(staged_path(p.string()), ec))
+      return;
     if (std::find(out.begin(), out.end(), p.string()) == out.end()) out.push_back(p.string());
   };
   for (const std::string& name : ctx.named) {
     const fs::path p = fs::path(ctx.dir) / name;
     std::error_code ec;
-    if (fs::is_directory(p, ec)) {
+    if (fs::is_directory(staged_path(p.string()), ec)) {
       for (const std::string& f : files_in_folder(p.string())) add(f);
     } else {
       add(p);
@@ -202,8 +204,9 @@ std::function<int()> setup(CLI::App& app) {
     report["output_dir"] = *dir;
     CommonOptions ro = *common;
     if (ro.report_path.empty()) ro.report_path = (fs::path(*dir) / "report.json").string();
-    write_report(ro, "demo", report, {{}, demo_outputs(ctx, ro.report_path)});
-    batch::write_demo_contact_sheet(*dir, report);  // DIR/index.html (issue 20, item 4)
+    const std::vector<std::string> outputs = demo_outputs(ctx, ro.report_path);
+    write_report(ro, "demo", report, {{}, outputs});
+    batch::write_demo_contact_sheet(*dir, report, outputs);  // DIR/index.html (issue 20, item 4)
     std::printf("demo: done in %.1f s; results in %s (report.json lists them)\n", total.seconds(), dir->c_str());
     return 0;
   };

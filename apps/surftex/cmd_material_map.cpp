@@ -251,8 +251,10 @@ int run(const Args& a) {
   RunFiles run_files{{a.mesh, a.tile, a.constraints, a.update, a.state}, {}};
   for (const char* f : kOutputs)
     if (std::string(f) != "report.json") run_files.outputs.push_back(a.out + "/" + f);
-  write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
-                    a.common.force);
+  // OUT/report.json, unless --report names that same file (written once).
+  if (a.common.report_path.empty() || !same_file(a.common.report_path, a.out + "/report.json"))
+    write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
+                      a.common.force);
   write_report(a.common, "material-map", rep, run_files);
   if (!a.common.quiet)
     std::fprintf(stderr, "material-map: %zu faces, %.1f%% singular, written to %s (%.2f s)\n",
@@ -371,6 +373,8 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   const BakedAsset baked = bake_asset(mesh, sing, tile, 512, 0.03, mapping.result().default_scale);
   write_meshes(mesh, baked, ctx.path("material_map.obj"), ctx.path("material_map.glb"), ctx.path("material_map.ply"),
                true);
+  for (const char* f : {"material_map.mtl", "material_map.png", "material_map_normal.png", "material_map_height.png"})
+    ctx.path(f);  // the OBJ's material and maps (listed when they exist)
   write_image(ctx.path("material_map_plain.png"), img.plain);
   write_image(ctx.path("material_map_fixed.png"), img.fixed);
   write_image(ctx.path("material_map_normalmap.png"), img.normal);

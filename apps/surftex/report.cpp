@@ -60,8 +60,11 @@ nlohmann::json hash_inputs(const std::vector<std::string>& inputs) {
 std::vector<std::string> files_in_folder(const std::string& dir) {
   std::vector<std::string> files;
   std::error_code ec;
-  for (const auto& e : fs::recursive_directory_iterator(dir, ec))
-    if (e.is_regular_file(ec)) files.push_back(e.path().string());
+  // A folder this run wrote is still in its staging folder (output_file.h):
+  // listed there, named by where it will be.
+  const fs::path where = staged_path(dir);
+  for (const auto& e : fs::recursive_directory_iterator(where, ec))
+    if (e.is_regular_file(ec)) files.push_back((fs::path(dir) / fs::relative(e.path(), where, ec)).string());
   std::sort(files.begin(), files.end());
   return files;
 }
