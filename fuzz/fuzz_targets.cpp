@@ -68,12 +68,19 @@ struct SmallImages {
   ~SmallImages() { set_image_limits(saved); }
 };
 
+// A binary glTF from bytes (the reader's external-file paths are not taken:
+// a GLB carries its buffers).
+PolygonSoup read_glb_bytes(const std::string& path, std::string_view data) {
+  return mesh_io::read_gltf(path, data, true);
+}
+
 }  // namespace
 
 int one_obj(const std::uint8_t* d, std::size_t n) { return parse_mesh(mesh_io::read_obj, "fuzz.obj", d, n); }
 int one_off(const std::uint8_t* d, std::size_t n) { return parse_mesh(mesh_io::read_off, "fuzz.off", d, n); }
 int one_ply(const std::uint8_t* d, std::size_t n) { return parse_mesh(mesh_io::read_ply, "fuzz.ply", d, n); }
 int one_stl(const std::uint8_t* d, std::size_t n) { return parse_mesh(mesh_io::read_stl, "fuzz.stl", d, n); }
+int one_glb(const std::uint8_t* d, std::size_t n) { return parse_mesh(read_glb_bytes, "fuzz.glb", d, n); }
 
 // The header check on any bytes (as PNG, JPEG, TIFF, EXR: OpenImageIO picks
 // the reader from the content for a file without extension); an image that
@@ -127,6 +134,7 @@ const std::vector<Target>& targets() {
                                      {"fuzz_off", one_off},
                                      {"fuzz_ply", one_ply},
                                      {"fuzz_stl", one_stl},
+                                     {"fuzz_glb", one_glb},
                                      {"fuzz_image_header", one_image_header},
                                      {"fuzz_constraints", one_constraints},
                                      {"fuzz_tile_json", one_tile_json}};

@@ -27,6 +27,7 @@ const std::vector<Target>& targets();
 
 int one_obj(const std::uint8_t* data, std::size_t size);
 int one_off(const std::uint8_t* data, std::size_t size);
+int one_glb(const std::uint8_t* data, std::size_t size);
 int one_ply(const std::uint8_t* data, std::size_t size);
 int one_stl(const std::uint8_t* data, std::size_t size);
 int one_image_header(const std::uint8_t* data, std::size_t size);

@@ -19,7 +19,7 @@ while (($#)); do
     *) targets+=("$1"); shift ;;
   esac
 done
-all=(fuzz_obj fuzz_off fuzz_ply fuzz_stl fuzz_image_header fuzz_constraints fuzz_tile_json)
+all=(fuzz_obj fuzz_off fuzz_ply fuzz_stl fuzz_glb fuzz_image_header fuzz_constraints fuzz_tile_json)
 ((${#targets[@]})) || targets=("${all[@]}")
 
 SURFTEX_FUZZ=1 bash "$root/scripts/setup.sh"
@@ -45,6 +45,7 @@ seed fuzz_obj "$data"/meshes/*.obj "$data"/broken/*.obj "$data"/swatches/*.obj
 seed fuzz_off "$data"/meshes/*.off "$data"/broken/*.off "$data"/swatches/*.off
 seed fuzz_ply "$data"/meshes/*.ply "$data"/broken/*.ply
 seed fuzz_stl "$data"/broken/*.stl
+seed fuzz_glb "$data"/meshes/*.glb "$root"/fuzz/seeds/glb/*.glb
 seed fuzz_image_header "$data"/textures/*_64.png "$data"/textures/*_96.png "$data"/textures/*_100.png
 if command -v oiiotool >/dev/null 2>&1 && [[ ! -f "$work/fuzz_image_header/small.jpg" ]]; then
   for ext in jpg tif exr bmp tga; do  # one small file per format OpenImageIO reads

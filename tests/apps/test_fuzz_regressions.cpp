@@ -60,6 +60,7 @@ TEST(FuzzRegressions, SeedInputsRunThroughEveryTarget) {
   };
   EXPECT_GT(replay(target("fuzz_constraints"), fs::path(SURFTEX_SOURCE_DIR) / "fuzz" / "seeds" / "constraints"), 0u);
   EXPECT_GT(replay(target("fuzz_tile_json"), fs::path(SURFTEX_SOURCE_DIR) / "fuzz" / "seeds" / "tile_json"), 0u);
+  EXPECT_GT(replay(target("fuzz_glb"), fs::path(SURFTEX_SOURCE_DIR) / "fuzz" / "seeds" / "glb"), 0u);
   // A few real files per mesh format and an image, from the shared data.
   for (const char* f : {"meshes/spot_quads.obj", "broken/malformed_indices.obj", "broken/truncated.off"}) {
     const fs::path p = surftex::test::shared_data(f);
