@@ -94,12 +94,19 @@ std::string read_text(const std::string& path) {
   return ss.str();
 }
 
-// The child's argv: SUBCOMMAND -o OUTPUT --report STAGE/report.json
+// Subcommands that write OUTDIR/report.json themselves: --report naming it
+// too would be two outputs of one run naming one file (refused).
+bool writes_own_report(const std::string& subcommand) {
+  return subcommand == "patches" || subcommand == "subdiv" || subcommand == "material-map" || subcommand == "demo";
+}
+
+// The child's argv: SUBCOMMAND -o OUTPUT [--report STAGE/report.json]
 // [--threads N] ARGS... (options first: a "--" among ARGS stays last).
 std::vector<std::string> child_argv(const JobRunOptions& o, const fs::path& stage) {
   std::vector<std::string> argv{o.surftex_exe, o.command.at(0), "-o",
-                                (o.output_file.empty() ? stage : stage / o.output_file).string(), "--report",
-                                (stage / "report.json").string()};
+                                (o.output_file.empty() ? stage : stage / o.output_file).string()};
+  if (!(o.output_file.empty() && writes_own_report(o.command.at(0))))
+    argv.insert(argv.end(), {"--report", (stage / "report.json").string()});
   if (o.threads >= 0) argv.insert(argv.end(), {"--threads", std::to_string(o.threads)});
   argv.insert(argv.end(), o.command.begin() + 1, o.command.end());
   return argv;

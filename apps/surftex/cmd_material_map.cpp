@@ -251,10 +251,8 @@ int run(const Args& a) {
   RunFiles run_files{{a.mesh, a.tile, a.constraints, a.update, a.state}, {}};
   for (const char* f : kOutputs)
     if (std::string(f) != "report.json") run_files.outputs.push_back(a.out + "/" + f);
-  // OUT/report.json, unless --report names that same file (written once).
-  if (a.common.report_path.empty() || !same_file(a.common.report_path, a.out + "/report.json"))
-    write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
-                      a.common.force);
+  write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
+                    a.common.force);
   write_report(a.common, "material-map", rep, run_files);
   if (!a.common.quiet)
     std::fprintf(stderr, "material-map: %zu faces, %.1f%% singular, written to %s (%.2f s)\n",

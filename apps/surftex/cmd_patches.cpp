@@ -274,10 +274,8 @@ int run(const PatchArgs& a) {
   RunFiles files{inputs, {}};
   for (const auto& name : rep["outputs"]) files.outputs.push_back((fs::path(a.outdir) / name.get<std::string>()).string());
   rep.erase("outputs");  // a shared report key (surftex/report.h): paths, not names
-  // OUTDIR/report.json, unless --report names that same file (written once).
-  const std::string own = (fs::path(a.outdir) / "report.json").string();
-  if (a.common.report_path.empty() || !same_file(a.common.report_path, own))
-    write_file_atomic(own, make_report(a.common, "patches", rep, files).dump(2) + "\n", true);
+  write_file_atomic((fs::path(a.outdir) / "report.json").string(),
+                    make_report(a.common, "patches", rep, files).dump(2) + "\n", true);
   write_report(a.common, "patches", rep, files);
   if (!a.common.quiet)
     std::printf("%s: %d patches, %zu texels in %.2f s (%.0f texels/s), seam ratio %.3f\n",
