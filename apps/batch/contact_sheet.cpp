@@ -214,14 +214,8 @@ void write_demo_contact_sheet(const std::string& dir, const nlohmann::json& repo
                               const std::vector<std::string>& files) {
   const fs::path root(dir);
   std::vector<std::string> images;  // relative to dir
-  std::error_code ec;
   for (const std::string& f : files)
     if (is_image_file(fs::path(f))) images.push_back(fs::path(f).lexically_relative(root).generic_string());
-  if (files.empty())
-    for (auto it = fs::recursive_directory_iterator(root, ec); !ec && it != fs::recursive_directory_iterator();
-         it.increment(ec))
-      if (it->is_regular_file(ec) && is_image_file(it->path()))
-        images.push_back(fs::relative(it->path(), root, ec).generic_string());
   std::sort(images.begin(), images.end());
   std::set<std::string> claimed;
   ContactSheet sheet;

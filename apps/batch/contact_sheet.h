@@ -49,9 +49,9 @@ ContactSheet batch_contact_sheet(const std::string& title, const std::vector<Job
 /// ({"steps": {NAME: {...}}}): one card per step with the images it made
 /// (files its JSON names, its subfolder DIR/NAME/, files named after the step
 /// or after one of its parts), and a last card with images no step claims.
-/// `files`: the run's outputs (absolute paths under DIR), when its files are
-/// still staged (geometry/output_file.h); empty = the images found in DIR.
+/// `files`: the run's outputs (paths under DIR; they may still be staged,
+/// geometry/output_file.h), of which the images are shown.
 void write_demo_contact_sheet(const std::string& dir, const nlohmann::json& report,
-                              const std::vector<std::string>& files = {});
+                              const std::vector<std::string>& files);
 
 }  // namespace surftex::batch

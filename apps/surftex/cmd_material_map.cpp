@@ -124,8 +124,9 @@ nlohmann::json bake_report(const BakedAsset& a) {
 // OBJ (+MTL, base colour, normal and 16-bit height maps), GLB (base colour
 // and normal texture, the material m as a vertex attribute) with the atlas
 // uv; PLY with m as a vertex scalar.
-void write_meshes(Mesh& mesh, const BakedAsset& a, const std::string& obj, const std::string& glb,
-                  const std::string& ply, bool force) {
+// Returns every file written (write_mesh's lists: the OBJ's .mtl and maps too).
+std::vector<std::string> write_meshes(Mesh& mesh, const BakedAsset& a, const std::string& obj, const std::string& glb,
+                                      const std::string& ply, bool force) {
   auto mat = find(mesh, kVertexMaterial).first;
   auto scalar = mesh.add_property_map<VertexIndex, double>("material", 0.0).first;
   for (VertexIndex v : mesh.vertices()) scalar[v] = mat[v];
@@ -135,16 +136,17 @@ void write_meshes(Mesh& mesh, const BakedAsset& a, const std::string& obj, const
   wo.normal_texture = &a.normal;
   wo.height_texture = &a.bake.height;
   wo.texture_repeat = false;
-  write_mesh(obj, mesh, wo);
+  std::vector<std::string> files = write_mesh(obj, mesh, wo);
   wo.height_texture = nullptr;
   wo.vertex_scalar_property = "material";
-  write_mesh(glb, mesh, wo);
+  for (const std::string& f : write_mesh(glb, mesh, wo)) files.push_back(f);
   WriteMeshOptions po;
   po.overwrite = force;
   po.write_uvs = false;
   po.vertex_scalar_property = "material";
-  write_mesh(ply, mesh, po);
+  for (const std::string& f : write_mesh(ply, mesh, po)) files.push_back(f);
   mesh.remove_property_map(scalar);
+  return files;
 }
 
 MaterialMappingOptions mapping_options(const Args& a) {
@@ -369,10 +371,8 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   z_up_to_y_up(mesh);  // the torus was built around z: lying flat in glTF viewers
   const Outputs img = render_all(mesh, sing, tile, 384, {20.f, 45.f}, 0.03);
   const BakedAsset baked = bake_asset(mesh, sing, tile, 512, 0.03, mapping.result().default_scale);
-  write_meshes(mesh, baked, ctx.path("material_map.obj"), ctx.path("material_map.glb"), ctx.path("material_map.ply"),
-               true);
-  for (const char* f : {"material_map.mtl", "material_map.png", "material_map_normal.png", "material_map_height.png"})
-    ctx.path(f);  // the OBJ's material and maps (listed when they exist)
+  ctx.wrote(write_meshes(mesh, baked, ctx.path("material_map.obj"), ctx.path("material_map.glb"),
+                         ctx.path("material_map.ply"), true));
   write_image(ctx.path("material_map_plain.png"), img.plain);
   write_image(ctx.path("material_map_fixed.png"), img.fixed);
   write_image(ctx.path("material_map_normalmap.png"), img.normal);

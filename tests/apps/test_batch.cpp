@@ -338,15 +338,18 @@ TEST(ContactSheet, FailedCardsFirstRelativeLinksEscapedText) {
 
 TEST(ContactSheet, DemoCardsClaimTheImagesOfTheirSteps) {
   const fs::path dir = surftex::test::temp_dir("batch-demo-sheet");
+  std::vector<std::string> files;  // the demo run's outputs
   for (const char* f : {"synth_el2pass.png", "tile_noise.png", "exemplar_cells.png", "torus_tiled.png",
-                        "patches/render.png", "patches_exemplar.png"})
+                        "patches/render.png", "patches_exemplar.png"}) {
     write(dir / f, "png");
+    files.push_back((dir / f).string());
+  }
   const nlohmann::json report = nlohmann::json::parse(R"({"seconds": 3.0, "steps": {
     "synthesis": {"el2pass": {"bidirectional_similarity": 0.5}, "graphcut": {}, "tile": {"wrap_seam_ratio": 1.1},
                   "seconds_total": 1.0},
     "textured_torus": {"faces": 10, "files": ["torus_tiled.obj", "torus_tiled.png"], "seconds_total": 0.5},
     "patches": {"patches": 4, "outputs": ["render.png"], "seconds_total": 1.5}}})");
-  write_demo_contact_sheet(dir.string(), report);
+  write_demo_contact_sheet(dir.string(), report, files);
   const std::string h = read_all(dir / "index.html");
   auto card = [&](const std::string& name) {
     const std::size_t a = h.find("id=\"card-" + name + "\"");
