@@ -271,6 +271,30 @@ TEST(BatchCli, ASecondRunRerunsOnlyMissingOrChangedJobs) {
   fs::remove_all(dir);
 }
 
+// Subcommands that write OUTDIR/report.json themselves (patches, subdiv,
+// material-map, demo) run as folder jobs without a --report of the batch's
+// (naming the same file twice is refused): the job succeeds and the summary
+// reads the report the subcommand wrote.
+TEST(BatchCli, FolderJobsThatWriteTheirOwnReportSucceedAndAreSummarized) {
+  const fs::path dir = temp_dir("batch-folder-jobs");
+  write(dir / "jobs.txt", "sub: subdiv " + q(shared_data("meshes/eight_genus2.off")) + " " +
+                              q(shared_data("textures/leather_64.png")) +
+                              " --levels 0 --passes 1 --region 5 --pyramid --atlas-size 256\n");
+  const auto r =
+      run_surftex("batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) + " --jobs 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json s = read_json(dir / "out" / "summary.json");
+  EXPECT_EQ(s["counts"]["ok"], 1) << s.dump(2);
+  const nlohmann::json* j = job(s, "sub");
+  ASSERT_NE(j, nullptr);
+  EXPECT_EQ((*j)["status"], "ok");
+  const nlohmann::json report = read_json(dir / "out" / "sub" / "report.json");
+  EXPECT_EQ(report["command"], "subdiv");
+  EXPECT_FALSE((*j)["outputs"].empty());
+  EXPECT_FALSE((*j)["images"].empty()) << j->dump(2);
+  fs::remove_all(dir);
+}
+
 TEST(BatchCli, ABadInputIsNotRetriedUntilItChangesOrRetryFailedIsGiven) {
   const fs::path dir = temp_dir("batch-retry");
   fs::copy_file(shared_data("broken/truncated.off"), dir / "in.off");

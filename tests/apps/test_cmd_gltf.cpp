@@ -167,3 +167,25 @@ TEST(CmdGltf, BadGlbIsRefusedWithoutOutput) {
   expect_refused(test::run_surftex("convert " + q(d + "/points.glb") + " -o " + q(d + "/p.obj")), d + "/p.obj",
                  "no triangles");
 }
+
+// A texture path that does not exist, named on the command line or by an
+// OBJ's material: refused with its path, exit 2, nothing written.
+TEST(CmdGltf, ATexturePathThatDoesNotExistIsRefusedWithoutOutput) {
+  const std::string d = test::temp_dir("cmd-gltf-notex");
+  std::ofstream(d + "/quad.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                 << "f 1/1 2/2 3/3 4/4\n";
+  expect_refused(test::run_surftex("render " + q(d + "/quad.obj") + " --texture " + q(d + "/nope.png") + " -o " +
+                                   q(d + "/r.png") + " -q"),
+                 d + "/r.png", "nope.png");
+  expect_refused(test::run_surftex("convert " + q(d + "/quad.obj") + " --texture " + q(d + "/nope.png") + " -o " +
+                                   q(d + "/c.glb") + " -q"),
+                 d + "/c.glb", "nope.png");
+  // The material's map_Kd names a missing file.
+  std::ofstream(d + "/lost.mtl") << "newmtl m\nKd 1 1 1\nmap_Kd gone.png\n";
+  std::ofstream(d + "/lost.obj") << "mtllib lost.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                                 << "usemtl m\nf 1/1 2/2 3/3\n";
+  expect_refused(test::run_surftex("convert " + q(d + "/lost.obj") + " -o " + q(d + "/l.glb") + " -q"), d + "/l.glb",
+                 "gone.png");
+  expect_refused(test::run_surftex("render " + q(d + "/lost.obj") + " -o " + q(d + "/l.png") + " -q"), d + "/l.png",
+                 "gone.png");
+}

@@ -200,6 +200,13 @@ TEST(CmdMaterialMap, BakedAssetRendersLikeTheFixedRender) {
   EXPECT_GE(db, 30.0);
   // The plain (unfixed) render is further away: the bake holds the fix.
   EXPECT_LT(psnr(read_image(out + "/render_plain.png"), read_image(dir + "/obj_render.png")), db);
+  // The GLB as a glTF viewer shows it (its embedded base-colour texture, its
+  // own sampler), with no texture given on the command line.
+  r = test::run_surftex("render '" + out + "/mesh.glb' --size 256 -q -o '" + dir + "/glb_render.png'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double glb_db = psnr(read_image(out + "/render_fixed.png"), read_image(dir + "/glb_render.png"));
+  EXPECT_GE(glb_db, 30.0);
+  EXPECT_LT(psnr(read_image(out + "/render_plain.png"), read_image(dir + "/glb_render.png")), glb_db);
   const nlohmann::json g = test::glb_json(out + "/mesh.glb");
   ASSERT_TRUE(g.contains("materials"));
   EXPECT_TRUE(g["materials"][0]["pbrMetallicRoughness"].contains("baseColorTexture"));
