@@ -74,7 +74,9 @@ run_one() {
   local reg="$root/fuzz/regressions/$t"
   mkdir -p "$reg" "$build/new/$t"
   # New corpus entries go to build/new (not to the repository); findings to fuzz/regressions.
-  if "$build/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  # A fixed seed (SURFTEX_FUZZ_SEED, default 1) so that a CI run explores the same inputs
+  # first each time; 0 asks libFuzzer for a random one.
+  if "$build/$t" -seed="${SURFTEX_FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
        -max_len=131072 -print_final_stats=1 -artifact_prefix="$reg/" \
        "$build/new/$t" "$work/$t" >"$build/$t.log" 2>&1; then
     echo "fuzz: $t clean for ${seconds} s ($(grep -m1 -o 'stat::number_of_executed_units: *[0-9]*' "$build/$t.log" | grep -o '[0-9]*$') inputs)"

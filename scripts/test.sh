@@ -34,10 +34,6 @@ if [[ $sanitize == 1 ]]; then
   # frames, so scripts/lsan.supp matches less; the one known third-party leak
   # (libpng longjmp-ing through OpenImageIO on a damaged PNG) is no longer
   # reached since geometry/image_io checks a PNG's chunks before libpng does.
-  # use_tls=0: LSan's scan of dynamic TLS crashes its tracer (SIGSEGV, "LeakSanitizer has
-  # encountered a fatal error", exit 1) in any run that has dlopen-ed the OpenImageIO module
-  # (geometry/image_io_loader.cpp) with several threads alive (glibc 2.36, GCC 12's
-  # libsanitizer); blocks reachable only from TLS are then suppressed in lsan.supp.
-  export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp:use_tls=0"
+  export LSAN_OPTIONS="suppressions=$root/scripts/lsan.supp"
   (cd "$root/build-asan" && SURFTEX_SANITIZED=1 ctest --output-on-failure -j "$(nproc)")
 fi
