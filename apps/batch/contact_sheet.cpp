@@ -246,11 +246,14 @@ void write_demo_contact_sheet(const std::string& dir, const nlohmann::json& repo
         if (mine) owner[img] = name;
       }
     }
+  // The report's "seconds": one number per step (and "total" once the shared keys are added).
+  const nlohmann::json times = report.contains("seconds") && report["seconds"].is_object() ? report["seconds"]
+                                                                                          : nlohmann::json::object();
   for (const auto& [name, step] : steps.items()) {
     SheetCard c;
     c.title = name;
     c.status = "ok";
-    if (step.contains("seconds_total") && step["seconds_total"].is_number()) c.seconds = step["seconds_total"];
+    if (times.contains(name) && times[name].is_number()) c.seconds = times[name];
     for (const std::string& img : images)
       if (auto it = owner.find(img); it != owner.end() && it->second == name) c.images.push_back(img), claimed.insert(img);
     c.images = order_images(c.images);
@@ -264,8 +267,12 @@ void write_demo_contact_sheet(const std::string& dir, const nlohmann::json& repo
     if (!claimed.count(img)) rest.images.push_back(img);
   if (!rest.images.empty()) sheet.cards.push_back(rest);
   char sub[128];
-  const double total = report.contains("seconds") && report["seconds"].is_number() ? report["seconds"].get<double>()
-                                                                                    : -1;
+  double total = times.contains("total") && times["total"].is_number() ? times["total"].get<double>() : -1;
+  if (total < 0 && !times.empty()) {
+    total = 0;
+    for (const auto& [name, t] : times.items())
+      if (t.is_number()) total += t.get<double>();
+  }
   std::snprintf(sub, sizeof sub, "%zu steps, %zu images%s", steps.size(), images.size(),
                 total >= 0 ? (", " + format_seconds(total)).c_str() : "");
   sheet.subtitle = sub;

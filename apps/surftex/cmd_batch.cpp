@@ -58,6 +58,21 @@ std::string job_runner(const std::string& surftex) {
   return p.string();
 }
 
+// OUT/summary.json: the jobs' summary with the keys every report has
+// (surftex/report.h): version, command line, the manifest's hash, seconds.total,
+// and as outputs the contact sheet and every job's outputs (paths under OUT);
+// "seed" is the default (each job has its own), "threads" the jobs at once.
+void write_summary(const fs::path& out, const BatchManifest& m, const std::vector<JobSummary>& jobs, int parallel) {
+  nlohmann::json fields = summary_json(m, jobs);
+  RunFiles files{{m.path}, {(out / "index.html").string()}};
+  for (const JobSummary& s : jobs)
+    for (const std::string& f : s.outputs) files.outputs.push_back((out / f).string());
+  CommonOptions opt;
+  opt.threads = parallel;
+  const nlohmann::json r = make_report(opt, "batch", std::move(fields), files);
+  write_file_atomic((out / "summary.json").string(), r.dump(2) + "\n", true);
+}
+
 std::string read_text(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
   std::stringstream ss;
@@ -261,8 +276,8 @@ int run_batch(const BatchArgs& a) {
   }
   std::vector<JobSummary> summaries;
   for (const BatchJob& j : m.jobs) summaries.push_back(summarize_job(j, out.string()));
-  write_file_atomic((out / "summary.json").string(), summary_json(m, summaries).dump(2) + "\n", true);
   write_contact_sheet((out / "index.html").string(), batch_contact_sheet("surftex batch: " + m.path, summaries));
+  write_summary(out, m, summaries, a.jobs);  // after index.html: it lists it
   ::close(lock);
   int ok = 0, failed = 0, other = 0;
   for (const JobSummary& s : summaries) (s.status == "ok" ? ok : s.status == "failed" ? failed : other)++;

@@ -112,8 +112,8 @@ nlohmann::json step_synthesis(DemoContext& ctx) {
   el.progress = ctx.progress;
   Image el_out = efros_leung_synthesize(noise, 128, 128, el);
   write_image(ctx.path("synth_el2pass.png"), el_out);
-  j["el2pass"] = {{"seconds", t.seconds()},
-                  {"size", "128x128"},
+  j["seconds"]["el2pass"] = t.seconds();
+  j["el2pass"] = {{"size", "128x128"},
                   {"bidirectional_similarity", bidirectional_similarity(el_out, noise, {.patch = 7, .periodic_exemplar = true, .stride = 2}).total},
                   {"histogram_chi2", histogram_chi_square(el_out, noise)}};
 
@@ -128,7 +128,8 @@ nlohmann::json step_synthesis(DemoContext& ctx) {
   eo.rotations = 32;
   Image oriented = efros_leung_synthesize(in, eo).image;
   write_image(ctx.path("synth_oriented_wavy.png"), oriented);
-  j["oriented"] = {{"seconds", t.seconds()}, {"rotations", eo.rotations}};
+  j["seconds"]["oriented"] = t.seconds();
+  j["oriented"] = {{"rotations", eo.rotations}};
 
   t.reset();
   GraphcutOptions gc;
@@ -136,8 +137,8 @@ nlohmann::json step_synthesis(DemoContext& ctx) {
   gc.progress = ctx.progress;
   Image gc_out = graphcut_synthesize(cells, 256, 256, gc);
   write_image(ctx.path("synth_graphcut.png"), gc_out);
-  j["graphcut"] = {{"seconds", t.seconds()},
-                   {"size", "256x256"},
+  j["seconds"]["graphcut"] = t.seconds();
+  j["graphcut"] = {{"size", "256x256"},
                    {"bidirectional_similarity", bidirectional_similarity(gc_out, cells, {.patch = 7, .periodic_exemplar = false, .stride = 4}).total}};
 
   t.reset();
@@ -146,7 +147,8 @@ nlohmann::json step_synthesis(DemoContext& ctx) {
   to.progress = ctx.progress;
   ctx.tile = make_tileable(make_noise(96, 4, ctx.seed), 128, to);
   write_image(ctx.path("tile_noise.png"), ctx.tile);
-  j["tile"] = {{"seconds", t.seconds()}, {"wrap_seam_ratio", wrap_seam_ratio(ctx.tile)}};
+  j["seconds"]["tile"] = t.seconds();
+  j["tile"] = {{"wrap_seam_ratio", wrap_seam_ratio(ctx.tile)}};
   return j;
 }
 

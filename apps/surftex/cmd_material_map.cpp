@@ -327,7 +327,6 @@ SubcommandRegistrar reg{
 // ---- demo step ---------------------------------------------------------------
 
 nlohmann::json demo_material_map(DemoContext& ctx) {
-  Timer timer;
   // A small 3D tile morphing noise into cells.
   std::vector<MaterialKey> keys(2);
   keys[0].texture = make_noise(64, 4, ctx.seed);
@@ -380,9 +379,8 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
           {"tile_layers", tile.layers.size()},
           {"singular_fraction", sing.singular_fraction},
           {"atlas", bake_report(baked)},
-          {"seconds", timer.seconds()},
-          {"files",
-           {"material_tile/", "material_map.obj", "material_map.mtl", "material_map.png", "material_map_normal.png",
+          {"outputs",
+           {"material_tile/tile.json", "material_map.obj", "material_map.mtl", "material_map.png", "material_map_normal.png",
             "material_map_height.png", "material_map.glb", "material_map.ply", "material_map_plain.png",
             "material_map_fixed.png", "material_map_normalmap.png"}}};
 }

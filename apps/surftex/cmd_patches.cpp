@@ -381,6 +381,7 @@ DemoStepRegistrar demo{{30, "patches",
                           nlohmann::json j =
                               run_pipeline(mesh, {ex}, po, ctx.path("patches"), ctx.seed, 2.0);
                           write_file_atomic(ctx.path("patches/report.json"), j.dump(2) + "\n", true);
+                          for (auto& name : j["outputs"]) name = "patches/" + name.get<std::string>();  // under the demo folder
                           return j;
                         }}};
 

@@ -577,8 +577,8 @@ nlohmann::json step_quilt(DemoContext& ctx) {
   color_by_element(plane, ctx.seed);
   write_mesh(ctx.path("quilt_plane_chainmail.ply"), plane);
   write_image(ctx.path("quilt_plane_chainmail.png"), render_preview(plane));
-  j["plane"] = {{"elements", pr.elements}, {"faces", pr.faces}, {"seconds", t.seconds()},
-                {"files", {"quilt_plane_chainmail.ply", "quilt_plane_chainmail.png"}}};
+  j["plane"] = {{"elements", pr.elements}, {"faces", pr.faces}, {"outputs", {"quilt_plane_chainmail.ply", "quilt_plane_chainmail.png"}}};
+  j["seconds"]["plane"] = t.seconds();
   t.reset();
   Mesh base;
   make_icosphere(base, 2);
@@ -605,8 +605,8 @@ nlohmann::json step_quilt(DemoContext& ctx) {
                  {"stretch_before", er.stretch.stretch_before},
                  {"stretch_after", er.stretch.stretch_after},
                  {"self_intersections", er.embed.self_intersecting_pairs},
-                 {"seconds", t.seconds()},
-                 {"files", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
+                 {"outputs", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
+  j["seconds"]["sphere"] = t.seconds();
   return j;
 }
 

@@ -53,11 +53,21 @@ bool shows_materials(const std::vector<MeshMaterial>& materials) {
   return false;
 }
 
+RenderOptions::Wrap render_wrap(MeshMaterial::Wrap w) {
+  switch (w) {
+    case MeshMaterial::Wrap::ClampToEdge: return RenderOptions::Wrap::Clamp;
+    case MeshMaterial::Wrap::MirroredRepeat: return RenderOptions::Wrap::Mirror;
+    case MeshMaterial::Wrap::Repeat: break;
+  }
+  return RenderOptions::Wrap::Repeat;
+}
+
 // The base colour a glTF viewer shows (glTF 2.0 section 3.9.2): the
-// material's baseColorFactor times its texture at the corner UVs times the
-// vertex colour, each where present.
+// material's baseColorFactor times its texture at the corner UVs (wrapped as
+// its sampler says, or clamped with --clamp) times the vertex colour, each
+// where present.
 FragmentCallback material_shader(const Mesh& mesh, const RenderMesh& rm, const std::vector<MeshMaterial>& materials,
-                                 RenderOptions::Wrap wrap) {
+                                 bool clamp) {
   auto fm = find(mesh, kFaceMaterial);
   std::vector<int> tri_material(rm.triangles.size(), -1);
   if (fm.second)
@@ -65,7 +75,7 @@ FragmentCallback material_shader(const Mesh& mesh, const RenderMesh& rm, const s
       const int m = fm.first[FaceIndex(static_cast<std::uint32_t>(rm.triangle_face[t]))];
       tri_material[t] = m >= 0 && static_cast<std::size_t>(m) < materials.size() ? m : -1;
     }
-  return [&rm, &materials, wrap, tri_material](int t, const Vec3f& b) -> Vec3f {
+  return [&rm, &materials, clamp, tri_material](int t, const Vec3f& b) -> Vec3f {
     Vec3f c{1.f, 1.f, 1.f};
     const int m = tri_material[static_cast<std::size_t>(t)];
     if (m >= 0) {
@@ -77,7 +87,8 @@ FragmentCallback material_shader(const Mesh& mesh, const RenderMesh& rm, const s
           u += b[k] * rm.corner_uvs[3 * t + k][0];
           v += b[k] * rm.corner_uvs[3 * t + k][1];
         }
-        const Vec3f s = sample_texture(mat.texture, u, v, wrap);
+        const Vec3f s = clamp ? sample_texture(mat.texture, u, v, RenderOptions::Wrap::Clamp)
+                              : sample_texture(mat.texture, u, v, render_wrap(mat.wrap_s), render_wrap(mat.wrap_t));
         for (int k = 0; k < 3; ++k) c[k] *= s[k];
       }
     }
@@ -151,7 +162,7 @@ int run(RenderArgs& a) {
   t.reset();
   report_progress(progress, "render", 0.0);
   RenderMesh rm = make_render_mesh(mesh, mopt);
-  if (material_colors) opt.callback = material_shader(mesh, rm, in.materials, opt.wrap);
+  if (material_colors) opt.callback = material_shader(mesh, rm, in.materials, a.clamp);
   const Camera cam = fit_camera(bounding_box(rm), a.view[0], a.view[1],
                                 a.ortho ? Camera::Projection::Orthographic : Camera::Projection::Perspective, 1.f);
   RenderResult res = render(rm, cam, opt);
@@ -224,7 +235,9 @@ SubcommandRegistrar reg{{"render", "Render a mesh to an image with the software 
       ->check(CLI::IsMember({"auto", "material", "vertex", "none"}));
   app.add_flag("--flat", a->flat, "Flat shading with face normals (default: smooth vertex normals)");
   app.add_flag("--no-shade", a->no_shade, "No lighting: the raw colours (default: Lambert + ambient 0.25)");
-  app.add_flag("--clamp", a->clamp, "Clamp texture coordinates to [0,1] (default: repeat)");
+  app.add_flag("--clamp", a->clamp,
+               "Clamp texture coordinates to [0,1] (default: a material's texture wraps as its glTF sampler "
+               "says, REPEAT without one or for OBJ; --texture repeats)");
   add_common_options(app, a->common);
   return [a] { return run(*a); };
 }}};

@@ -467,7 +467,12 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  PbrSettings pbr;
                                  pbr.atlas_size = 512;
                                  pbr.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
-                                 j["outputs"] = write_outputs(mesh, output_paths(dir), true, pbr);
+                                 nlohmann::json written = write_outputs(mesh, output_paths(dir), true, pbr);
+                                 // Report keys as the CLI's (issue 16 item 7): names under the demo folder.
+                                 for (const auto& f : written["files"])
+                                   j["outputs"].push_back(fs::relative(f.get<std::string>(), ctx.dir).string());
+                                 written.erase("files");
+                                 j["export"] = written;
                                  return j;
                                }}};
 

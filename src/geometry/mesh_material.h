@@ -30,6 +30,11 @@ struct MeshMaterial {
   std::string texture_origin;
   /// The decoded texture (load_material_textures), empty until then.
   Image texture;
+  /// How coordinates outside [0,1] read the texture, per axis: a glTF
+  /// sampler's wrapS / wrapT (REPEAT when it has no sampler, glTF 2.0
+  /// section 5.26); OBJ map_Kd repeats.
+  enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+  Wrap wrap_s = Wrap::Repeat, wrap_t = Wrap::Repeat;
 
   bool has_texture() const { return !texture_file.empty() || !texture_bytes.empty(); }
 };

@@ -616,28 +616,50 @@ Camera fit_camera(const BBox3f& box, float azimuth_deg, float elevation_deg, Cam
   return cam;
 }
 
-Vec3f sample_texture(const Image& tex, float u, float v, RenderOptions::Wrap wrap) {
-  const int w = tex.width, h = tex.height;
-  double uu = u, vv = 1.0 - static_cast<double>(v);
-  if (wrap == RenderOptions::Wrap::Repeat) {
-    uu -= std::floor(uu);
-    vv -= std::floor(vv);
-  } else {
-    uu = std::clamp(uu, 0.0, 1.0);
-    vv = std::clamp(vv, 0.0, 1.0);
+namespace {
+
+// A texture coordinate (texel units after * size) brought into the range its
+// wrap reads: one period for Repeat, two (there and back) for Mirror.
+double wrap_coordinate(double t, RenderOptions::Wrap wrap) {
+  switch (wrap) {
+    case RenderOptions::Wrap::Repeat: return t - std::floor(t);
+    case RenderOptions::Wrap::Mirror: return t - 2.0 * std::floor(t / 2.0);
+    case RenderOptions::Wrap::Clamp: break;
   }
+  return std::clamp(t, 0.0, 1.0);
+}
+
+// A texel index of the bilinear footprint, wrapped like its coordinate.
+int wrap_index(int i, int n, RenderOptions::Wrap wrap) {
+  switch (wrap) {
+    case RenderOptions::Wrap::Repeat: return ((i % n) + n) % n;
+    case RenderOptions::Wrap::Mirror: {
+      const int k = ((i % (2 * n)) + 2 * n) % (2 * n);
+      return k < n ? k : 2 * n - 1 - k;
+    }
+    case RenderOptions::Wrap::Clamp: break;
+  }
+  return std::clamp(i, 0, n - 1);
+}
+
+}  // namespace
+
+Vec3f sample_texture(const Image& tex, float u, float v, RenderOptions::Wrap wrap) {
+  return sample_texture(tex, u, v, wrap, wrap);
+}
+
+Vec3f sample_texture(const Image& tex, float u, float v, RenderOptions::Wrap wrap_u, RenderOptions::Wrap wrap_v) {
+  const int w = tex.width, h = tex.height;
+  // Rows run down from v = 1 (t = 1 - v, glTF's coordinate), so t is wrapped.
+  const double uu = wrap_coordinate(u, wrap_u), vv = wrap_coordinate(1.0 - static_cast<double>(v), wrap_v);
   double x = uu * w - 0.5, y = vv * h - 0.5;
   double fx0 = std::floor(x), fy0 = std::floor(y);
   float ax = static_cast<float>(x - fx0), ay = static_cast<float>(y - fy0);
   int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0), x1 = x0 + 1, y1 = y0 + 1;
-  auto fix = [wrap](int i, int n) {
-    if (wrap == RenderOptions::Wrap::Repeat) return ((i % n) + n) % n;
-    return std::clamp(i, 0, n - 1);
-  };
-  x0 = fix(x0, w);
-  x1 = fix(x1, w);
-  y0 = fix(y0, h);
-  y1 = fix(y1, h);
+  x0 = wrap_index(x0, w, wrap_u);
+  x1 = wrap_index(x1, w, wrap_u);
+  y0 = wrap_index(y0, h, wrap_v);
+  y1 = wrap_index(y1, h, wrap_v);
   Vec3f out;
   const int nc = tex.channels;
   for (int c = 0; c < 3; ++c) {

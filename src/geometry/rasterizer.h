@@ -101,7 +101,9 @@ struct RenderOptions {
   /// ColorSource::Texture: sampled bilinearly at the corner UVs (u right, v up:
   /// v = 0 is the bottom row). 1 channel = grey, >= 3 channels = the first 3.
   const Image* texture = nullptr;
-  enum class Wrap { Repeat, Clamp };
+  /// Texture coordinates outside [0,1]: Repeat, Clamp (to the edge texel) or
+  /// Mirror (there and back: glTF MIRRORED_REPEAT).
+  enum class Wrap { Repeat, Clamp, Mirror };
   Wrap wrap = Wrap::Repeat;
   FragmentCallback callback;  ///< ColorSource::Callback
 
@@ -134,5 +136,7 @@ RenderResult render(const RenderMesh& mesh, const Camera& camera, const RenderOp
 /// Bilinear texture lookup at (u, v) with v up, as render() does: texel
 /// centres at ((i + 0.5) / width, 1 - (j + 0.5) / height). Returns RGB.
 Vec3f sample_texture(const Image& texture, float u, float v, RenderOptions::Wrap wrap);
+/// The same with a wrap per axis (glTF wrapS / wrapT).
+Vec3f sample_texture(const Image& texture, float u, float v, RenderOptions::Wrap wrap_u, RenderOptions::Wrap wrap_v);
 
 }  // namespace surftex

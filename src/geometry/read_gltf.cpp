@@ -498,6 +498,28 @@ std::vector<Instance> mesh_instances(const std::string& path, const tinygltf::Mo
 }
 
 // ------------------------------------------------------------------ materials
+MeshMaterial::Wrap wrap_mode(const std::string& path, int sampler, const char* axis, int code) {
+  switch (code) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return MeshMaterial::Wrap::Repeat;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return MeshMaterial::Wrap::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return MeshMaterial::Wrap::MirroredRepeat;
+    default:
+      fail_io(path, "", "sampler " + std::to_string(sampler) + " has " + axis + " " + std::to_string(code) +
+                            ", not a glTF wrap mode (10497, 33071 or 33648)");
+  }
+  return MeshMaterial::Wrap::Repeat;
+}
+
+// The texture's sampler wrap modes (none: REPEAT on both axes).
+void read_sampler_wrap(const std::string& path, const tinygltf::Model& m, const tinygltf::Texture& tex, MeshMaterial& mm) {
+  if (tex.sampler < 0) return;
+  if (static_cast<std::size_t>(tex.sampler) >= m.samplers.size())
+    fail_io(path, "", "a texture names sampler " + std::to_string(tex.sampler) + ", which does not exist");
+  const tinygltf::Sampler& s = m.samplers[static_cast<std::size_t>(tex.sampler)];
+  mm.wrap_s = wrap_mode(path, tex.sampler, "wrapS", s.wrapS);
+  mm.wrap_t = wrap_mode(path, tex.sampler, "wrapT", s.wrapT);
+}
+
 std::vector<MeshMaterial> read_materials(const std::string& path, const tinygltf::Model& m,
                                          std::vector<int>& texcoord) {
   std::vector<MeshMaterial> out;
@@ -513,7 +535,9 @@ std::vector<MeshMaterial> read_materials(const std::string& path, const tinygltf
     if (bt.index >= 0) {
       if (static_cast<std::size_t>(bt.index) >= m.textures.size())
         fail_io(path, "", "material '" + mm.name + "' names texture " + std::to_string(bt.index) + ", which does not exist");
-      const int src = m.textures[static_cast<std::size_t>(bt.index)].source;
+      const tinygltf::Texture& tex = m.textures[static_cast<std::size_t>(bt.index)];
+      read_sampler_wrap(path, m, tex, mm);
+      const int src = tex.source;
       if (src < 0 || static_cast<std::size_t>(src) >= m.images.size())
         fail_io(path, "", "texture " + std::to_string(bt.index) + " of material '" + mm.name + "' has no image surftex can read");
       const tinygltf::Image& im = m.images[static_cast<std::size_t>(src)];

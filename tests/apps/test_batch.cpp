@@ -344,11 +344,12 @@ TEST(ContactSheet, DemoCardsClaimTheImagesOfTheirSteps) {
     write(dir / f, "png");
     files.push_back((dir / f).string());
   }
-  const nlohmann::json report = nlohmann::json::parse(R"({"seconds": 3.0, "steps": {
+  const nlohmann::json report = nlohmann::json::parse(R"({"seconds": {"synthesis": 1.0, "textured_torus": 0.5,
+    "patches": 72.0}, "steps": {
     "synthesis": {"el2pass": {"bidirectional_similarity": 0.5}, "graphcut": {}, "tile": {"wrap_seam_ratio": 1.1},
-                  "seconds_total": 1.0},
-    "textured_torus": {"faces": 10, "files": ["torus_tiled.obj", "torus_tiled.png"], "seconds_total": 0.5},
-    "patches": {"patches": 4, "outputs": ["render.png"], "seconds_total": 1.5}}})");
+                  "seconds": {"el2pass": 0.25}},
+    "textured_torus": {"faces": 10, "outputs": ["torus_tiled.obj", "torus_tiled.png"]},
+    "patches": {"patches": 4, "outputs": ["render.png"]}}})");
   write_demo_contact_sheet(dir.string(), report, files);
   const std::string h = read_all(dir / "index.html");
   auto card = [&](const std::string& name) {
@@ -363,6 +364,10 @@ TEST(ContactSheet, DemoCardsClaimTheImagesOfTheirSteps) {
   EXPECT_NE(card("other images").find("exemplar_cells.png"), std::string::npos);
   EXPECT_NE(card("other images").find("tile_noise.png"), std::string::npos);
   EXPECT_NE(card("synthesis").find("el2pass bidirectional_similarity"), std::string::npos);
+  // Step times from the report's "seconds" object (the shared schema), total in the subtitle.
+  EXPECT_NE(card("patches").find("1m12s"), std::string::npos);
+  EXPECT_NE(card("textured_torus").find("0.5 s"), std::string::npos);
+  EXPECT_NE(h.find("1m14s"), std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "apps/report_schema.h"
 #include "batch/batch_manifest.h"
 #include "test_support.h"
 
@@ -109,6 +110,10 @@ void check_isolation_and_summary(const surftex::test::RunResult& run, const fs::
   }
   EXPECT_TRUE(fs::exists(out / "eight" / "render.png"));
   EXPECT_TRUE(fs::exists(out / "spot" / "render.png"));
+  // The keys every report has (issue 16 item 7): the manifest hashed, the sheet and the jobs' files as outputs.
+  surftex::test::expect_report_schema(s, "batch", {}, {(out / "index.html").string(), (out / "spot" / "render.png").string()});
+  ASSERT_EQ(s["inputs"].size(), 1u);
+  EXPECT_EQ(s["inputs"][0]["path"], s["manifest"]);
   EXPECT_TRUE(fs::exists(out / "beans" / "synth.png"));
   EXPECT_FALSE(job(s, "eight")->at("figures").empty());  // seam ratio, patches, faces
   EXPECT_TRUE(job(s, "eight")->at("figures").contains("seam ratio"));

@@ -46,6 +46,30 @@ std::array<double, 3> extent(const std::string& glb) {
   return {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
 }
 
+// The steps' entries use the report schema's names (issue 16 item 7): files
+// under "outputs" (names under the demo folder, each existing), times under
+// "seconds" as an object of numbers; no "files", "seconds_total" or "timings".
+void expect_step_keys_follow_the_schema(const nlohmann::json& j, const std::string& dir, const std::string& at = "steps") {
+  if (j.is_array()) {
+    for (const auto& v : j) expect_step_keys_follow_the_schema(v, dir, at + "[]");
+    return;
+  }
+  if (!j.is_object()) return;
+  for (const auto& [k, v] : j.items()) {
+    const std::string where = at + "." + k;
+    EXPECT_TRUE(k != "files" && k != "seconds_total" && k != "timings") << where;
+    if (k == "seconds") {
+      EXPECT_TRUE(v.is_object()) << where;
+      for (const auto& [stage, s] : v.items()) EXPECT_TRUE(s.is_number()) << where << "." << stage;
+    } else if (k == "outputs") {
+      ASSERT_TRUE(v.is_array()) << where;
+      for (const auto& f : v) EXPECT_TRUE(fs::is_regular_file(fs::path(dir) / f.get<std::string>())) << where << ": " << f;
+    } else {
+      expect_step_keys_follow_the_schema(v, dir, where);
+    }
+  }
+}
+
 }  // namespace
 
 TEST(CmdDemo, WritesValidUprightAssetsAndOneReport) {
@@ -90,4 +114,5 @@ TEST(CmdDemo, WritesValidUprightAssetsAndOneReport) {
     expected.push_back(out + "/" + f);
   test::expect_report_schema(j, "demo", {}, expected);
   EXPECT_TRUE(j["seconds"].contains("textured_torus"));
+  expect_step_keys_follow_the_schema(j["steps"], out);
 }

@@ -189,3 +189,119 @@ TEST(CmdGltf, ATexturePathThatDoesNotExistIsRefusedWithoutOutput) {
   expect_refused(test::run_surftex("render " + q(d + "/lost.obj") + " -o " + q(d + "/l.png") + " -q"), d + "/l.png",
                  "gone.png");
 }
+
+namespace {
+
+// A unit quad in the xy plane with u running 0..3 across it, textured with an
+// 8 x 1 image (left half black, right half white) whose sampler wraps u with
+// `wrap_s` (glTF codes), written as a GLB by tinygltf itself.
+void write_wrap_quad(const std::string& path, const std::string& png, int wrap_s) {
+  tinygltf::Model m;
+  m.asset.version = "2.0";
+  const float pos[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const float uv[] = {0, 1, 3, 1, 3, 0, 0, 0};
+  const std::uint16_t idx[] = {0, 1, 2, 0, 2, 3};
+  const std::string img = read_bytes(png);
+  tinygltf::Buffer buf;
+  auto add = [&](const void* p, std::size_t n, int target) {
+    while (buf.data.size() % 4) buf.data.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = buf.data.size();
+    v.byteLength = n;
+    v.target = target;
+    buf.data.insert(buf.data.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
+    m.bufferViews.push_back(v);
+    return static_cast<int>(m.bufferViews.size() - 1);
+  };
+  auto accessor = [&](int view, int comp, int type, std::size_t count, std::vector<double> mn = {}, std::vector<double> mx = {}) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = comp;
+    a.type = type;
+    a.count = count;
+    a.minValues = std::move(mn);
+    a.maxValues = std::move(mx);
+    m.accessors.push_back(a);
+    return static_cast<int>(m.accessors.size() - 1);
+  };
+  tinygltf::Primitive prim;
+  prim.attributes["POSITION"] = accessor(add(pos, sizeof pos, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                         TINYGLTF_TYPE_VEC3, 4, {0, 0, 0}, {1, 1, 0});
+  prim.attributes["TEXCOORD_0"] =
+      accessor(add(uv, sizeof uv, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, 4);
+  prim.indices = accessor(add(idx, sizeof idx, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR, 6);
+  prim.material = 0;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Image im;
+  im.bufferView = add(img.data(), img.size(), 0);
+  m.bufferViews.back().target = 0;
+  im.mimeType = "image/png";
+  m.images.push_back(im);
+  tinygltf::Sampler s;
+  s.wrapS = wrap_s;
+  s.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  m.samplers.push_back(s);
+  tinygltf::Texture t;
+  t.source = 0;
+  t.sampler = 0;
+  m.textures.push_back(t);
+  tinygltf::Material mat;
+  mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+  m.materials.push_back(mat);
+  tinygltf::Mesh mesh;
+  mesh.primitives.push_back(prim);
+  m.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  m.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  m.scenes.push_back(scene);
+  m.defaultScene = 0;
+  m.buffers.push_back(buf);
+  tinygltf::TinyGLTF io;
+  ASSERT_TRUE(io.WriteGltfSceneToFile(&m, path, false, true, false, true));
+}
+
+// Along the middle row of a front view: the surface's pixels (background red
+// excluded) as 'b' / 'w', runs merged.
+std::string middle_row_runs(const Image& img) {
+  std::string runs;
+  const int y = img.height / 2;
+  for (int x = 0; x < img.width; ++x) {
+    if (img.at(x, y, 0) > 0.9f && img.at(x, y, 1) < 0.1f) continue;  // background
+    const char c = img.at(x, y, 1) > 0.5f ? 'w' : 'b';
+    if (runs.empty() || runs.back() != c) runs += c;
+  }
+  return runs;
+}
+
+}  // namespace
+
+TEST(CmdGltf, RenderWrapsATextureAsItsSamplerSays) {
+  // u runs 0..3 over the quad: REPEAT shows black-white three times, MIRRORED_REPEAT
+  // black-white, white-black, black-white (two runs merge), CLAMP_TO_EDGE one black
+  // run then white to the end; --clamp forces the last.
+  const std::string d = test::temp_dir("cmd-gltf-wrap");
+  Image tex(8, 1, 3);
+  for (int x = 4; x < 8; ++x)
+    for (int c = 0; c < 3; ++c) tex.at(x, 0, c) = 1.f;
+  write_image(d + "/bw.png", tex);
+  const std::string view = " --view 0,0 --ortho --no-shade --supersample 1 --size 240 --background 1,0,0 -q";
+  const std::vector<std::pair<int, std::string>> cases{{TINYGLTF_TEXTURE_WRAP_REPEAT, "bwbwbw"},
+                                                       {TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT, "bwbw"},
+                                                       {TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE, "bw"}};
+  for (const auto& [wrap, runs] : cases) {
+    const std::string glb = d + "/q" + std::to_string(wrap) + ".glb", png = d + "/q" + std::to_string(wrap) + ".png";
+    write_wrap_quad(glb, d + "/bw.png", wrap);
+    const auto r = test::run_surftex("render " + q(glb) + " -o " + q(png) + view);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(middle_row_runs(read_image(png)), runs) << "wrap " << wrap;
+  }
+  const auto r = test::run_surftex("render " + q(d + "/q10497.glb") + " --clamp -o " + q(d + "/forced.png") + view);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(middle_row_runs(read_image(d + "/forced.png")), "bw");
+  fs::remove_all(d);
+}

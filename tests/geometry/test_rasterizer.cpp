@@ -144,6 +144,11 @@ TEST(Rasterizer, SampleTextureHitsTexelCentresAndWraps) {
   EXPECT_FLOAT_EQ(sample_texture(tex, 0.f, 0.75f, W::Repeat)[0], 1.5f);    // halfway between texels 3 and 0
   EXPECT_FLOAT_EQ(sample_texture(tex, 1.125f, -0.75f, W::Repeat)[0], 10.f);  // wraps to texel (0,1)
   EXPECT_FLOAT_EQ(sample_texture(tex, 0.125f, 0.f, W::Repeat)[0], 5.f);      // halfway between rows 1 and 0
+  EXPECT_FLOAT_EQ(sample_texture(tex, 1.125f, 0.75f, W::Mirror)[0], 3.f);   // past u = 1 back over texel 3
+  EXPECT_FLOAT_EQ(sample_texture(tex, -0.125f, 0.75f, W::Mirror)[0], 0.f);  // before u = 0 over texel 0
+  EXPECT_FLOAT_EQ(sample_texture(tex, 1.125f, 0.75f, W::Repeat, W::Clamp)[0], 0.f);  // a wrap per axis
+  EXPECT_FLOAT_EQ(sample_texture(tex, 0.125f, 1.25f, W::Repeat, W::Clamp)[0], 0.f);
+  EXPECT_FLOAT_EQ(sample_texture(tex, 0.125f, 1.25f, W::Clamp, W::Repeat)[0], 10.f);
 }
 
 TEST(Rasterizer, CubeOccludesPlaneWhateverTheDrawOrder) {
