@@ -8,7 +8,7 @@
 //
 // Protocol: one JSON array per stdin line, [STDERR_FILE, TIMEOUT_S, ARG...];
 // one JSON object per stdout line: {"status": exit code | -signal,
-// "hang": bool, "seconds": wall, "max_rss_kb": of the child}.
+// "hang": bool, "seconds": wall, "cpu_seconds": user + system, "max_rss_kb": of the child}.
 #define main surftex_cli_main
 #include "../apps/main.cpp"
 #undef main
@@ -80,7 +80,9 @@ int main() {
       usleep(2000);
     }
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -(WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-    nlohmann::json out{{"status", code}, {"hang", hang}, {"seconds", now() - t0}, {"max_rss_kb", ru.ru_maxrss}};
+    const double cpu = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+    nlohmann::json out{{"status", code}, {"hang", hang}, {"seconds", now() - t0}, {"cpu_seconds", cpu},
+                       {"max_rss_kb", ru.ru_maxrss}};
     std::cout << out.dump() << std::endl;
   }
   return 0;

@@ -9,9 +9,9 @@
 // in texels: shelf packing of their boxes (tallest first) with 2 g + 3 texels
 // between boxes and from the border (g = the gutter of geometry/
 // atlas_gutter.h, plus the raster's one-texel band on each side), at the
-// largest common scale that fits (bisection). When the full gutter costs more
-// than half the texel density of a one-texel gutter (many small charts:
-// armadillo_52k has 818), the largest power-of-two gutter that keeps half is
+// largest common scale that fits (bisection). When the full gutter leaves
+// less than a quarter of the texel density of a one-texel gutter (very many
+// small charts), the largest power-of-two gutter that keeps a quarter is
 // used instead and `protected_mip_size` says down to which mip level the
 // atlas stays clean. Then every face is rasterised
 // in uv space (geometry/uv_raster.h) and the gutters are verified on the
