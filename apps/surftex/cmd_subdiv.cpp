@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <type_traits>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "geometry/bake_vertex_colors.h"
@@ -28,8 +30,10 @@
 #include "texture/displace_by_vertex_color.h"
 #include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
+#include "texture/subdivision_exemplar_maps.h"
 #include "texture/subdivision_synthesis.h"
 #include "texture/surface_fidelity.h"
+#include "texture/tangent_space_bake.h"
 
 namespace fs = std::filesystem;
 
@@ -43,8 +47,9 @@ namespace {
 // input, e.g. around valence-2 vertices. The other fan starts are tried, and
 // if every start has such a diagonal, the face's fan is built on copies of
 // its vertices (same positions and colours): a separate small component that
-// the atlas charts on its own.
-Mesh triangulated_copy(const Mesh& m) {
+// the atlas charts on its own. `from` (optional) receives the source vertex
+// of every vertex of the copy.
+Mesh triangulated_copy(const Mesh& m, std::vector<VertexIndex>* from_out = nullptr) {
   auto key = [](VertexIndex a, VertexIndex b) {
     const std::uint64_t x = std::min(a.idx(), b.idx()), y = std::max(a.idx(), b.idx());
     return (x << 32) | y;
@@ -90,6 +95,7 @@ Mesh triangulated_copy(const Mesh& m) {
     auto dst = get_or_add(t, kVertexColor);
     for (VertexIndex v : t.vertices()) dst[v] = src.first[from[v.idx()]];
   }
+  if (from_out) *from_out = std::move(from);
   return t;
 }
 
@@ -106,7 +112,8 @@ Outputs output_paths(const std::string& dir) {
 std::vector<std::string> output_files(const std::string& dir) {
   std::vector<std::string> f;
   for (const char* n : {"surface.ply", "surface.glb", "surface_atlas.obj", "surface_atlas.mtl", "surface_atlas.png",
-                        "surface_atlas_normal.png", "surface_atlas_height.png", "render.png", "report.json"})
+                        "surface_atlas_normal.png", "surface_atlas_height.png", "surface_atlas_roughness.png", "render.png",
+                        "report.json"})
     f.push_back((fs::path(dir) / n).string());
   return f;
 }
@@ -118,12 +125,26 @@ struct PbrSettings {
   double texel_size = 0;        ///< synthesis texel in mesh units: > 0 measures the atlas seams (issue 18 item 3)
 };
 
+// Per-vertex values read from the exemplar maps (--exemplar-height,
+// --exemplar-roughness: one per vertex; --exemplar-normal: object-space unit
+// normals), by vertex index of the synthesised mesh; empty = not given.
+struct VertexMaps {
+  std::vector<float> height, roughness;
+  std::vector<std::array<float, 3>> normal;
+};
+
 // The vertex colours baked into a gutter atlas of a triangulated copy, with
 // height (luminance) and normal maps: surface_atlas.obj (+MTL, maps) and
 // surface.glb (atlas as base colour, normal map, vertex colours kept as
 // _COLOR beside the texture that holds them: COLOR_0 would multiply it);
-// surface.ply keeps the polygons with COLOR_0-style vertex colours.
-nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const PbrSettings& pbr) {
+// surface.ply keeps the polygons with COLOR_0-style vertex colours. With
+// exemplar maps: height and roughness baked from their vertex values like the
+// colour (roughness -> surface_atlas_roughness.png, the GLB's
+// metallicRoughnessTexture), the normal map from the object-space vertex
+// normals in the GLB's tangent frames (texture/tangent_space_bake.h), else
+// from the height.
+nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const PbrSettings& pbr,
+                             const VertexMaps& maps = {}) {
   nlohmann::json j;
   Timer t;
   WriteMeshOptions wo;
@@ -132,20 +153,33 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
   std::vector<std::string> files = write_mesh(o.ply, mesh, wo);
   j["seconds_write_mesh"] = t.seconds();
   t.reset();
-  Mesh tri = triangulated_copy(mesh);
+  std::vector<VertexIndex> from;
+  Mesh tri = triangulated_copy(mesh, &from);
   const GutterAtlas ga = compute_gutter_atlas(tri, pbr.atlas_size);
   BakeOptions bo;
   bo.size = pbr.atlas_size;
   const BakeResult baked = bake_vertex_colors(tri, bo);
-  const Image height = height_from_luminance(baked.image);
+  auto on_copy = [&](const auto& per_vertex) {  // values of `mesh` -> vertices of `tri`
+    std::vector<typename std::decay_t<decltype(per_vertex)>::value_type> t(tri.num_vertices());
+    for (VertexIndex v : tri.vertices()) t[v.idx()] = per_vertex[from[v.idx()].idx()];
+    return t;
+  };
+  const Image height = maps.height.empty() ? height_from_luminance(baked.image)
+                                           : bake_vertex_values(tri, on_copy(maps.height), 1, bo).image;
   const double atlas_per_exemplar = ga.atlas.uv_per_length * pbr.atlas_size / pbr.texels_per_length;
-  const Image normal = normal_map_from_height(height, baked.chart, pbr.bump * atlas_per_exemplar);
+  const Image normal = maps.normal.empty()
+                           ? normal_map_from_height(height, baked.chart, pbr.bump * atlas_per_exemplar)
+                           : tangent_space_normal_map(tri, on_copy(maps.normal), pbr.atlas_size);
+  Image mr;
+  if (!maps.roughness.empty())
+    mr = metallic_roughness_from_roughness(bake_vertex_values(tri, on_copy(maps.roughness), 1, bo).image);
   WriteMeshOptions ao;
   ao.overwrite = force;
   ao.write_colors = false;
   ao.texture = &baked.image;
   ao.normal_texture = &normal;
   ao.height_texture = &height;
+  ao.metallic_roughness_texture = &mr;
   ao.texture_repeat = false;
   for (const std::string& f : write_mesh(o.obj, tri, ao)) files.push_back(f);
   ao.height_texture = nullptr;
@@ -158,7 +192,9 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
                 {"protected_mip_size", ga.protected_mip_size},
                 {"mean_area_distortion", ga.atlas.mean_area_distortion}, {"flipped_faces", ga.atlas.flipped_faces},
                 {"bump", pbr.bump}, {"atlas_texels_per_exemplar_texel", atlas_per_exemplar},
-                {"seconds", {{"bake", t.seconds()}}}};
+                {"normal_source", maps.normal.empty() ? "height" : "exemplar_normal"},
+                {"height_source", maps.height.empty() ? "luminance" : "exemplar_height"},
+                {"roughness", !maps.roughness.empty()}, {"seconds", {{"bake", t.seconds()}}}};
   if (pbr.texel_size > 0)  // colour jumps across the baked atlas's chart seams (issue 18 item 3)
     j["atlas"]["seam"] = to_json(surface_seam_ratio(tri, atlas_color_source(tri, baked.image),
                                                     seam_edges_from_corner_uv(tri), pbr.texel_size));
@@ -267,6 +303,7 @@ nlohmann::json subdiv_fidelity(const Mesh& mesh, const SubdivisionSynthesisResul
 
 struct SubdivArgs {
   std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
+  std::string exemplar_normal, exemplar_height, exemplar_roughness;
   double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
   int levels = -1, passes = 1, adaptive_steps = 4, atlas = 1024, exhaustive_levels = 1;
   std::size_t max_vertices = 150000;
@@ -275,13 +312,73 @@ struct SubdivArgs {
   CommonOptions common;
 };
 
+// Exemplar maps (--exemplar-normal, --exemplar-height, --exemplar-roughness):
+// each the colour exemplar's size, a normal map RGB. Read before the
+// synthesis, so a bad map stops the run before any output.
+struct ExemplarMaps {
+  Image normal, height, roughness;
+};
+
+ExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
+  auto read_map = [&](const std::string& path, const char* what) -> Image {
+    if (path.empty()) return {};
+    Image m = read_image(path);
+    if (m.width != colour.width || m.height != colour.height)
+      throw InvalidInputError(std::string(what) + " '" + path + "' is " + std::to_string(m.width) + " x " +
+                              std::to_string(m.height) + ", the colour exemplar '" + a.exemplar + "' is " +
+                              std::to_string(colour.width) + " x " + std::to_string(colour.height) +
+                              " (exemplar maps must match it texel for texel)");
+    return m;
+  };
+  ExemplarMaps maps;
+  maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");
+  if (!maps.normal.empty() && maps.normal.channels < 3)
+    throw InvalidInputError("--exemplar-normal '" + a.exemplar_normal + "' has " +
+                            std::to_string(maps.normal.channels) + " channel(s): a tangent-space normal map is RGB");
+  maps.height = read_map(a.exemplar_height, "--exemplar-height");
+  maps.roughness = read_map(a.exemplar_roughness, "--exemplar-roughness");
+  return maps;
+}
+
+// The maps' values at the final vertices, where the colour was read
+// (texture/subdivision_exemplar_maps.h); `filled` counts vertices without a lookup.
+VertexMaps vertex_maps(const Mesh& mesh, const SubdivisionSynthesisResult& r, const ExemplarMaps& maps, int w, int h,
+                       std::size_t& filled) {
+  VertexMaps vm;
+  filled = 0;
+  if (!maps.height.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.height, w, h);
+    vm.height = vertex_luminance(v);
+    filled = v.filled;
+  }
+  if (!maps.roughness.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.roughness, w, h);
+    vm.roughness = vertex_luminance(v);
+    filled = v.filled;
+  }
+  if (!maps.normal.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.normal, w, h);
+    vm.normal = object_normals_from_map(mesh, v);
+    filled = v.filled;
+  }
+  return vm;
+}
+
 int run_subdiv(const SubdivArgs& a) {
   require_input_file(a.mesh, "mesh");
   require_input_file(a.exemplar, "exemplar");
+  std::vector<std::string> inputs{a.mesh, a.exemplar};
+  for (const auto& [path, what] : {std::pair{a.exemplar_normal, "--exemplar-normal"},
+                                   {a.exemplar_height, "--exemplar-height"},
+                                   {a.exemplar_roughness, "--exemplar-roughness"}})
+    if (!path.empty()) {
+      require_input_file(path, what);
+      inputs.push_back(path);
+    }
   const Outputs out = output_paths(a.outdir);
   for (const std::string& p : output_files(a.outdir)) {
     if (fs::path(p).filename() == "report.json") continue;  // the report is replaced (as before)
-    check_output(p, {a.mesh, a.exemplar}, a.common.force, false);
+    check_output(p, inputs, a.common.force, false);
   }
   auto limit = apply_thread_limit(a.common.threads);
   Timer total, t;
@@ -289,6 +386,7 @@ int run_subdiv(const SubdivArgs& a) {
   // sqrt(2)-subdivision takes any polygons: they are kept when they need no repair.
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common, true);
   const Image ex = read_image(a.exemplar);
+  const ExemplarMaps maps = read_exemplar_maps(a, ex);
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;
@@ -324,6 +422,8 @@ int run_subdiv(const SubdivArgs& a) {
   const nlohmann::json fidelity = subdiv_fidelity(mesh, r, a.common.seed);
   DisplaceResult disp;
   if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);
+  std::size_t no_lookup = 0;  // frames of the surface as written (after --displace)
+  const VertexMaps vmaps = vertex_maps(mesh, r, maps, ex.width, ex.height, no_lookup);
   ensure_directory(a.outdir);
   nlohmann::json rep = synthesis_report(r, o);
   rep["fidelity"] = fidelity;
@@ -332,13 +432,16 @@ int run_subdiv(const SubdivArgs& a) {
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   rep["displace"] = a.displace;
+  if (!a.exemplar_normal.empty() || !a.exemplar_height.empty() || !a.exemplar_roughness.empty())
+    rep["exemplar_maps"] = {{"normal", a.exemplar_normal}, {"height", a.exemplar_height},
+                            {"roughness", a.exemplar_roughness}, {"vertices_without_lookup", no_lookup}};
   PbrSettings pbr;
   pbr.atlas_size = a.atlas;
   pbr.bump = a.bump;
   pbr.texels_per_length = r.scale.r_scale / r.object_unit;
   pbr.texel_size = r.scale.texel_size;
-  nlohmann::json written = write_outputs(mesh, out, a.common.force, pbr);
-  const RunFiles files{{a.mesh, a.exemplar}, written["files"].get<std::vector<std::string>>()};
+  nlohmann::json written = write_outputs(mesh, out, a.common.force, pbr, vmaps);
+  const RunFiles files{inputs, written["files"].get<std::vector<std::string>>()};
   rep["seconds"] = {{"read", seconds_read},
                     {"synthesis", r.seconds_total},
                     {"write_mesh", written["seconds_write_mesh"]},
@@ -383,7 +486,8 @@ SubcommandRegistrar reg_subdiv{
        app.add_option("-o,--output", a->outdir,
                       "Output folder: surface.ply (vertex colours), surface.glb (baked atlas as base colour, "
                       "normal map, vertex colours as _COLOR), surface_atlas.obj/.mtl/.png (baked atlas) with "
-                      "surface_atlas_normal.png and surface_atlas_height.png (16-bit), render.png, report.json")
+                      "surface_atlas_normal.png and surface_atlas_height.png (16-bit) (and surface_atlas_roughness.png "
+                      "with --exemplar-roughness), render.png, report.json")
            ->required();
        auto* ts = app.add_option("--texel-size", a->texel_size,
                                  "Texture scale: Nx = N exemplar widths across the longest bounding-box side, or "
@@ -438,9 +542,22 @@ SubcommandRegistrar reg_subdiv{
                       "size/64 texels so every mip level down to 64 px is free of bleeding)")
            ->check(CLI::Range(64, 8192));
        app.add_option("--bump", a->bump,
-                      "Normal-map strength (surface_atlas_normal.png, from the height = luminance): tilt per "
-                      "unit height slope, height per exemplar texel, 0..100 (default 2)")
+                      "Normal-map strength (surface_atlas_normal.png, from the height = luminance or "
+                      "--exemplar-height): tilt per unit height slope, height per exemplar texel, 0..100 (default 2)")
            ->check(CLI::Range(0.0, 100.0));
+       app.add_option("--exemplar-normal", a->exemplar_normal,
+                      "Tangent-space normal map of the exemplar (RGB = (n+1)/2, x right, +Y up, the exemplar's "
+                      "size): read at every vertex where its colour was read, turned onto the surface as the "
+                      "exemplar was laid there, into surface_atlas_normal.png in the GLB's tangent frames "
+                      "(default: from the height)");
+       app.add_option("--exemplar-height", a->exemplar_height,
+                      "Height map of the exemplar (grey, or RGB luminance; the exemplar's size): read where the "
+                      "colour was into surface_atlas_height.png, and the normal map from it unless "
+                      "--exemplar-normal (default: the luminance of the synthesised colour)");
+       app.add_option("--exemplar-roughness", a->exemplar_roughness,
+                      "Roughness map of the exemplar (grey, the exemplar's size): read where the colour was into "
+                      "surface_atlas_roughness.png, the GLB's metallicRoughnessTexture (metallic 0) and the MTL's "
+                      "map_Pr (default: none)");
        app.add_flag("--pyramid", a->pyramid, "Match against a Gaussian pyramid instead of the stack (faster, coarser)");
        app.add_flag("--fixed-region", a->fixed_region,
                     "Region size n in level-0 texels at every level (the paper's a = 1 for a stack); default: n "

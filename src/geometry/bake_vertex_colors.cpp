@@ -9,54 +9,77 @@
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
-#include "geometry/uv_raster.h"
 
 namespace surftex {
 
-BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt) {
-  if (opt.size < 1 || opt.size > 16384)
-    throw InvalidInputError("bake_vertex_colors: size must be in 1..16384 (got " + std::to_string(opt.size) + ")");
+AtlasTexels rasterize_atlas(const Mesh& mesh, int size) {
+  if (size < 1 || size > 16384)
+    throw InvalidInputError("bake_vertex_colors: size must be in 1..16384 (got " + std::to_string(size) + ")");
   auto uv = find(mesh, kCornerUV);
-  auto col = find(mesh, kVertexColor);
-  if (!uv.second || !col.second)
-    throw InvalidInputError("bake_vertex_colors: the mesh needs kCornerUV (h:uv) and kVertexColor (v:color)");
+  if (!uv.second) throw InvalidInputError("bake_vertex_colors: the mesh needs kCornerUV (h:uv)");
   auto patch = find(mesh, kFacePatch);
-  const int N = opt.size;
   std::vector<UvTriangle> tris;
-  std::vector<std::array<VertexIndex, 3>> corners;
   std::vector<int> chart_of;
+  AtlasTexels at;
   for (FaceIndex f : mesh.faces()) {
     if (mesh.degree(f) != 3)
       throw InvalidInputError("bake_vertex_colors: face " + std::to_string(f.idx()) + " is not a triangle");
     UvTriangle t;
-    std::array<VertexIndex, 3> v;
+    std::array<std::size_t, 3> c;
     int i = 0;
     for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
       t[i] = {uv.first[h][0], uv.first[h][1]};
-      v[i++] = mesh.target(h);
+      c[i++] = h.idx();
     }
     tris.push_back(t);
-    corners.push_back(v);
+    at.corner.push_back(c);
     chart_of.push_back(patch.second ? std::max(0, patch.first[f]) : 0);
   }
-  const UvRaster r = rasterize_uv_triangles(tris, N, N, 1.0);
-  BakeResult res;
-  res.image = Image(N, N, 3);
-  res.chart.assign(static_cast<std::size_t>(N) * N, -1);
-  for (std::size_t i = 0; i < res.chart.size(); ++i) {
-    const int t = r.triangle[i];
+  at.raster = rasterize_uv_triangles(tris, size, size, 1.0);
+  at.chart.assign(static_cast<std::size_t>(size) * size, -1);
+  for (std::size_t i = 0; i < at.chart.size(); ++i) {
+    const int t = at.raster.triangle[i];
     if (t < 0) continue;
-    res.chart[i] = chart_of[t];
-    ++res.covered;
-    for (int k = 0; k < 3; ++k) {
+    at.chart[i] = chart_of[t];
+    ++at.covered;
+  }
+  return at;
+}
+
+BakeResult bake_vertex_values(const Mesh& mesh, const std::vector<float>& values, int C, const BakeOptions& opt) {
+  if (C < 1 || values.size() != static_cast<std::size_t>(C) * mesh.num_vertices())
+    throw InvalidInputError("bake_vertex_values: " + std::to_string(values.size()) + " values for " +
+                            std::to_string(mesh.num_vertices()) + " vertices x " + std::to_string(C) + " channels");
+  const AtlasTexels at = rasterize_atlas(mesh, opt.size);
+  const int N = opt.size;
+  BakeResult res;
+  res.image = Image(N, N, C);
+  res.chart = at.chart;
+  res.covered = at.covered;
+  for (std::size_t i = 0; i < res.chart.size(); ++i) {
+    const int t = at.raster.triangle[i];
+    if (t < 0) continue;
+    for (int k = 0; k < C; ++k) {
       float s = 0.f;
-      for (int c = 0; c < 3; ++c) s += r.bary[i][c] * col.first[corners[t][c]][k];
-      res.image.data[3 * i + k] = s;
+      for (int c = 0; c < 3; ++c)
+        s += at.raster.bary[i][c] * values[mesh.target(HalfedgeIndex(static_cast<Mesh::size_type>(at.corner[t][c]))).idx() * C + k];
+      res.image.data[C * i + k] = s;
     }
   }
   res.owner = res.chart;
   if (res.covered > 0) dilate_charts(res.image, res.owner);
   return res;
+}
+
+BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt) {
+  auto uv = find(mesh, kCornerUV);
+  auto col = find(mesh, kVertexColor);
+  if (!uv.second || !col.second)
+    throw InvalidInputError("bake_vertex_colors: the mesh needs kCornerUV (h:uv) and kVertexColor (v:color)");
+  std::vector<float> values(3 * mesh.num_vertices(), 0.f);
+  for (VertexIndex v : mesh.vertices())
+    for (int k = 0; k < 3; ++k) values[3 * v.idx() + k] = col.first[v][k];
+  return bake_vertex_values(mesh, values, 3, opt);
 }
 
 }  // namespace surftex

@@ -11,6 +11,11 @@
 // kFacePatch when present (geometry/gutter_atlas.h spaces them for mip
 // gutters), else one chart.
 //
+// bake_vertex_values does the same for any per-vertex values (height,
+// roughness: "every channel" of a synthesis); rasterize_atlas gives the
+// texels, their triangle and barycentrics, for bakers that blend other
+// per-corner data (texture/tangent_space_bake.h).
+//
 // Reads kCornerUV, kVertexColor, kFacePatch (optional). Throws
 // InvalidInputError (non-triangle face, missing map, size outside 1..16384).
 
@@ -19,6 +24,7 @@
 
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
+#include "geometry/uv_raster.h"
 
 namespace surftex {
 
@@ -34,5 +40,19 @@ struct BakeResult {
 };
 
 BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt = {});
+
+/// `values`: `channels` floats per vertex, indexed by vertex index; the
+/// image has `channels` channels. Throws InvalidInputError on a size mismatch.
+BakeResult bake_vertex_values(const Mesh& mesh, const std::vector<float>& values, int channels,
+                              const BakeOptions& opt = {});
+
+/// The texels every face covers (faces in index order = raster triangles).
+struct AtlasTexels {
+  UvRaster raster;
+  std::vector<std::array<std::size_t, 3>> corner;  ///< per triangle: the halfedge index of each corner (target = vertex)
+  std::vector<int> chart;                          ///< per texel: chart (kFacePatch, else 0), -1 = none
+  std::size_t covered = 0;
+};
+AtlasTexels rasterize_atlas(const Mesh& mesh, int size);
 
 }  // namespace surftex

@@ -17,12 +17,11 @@
 
 #include "geometry/errors.h"
 #include "geometry/face_material.h"
-#include "geometry/newell.h"
+#include "geometry/gltf_vertex_frames.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
 #include "geometry/properties.h"
-#include "geometry/vertex_tangents.h"
 
 namespace fs = std::filesystem;
 
@@ -102,32 +101,7 @@ Gathered gather(const std::string& path, const Mesh& mesh, const WriteMeshOption
                               opt.vertex_scalar_property + "' (vertex_scalar_property)");
     for (VertexIndex v : mesh.vertices()) g.scalar.push_back(m.first[v]);
   }
-  if (want_normals && opt.write_normals) {
-    g.normals.assign(g.pos.size(), {0.f, 0.f, 0.f});
-    auto m = find(mesh, kVertexNormal);
-    if (m.second) {
-      for (VertexIndex v : mesh.vertices()) {
-        const Vector3& n = m.first[v];
-        g.normals[id[v.idx()]] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
-      }
-    } else {
-      // Area-weighted smooth normals (Newell's method per face: twice the
-      // vector area, so larger faces weigh more).
-      std::vector<std::array<double, 3>> acc(g.pos.size(), {0.0, 0.0, 0.0});
-      for (const auto& f : g.faces) {
-        const std::array<double, 3> n =
-            newell_normal(f.size(), [&](std::size_t k) -> const std::array<double, 3>& { return g.pos[f[k]]; });
-        for (std::size_t v : f)
-          for (int c = 0; c < 3; ++c) acc[v][c] += n[c];
-      }
-      for (std::size_t i = 0; i < acc.size(); ++i) {
-        double l = std::sqrt(acc[i][0] * acc[i][0] + acc[i][1] * acc[i][1] + acc[i][2] * acc[i][2]);
-        g.normals[i] = l > 0 ? std::array<float, 3>{static_cast<float>(acc[i][0] / l), static_cast<float>(acc[i][1] / l),
-                                                    static_cast<float>(acc[i][2] / l)}
-                             : std::array<float, 3>{0.f, 0.f, 1.f};
-      }
-    }
-  }
+  if (want_normals && opt.write_normals) g.normals = export_vertex_normals(mesh);  // compact order
   return g;
 }
 
@@ -465,21 +439,13 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
       throw InvalidInputError("cannot write '" + path + "': material '" + m.name +
                               "' has a texture but the mesh has no texture coordinates to map it with");
   // One glTF vertex per distinct (vertex, uv) pair: vertices are split at UV seams.
-  std::vector<std::size_t> src;          // glTF vertex -> mesh vertex (compact id)
-  std::vector<std::array<float, 2>> tc;  // glTF TEXCOORD_0 (v flipped)
+  GltfVertexSplit split;
   // Triangles per material: one primitive each, sharing the vertex attributes.
   std::vector<std::vector<std::uint32_t>> indices(groups.materials.size());
-  std::map<std::pair<std::size_t, std::array<double, 2>>, std::uint32_t> key_to_id;
   auto vid = [&](std::size_t v, HalfedgeIndex h) -> std::uint32_t {
     std::array<double, 2> uv{0.0, 0.0};
     if (g.has_uv) uv = {g.uv[h][0], g.uv[h][1]};
-    auto [it, inserted] = key_to_id.emplace(std::make_pair(v, uv), static_cast<std::uint32_t>(src.size()));
-    if (inserted) {
-      src.push_back(v);
-      // glTF's UV origin is the top-left of the image, OBJ's/ours the bottom-left.
-      tc.push_back({static_cast<float>(uv[0]), static_cast<float>(1.0 - uv[1])});
-    }
-    return it->second;
+    return split.id(v, uv);
   };
   for (std::size_t f = 0; f < g.faces.size(); ++f) {
     const auto& fv = g.faces[f];
@@ -491,6 +457,8 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
       out.push_back(vid(fv[k + 1], g.corners[f][k + 1]));
     }
   }
+  const std::vector<std::size_t>& src = split.source();        // glTF vertex -> mesh vertex (compact id)
+  const std::vector<std::array<float, 2>>& tc = split.texcoord();  // glTF TEXCOORD_0 (v flipped)
   if (src.size() > 0xffffffffu) throw InvalidInputError("cannot write '" + path + "': too many vertices for glTF");
 
   tinygltf::Model model;
@@ -551,17 +519,10 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
   }
   if (opt.texture != nullptr && !opt.texture->empty() && g.has_uv && !g.normals.empty() &&
       opt.normal_texture != nullptr && !opt.normal_texture->empty()) {
-    // TANGENT for the normal map (geometry/vertex_tangents.h), from the uv with v up.
-    std::vector<std::array<float, 3>> p(src.size()), n(src.size());
-    std::vector<std::array<float, 2>> t(src.size());
-    for (std::size_t i = 0; i < src.size(); ++i) {
-      for (int c = 0; c < 3; ++c) p[i][c] = static_cast<float>(g.pos[src[i]][c]);
-      n[i] = g.normals[src[i]];
-      t[i] = {tc[i][0], 1.f - tc[i][1]};
-    }
+    // TANGENT for the normal map (geometry/gltf_vertex_frames.h).
     std::vector<std::uint32_t> all;
     for (const auto& part : indices) all.insert(all.end(), part.begin(), part.end());
-    const std::vector<std::array<float, 4>> tan = vertex_tangents(p, n, t, all);
+    const std::vector<std::array<float, 4>> tan = gltf_vertex_tangents(g.pos, g.normals, split, all);
     int view = add_view(tan.data(), tan.size() * 16, TINYGLTF_TARGET_ARRAY_BUFFER);
     prim.attributes["TANGENT"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, src.size());
   }

@@ -102,6 +102,12 @@ Image to_rgb(const Image& in) {
 
 }  // namespace
 
+Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale) {
+  if (img.empty()) throw InvalidInputError("resample_as_synthesised: the image is empty");
+  if (scale.exemplar_scale < 1.0) return reduce_exemplar(img, scale.exemplar_width, scale.exemplar_height);
+  return img;
+}
+
 SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double input_mean_edge,
                                           const SubdivisionSynthesisOptions& opt) {
   validate(opt);
@@ -180,6 +186,7 @@ struct VertexJob {
     std::array<float, 3> color;
     int level;                  ///< stack level the colour was read from
     std::array<int, 2> source;  ///< level-0 exemplar texel
+    ExemplarLookup lookup;      ///< where the colour was read
   };
   std::vector<Write> writes;  ///< centre first
   double t_region = 0, t_match = 0, t_transfer = 0;
@@ -248,6 +255,7 @@ struct JobScratch {
   std::vector<SampleGroup> groups;
   std::vector<TransferNode> nodes;
   std::vector<std::array<int, 2>> offsets, own_sources;
+  std::vector<ExemplarLookup> lookups;
   std::vector<char> inside;
   std::vector<float> penalty;
 };
@@ -262,6 +270,7 @@ struct PassContext {
   const std::vector<Color3f>& color;
   const std::vector<int>& color_level;  ///< stack level each vertex's colour was read from
   const std::vector<std::array<int, 2>>& source;  ///< level-0 source texel per vertex
+  const std::vector<ExemplarLookup>& lookup;      ///< where each vertex's colour was read
   const RepetitionGrid* grid;           ///< null = no repetition term
   double sigma2;                        ///< summed channel variance of level 0
   double r_scale;
@@ -399,9 +408,11 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
   }
   const int sc = c.ex.scale(lp);
   if (!opt.graph_cut) {
-    job.writes.push_back({p, texel(c.ex, lp, job.m.qx, job.m.qy), lp, {job.m.qx * sc, job.m.qy * sc}});
+    job.writes.push_back({p, texel(c.ex, lp, job.m.qx, job.m.qy), lp, {job.m.qx * sc, job.m.qy * sc},
+                          {lp, double(job.m.qx), double(job.m.qy)}});
   } else {
     s.nodes.resize(reg.vertices.size());
+    s.lookups.resize(reg.vertices.size());
     for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
       const std::size_t v = reg.vertices[i];
       RegionSample smp{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {}};
@@ -416,8 +427,8 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
       // exemplar, not a nearest-texel one whose duplicated and skipped texels
       // break its fine structure. Pinned vertices keep their colour.
       const double lsc = c.ex.pyramid ? static_cast<double>(sc) : 1.0;  // as sample_offset
-      n.texture = n.pinned ? n.surface
-                           : texel_bilinear(c.ex, lv, job.m.qx + smp.du / lsc, job.m.qy - smp.dv / lsc);
+      s.lookups[i] = n.pinned ? c.lookup[v] : ExemplarLookup{lv, job.m.qx + smp.du / lsc, job.m.qy - smp.dv / lsc};
+      n.texture = n.pinned ? n.surface : texel_bilinear(c.ex, lv, s.lookups[i].x, s.lookups[i].y);
       n.distance = std::sqrt(smp.du * smp.du + smp.dv * smp.dv);
       n.hops = reg.hops[i];
     }
@@ -433,8 +444,8 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
           const int W = c.ex.width(lp), H = c.ex.height(lp);
           sx = ((sx % W) + W) % W, sy = ((sy % H) + H) % H;
         }
-        job.writes.push_back(
-            {reg.vertices[i], s.nodes[i].texture, c.ex.pyramid ? lp : c.level[reg.vertices[i]], {sx * sc, sy * sc}});
+        job.writes.push_back({reg.vertices[i], s.nodes[i].texture, c.ex.pyramid ? lp : c.level[reg.vertices[i]],
+                              {sx * sc, sy * sc}, s.lookups[i]});
       }
   }
   job.t_transfer = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
@@ -460,12 +471,16 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,
                                   std::mt19937_64& rng, std::vector<int>* color_level_io,
-                                  std::vector<std::array<int, 2>>* source_io, const PassGeometry* geometry) {
+                                  std::vector<std::array<int, 2>>* source_io, const PassGeometry* geometry,
+                                  std::vector<ExemplarLookup>* lookup_io) {
   const std::size_t nv = mesh.number_of_vertices();
   if (source_io && source_io->size() != nv)
     throw InvalidInputError("synthesis_pass: source has " + std::to_string(source_io->size()) + " entries for " +
                             std::to_string(nv) + " vertices");
   if (colored.size() != nv) throw InvalidInputError("synthesis_pass: colored has the wrong size");
+  if (lookup_io && lookup_io->size() != nv)
+    throw InvalidInputError("synthesis_pass: lookup has " + std::to_string(lookup_io->size()) + " entries for " +
+                            std::to_string(nv) + " vertices");
   if (color_level_io && color_level_io->size() != nv)
     throw InvalidInputError("synthesis_pass: color_level has " + std::to_string(color_level_io->size()) +
                             " entries for " + std::to_string(nv) + " vertices");
@@ -496,6 +511,9 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
   std::vector<std::array<int, 2>> own_source;
   if (!source_io) own_source.assign(nv, {-1, -1});
   std::vector<std::array<int, 2>>& source = source_io ? *source_io : own_source;
+  std::vector<ExemplarLookup> own_lookup;
+  if (!lookup_io) own_lookup.assign(nv, {});
+  std::vector<ExemplarLookup>& lookup = lookup_io ? *lookup_io : own_lookup;
   // The repetition counts (see SubdivisionSynthesisOptions::repetition_penalty);
   // they are updated after every chunk's commits, so every job of a chunk
   // reads the counts as they were at the chunk's start (whatever the threads).
@@ -519,8 +537,8 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
   SynthesisPassStats st;
   st.seconds_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
   const bool coherent = source_io && geo.mesh_level >= opt.exhaustive_levels;
-  const PassContext ctx{graph, fr,     ex,        index,  level,   colored, color,
-                        color_level, source, grid.get(), sigma2, r_scale, opt, coherent};
+  const PassContext ctx{graph,  fr,     ex,         index,  level,   colored, color, color_level,
+                        source, lookup, grid.get(), sigma2, r_scale, opt,     coherent};
   struct SourceChange {
     std::size_t vertex;
     std::array<int, 2> before, after;
@@ -571,6 +589,7 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
         color[p] = {t[0], t[1], t[2]};
         color_level[p] = lp;
         source[p] = {x * ex.scale(lp), y * ex.scale(lp)};
+        lookup[p] = {lp, double(x), double(y)};
         if (grid) changed.push_back({p, {-1, -1}, source[p]});
         colored[p] = 1;
         written[p] = stamp;
@@ -608,6 +627,7 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
         if (grid)
           changed.push_back({w.vertex, colored[w.vertex] ? source[w.vertex] : std::array<int, 2>{-1, -1}, w.source});
         source[w.vertex] = w.source;
+        lookup[w.vertex] = w.lookup;
         colored[w.vertex] = 1;
         written[w.vertex] = stamp;
         if (w.vertex != p) {
@@ -645,9 +665,7 @@ namespace {
 // The exemplar as synthesised (RGB, reduced to the chosen synthesis texel)
 // and whether it wraps (issue 18 item 2).
 void prepare_exemplar(const Image& exemplar, const SubdivisionSynthesisOptions& opt, SubdivisionSynthesisResult& res) {
-  Image rgb = to_rgb(exemplar);
-  if (res.scale.exemplar_scale < 1.0)
-    rgb = reduce_exemplar(rgb, res.scale.exemplar_width, res.scale.exemplar_height);
+  Image rgb = resample_as_synthesised(to_rgb(exemplar), res.scale);
   res.scale.exemplar_width = rgb.width;
   res.scale.exemplar_height = rgb.height;
   res.wrap_seam_ratio = (rgb.width >= 2 && rgb.height >= 2) ? wrap_seam_ratio(rgb) : 1.0;
@@ -679,11 +697,13 @@ int bounded_levels(const SubdivisionSynthesisResult& res, const SubdivisionSynth
 // Level > 0: one sqrt(2) step; old vertices keep index, colour, colour level
 // and source; a face point's averaged colour is at least as coarse as its
 // face's corners (its neighbours) and has no source yet.
-void subdivide_level(Mesh& mesh, std::vector<int>& color_level, std::vector<std::array<int, 2>>& source) {
+void subdivide_level(Mesh& mesh, std::vector<int>& color_level, std::vector<std::array<int, 2>>& source,
+                     std::vector<ExemplarLookup>& lookup) {
   const std::size_t old_nv = mesh.number_of_vertices();
   sqrt2_subdivide(mesh);
   color_level.resize(mesh.number_of_vertices(), 0);
   source.resize(mesh.number_of_vertices(), {-1, -1});
+  lookup.resize(mesh.number_of_vertices(), ExemplarLookup{});
   for (std::size_t v = old_nv; v < color_level.size(); ++v) {
     const VertexIndex fv(static_cast<Mesh::size_type>(v));
     int l = 0;
@@ -718,6 +738,7 @@ struct LevelContext {
   std::vector<char>& colored;
   std::vector<int>& color_level;
   std::vector<std::array<int, 2>>& source;
+  std::vector<ExemplarLookup>& lookup;
 };
 
 // The passes of one level: pass 1, fill passes for the vertices it skipped
@@ -732,7 +753,7 @@ void synthesize_level(Mesh& mesh, int level, const SubdivisionSynthesisOptions& 
     report_progress(opt.progress, "synthesis level " + std::to_string(level),
                     double(level * opt.passes + pass) / double((c.levels + 1) * opt.passes));
     ls.pass_stats.push_back(synthesis_pass(mesh, c.ex, c.index, order, c.colored, c.r_mesh, hierarchy_level, opt, c.rng,
-                                           &c.color_level, &c.source, &geo));
+                                           &c.color_level, &c.source, &geo, &c.lookup));
     ++ls.passes;
     if (pass > 0) continue;
     for (int guard = 0; guard < 10000; ++guard) {
@@ -741,7 +762,7 @@ void synthesize_level(Mesh& mesh, int level, const SubdivisionSynthesisOptions& 
         if (!c.colored[v] && !mesh.is_isolated(VertexIndex(static_cast<Mesh::size_type>(v)))) missing.push_back(v);
       if (missing.empty()) break;
       const SynthesisPassStats fs = synthesis_pass(mesh, c.ex, c.index, missing, c.colored, c.r_mesh, hierarchy_level,
-                                                   opt, c.rng, &c.color_level, &c.source, &geo);
+                                                   opt, c.rng, &c.color_level, &c.source, &geo, &c.lookup);
       ls.pass_stats.push_back(fs);
       ++ls.passes;
       ++ls.fill_passes;
@@ -753,6 +774,7 @@ void synthesize_level(Mesh& mesh, int level, const SubdivisionSynthesisOptions& 
         c.colored[missing.front()] = 1;
         c.color_level[missing.front()] = 0;
         c.source[missing.front()] = {x, y};
+        c.lookup[missing.front()] = {0, double(x), double(y)};
       }
     }
   }
@@ -798,13 +820,15 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
   std::vector<char> colored;
   std::vector<int> color_level(mesh.number_of_vertices(), 0);  // stack level each vertex's colour was read from
   res.source.assign(mesh.number_of_vertices(), {-1, -1});
-  LevelContext lc{ex, index, r_mesh, levels, rng, colored, color_level, res.source};
+  res.lookup.assign(mesh.number_of_vertices(), ExemplarLookup{});
+  res.pyramid = opt.pyramid;
+  LevelContext lc{ex, index, r_mesh, levels, rng, colored, color_level, res.source, res.lookup};
   for (int level = 0; level <= levels; ++level) {
     SynthesisLevelStats ls;
     ls.level = level;
     Timer t;
     if (level > 0) {
-      subdivide_level(mesh, color_level, res.source);
+      subdivide_level(mesh, color_level, res.source, res.lookup);
       ls.seconds_subdivide = t.seconds();
     }
     t.reset();

@@ -174,6 +174,15 @@ struct SynthesisLevelStats {
   double seconds_subdivide = 0, seconds_fields = 0, seconds_synthesis = 0;
 };
 
+/// Where a vertex's colour was read: stack (or pyramid) level and position in
+/// that level's texels, read bilinearly as the level wraps or clamps
+/// (texel_bilinear; integer positions for single-texel reads). Level -1 =
+/// not read from the exemplar (a face point's averaged colour).
+struct ExemplarLookup {
+  int level = -1;
+  double x = 0, y = 0;
+};
+
 /// The scale and depth chosen from the inputs (step 1), reported by the CLI.
 struct SubdivisionScale {
   const char* scale_from = "repeats";  ///< "rscale", "texels_per_edge" or "repeats"
@@ -203,6 +212,10 @@ struct SubdivisionSynthesisResult {
   /// Per final vertex: the exemplar texel (level 0 of `exemplar`) its colour
   /// was read from, {-1, -1} if none (a face point never matched or patched).
   std::vector<std::array<int, 2>> source;
+  /// Per final vertex: the exact lookup its colour came from, so that other
+  /// maps of the exemplar can be read the same way (subdivision_exemplar_maps.h).
+  std::vector<ExemplarLookup> lookup;
+  bool pyramid = false;  ///< the exemplar levels were a pyramid (options.pyramid)
   double seconds_total = 0;
 };
 
@@ -215,6 +228,12 @@ SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double
 
 SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& exemplar,
                                                      const SubdivisionSynthesisOptions& opt = {});
+
+/// An image of the input exemplar's size resampled as the exemplar was for
+/// the synthesis (SubdivisionScale: reduced when exemplar_scale < 1: halved
+/// with the binomial blur while more than twice the target, then bilinear),
+/// any channel count, float. Throws InvalidInputError if `img` is empty.
+Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale);
 
 /// The per-level geometry a pass reads: vertex frames and the region graph.
 /// Built once per mesh level and shared by all its passes (they do not move
@@ -252,11 +271,13 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
 /// texel each colour came from ({-1,-1} = none); the repetition penalty and
 /// the result's source record need it (no penalty without it). `geometry`
 /// (optional): make_pass_geometry(mesh), reused; null = built here.
+/// `lookup` (optional, one entry per vertex, updated): where each colour was read.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,
                                   std::mt19937_64& rng, std::vector<int>* color_level = nullptr,
                                   std::vector<std::array<int, 2>>* source = nullptr,
-                                  const PassGeometry* geometry = nullptr);
+                                  const PassGeometry* geometry = nullptr,
+                                  std::vector<ExemplarLookup>* lookup = nullptr);
 
 }  // namespace surftex

@@ -55,6 +55,45 @@ inline nlohmann::json glb_json(const std::string& path) {
   return nlohmann::json::parse(b.substr(20, len));
 }
 
+/// A GLB as surftex writes it (one buffer, tightly packed views): its JSON and
+/// BIN chunk, and readers of its accessors and embedded images.
+struct Glb {
+  nlohmann::json json = nlohmann::json::object();
+  std::string bin;
+  std::string view_bytes(int view) const {
+    const auto& v = json["bufferViews"][view];
+    return bin.substr(v.value("byteOffset", 0), v["byteLength"].get<std::size_t>());
+  }
+  /// Components of a FLOAT (5126) or UNSIGNED_INT (5125) accessor, as T.
+  template <class T>
+  std::vector<T> accessor(int a) const {
+    const auto& acc = json["accessors"][a];
+    const std::string b = view_bytes(acc["bufferView"].get<int>());
+    const std::string type = acc["type"];
+    const std::size_t per = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
+    std::vector<T> out(acc["count"].get<std::size_t>() * per);
+    if (b.size() >= out.size() * 4) std::memcpy(out.data(), b.data() + acc.value("byteOffset", 0), out.size() * 4);
+    return out;
+  }
+  /// The encoded bytes of image `i` (PNG).
+  std::string image_bytes(int i) const { return view_bytes(json["images"][i]["bufferView"].get<int>()); }
+};
+
+inline Glb read_glb(const std::string& path) {
+  Glb g;
+  g.json = glb_json(path);
+  const std::string b = file_bytes(path);
+  std::uint32_t len = 0;
+  if (b.size() < 20) return g;
+  std::memcpy(&len, b.data() + 12, 4);
+  const std::size_t bin_at = 20 + static_cast<std::size_t>(len);
+  if (bin_at + 8 > b.size()) return g;
+  std::uint32_t bin_len = 0;
+  std::memcpy(&bin_len, b.data() + bin_at, 4);
+  g.bin = b.substr(bin_at + 8, bin_len);
+  return g;
+}
+
 /// Bit depth of a PNG (IHDR byte 24), 0 if not a PNG.
 inline int png_bit_depth(const std::string& path) {
   const std::string b = file_bytes(path);
