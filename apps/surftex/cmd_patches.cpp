@@ -231,14 +231,8 @@ int run(const PatchArgs& a) {
   // Exemplar maps: the colour exemplar's size, resized with it.
   ExemplarMaps maps;
   auto read_map = [&](const std::string& path, const char* what) -> Image {
-    if (path.empty()) return {};
-    Image m = read_image(path);
-    if (m.width != colour.width || m.height != colour.height)
-      throw InvalidInputError(std::string(what) + " '" + path + "' is " + std::to_string(m.width) + " x " +
-                              std::to_string(m.height) + ", the colour exemplar '" + a.exemplar + "' is " +
-                              std::to_string(colour.width) + " x " + std::to_string(colour.height) +
-                              " (exemplar maps must match it texel for texel)");
-    return as_rgb(m, a.exemplar_size);
+    Image m = read_exemplar_map(path, what, a.exemplar, colour);
+    return m.empty() ? m : as_rgb(m, a.exemplar_size);
   };
   maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");
   maps.height = read_map(a.exemplar_height, "--exemplar-height");

@@ -321,14 +321,7 @@ struct ExemplarMaps {
 
 ExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
   auto read_map = [&](const std::string& path, const char* what) -> Image {
-    if (path.empty()) return {};
-    Image m = read_image(path);
-    if (m.width != colour.width || m.height != colour.height)
-      throw InvalidInputError(std::string(what) + " '" + path + "' is " + std::to_string(m.width) + " x " +
-                              std::to_string(m.height) + ", the colour exemplar '" + a.exemplar + "' is " +
-                              std::to_string(colour.width) + " x " + std::to_string(colour.height) +
-                              " (exemplar maps must match it texel for texel)");
-    return m;
+    return read_exemplar_map(path, what, a.exemplar, colour);
   };
   ExemplarMaps maps;
   maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");

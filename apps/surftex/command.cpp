@@ -240,4 +240,16 @@ void check_parsed_arguments(const CLI::App& sub) {
     throw IOError("--report '" + report + "' already exists (pass --force to replace it)");
 }
 
+Image read_exemplar_map(const std::string& path, const char* option, const std::string& colour_path,
+                        const Image& colour) {
+  if (path.empty()) return {};
+  Image m = read_image(path);
+  if (m.width != colour.width || m.height != colour.height)
+    throw InvalidInputError(std::string(option) + " '" + path + "' is " + std::to_string(m.width) + " x " +
+                            std::to_string(m.height) + ", the colour exemplar '" + colour_path + "' is " +
+                            std::to_string(colour.width) + " x " + std::to_string(colour.height) +
+                            " (exemplar maps must match it texel for texel)");
+  return m;
+}
+
 }  // namespace surftex::cli

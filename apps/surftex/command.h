@@ -18,6 +18,7 @@
 #include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
 #include "surftex/report.h"
+#include "geometry/image.h"
 #include "geometry/work_budget.h"
 
 namespace surftex::cli {
@@ -92,6 +93,12 @@ LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const Comm
 /// memory budget or its exemplar over the method's size; otherwise prints
 /// the estimate in one "note:" line on stderr unless opt.quiet.
 void check_budget(const WorkEstimate& estimate, const CommonOptions& opt);
+
+/// An exemplar map given beside the colour exemplar (--exemplar-normal, ...):
+/// empty when `path` is empty; refused (InvalidInputError naming `option`
+/// and both sizes) unless it has the colour exemplar's size.
+Image read_exemplar_map(const std::string& path, const char* option, const std::string& colour_path,
+                        const Image& colour);
 
 struct Subcommand {
   std::string name;
