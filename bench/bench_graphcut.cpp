@@ -113,182 +113,230 @@ std::vector<double> exemplar_worst_line_ratio(const Image& ex, int size) {
   return {median(v), median(vc), median(vr)};
 }
 
-}  // namespace
+// The command line (see the header comment).
+struct BenchArgs {
+  std::string dir, work;
+  std::vector<std::string> files;  // the textures, sorted
+  int gmic_runs = 3, tile_size = 128;
+  std::string mode = "all";
+  TileOptions tile_options;
+};
 
-int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures";
-  const std::string work = argc > 2 ? argv[2] : "/tmp/surftex_bench_graphcut";
-  fs::create_directories(work);
-  const bool have_gmic = std::system("command -v gmic >/dev/null 2>&1") == 0;
+// The textures of `dir` (PNG), only those listed in `names` unless it is "-".
+std::vector<std::string> texture_files(const std::string& dir, const char* names) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().extension() == ".png") {
-      if (argc > 3 && std::string(argv[3]) != "-" && ("," + std::string(argv[3]) + ",").find("," + e.path().stem().string() + ",") ==
-                          std::string::npos)
+      if (names && std::string(names) != "-" &&
+          ("," + std::string(names) + ",").find("," + e.path().stem().string() + ",") == std::string::npos)
         continue;
       files.push_back(e.path().string());
     }
   std::sort(files.begin(), files.end());
+  return files;
+}
 
+BenchArgs parse_args(int argc, char** argv) {
+  BenchArgs a;
+  a.dir = argc > 1 ? argv[1] : std::string(SURFTEX_SHARED_DATA_DIR) + "/textures";
+  a.work = argc > 2 ? argv[2] : "/tmp/surftex_bench_graphcut";
+  fs::create_directories(a.work);
+  a.files = texture_files(a.dir, argc > 3 ? argv[3] : nullptr);
   // G'MIC's syntexturize_matchpatch is unseeded: its output (and score) moves
   // between runs, so it runs `gmic_runs` times and we compare with the median.
-  const int gmic_runs = argc > 4 ? std::max(0, std::atoi(argv[4])) : 3;
-  const int tile_size = argc > 5 ? std::max(8, std::atoi(argv[5])) : 128;
-  const std::string mode = argc > 6 ? argv[6] : "all";
-  TileOptions tile_options;
-  if (argc > 7) tile_options.straight_seam_steps = std::max(0, std::atoi(argv[7]));
-  if (argc > 8) tile_options.straight_seam_cost_tolerance = std::max(0.0, std::atof(argv[8]));
-  if (mode != "all" && mode != "synthesis" && mode != "tile") {
-    std::fprintf(stderr, "bench_graphcut: MODE must be all, synthesis or tile, got '%s'\n", mode.c_str());
-    return 2;
-  }
-  const bool run_synthesis = mode != "tile", run_tile = mode != "synthesis";
+  a.gmic_runs = argc > 4 ? std::max(0, std::atoi(argv[4])) : 3;
+  a.tile_size = argc > 5 ? std::max(8, std::atoi(argv[5])) : 128;
+  a.mode = argc > 6 ? argv[6] : "all";
+  if (argc > 7) a.tile_options.straight_seam_steps = std::max(0, std::atoi(argv[7]));
+  if (argc > 8) a.tile_options.straight_seam_cost_tolerance = std::max(0.0, std::atof(argv[8]));
+  return a;
+}
 
-  int compared = 0, no_worse = 0, faster = 0, tiles_ok = 0, tiles_ok_synthesis_cut = 0, tiles_worst_ok = 0, tiles_sm_worst_ok = 0;
+// The counts and sums of the summary line.
+struct Totals {
+  int compared = 0, no_worse = 0, faster = 0, tiles_ok = 0, tiles_ok_synthesis_cut = 0, tiles_worst_ok = 0,
+      tiles_sm_worst_ok = 0;
   double expected_fail = 0, seam_total = 0;
   double t_ours = 0, t_gmic = 0, cpu_ours = 0, cpu_gmic = 0;
-  for (const auto& f : files) {
+};
+
+// G'MIC's 256x256 syntexturize_matchpatch, `runs` times: the medians of its
+// similarity, wall and CPU times against ours (bds, seconds) into j and t.
+void gmic_figures(const BenchArgs& a, const std::string& f, const std::string& name, const Image& ex,
+                  double ours_bds, double ours_s, double ours_cpu, nlohmann::json& j, Totals& t) {
+  std::vector<double> walls, cpus, scores;
+  int failed_rc = 0;
+  Timer tm;
+  for (int run = 0; run < a.gmic_runs; ++run) {
+    const std::string gm_png = a.work + "/" + name + "_gmic" + std::to_string(run) + ".png";
+    fs::remove(gm_png);
+    const std::string cmd = "gmic -v -1 input '" + f + "' syntexturize_matchpatch 256,256 output '" + gm_png +
+                            "' >/dev/null 2>&1";
+    double g0 = children_cpu_seconds();
+    tm.reset();
+    int rc = std::system(cmd.c_str());
+    const double gm_s = tm.seconds(), gm_cpu = children_cpu_seconds() - g0;
+    if (rc != 0 || !fs::exists(gm_png)) {
+      failed_rc = rc != 0 ? rc : -1;
+      continue;
+    }
+    Image g = match_channels(read_image(gm_png), ex.channels);
+    walls.push_back(gm_s);
+    cpus.push_back(gm_cpu);
+    scores.push_back(bidirectional(g, ex).total);
+  }
+  if (!scores.empty()) {
+    const double gm_bds = median(scores), gm_s = median(walls), gm_cpu = median(cpus);
+    j["gmic_runs"] = scores.size();
+    j["gmic_seconds_all"] = walls;
+    j["gmic_cpu_seconds_all"] = cpus;
+    j["gmic_bds_all"] = scores;
+    j["gmic_seconds"] = gm_s;
+    j["gmic_cpu_seconds"] = gm_cpu;
+    j["gmic_bds"] = gm_bds;
+    j["surftex_no_worse"] = ours_bds <= gm_bds;
+    j["surftex_faster_wall"] = ours_s <= gm_s;
+    j["surftex_faster_cpu"] = ours_cpu <= gm_cpu;
+    ++t.compared;
+    if (ours_bds <= gm_bds) ++t.no_worse;
+    if (ours_cpu <= gm_cpu) ++t.faster;
+    t.t_ours += ours_s;
+    t.t_gmic += gm_s;
+    t.cpu_ours += ours_cpu;
+    t.cpu_gmic += gm_cpu;
+  }
+  if (failed_rc != 0) j["gmic_error"] = failed_rc;
+}
+
+// Our 256x256 graph-cut synthesis (seed 1): time, similarity, seam cost and
+// patch counts; then G'MIC's when it is there and asked for.
+void synthesis_figures(const BenchArgs& a, bool have_gmic, const std::string& f, const std::string& name,
+                       const Image& ex, nlohmann::json& j, Totals& t) {
+  GraphcutOptions o;
+  o.seed = 1;
+  double c0 = self_cpu_seconds();
+  Timer tm;
+  GraphcutResult r = graphcut_synthesize_detailed(ex, 256, 256, o);
+  const double ours_s = tm.seconds(), ours_cpu = self_cpu_seconds() - c0;
+  const std::string ours_png = a.work + "/" + name + "_graphcut.png";
+  write_image(ours_png, r.image);
+  BidirectionalResult bo = bidirectional(r.image, ex);
+  j["surftex_seconds"] = ours_s;
+  j["surftex_cpu_seconds"] = ours_cpu;
+  j["surftex_bds"] = bo.total;
+  j["surftex_coherence"] = bo.coherence;
+  j["surftex_completeness"] = bo.completeness;
+  j["surftex_seam_cost"] = {r.seam_cost_after_fill, r.seam_cost_final};
+  j["surftex_patches"] = {r.fill_patches, r.refinement_tried, r.refinement_accepted};
+  if (have_gmic && a.gmic_runs > 0) gmic_figures(a, f, name, ex, bo.total, ours_s, ours_cpu, j, t);
+}
+
+// Roll-independent figures of a tile: the worst line of the torus, and the
+// distribution of the wrap-seam ratio over all size x size rolls (the
+// synthesis cut is one draw from it if no line is special). Returns the
+// fraction of rolls above 1.3.
+double roll_figures(const TileResult& tr, int tile_size, nlohmann::json& j) {
+  const LineJumpProfile prof = line_jump_profile(tr.tile, true);
+  std::vector<double> rolls;
+  rolls.reserve(static_cast<std::size_t>(tile_size) * tile_size);
+  for (int ry = 0; ry < tile_size; ++ry)
+    for (int rx = 0; rx < tile_size; ++rx) rolls.push_back(rolled_wrap_seam_ratio(prof, rx, ry));
+  const double above =
+      static_cast<double>(std::count_if(rolls.begin(), rolls.end(), [](double v) { return v > 1.3; })) /
+      static_cast<double>(rolls.size());
+  j["tile_worst_line_ratio"] = tr.worst_line_ratio;
+  j["tile_worst_line"] = {prof.worst_is_column ? "column" : "row", prof.worst_index};  // in the rolled tile
+  j["tile_worst_column_row_ratio"] = {prof.worst_column_ratio, prof.worst_row_ratio};
+  j["tile_source_matched_wrap_ratio_at_synthesis_cut"] = tr.source_matched_wrap_ratio_at_synthesis_cut;
+  j["tile_source_matched_worst_line_ratio"] = tr.source_matched_worst_line_ratio;
+  j["tile_synthesis_cut_percentile"] = {tr.synthesis_column_percentile, tr.synthesis_row_percentile};
+  j["tile_roll_wrap_ratio_median"] = median(rolls);
+  j["tile_roll_wrap_ratio_fraction_above_1_3"] = above;
+  return above;
+}
+
+// The periodic tile of TILE_SIZE: its seam figures against the exemplar's,
+// and the tile repeated 2x2 written to the work folder.
+void tile_figures(const BenchArgs& a, const std::string& name, const Image& ex, nlohmann::json& j,
+                  Totals& t) {
+  const int tile_size = a.tile_size;
+  double c0 = self_cpu_seconds();
+  Timer tm;
+  TileResult tr = make_tileable_detailed(ex, tile_size, a.tile_options);
+  j["tile_size"] = tile_size;
+  j["tile_seconds"] = tm.seconds();
+  j["tile_cpu_seconds"] = self_cpu_seconds() - c0;
+  j["tile_wrap_seam_ratio"] = tr.wrap_seam_ratio;
+  j["tile_wrap_seam_ratio_at_synthesis_cut"] = tr.wrap_seam_ratio_at_synthesis_cut;
+  j["tile_cut_shift"] = {tr.shift_x, tr.shift_y};
+  j["tile_seam_cost"] = tr.seam_cost;
+  const double above = roll_figures(tr, tile_size, j);
+  const std::vector<double> exw = exemplar_worst_line_ratio(ex, tile_size);
+  j["exemplar_worst_line_ratio"] = exw[0];
+  j["exemplar_worst_column_row_ratio"] = {exw[1], exw[2]};
+  t.expected_fail += above;
+  t.seam_total += tr.seam_cost;
+  if (tr.worst_line_ratio <= 1.3) ++t.tiles_worst_ok;
+  if (tr.source_matched_worst_line_ratio <= 1.3) ++t.tiles_sm_worst_ok;
+  const WrapSeamStats ws = wrap_seam_stats(tr.tile);
+  j["tile_wrap_mean_jump"] = ws.wrap_mean;
+  j["tile_inside_mean_jump"] = ws.inside_mean;
+  j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
+  if (tr.wrap_seam_ratio <= 1.3) ++t.tiles_ok;
+  if (tr.wrap_seam_ratio_at_synthesis_cut <= 1.3) ++t.tiles_ok_synthesis_cut;
+  Image rep(2 * tile_size, 2 * tile_size, tr.tile.channels);
+  for (int y = 0; y < rep.height; ++y)
+    for (int x = 0; x < rep.width; ++x)
+      for (int c = 0; c < rep.channels; ++c) rep.at(x, y, c) = tr.tile.at(x % tile_size, y % tile_size, c);
+  write_image(a.work + "/" + name + "_tile2x2.png", rep);
+}
+
+nlohmann::json summary(const BenchArgs& a, bool have_gmic, const Totals& t) {
+  nlohmann::json s;
+  s["summary"] = true;
+  s["textures"] = a.files.size();
+  s["gmic_available"] = have_gmic;
+  s["compared"] = t.compared;
+  s["gmic_runs_per_texture"] = a.gmic_runs;
+  s["no_worse_bds_than_gmic_median"] = t.no_worse;
+  s["fraction_no_worse_bds"] = t.compared ? static_cast<double>(t.no_worse) / t.compared : 0.0;
+  s["surftex_cpu_no_slower"] = t.faster;
+  s["wall_time_ratio_surftex_over_gmic"] = t.t_gmic > 0 ? t.t_ours / t.t_gmic : 0.0;
+  s["cpu_time_ratio_surftex_over_gmic"] = t.cpu_gmic > 0 ? t.cpu_ours / t.cpu_gmic : 0.0;
+  s["surftex_total_seconds"] = t.t_ours;
+  s["gmic_total_seconds"] = t.t_gmic;
+  s["tile_size"] = a.tile_size;
+  s["tiles_wrap_seam_ratio_le_1_3"] = t.tiles_ok;
+  s["tiles_wrap_seam_ratio_at_synthesis_cut_le_1_3"] = t.tiles_ok_synthesis_cut;
+  s["tiles_worst_line_ratio_le_1_3"] = t.tiles_worst_ok;
+  s["tiles_source_matched_worst_line_ratio_le_1_3"] = t.tiles_sm_worst_ok;
+  s["tiles_expected_wrap_ratio_above_1_3_at_a_random_cut"] = t.expected_fail;
+  s["tiles_seam_cost_sum"] = t.seam_total;
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const BenchArgs a = parse_args(argc, argv);
+  const bool have_gmic = std::system("command -v gmic >/dev/null 2>&1") == 0;
+  if (a.mode != "all" && a.mode != "synthesis" && a.mode != "tile") {
+    std::fprintf(stderr, "bench_graphcut: MODE must be all, synthesis or tile, got '%s'\n", a.mode.c_str());
+    return 2;
+  }
+  const bool run_synthesis = a.mode != "tile", run_tile = a.mode != "synthesis";
+  Totals t;
+  for (const auto& f : a.files) {
     const std::string name = fs::path(f).stem().string();
     Image ex = read_image(f);
     nlohmann::json j;
     j["texture"] = name;
     j["exemplar"] = std::to_string(ex.width) + "x" + std::to_string(ex.height) + "x" + std::to_string(ex.channels);
-
-    if (run_synthesis) {
-      GraphcutOptions o;
-      o.seed = 1;
-      double c0 = self_cpu_seconds();
-      Timer tm;
-      GraphcutResult r = graphcut_synthesize_detailed(ex, 256, 256, o);
-      const double ours_s = tm.seconds(), ours_cpu = self_cpu_seconds() - c0;
-      const std::string ours_png = work + "/" + name + "_graphcut.png";
-      write_image(ours_png, r.image);
-      BidirectionalResult bo = bidirectional(r.image, ex);
-      j["surftex_seconds"] = ours_s;
-      j["surftex_cpu_seconds"] = ours_cpu;
-      j["surftex_bds"] = bo.total;
-      j["surftex_coherence"] = bo.coherence;
-      j["surftex_completeness"] = bo.completeness;
-      j["surftex_seam_cost"] = {r.seam_cost_after_fill, r.seam_cost_final};
-      j["surftex_patches"] = {r.fill_patches, r.refinement_tried, r.refinement_accepted};
-
-      if (have_gmic && gmic_runs > 0) {
-        std::vector<double> walls, cpus, scores;
-        int failed_rc = 0;
-        for (int run = 0; run < gmic_runs; ++run) {
-          const std::string gm_png = work + "/" + name + "_gmic" + std::to_string(run) + ".png";
-          fs::remove(gm_png);
-          const std::string cmd = "gmic -v -1 input '" + f + "' syntexturize_matchpatch 256,256 output '" +
-                                  gm_png + "' >/dev/null 2>&1";
-          double g0 = children_cpu_seconds();
-          tm.reset();
-          int rc = std::system(cmd.c_str());
-          const double gm_s = tm.seconds(), gm_cpu = children_cpu_seconds() - g0;
-          if (rc != 0 || !fs::exists(gm_png)) {
-            failed_rc = rc != 0 ? rc : -1;
-            continue;
-          }
-          Image g = match_channels(read_image(gm_png), ex.channels);
-          walls.push_back(gm_s);
-          cpus.push_back(gm_cpu);
-          scores.push_back(bidirectional(g, ex).total);
-        }
-        if (!scores.empty()) {
-          const double gm_bds = median(scores), gm_s = median(walls), gm_cpu = median(cpus);
-          j["gmic_runs"] = scores.size();
-          j["gmic_seconds_all"] = walls;
-          j["gmic_cpu_seconds_all"] = cpus;
-          j["gmic_bds_all"] = scores;
-          j["gmic_seconds"] = gm_s;
-          j["gmic_cpu_seconds"] = gm_cpu;
-          j["gmic_bds"] = gm_bds;
-          j["surftex_no_worse"] = bo.total <= gm_bds;
-          j["surftex_faster_wall"] = ours_s <= gm_s;
-          j["surftex_faster_cpu"] = ours_cpu <= gm_cpu;
-          ++compared;
-          if (bo.total <= gm_bds) ++no_worse;
-          if (ours_cpu <= gm_cpu) ++faster;
-          t_ours += ours_s;
-          t_gmic += gm_s;
-          cpu_ours += ours_cpu;
-          cpu_gmic += gm_cpu;
-        }
-        if (failed_rc != 0) j["gmic_error"] = failed_rc;
-      }
-    }  // run_synthesis
-
-    if (run_tile) {
-      const TileOptions& to = tile_options;
-      double c0 = self_cpu_seconds();
-      Timer tm;
-      TileResult t = make_tileable_detailed(ex, tile_size, to);
-      j["tile_size"] = tile_size;
-      j["tile_seconds"] = tm.seconds();
-      j["tile_cpu_seconds"] = self_cpu_seconds() - c0;
-      j["tile_wrap_seam_ratio"] = t.wrap_seam_ratio;
-      j["tile_wrap_seam_ratio_at_synthesis_cut"] = t.wrap_seam_ratio_at_synthesis_cut;
-      j["tile_cut_shift"] = {t.shift_x, t.shift_y};
-      j["tile_seam_cost"] = t.seam_cost;
-      // Roll-independent figures: the worst line of the torus, and the
-      // distribution of the wrap-seam ratio over all size x size rolls (the
-      // synthesis cut is one draw from it if no line is special).
-      const LineJumpProfile prof = line_jump_profile(t.tile, true);
-      std::vector<double> rolls;
-      rolls.reserve(static_cast<std::size_t>(tile_size) * tile_size);
-      for (int ry = 0; ry < tile_size; ++ry)
-        for (int rx = 0; rx < tile_size; ++rx) rolls.push_back(rolled_wrap_seam_ratio(prof, rx, ry));
-      const double above = static_cast<double>(std::count_if(rolls.begin(), rolls.end(), [](double v) { return v > 1.3; })) /
-                           static_cast<double>(rolls.size());
-      j["tile_worst_line_ratio"] = t.worst_line_ratio;
-      j["tile_worst_line"] = {prof.worst_is_column ? "column" : "row", prof.worst_index};  // in the rolled tile
-      j["tile_worst_column_row_ratio"] = {prof.worst_column_ratio, prof.worst_row_ratio};
-      j["tile_source_matched_wrap_ratio_at_synthesis_cut"] = t.source_matched_wrap_ratio_at_synthesis_cut;
-      j["tile_source_matched_worst_line_ratio"] = t.source_matched_worst_line_ratio;
-      j["tile_synthesis_cut_percentile"] = {t.synthesis_column_percentile, t.synthesis_row_percentile};
-      j["tile_roll_wrap_ratio_median"] = median(rolls);
-      j["tile_roll_wrap_ratio_fraction_above_1_3"] = above;
-      const std::vector<double> exw = exemplar_worst_line_ratio(ex, tile_size);
-      j["exemplar_worst_line_ratio"] = exw[0];
-      j["exemplar_worst_column_row_ratio"] = {exw[1], exw[2]};
-      expected_fail += above;
-      seam_total += t.seam_cost;
-      if (t.worst_line_ratio <= 1.3) ++tiles_worst_ok;
-      if (t.source_matched_worst_line_ratio <= 1.3) ++tiles_sm_worst_ok;
-      const WrapSeamStats ws = wrap_seam_stats(t.tile);
-      j["tile_wrap_mean_jump"] = ws.wrap_mean;
-      j["tile_inside_mean_jump"] = ws.inside_mean;
-      j["exemplar_wrap_seam_ratio"] = wrap_seam_ratio(ex);
-      if (t.wrap_seam_ratio <= 1.3) ++tiles_ok;
-      if (t.wrap_seam_ratio_at_synthesis_cut <= 1.3) ++tiles_ok_synthesis_cut;
-      Image rep(2 * tile_size, 2 * tile_size, t.tile.channels);
-      for (int y = 0; y < rep.height; ++y)
-        for (int x = 0; x < rep.width; ++x)
-          for (int c = 0; c < rep.channels; ++c) rep.at(x, y, c) = t.tile.at(x % tile_size, y % tile_size, c);
-      write_image(work + "/" + name + "_tile2x2.png", rep);
-    }  // run_tile
+    if (run_synthesis) synthesis_figures(a, have_gmic, f, name, ex, j, t);
+    if (run_tile) tile_figures(a, name, ex, j, t);
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);
   }
-  nlohmann::json s;
-  s["summary"] = true;
-  s["textures"] = files.size();
-  s["gmic_available"] = have_gmic;
-  s["compared"] = compared;
-  s["gmic_runs_per_texture"] = gmic_runs;
-  s["no_worse_bds_than_gmic_median"] = no_worse;
-  s["fraction_no_worse_bds"] = compared ? static_cast<double>(no_worse) / compared : 0.0;
-  s["surftex_cpu_no_slower"] = faster;
-  s["wall_time_ratio_surftex_over_gmic"] = t_gmic > 0 ? t_ours / t_gmic : 0.0;
-  s["cpu_time_ratio_surftex_over_gmic"] = cpu_gmic > 0 ? cpu_ours / cpu_gmic : 0.0;
-  s["surftex_total_seconds"] = t_ours;
-  s["gmic_total_seconds"] = t_gmic;
-  s["tile_size"] = tile_size;
-  s["tiles_wrap_seam_ratio_le_1_3"] = tiles_ok;
-  s["tiles_wrap_seam_ratio_at_synthesis_cut_le_1_3"] = tiles_ok_synthesis_cut;
-  s["tiles_worst_line_ratio_le_1_3"] = tiles_worst_ok;
-  s["tiles_source_matched_worst_line_ratio_le_1_3"] = tiles_sm_worst_ok;
-  s["tiles_expected_wrap_ratio_above_1_3_at_a_random_cut"] = expected_fail;
-  s["tiles_seam_cost_sum"] = seam_total;
-  std::printf("%s\n", s.dump().c_str());
+  std::printf("%s\n", summary(a, have_gmic, t).dump().c_str());
   return 0;
 }

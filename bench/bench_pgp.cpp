@@ -482,160 +482,163 @@ void driver_figures(const std::string& path, const std::string& name) {
   emit(name, nf, "driver_update", t_up, fig);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// The command line: flags, then the meshes (default: fandisk, dragon_25k,
+// armadillo_52k of the shared data).
+struct BenchArgs {
   std::vector<std::string> meshes;
   bool sweep = true, field_sweep = false, curl_only = false;
   PgpOptions pgp_options;  // the defaults (curl correction off) unless --curl-correction
+};
+
+BenchArgs parse_args(int argc, char** argv) {
+  BenchArgs a;
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-sweep")
-      sweep = false;
+      a.sweep = false;
     else if (std::string(argv[i]) == "--curl-only")
-      curl_only = true;
+      a.curl_only = true;
     else if (std::string(argv[i]) == "--curl-correction")
-      pgp_options.curl_correction = true;
+      a.pgp_options.curl_correction = true;
     else if (std::string(argv[i]) == "--no-swap")
-      pgp_options.swap_coordinates = false;  // the paper's simplified PGP (section 2.3)
+      a.pgp_options.swap_coordinates = false;  // the paper's simplified PGP (section 2.3)
     else if (std::string(argv[i]) == "--one-system")
-      pgp_options.separate_halves = false;  // with --no-swap: one block-diagonal CHOLMOD system
+      a.pgp_options.separate_halves = false;  // with --no-swap: one block-diagonal CHOLMOD system
     else if (std::string(argv[i]) == "--field-sweep")
-      field_sweep = true;
+      a.field_sweep = true;
     else
-      meshes.push_back(argv[i]);
+      a.meshes.push_back(argv[i]);
   }
-  g_swap_coordinates = pgp_options.swap_coordinates;
-  g_separate_halves = !pgp_options.swap_coordinates && pgp_options.separate_halves;
-  if (meshes.empty()) {
+  if (a.meshes.empty()) {
     const std::string d = std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/";
-    meshes = {d + "fandisk.off", d + "dragon_25k.off", d + "armadillo_52k.off"};
+    a.meshes = {d + "fandisk.off", d + "dragon_25k.off", d + "armadillo_52k.off"};
   }
-  for (const std::string& path : meshes) {
-    driver_figures(path, path.substr(path.find_last_of('/') + 1));
-    Mesh mesh;
-    read_mesh(path, mesh);
-    const std::size_t nf = mesh.number_of_faces();
-    const std::string name = path.substr(path.find_last_of('/') + 1);
+  return a;
+}
 
-    // Sparse strokes: 20 faces spread over the mesh with a projected direction.
-    std::vector<DirectionConstraint> strokes;
-    for (std::size_t i = 0; i < 20; ++i)
-      strokes.push_back({static_cast<std::uint32_t>(i * nf / 20), {1.0, 0.3, 0.2}});
-    if (curl_only) {
-      // The curvature field of the runs below, then only the curl figures.
-      compute_principal_curvatures(mesh);
-      interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, 0.05), {});
-      for (double k : {4.0, 8.0, 16.0}) curl_correction_figures(mesh, name, k);
-      continue;
-    }
-    emit(name, nf, "principal_curvatures",
-         best_of_3([&] { compute_principal_curvatures(mesh); }));
-    std::vector<DirectionConstraint> curv = constraints_from_principal_directions(mesh, 0.05);
-    emit(name, nf, "interpolate_orientation",
-         best_of_3([&] { interpolate_direction_field(mesh, strokes, {}); }),
-         {{"constraints", strokes.size()}});
-    emit(name, nf, "interpolate_orientation_from_curvature",
-         best_of_3([&] { interpolate_direction_field(mesh, curv, {}); }),
-         {{"constraints", curv.size()}});
-    interpolate_scalar_field(mesh, {{0, 1.0}}, scale_field_options());
-    // Scale: the default period, 8 mean edge lengths (pgp_default_scale).
-    const double period = pgp_default_scale(mesh, 8.0);
-    interpolate_scalar_field(mesh, {{0, period}}, scale_field_options());
-    interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
-                             material_field_options());
-    PeriodicGlobalParameterization pgp(mesh, pgp_options);
-    // The first call pays the ordering and the symbolic analysis (one-shot
-    // runs such as the CLI's); the best of 3 reuses them.
-    PgpResult init;
+// One mesh's runs: its name and face count for every line, and the PGP
+// options of the run.
+struct MeshRun {
+  std::string name;
+  std::size_t nf = 0;
+  PgpOptions pgp_options;
+  PgpSingularityOptions sing_options;
+};
+
+// Principal curvatures, then the orientation field interpolated from sparse
+// strokes and from the principal directions `curv` returns (5% of faces).
+std::vector<DirectionConstraint> orientation_figures(Mesh& mesh, const MeshRun& run,
+                                                     const std::vector<DirectionConstraint>& strokes) {
+  emit(run.name, run.nf, "principal_curvatures", best_of_3([&] { compute_principal_curvatures(mesh); }));
+  std::vector<DirectionConstraint> curv = constraints_from_principal_directions(mesh, 0.05);
+  emit(run.name, run.nf, "interpolate_orientation",
+       best_of_3([&] { interpolate_direction_field(mesh, strokes, {}); }), {{"constraints", strokes.size()}});
+  emit(run.name, run.nf, "interpolate_orientation_from_curvature",
+       best_of_3([&] { interpolate_direction_field(mesh, curv, {}); }), {{"constraints", curv.size()}});
+  return curv;
+}
+
+// PGP initialisation: the first call pays the ordering and the symbolic
+// analysis (one-shot runs such as the CLI's); the best of 3 reuses them.
+// Then the singularity detection on the result.
+void initialization_figures(Mesh& mesh, const MeshRun& run, PeriodicGlobalParameterization& pgp) {
+  PgpResult init;
+  Timer t_first;
+  const std::clock_t c_first = std::clock();
+  const PgpResult first = pgp.initialize();
+  g_last_cpu = double(std::clock() - c_first) / CLOCKS_PER_SEC;
+  emit(run.name, run.nf, "pgp_initialize_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
+  const double t_init = best_of_3([&] { keep_fastest(init, pgp.initialize()); });
+  emit(run.name, run.nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
+  PgpSingularities sing;
+  const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh, run.sing_options); });
+  nlohmann::json fig = singularity_figures(mesh, sing);
+  fig["diagnosis"] = singular_face_diagnosis(mesh, sing);
+  emit(run.name, run.nf, "detect_singularities", t_sing, fig);
+}
+
+// Local update (Ray et al. 2009, Table 1): an effect area of 25% of the
+// faces around vertex `seed`; orientation, scale and PGP re-solved there,
+// each timed, and their total.
+void local_update_figures(Mesh& mesh, const MeshRun& run, PeriodicGlobalParameterization& pgp, double period,
+                          const EffectAreaOptions& eo, std::uint32_t seed) {
+  const std::string& name = run.name;
+  const std::size_t nf = run.nf;
+  EffectArea area;
+  const double t_area = best_of_3([&] { area = compute_effect_area(mesh, {seed}, eo); });
+  emit(name, nf, "effect_area", t_area, {{"area_faces", area.free_faces}});
+  const std::uint32_t cf = static_cast<std::uint32_t>(mesh.face(mesh.halfedge(VertexIndex(seed))).idx());
+  DirectionFieldOptions dopt;
+  dopt.area = &area;
+  ScalarFieldOptions sopt = scale_field_options();
+  sopt.area = &area;
+  double t_dir = 0, t_scale = 0, t_pgp = 0;
+  PgpResult last;
+  double cpu_total = 0;
+  t_dir = best_of_3([&] { interpolate_direction_field(mesh, {{cf, {0.0, 1.0, 1.0}}}, dopt); });
+  emit(name, nf, "local_update_orientation", t_dir, {{"area_faces", area.free_faces}});
+  cpu_total += g_last_cpu;
+  t_scale = best_of_3([&] { interpolate_scalar_field(mesh, {{seed, 0.7 * period}}, sopt); });
+  emit(name, nf, "local_update_scale", t_scale, {{"area_faces", area.free_faces}});
+  cpu_total += g_last_cpu;
+  {
     Timer t_first;
     const std::clock_t c_first = std::clock();
-    const PgpResult first = pgp.initialize();
+    const PgpResult first = pgp.update(area);
     g_last_cpu = double(std::clock() - c_first) / CLOCKS_PER_SEC;
-    emit(name, nf, "pgp_initialize_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
-    const double t_init = best_of_3([&] { keep_fastest(init, pgp.initialize()); });
-    emit(name, nf, "pgp_initialize", t_init, {{"breakdown", breakdown(init)}});
-    PgpSingularities sing;
-    PgpSingularityOptions sing_options;
-    sing_options.pgp = pgp_options;
-    const double t_sing = best_of_3([&] { sing = detect_pgp_singularities(mesh, sing_options); });
-    {
-      nlohmann::json fig = singularity_figures(mesh, sing);
-      fig["diagnosis"] = singular_face_diagnosis(mesh, sing);
-      emit(name, nf, "detect_singularities", t_sing, fig);
-    }
+    emit(name, nf, "local_update_pgp_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
+  }
+  t_pgp = best_of_3([&] { keep_fastest(last, pgp.update(area)); });
+  emit(name, nf, "local_update_pgp", t_pgp,
+       {{"area_faces", area.free_faces}, {"breakdown", breakdown(last)}});
+  cpu_total += g_last_cpu;
+  g_last_cpu = cpu_total;
+  emit(name, nf, "local_update_total", t_dir + t_scale + t_pgp, {{"area_faces", area.free_faces}});
+}
 
-    // Local update: effect area of 25% of the faces around a vertex.
-    EffectAreaOptions eo;
-    eo.max_faces = nf / 4;
-    const std::uint32_t seed = static_cast<std::uint32_t>(mesh.number_of_vertices() / 3);
-    EffectArea area;
-    const double t_area = best_of_3([&] { area = compute_effect_area(mesh, {seed}, eo); });
-    emit(name, nf, "effect_area", t_area, {{"area_faces", area.free_faces}});
-    const std::uint32_t cf = static_cast<std::uint32_t>(mesh.face(mesh.halfedge(VertexIndex(seed))).idx());
-    DirectionFieldOptions dopt;
-    dopt.area = &area;
-    ScalarFieldOptions sopt = scale_field_options();
-    sopt.area = &area;
-    double t_dir = 0, t_scale = 0, t_pgp = 0;
-    PgpResult last;
-    double cpu_total = 0;
-    t_dir = best_of_3([&] { interpolate_direction_field(mesh, {{cf, {0.0, 1.0, 1.0}}}, dopt); });
-    emit(name, nf, "local_update_orientation", t_dir, {{"area_faces", area.free_faces}});
-    cpu_total += g_last_cpu;
-    t_scale = best_of_3([&] { interpolate_scalar_field(mesh, {{seed, 0.7 * period}}, sopt); });
-    emit(name, nf, "local_update_scale", t_scale, {{"area_faces", area.free_faces}});
-    cpu_total += g_last_cpu;
-    {
-      Timer t_first;
-      const std::clock_t c_first = std::clock();
-      const PgpResult first = pgp.update(area);
-      g_last_cpu = double(std::clock() - c_first) / CLOCKS_PER_SEC;
-      emit(name, nf, "local_update_pgp_first_call", t_first.seconds(), {{"breakdown", breakdown(first)}});
-    }
-    t_pgp = best_of_3([&] { keep_fastest(last, pgp.update(area)); });
-    emit(name, nf, "local_update_pgp", t_pgp,
-         {{"area_faces", area.free_faces}, {"breakdown", breakdown(last)}});
-    cpu_total += g_last_cpu;
-    g_last_cpu = cpu_total;
-    emit(name, nf, "local_update_total", t_dir + t_scale + t_pgp, {{"area_faces", area.free_faces}});
-    // The whole update as one timed run, as the pipeline (material-map
-    // --update) does it: orientation, scale and the PGP's order of the
-    // area's free vertices (PeriodicGlobalParameterization::prepare(area))
-    // side by side (independent), then the PGP. "new_area": each of the 3 runs a new constraint
-    // at another seed vertex, hence another effect area (ordering, pattern
-    // and symbolic analysis redone: the PGP's first-call path);
-    // "same_area": the area of the first run again (analysis reused).
-    {
-      PgpResult last_whole;
-      auto whole = [&](std::uint32_t s) {
-        const EffectArea a2 = compute_effect_area(mesh, {s}, eo);
-        DirectionFieldOptions d2;
-        d2.area = &a2;
-        ScalarFieldOptions s2 = scale_field_options();
-        s2.area = &a2;
-        const std::uint32_t f2 = static_cast<std::uint32_t>(mesh.face(mesh.halfedge(VertexIndex(s))).idx());
-        tbb::parallel_invoke([&] { interpolate_direction_field(mesh, {{f2, {0.0, 1.0, 1.0}}}, d2); },
-                             [&] { interpolate_scalar_field(mesh, {{s, 0.7 * period}}, s2); },
-                             [&] { pgp.prepare(a2); });
-        last_whole = pgp.update(a2);
-      };
-      int run = 0;
-      const std::uint32_t nvtx = static_cast<std::uint32_t>(mesh.number_of_vertices());
-      const double t_new = best_of_3([&] { whole((seed + (++run) * (nvtx / 7)) % nvtx); });
-      emit(name, nf, "local_update_whole_new_area", t_new,
-           {{"note", "effect area inside the timer; orientation || scale || PGP order, then PGP"},
-            {"breakdown", breakdown(last_whole)}});
-      whole(seed);
-      const double t_same = best_of_3([&] { whole(seed); });
-      emit(name, nf, "local_update_whole_same_area", t_same, {{"breakdown", breakdown(last_whole)}});
-    }
+// The whole update as one timed run, as the pipeline (material-map
+// --update) does it: orientation, scale and the PGP's order of the area's
+// free vertices (PeriodicGlobalParameterization::prepare(area)) side by side
+// (independent), then the PGP. "new_area": each of the 3 runs a new
+// constraint at another seed vertex, hence another effect area (ordering,
+// pattern and symbolic analysis redone: the PGP's first-call path);
+// "same_area": the area of the first run again (analysis reused).
+void whole_update_figures(Mesh& mesh, const MeshRun& run, PeriodicGlobalParameterization& pgp, double period,
+                          const EffectAreaOptions& eo, std::uint32_t seed) {
+  PgpResult last_whole;
+  auto whole = [&](std::uint32_t s) {
+    const EffectArea a2 = compute_effect_area(mesh, {s}, eo);
+    DirectionFieldOptions d2;
+    d2.area = &a2;
+    ScalarFieldOptions s2 = scale_field_options();
+    s2.area = &a2;
+    const std::uint32_t f2 = static_cast<std::uint32_t>(mesh.face(mesh.halfedge(VertexIndex(s))).idx());
+    tbb::parallel_invoke(
+        [&] {
+          interpolate_direction_field(mesh, {{f2, {0.0, 1.0, 1.0}}}, d2);
+        },
+        [&] {
+          interpolate_scalar_field(mesh, {{s, 0.7 * period}}, s2);
+        },
+        [&] { pgp.prepare(a2); });
+    last_whole = pgp.update(a2);
+  };
+  int k = 0;
+  const std::uint32_t nvtx = static_cast<std::uint32_t>(mesh.number_of_vertices());
+  const double t_new = best_of_3([&] { whole((seed + (++k) * (nvtx / 7)) % nvtx); });
+  emit(run.name, run.nf, "local_update_whole_new_area", t_new,
+       {{"note", "effect area inside the timer; orientation || scale || PGP order, then PGP"},
+        {"breakdown", breakdown(last_whole)}});
+  whole(seed);
+  const double t_same = best_of_3([&] { whole(seed); });
+  emit(run.name, run.nf, "local_update_whole_same_area", t_same, {{"breakdown", breakdown(last_whole)}});
+}
 
-    // Singular fraction against the curvature field's smoothness: jet-fitting
-    // rings and the fraction of faces constrained (8 edges per period).
-    for (int rings : {2, 4})
-      for (double fraction : {0.05, 0.1})
+// Singular fraction against the curvature field's smoothness: jet-fitting
+// rings and the fraction of faces constrained (8 edges per period).
+void field_sweep_figures(Mesh& mesh, const MeshRun& run) {
+  for (int rings : {2, 4})
+    for (double fraction : {0.05, 0.1})
       for (double smoothing : {0.0, 4.0, 16.0, 64.0}) {
-        if (!field_sweep) break;
         PrincipalCurvatureOptions co;
         co.rings = rings;
         co.max_rings = std::max(co.max_rings, rings);
@@ -644,28 +647,81 @@ int main(int argc, char** argv) {
         fo.smoothing = smoothing;
         interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, fraction), fo);
         interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, 8.0)}}, scale_field_options());
-        PeriodicGlobalParameterization p2(mesh, pgp_options);
+        PeriodicGlobalParameterization p2(mesh, run.pgp_options);
         p2.initialize();
-        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
+        nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, run.sing_options));
         fig["rings"] = rings;
         fig["constrained_fraction"] = fraction;
         fig["smoothing"] = smoothing;
-        emit(name, nf, "singular_fraction_vs_curvature_field", 0.0, fig);
+        emit(run.name, run.nf, "singular_fraction_vs_curvature_field", 0.0, fig);
       }
+}
 
-    // Singular fraction against the period (in mean edge lengths), the field
-    // interpolated from the 5% most anisotropic faces' principal directions.
-    for (int field = 0; field < 2 && sweep; ++field)
+// Singular fraction against the period (in mean edge lengths), the field
+// interpolated from the strokes and from the 5% most anisotropic faces'
+// principal directions.
+void period_sweep_figures(Mesh& mesh, const MeshRun& run, const std::vector<DirectionConstraint>& strokes,
+                          const std::vector<DirectionConstraint>& curv) {
+  for (int field = 0; field < 2; ++field)
     for (double k : {4.0, 8.0, 16.0}) {
       interpolate_direction_field(mesh, field ? curv : strokes, {});
       interpolate_scalar_field(mesh, {{0, pgp_default_scale(mesh, k)}}, scale_field_options());
-      PeriodicGlobalParameterization p2(mesh, pgp_options);
+      PeriodicGlobalParameterization p2(mesh, run.pgp_options);
       p2.initialize();
-      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, sing_options));
+      nlohmann::json fig = singularity_figures(mesh, detect_pgp_singularities(mesh, run.sing_options));
       fig["edges_per_period"] = k;
       fig["field"] = field ? "curvature" : "strokes";
-      emit(name, nf, "singular_fraction_vs_period", 0.0, fig);
+      emit(run.name, run.nf, "singular_fraction_vs_period", 0.0, fig);
     }
+}
+
+// Every figure of one mesh: the pipeline at the CLI's defaults, then the
+// paper table's steps (or only the curl-correction figures).
+void bench_mesh(const std::string& path, const BenchArgs& args) {
+  const std::string name = path.substr(path.find_last_of('/') + 1);
+  driver_figures(path, name);
+  Mesh mesh;
+  read_mesh(path, mesh);
+  MeshRun run;
+  run.name = name;
+  run.nf = mesh.number_of_faces();
+  run.pgp_options = args.pgp_options;
+  run.sing_options.pgp = args.pgp_options;
+  // Sparse strokes: 20 faces spread over the mesh with a projected direction.
+  std::vector<DirectionConstraint> strokes;
+  for (std::size_t i = 0; i < 20; ++i)
+    strokes.push_back({static_cast<std::uint32_t>(i * run.nf / 20), {1.0, 0.3, 0.2}});
+  if (args.curl_only) {
+    // The curvature field of the runs below, then only the curl figures.
+    compute_principal_curvatures(mesh);
+    interpolate_direction_field(mesh, constraints_from_principal_directions(mesh, 0.05), {});
+    for (double k : {4.0, 8.0, 16.0}) curl_correction_figures(mesh, name, k);
+    return;
   }
+  const std::vector<DirectionConstraint> curv = orientation_figures(mesh, run, strokes);
+  interpolate_scalar_field(mesh, {{0, 1.0}}, scale_field_options());
+  // Scale: the default period, 8 mean edge lengths (pgp_default_scale).
+  const double period = pgp_default_scale(mesh, 8.0);
+  interpolate_scalar_field(mesh, {{0, period}}, scale_field_options());
+  interpolate_scalar_field(mesh, {{0, 0.0}, {static_cast<std::uint32_t>(mesh.number_of_vertices() / 2), 1.0}},
+                           material_field_options());
+  PeriodicGlobalParameterization pgp(mesh, args.pgp_options);
+  initialization_figures(mesh, run, pgp);
+  EffectAreaOptions eo;
+  eo.max_faces = run.nf / 4;
+  const std::uint32_t seed = static_cast<std::uint32_t>(mesh.number_of_vertices() / 3);
+  local_update_figures(mesh, run, pgp, period, eo, seed);
+  whole_update_figures(mesh, run, pgp, period, eo, seed);
+  if (args.field_sweep) field_sweep_figures(mesh, run);
+  if (args.sweep) period_sweep_figures(mesh, run, strokes, curv);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const BenchArgs args = parse_args(argc, argv);
+  g_swap_coordinates = args.pgp_options.swap_coordinates;
+  g_separate_halves = !args.pgp_options.swap_coordinates && args.pgp_options.separate_halves;
+  for (const std::string& path : args.meshes) bench_mesh(path, args);
   return 0;
 }

@@ -2,6 +2,9 @@
 # never directory-wide (third-party headers are SYSTEM includes).
 function(surftex_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(SURFTEX_PCH)  # say so when a precompiled header cannot be used
+    target_compile_options(${target} PRIVATE -Winvalid-pch)
+  endif()
   if(SURFTEX_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
@@ -32,7 +35,7 @@ function(surftex_add_module name)
 endfunction()
 
 # SURFTEX_PCH: one precompiled header per target, made of the headers most of
-# its sources include (docs/decisions/504-first-build.md).
+# its sources include (docs/decisions/504-first-build.md, 801-ci-time.md).
 function(surftex_precompile target)
   if(SURFTEX_PCH)
     target_precompile_headers(${target} PRIVATE ${ARGN})

@@ -7,6 +7,7 @@
 #include "geometry/read_mesh.h"
 #include "geometry/repair_mesh_json.h"
 #include "geometry/timer.h"
+#include "geometry/union_find.h"
 #include "surftex/command.h"
 
 namespace surftex::cli {
@@ -21,18 +22,10 @@ struct MeshTopology {
 MeshTopology topology(const Mesh& m) {
   MeshTopology t;
   // Components: union-find over vertices joined by edges.
-  std::vector<std::size_t> parent(m.num_vertices());
-  std::iota(parent.begin(), parent.end(), std::size_t{0});
-  auto root = [&](std::size_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (EdgeIndex e : m.edges()) {
-    std::size_t a = root(m.vertex(e, 0).idx()), b = root(m.vertex(e, 1).idx());
-    if (a != b) parent[a] = b;
-  }
+  UnionFind<std::size_t> sets(m.num_vertices());
+  for (EdgeIndex e : m.edges()) sets.unite(m.vertex(e, 0).idx(), m.vertex(e, 1).idx());
   for (VertexIndex v : m.vertices())
-    if (!m.is_isolated(v) && root(v.idx()) == v.idx()) ++t.components;
+    if (!m.is_isolated(v) && sets.find(v.idx()) == v.idx()) ++t.components;
   // Boundary loops: cycles of border halfedges.
   std::vector<char> seen(m.num_halfedges(), 0);
   for (HalfedgeIndex h : m.halfedges()) {

@@ -93,12 +93,15 @@ Outputs render_all(const Mesh& mesh, const PgpSingularities& sing, const Materia
   return o;
 }
 
-// The PBR set of the baked atlas: height (the tile's luminance through the
-// same lookups) and its tangent-space normal map; `bump` is the tilt per
-// unit of height per period, as in the render.
+// The PBR set of the baked atlas, every map through the colour's lookups:
+// height (the tile's height layers, else its luminance), roughness (the
+// tile's roughness layers, as glTF metallicRoughness) and the tangent-space
+// normal map (from the tile's normal layers, else from the height's slopes;
+// `bump` is the tilt per unit of height per period, as in the render).
 struct BakedAsset {
   MaterialBakeResult bake;
-  Image normal;
+  Image normal, metallic_roughness;
+  std::string normal_source;
 };
 
 BakedAsset bake_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int atlas_size,
@@ -107,7 +110,14 @@ BakedAsset bake_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTi
   MaterialBakeOptions bo;
   bo.size = atlas_size;
   a.bake = bake_material_space(mesh, sing, tile, bo);
+  if (!a.bake.roughness.empty()) a.metallic_roughness = metallic_roughness_from_roughness(a.bake.roughness);
+  if (!a.bake.object_normal.empty()) {  // the tile's normals, in the GLB's tangent frames
+    a.normal = material_space_tangent_normals(mesh, a.bake);
+    a.normal_source = "exemplar_normal";
+    return a;
+  }
   a.normal = normal_map_from_height(a.bake.height, a.bake.chart, bump * period * a.bake.texels_per_length);
+  a.normal_source = "height";
   return a;
 }
 
@@ -118,6 +128,9 @@ nlohmann::json bake_report(const BakedAsset& a) {
           {"protected_mip_size", b.protected_mip_size},
           {"margin", b.margin},             {"coverage", b.coverage},
           {"texels_per_length", b.texels_per_length},
+          {"normal_source", a.normal_source},
+          {"height_source", b.height_from_tile ? "exemplar_height" : "luminance"},
+          {"roughness", !b.roughness.empty()},
           {"seconds", {{"atlas", b.seconds_atlas}, {"lookup", b.seconds_lookup}, {"gutter", b.seconds_gutter}}}};
 }
 
@@ -135,6 +148,7 @@ std::vector<std::string> write_meshes(Mesh& mesh, const BakedAsset& a, const std
   wo.texture = &a.bake.color;
   wo.normal_texture = &a.normal;
   wo.height_texture = &a.bake.height;
+  wo.metallic_roughness_texture = &a.metallic_roughness;
   wo.texture_repeat = false;
   std::vector<std::string> files = write_mesh(obj, mesh, wo);
   wo.height_texture = nullptr;
@@ -147,6 +161,15 @@ std::vector<std::string> write_meshes(Mesh& mesh, const BakedAsset& a, const std
   for (const std::string& f : write_mesh(ply, mesh, po)) files.push_back(f);
   mesh.remove_property_map(scalar);
   return files;
+}
+
+// The map kinds the tile carries (tile.json "maps").
+nlohmann::json tile_maps(const MaterialTile& t) {
+  nlohmann::json m = nlohmann::json::array();
+  if (!t.normal_layers.empty()) m.push_back("normal");
+  if (!t.height_layers.empty()) m.push_back("height");
+  if (!t.roughness_layers.empty()) m.push_back("roughness");
+  return m;
 }
 
 MaterialMappingOptions mapping_options(const Args& a) {
@@ -162,6 +185,9 @@ MaterialMappingOptions mapping_options(const Args& a) {
 const char* const kOutputs[] = {"mesh.obj",         "mesh.mtl",         "mesh.png",         "mesh_normal.png",
                                 "mesh_height.png",  "mesh.glb",         "mesh.ply",         "render_plain.png",
                                 "render_fixed.png", "render_normalmap.png", "report.json",  "state.json"};
+
+// Written only when the tile has roughness layers (the OBJ's map_Pr).
+const char* const kRoughnessOutput = "mesh_roughness.png";
 
 void check_args(const Args& a) {
   require_input_file(a.mesh, "mesh");
@@ -180,6 +206,7 @@ void check_args(const Args& a) {
   for (const auto& i : {a.mesh, a.constraints, a.update, a.state})
     if (!i.empty()) ins.push_back(i);
   for (const char* f : kOutputs) check_output(a.out + "/" + f, ins, a.common.force, false);
+  check_output(a.out + "/" + kRoughnessOutput, ins, a.common.force, false);
 }
 
 int run(const Args& a) {
@@ -248,11 +275,12 @@ int run(const Args& a) {
   write_image(a.out + "/render_normalmap.png", img.normal, io);
   mapping.save_state(a.out + "/state.json", a.common.force);
   sec["total"] = total.seconds();
-  rep["tile"] = {{"dir", a.tile}, {"layers", tile.layers.size()}, {"size", tile.size}};
+  rep["tile"] = {{"dir", a.tile}, {"layers", tile.layers.size()}, {"size", tile.size}, {"maps", tile_maps(tile)}};
   rep["mesh"] = a.mesh;
   RunFiles run_files{{a.mesh, a.tile, a.constraints, a.update, a.state}, {}};
   for (const char* f : kOutputs)
     if (std::string(f) != "report.json") run_files.outputs.push_back(a.out + "/" + f);
+  if (!baked.bake.roughness.empty()) run_files.outputs.push_back(a.out + "/" + kRoughnessOutput);
   write_file_atomic(a.out + "/report.json", make_report(a.common, "material-map", rep, run_files).dump(2) + "\n",
                     a.common.force);
   write_report(a.common, "material-map", rep, run_files);
@@ -283,7 +311,9 @@ SubcommandRegistrar reg{
        app.add_option("-o,--output", a->out,
                       "Output folder: mesh.obj/.mtl and mesh.glb with the mapping baked into a uv atlas "
                       "(mesh.png base colour with the singularity fix and the material blend, mesh_normal.png "
-                      "tangent-space normal map, mesh_height.png 16-bit height), mesh.ply (material m as vertex "
+                      "tangent-space normal map, mesh_height.png 16-bit height; with the tile's map layers "
+                      "(material-tile --exemplar-*): height and normal from them, mesh_roughness.png as the "
+                      "GLB's metallicRoughnessTexture and the MTL's map_Pr), mesh.ply (material m as vertex "
                       "scalar, also in the GLB as _material), render_plain.png, render_fixed.png, "
                       "render_normalmap.png, report.json, state.json")
            ->required();

@@ -167,8 +167,10 @@ void check_quilt_size(const Swatch& s, double cell, double placements, const std
                             std::to_string(static_cast<int>(kMaxSwatchCells)) + " (0 = automatic, a tenth of the swatch)");
 }
 
-int run_quilt(QuiltArgs& a) {
-  // With --plane the positional arguments are just the swatch.
+// The inputs of a run (the swatch file unless generated, the base mesh),
+// after checking the arguments that need no file read. With --plane the
+// positional arguments are just the swatch.
+std::vector<std::string> check_quilt_args(QuiltArgs& a) {
   if (!a.plane.empty() && !a.base.empty() && a.swatch.empty()) std::swap(a.base, a.swatch);
   if (!a.plane.empty() && !a.base.empty())
     throw InvalidInputError("quilt: give either a base MESH or --plane WxH, not both");
@@ -185,10 +187,15 @@ int run_quilt(QuiltArgs& a) {
     throw InvalidInputError("quilt: --field must be up or none (got '" + a.field + "')");
   if (a.up.size() != 3 || !(a.up[0] * a.up[0] + a.up[1] * a.up[1] + a.up[2] * a.up[2] > 0))
     throw InvalidInputError("quilt: --up must be three numbers, not all zero");
+  return inputs;
+}
+
+// The output files: OUT, its .ply and .glb siblings (mesh mode), the render
+// (last, when there is one); each checked against the inputs and the others.
+std::vector<std::string> quilt_outputs(QuiltArgs& a, const std::vector<std::string>& inputs) {
   const std::string ext = lower_ext(a.output);
   if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".glb")
     throw InvalidInputError("quilt: unknown output format '" + a.output + "' (use .obj, .ply, .off, .glb)");
-  // Outputs: OUT, its .ply and .glb siblings (mesh mode), the render.
   std::vector<std::string> outputs{a.output};
   if (!a.base.empty())
     for (const std::string& e : {std::string(".ply"), std::string(".glb")})
@@ -200,14 +207,249 @@ int run_quilt(QuiltArgs& a) {
     others.insert(others.end(), outputs.begin(), outputs.begin() + static_cast<long>(i));
     check_output(outputs[i], others, a.common.force);
   }
+  return outputs;
+}
+
+// --plane WxH in swatch sizes; {0, 0} without --plane.
+std::pair<double, double> parse_plane(const std::string& plane) {
   double w = 0, h = 0;
-  if (!a.plane.empty()) {
-    char x = 0;
-    std::istringstream is(a.plane);
-    if (!(is >> w >> x >> h) || (x != 'x' && x != 'X') || !(w > 0) || !(h > 0) || !std::isfinite(w) ||
-        !std::isfinite(h) || !(is >> std::ws).eof())
-      throw InvalidInputError("quilt: --plane must be WxH with positive numbers in swatch sizes (got '" + a.plane + "')");
+  if (plane.empty()) return {w, h};
+  char x = 0;
+  std::istringstream is(plane);
+  if (!(is >> w >> x >> h) || (x != 'x' && x != 'X') || !(w > 0) || !(h > 0) || !std::isfinite(w) ||
+      !std::isfinite(h) || !(is >> std::ws).eof())
+    throw InvalidInputError("quilt: --plane must be WxH with positive numbers in swatch sizes (got '" +
+                            plane + "')");
+  return {w, h};
+}
+
+// Planar mesh quilting (section 2) of the swatch over w x h swatch sizes
+// into `out`, coloured by element; its figures into the report.
+void quilt_on_plane(const QuiltArgs& a, Mesh& sm, double w, double h, Mesh& out, nlohmann::json& rep) {
+  // --scale: factor applied to the swatch (the paper's s); the plane is in swatch sizes.
+  const double sc = a.scale > 0 ? a.scale : 1.0;
+  for (VertexIndex v : sm.vertices()) {
+    const Point3 p = sm.point(v);
+    sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
   }
+  const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
+  check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
+  check_budget(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())), a.common);
+  PlanarQuiltOptions o;
+  o.seed = a.common.seed;
+  o.cell_size = a.cell * sc;
+  o.subpatch_radius = a.subpatch;
+  o.progress = terminal_progress(a.common.quiet);
+  const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
+  if (out.number_of_faces() == 0)
+    throw InvalidInputError("quilt: no element was placed on the " + a.plane + " plane");
+  color_by_element(out, a.common.seed);
+  rep["plane"] = {w, h};
+  rep["swatch_faces"] = s.mesh.tris.size();
+  rep["swatch_elements"] = s.elements.size();
+  rep["elements"] = r.elements;
+  rep["faces"] = r.faces;
+  rep["vertices"] = r.vertices;
+  rep["steps"] = r.steps;
+  const auto [len_mean, len_max] = element_lengths(out, std::max(s.length(), s.width()));
+  rep["element_length_mean"] = len_mean;
+  rep["element_length_max"] = len_max;
+  write_stitch_stats(rep, r.stats);
+  rep["seconds"] = {{"quilt", r.seconds},
+                    {"match", r.stats.seconds_match},
+                    {"correspond", r.stats.seconds_correspond},
+                    {"deform", r.stats.seconds_deform},
+                    {"merge", r.stats.seconds_merge}};
+}
+
+// Refuses a surface quilt whose output could not be held: the placements
+// needed are the base area over the scaled swatch's xy area (the base mesh
+// is triangulated by load_method_mesh).
+void check_surface_quilt_size(const QuiltArgs& a, const Mesh& base, const Swatch& s, double relative_size) {
+  double area = 0;
+  for (FaceIndex f : base.faces()) area += face_area(base, f);
+  const CGAL::Bbox_3 bb = CGAL::Polygon_mesh_processing::bbox(base);
+  const double diag = std::sqrt(CGAL::square(bb.xmax() - bb.xmin()) + CGAL::square(bb.ymax() - bb.ymin()) +
+                                CGAL::square(bb.zmax() - bb.zmin()));
+  const double side = relative_size * diag, big = std::max(s.length(), s.width());
+  const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
+  check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
+                   "--scale " + std::to_string(relative_size));
+  check_budget(estimate_quilt(base.number_of_faces(), (swatch_area > 0 ? area / swatch_area : 0.0) *
+                                                          static_cast<double>(s.mesh.tris.size())),
+               a.common);
+}
+
+// The options of quilt_surface from the command line (the relative size set by the caller).
+void set_surface_quilt_options(const QuiltArgs& a, SurfaceQuiltOptions& o) {
+  o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
+  o.up = {a.up[0], a.up[1], a.up[2]};
+  o.cell_size = a.cell;
+  o.subpatch_radius = a.subpatch;
+  o.rotation_max_deg = a.max_turn;
+  o.align_to_overlap = !a.no_align;
+  o.align_field_max_deg = a.align_bound;
+  o.smooth_field = a.smooth_field;
+  o.seed = a.common.seed;
+  o.progress = terminal_progress(a.common.quiet);
+}
+
+// The figures of a surface quilt (section 3.1) and of its embedding through
+// the shell map (3.2) into the report.
+void report_surface_quilt(const SurfaceQuiltResult& r, const EmbedSurfaceQuiltResult& er,
+                          nlohmann::json& rep) {
+  rep["elements"] = r.elements;
+  rep["steps"] = r.steps;
+  rep["patches_shrunk"] = r.patches_shrunk;
+  rep["patches_transported"] = r.patches_transported;
+  rep["patches_aligned"] = r.patches_aligned;
+  rep["overlap_jump_deg"] = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
+  rep["patches_turned"] = r.patches_turned;
+  rep["elements_past_border"] = r.elements_past_border;
+  rep["elements_stretched"] = r.elements_stretched;
+  rep["edge_stretch_max"] = r.edge_stretch_max;
+  rep["crossings_resolved"] = r.crossings_resolved;
+  rep["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
+  rep["fragments_removed"] = r.fragments_removed;
+  rep["faces_refilled"] = r.faces_refilled;
+  rep["bare_fraction"] = r.bare_fraction;
+  write_stitch_stats(rep, r.stats);
+  rep["charts"] = er.atlas.num_charts;
+  rep["tets"] = er.tets;
+  rep["shell_height"] = er.shell_height;
+  rep["clamped_vertices"] = er.clamped_vertices;
+  rep["stretch_before"] = er.stretch.stretch_before;
+  rep["stretch_after"] = er.stretch.stretch_after;
+  rep["outside_vertices"] = er.embed.outside;
+  rep["elements_not_expressible"] = r.elements_not_expressible;
+  rep["elements_not_expressed"] = r.elements_not_expressed;
+  rep["elements_partial"] = r.elements_partial;
+  rep["seams_broken"] = r.seams_broken;
+  rep["z_fitted_elements"] = r.z_fitted_elements;
+  rep["outside_below"] = er.outside_below;
+  rep["outside_above"] = er.outside_above;
+  rep["outside_uv"] = er.outside_uv;
+  rep["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
+  if (er.outside_shell_measured) {
+    // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
+    rep["outside_shell"] = er.outside_shell.outside;
+    rep["outside_shell_below"] = er.outside_shell.below;
+    rep["outside_shell_above"] = er.outside_shell.above;
+    rep["outside_shell_side"] = er.outside_shell.side;
+    rep["outside_shell_max_distance"] = er.outside_shell.max_distance;
+  }
+  if (er.embed.checked) {
+    rep["self_intersections"] = er.embed.self_intersecting_pairs;
+    rep["self_intersections_within_elements"] = er.self_intersections_within;
+    rep["self_intersections_between_elements"] = er.self_intersections_between;
+  } else {
+    rep["self_intersections"] = nullptr;
+  }
+  rep["seconds"] = {{"quilt", r.seconds},
+                    {"patches", r.seconds_patch},
+                    {"match", r.stats.seconds_match},
+                    {"correspond", r.stats.seconds_correspond},
+                    {"deform", r.stats.seconds_deform},
+                    {"merge", r.stats.seconds_merge},
+                    {"resolve", r.stats.seconds_resolve},
+                    {"finish", r.seconds_finish},
+                    {"atlas", er.seconds_atlas},
+                    {"shell", er.seconds_shell},
+                    {"stretch", er.seconds_stretch},
+                    {"shell_map", er.seconds_map},
+                    {"embed", er.seconds_embed}};
+}
+
+// Surface mesh quilting (section 3.1) of the swatch over the base mesh,
+// embedded through the stretch-minimised shell map (3.2) into `out`,
+// coloured by element; `scene` is the grey base with `out` joined (for the
+// render). Its figures into the report.
+void quilt_on_mesh(const QuiltArgs& a, Mesh& sm, Mesh& out, Mesh& scene, nlohmann::json& rep) {
+  Timer t;
+  Mesh base;
+  rep["input_mesh"] = to_json(load_method_mesh(a.base, base, a.common));
+  base.collect_garbage();
+  const double read_seconds = t.seconds();
+  const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
+  SurfaceQuiltOptions o;
+  o.relative_size = a.scale > 0 ? a.scale : 0.25;
+  if (!(o.relative_size <= 10))
+    throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
+  check_surface_quilt_size(a, base, s, o.relative_size);
+  set_surface_quilt_options(a, o);
+  SurfaceQuilt q;
+  const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+  if (q.elements == 0 || q.tris.empty())
+    throw InvalidInputError("quilt: no element was placed on '" + a.base + "' at --scale " +
+                            std::to_string(o.relative_size) +
+                            " (the swatch may be too large for the mesh: lower --scale)");
+  EmbedSurfaceQuiltOptions eo;
+  eo.shell_height = a.shell_height;
+  eo.stretch.iterations = a.stretch_iterations;
+  eo.stretch.seed = a.common.seed;
+  eo.check_self_intersections = !a.no_check;
+  eo.progress = o.progress;
+  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+  color_by_element(out, a.common.seed);
+  report_surface_quilt(r, er, rep);
+  rep["mesh"] = a.base;
+  rep["base_faces"] = base.number_of_faces();
+  rep["swatch_faces"] = s.mesh.tris.size();
+  rep["swatch_elements"] = s.elements.size();
+  rep["swatch_up"] = axis_name(s.up_axis);
+  rep["up"] = a.up;
+  rep["scale"] = o.relative_size;
+  rep["field"] = a.field;
+  rep["faces"] = out.number_of_faces();
+  rep["vertices"] = out.number_of_vertices();
+  rep["max_turn_deg"] = o.rotation_max_deg;
+  rep["seconds"]["read"] = read_seconds;
+  scene = base;
+  get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+  scene.join(out);
+}
+
+// The quilt into every mesh output, and the render of `scene` when asked.
+void write_quilt_outputs(const QuiltArgs& a, const std::vector<std::string>& outputs, const Mesh& out,
+                         const Mesh& scene, nlohmann::json& rep) {
+  WriteMeshOptions wo;
+  wo.overwrite = a.common.force;
+  wo.write_uvs = false;
+  for (std::size_t i = 0; i + (a.render.empty() ? 0 : 1) < outputs.size(); ++i)
+    write_mesh(outputs[i], out, wo);
+  if (a.render.empty()) return;
+  WriteImageOptions io;
+  io.overwrite = a.common.force;
+  // The render stands the mesh on the axis nearest --up (+Y by default, as
+  // glTF viewers do); a plane lies in xy and is seen from above (+Z).
+  ViewOptions vo;
+  vo.size = 800;
+  vo.elevation_deg = 35.f;
+  const bool y_up = a.plane.empty() && std::abs(a.up[1]) >= std::abs(a.up[2]);
+  vo.up = y_up ? ViewOptions::Up::Y : ViewOptions::Up::Z;
+  write_image(a.render, render_view(scene, vo), io);
+  rep["render"] = a.render;
+}
+
+// The summary lines on stderr (unless --quiet).
+void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Mesh& out, double seconds) {
+  if (a.common.quiet) return;
+  std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
+               static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
+  if (!rep.contains("stretch_before")) return;
+  const auto& si = rep["self_intersections"];
+  std::string what = "not checked (--no-check)";
+  if (!si.is_null())
+    what = si.dump() + " intersecting face pairs (" + rep["self_intersections_within_elements"].dump() +
+           " within elements, " + rep["self_intersections_between_elements"].dump() + " between)";
+  std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n",
+               rep["stretch_before"].get<double>(), rep["stretch_after"].get<double>(), what.c_str());
+}
+
+int run_quilt(QuiltArgs& a) {
+  const std::vector<std::string> inputs = check_quilt_args(a);
+  const std::vector<std::string> outputs = quilt_outputs(a, inputs);
+  const auto [w, h] = parse_plane(a.plane);
   auto limit = apply_thread_limit(a.common.threads);
   Timer total;
   Timer t;
@@ -218,200 +460,17 @@ int run_quilt(QuiltArgs& a) {
   rep["output"] = a.output;
   Mesh out, scene;
   if (!a.plane.empty()) {
-    // --scale: factor applied to the swatch (the paper's s); the plane is in swatch sizes.
-    const double sc = a.scale > 0 ? a.scale : 1.0;
-    for (VertexIndex v : sm.vertices()) {
-      const Point3 p = sm.point(v);
-      sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
-    }
-    const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
-    check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
-    check_budget(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())), a.common);
-    PlanarQuiltOptions o;
-    o.seed = a.common.seed;
-    o.cell_size = a.cell * sc;
-    o.subpatch_radius = a.subpatch;
-    o.progress = terminal_progress(a.common.quiet);
-    const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
-    if (out.number_of_faces() == 0)
-      throw InvalidInputError("quilt: no element was placed on the " + a.plane + " plane");
-    color_by_element(out, a.common.seed);
-    rep["plane"] = {w, h};
-    rep["swatch_faces"] = s.mesh.tris.size();
-    rep["swatch_elements"] = s.elements.size();
-    rep["elements"] = r.elements;
-    rep["faces"] = r.faces;
-    rep["vertices"] = r.vertices;
-    rep["steps"] = r.steps;
-    const auto [len_mean, len_max] = element_lengths(out, std::max(s.length(), s.width()));
-    rep["element_length_mean"] = len_mean;
-    rep["element_length_max"] = len_max;
-    write_stitch_stats(rep, r.stats);
-    rep["seconds"] = {{"swatch", swatch_seconds}, {"quilt", r.seconds}, {"match", r.stats.seconds_match},
-                      {"correspond", r.stats.seconds_correspond}, {"deform", r.stats.seconds_deform},
-                      {"merge", r.stats.seconds_merge}};
+    quilt_on_plane(a, sm, w, h, out, rep);
     scene = out;
   } else {
-    t.reset();
-    Mesh base;
-    rep["input_mesh"] = to_json(load_method_mesh(a.base, base, a.common));
-    base.collect_garbage();
-    const double read_seconds = t.seconds();
-    const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
-    SurfaceQuiltOptions o;
-    o.relative_size = a.scale > 0 ? a.scale : 0.25;
-    if (!(o.relative_size <= 10)) throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
-    {
-      // Placements needed: the base area over the scaled swatch's xy area.
-      // (load_method_mesh triangulated the base mesh.)
-      double area = 0;
-      for (FaceIndex f : base.faces()) area += face_area(base, f);
-      const CGAL::Bbox_3 bb = CGAL::Polygon_mesh_processing::bbox(base);
-      const double diag = std::sqrt(CGAL::square(bb.xmax() - bb.xmin()) + CGAL::square(bb.ymax() - bb.ymin()) +
-                                    CGAL::square(bb.zmax() - bb.zmin()));
-      const double side = o.relative_size * diag, big = std::max(s.length(), s.width());
-      const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
-      check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
-                       "--scale " + std::to_string(o.relative_size));
-      check_budget(estimate_quilt(base.number_of_faces(),
-                                  (swatch_area > 0 ? area / swatch_area : 0.0) * static_cast<double>(s.mesh.tris.size())),
-                   a.common);
-    }
-    o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
-    o.up = {a.up[0], a.up[1], a.up[2]};
-    o.cell_size = a.cell;
-    o.subpatch_radius = a.subpatch;
-    o.rotation_max_deg = a.max_turn;
-    o.align_to_overlap = !a.no_align;
-    o.align_field_max_deg = a.align_bound;
-    o.smooth_field = a.smooth_field;
-    o.seed = a.common.seed;
-    o.progress = terminal_progress(a.common.quiet);
-    SurfaceQuilt q;
-    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-    if (q.elements == 0 || q.tris.empty())
-      throw InvalidInputError("quilt: no element was placed on '" + a.base + "' at --scale " +
-                              std::to_string(o.relative_size) + " (the swatch may be too large for the mesh: lower --scale)");
-    EmbedSurfaceQuiltOptions eo;
-    eo.shell_height = a.shell_height;
-    eo.stretch.iterations = a.stretch_iterations;
-    eo.stretch.seed = a.common.seed;
-    eo.check_self_intersections = !a.no_check;
-    eo.progress = o.progress;
-    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-    color_by_element(out, a.common.seed);
-    rep["mesh"] = a.base;
-    rep["base_faces"] = base.number_of_faces();
-    rep["swatch_faces"] = s.mesh.tris.size();
-    rep["swatch_elements"] = s.elements.size();
-    rep["swatch_up"] = axis_name(s.up_axis);
-    rep["up"] = a.up;
-    rep["scale"] = o.relative_size;
-    rep["field"] = a.field;
-    rep["elements"] = r.elements;
-    rep["faces"] = out.number_of_faces();
-    rep["vertices"] = out.number_of_vertices();
-    rep["steps"] = r.steps;
-    rep["patches_shrunk"] = r.patches_shrunk;
-    rep["patches_transported"] = r.patches_transported;
-    rep["patches_aligned"] = r.patches_aligned;
-    rep["overlap_jump_deg"] = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
-    rep["max_turn_deg"] = o.rotation_max_deg;
-    rep["patches_turned"] = r.patches_turned;
-    rep["elements_past_border"] = r.elements_past_border;
-    rep["elements_stretched"] = r.elements_stretched;
-    rep["edge_stretch_max"] = r.edge_stretch_max;
-    rep["crossings_resolved"] = r.crossings_resolved;
-    rep["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
-    rep["fragments_removed"] = r.fragments_removed;
-    rep["faces_refilled"] = r.faces_refilled;
-    rep["bare_fraction"] = r.bare_fraction;
-    write_stitch_stats(rep, r.stats);
-    rep["charts"] = er.atlas.num_charts;
-    rep["tets"] = er.tets;
-    rep["shell_height"] = er.shell_height;
-    rep["clamped_vertices"] = er.clamped_vertices;
-    rep["stretch_before"] = er.stretch.stretch_before;
-    rep["stretch_after"] = er.stretch.stretch_after;
-    rep["outside_vertices"] = er.embed.outside;
-    rep["elements_not_expressible"] = r.elements_not_expressible;
-    rep["elements_not_expressed"] = r.elements_not_expressed;
-    rep["elements_partial"] = r.elements_partial;
-    rep["seams_broken"] = r.seams_broken;
-    rep["z_fitted_elements"] = r.z_fitted_elements;
-    rep["outside_below"] = er.outside_below;
-    rep["outside_above"] = er.outside_above;
-    rep["outside_uv"] = er.outside_uv;
-    rep["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
-    if (er.outside_shell_measured) {
-      // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
-      rep["outside_shell"] = er.outside_shell.outside;
-      rep["outside_shell_below"] = er.outside_shell.below;
-      rep["outside_shell_above"] = er.outside_shell.above;
-      rep["outside_shell_side"] = er.outside_shell.side;
-      rep["outside_shell_max_distance"] = er.outside_shell.max_distance;
-    }
-    if (er.embed.checked) {
-      rep["self_intersections"] = er.embed.self_intersecting_pairs;
-      rep["self_intersections_within_elements"] = er.self_intersections_within;
-      rep["self_intersections_between_elements"] = er.self_intersections_between;
-    } else {
-      rep["self_intersections"] = nullptr;
-    }
-    rep["seconds"] = {{"swatch", swatch_seconds},
-                      {"read", read_seconds},
-                      {"quilt", r.seconds},
-                      {"patches", r.seconds_patch},
-                      {"match", r.stats.seconds_match},
-                      {"correspond", r.stats.seconds_correspond},
-                      {"deform", r.stats.seconds_deform},
-                      {"merge", r.stats.seconds_merge},
-                      {"resolve", r.stats.seconds_resolve},
-                      {"finish", r.seconds_finish},
-                      {"atlas", er.seconds_atlas},
-                      {"shell", er.seconds_shell},
-                      {"stretch", er.seconds_stretch},
-                      {"shell_map", er.seconds_map},
-                      {"embed", er.seconds_embed}};
-    scene = base;
-    get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
-    scene.join(out);
+    quilt_on_mesh(a, sm, out, scene, rep);
   }
+  rep["seconds"]["swatch"] = swatch_seconds;
   t.reset();
-  WriteMeshOptions wo;
-  wo.overwrite = a.common.force;
-  wo.write_uvs = false;
-  for (std::size_t i = 0; i + (a.render.empty() ? 0 : 1) < outputs.size(); ++i) write_mesh(outputs[i], out, wo);
-  if (!a.render.empty()) {
-    WriteImageOptions io;
-    io.overwrite = a.common.force;
-    // The render stands the mesh on the axis nearest --up (+Y by default, as
-    // glTF viewers do); a plane lies in xy and is seen from above (+Z).
-    ViewOptions vo;
-    vo.size = 800;
-    vo.elevation_deg = 35.f;
-    const bool y_up = a.plane.empty() && std::abs(a.up[1]) >= std::abs(a.up[2]);
-    vo.up = y_up ? ViewOptions::Up::Y : ViewOptions::Up::Z;
-    write_image(a.render, render_view(scene, vo), io);
-    rep["render"] = a.render;
-  }
+  write_quilt_outputs(a, outputs, out, scene, rep);
   rep["seconds"]["write"] = t.seconds();
   write_report(a.common, "quilt", rep, {inputs, outputs});
-  if (!a.common.quiet) {
-    std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
-                 static_cast<std::size_t>(out.number_of_faces()), total.seconds(), a.output.c_str());
-    if (rep.contains("stretch_before"))
-    {
-      const auto& si = rep["self_intersections"];
-      std::string what = "not checked (--no-check)";
-      if (!si.is_null())
-        what = si.dump() + " intersecting face pairs (" +
-               rep["self_intersections_within_elements"].dump() + " within elements, " +
-               rep["self_intersections_between_elements"].dump() + " between)";
-      std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n",
-                   rep["stretch_before"].get<double>(), rep["stretch_after"].get<double>(), what.c_str());
-    }
-  }
+  print_quilt_summary(a, rep, out, total.seconds());
   return 0;
 }
 

@@ -6,8 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
+#include <map>
 #include <numeric>
+#include <queue>
 #include <string>
 
 #include "geometry/disc_chart.h"
@@ -26,6 +29,8 @@ struct Chart {
   std::vector<std::array<double, 2>> uv;  // per chart-local vertex
   double min_u = 0, min_v = 0, w = 0, h = 0;  // bounding box after normalisation
   double area3d = 0;
+  double distortion = 1;  // the flattening's area_distortion
+  bool alive = true;      // false once merged into another chart
 };
 
 // Greedy region growing into disc charts (see header, step 1; the growth is
@@ -76,20 +81,160 @@ double signed_area(const std::array<double, 2>& a, const std::array<double, 2>& 
   return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
 }
 
-// Flattens the chart (geometry/disc_chart.h: disc check, LSCM, oriented and
-// scaled to its 3D area) and turns it to its smallest bounding box.
-void flatten_chart(const Mesh& mesh, Chart& ch, int chart_id) {
-  std::vector<int> faces;
-  for (FaceIndex f : ch.faces) faces.push_back(static_cast<int>(f.idx()));
-  DiscChartFlattening fl = flatten_disc_chart(mesh, faces);
-  const std::string what = "base mesh atlas: chart " + std::to_string(chart_id) + " (" + std::to_string(ch.faces.size()) + " faces): ";
-  if (fl.status == DiscChartFlattening::Status::kTopology) throw TopologyError(what + fl.error + " (non-manifold base mesh?)");
-  if (fl.status != DiscChartFlattening::Status::kOk) throw SolverError(what + fl.error);
-  ch.vertices.clear();
+// LSCM flattening of `faces` (geometry/disc_chart.h: disc check, oriented,
+// scaled to its 3D area, embedding check).
+DiscChartFlattening flatten(const Mesh& mesh, const std::vector<FaceIndex>& faces) {
+  std::vector<int> idx;
+  for (FaceIndex f : faces) idx.push_back(static_cast<int>(f.idx()));
+  return flatten_disc_chart(mesh, idx);
+}
+
+// A chart from its flattening, turned to its smallest bounding box.
+Chart make_chart(std::vector<FaceIndex> faces, DiscChartFlattening&& fl) {
+  Chart ch;
+  ch.faces = std::move(faces);
   for (int v : fl.vertices) ch.vertices.push_back(VertexIndex(static_cast<Mesh::size_type>(v)));
   ch.uv = std::move(fl.uv);
   ch.area3d = fl.area3d;
+  ch.distortion = fl.area_distortion;
   rotate_to_small_box(ch);
+  return ch;
+}
+
+// Flattens grown chart `faces` (see header, step 2). A flattening that is
+// not an embedding (LSCM folded the chart over itself) is split: its faces
+// regrown into discs of at most half its size, each flattened the same way.
+void flatten_or_split(const Mesh& mesh, std::vector<FaceIndex> faces, DiscGrowthState& state,
+                      std::vector<char>& free_face, std::vector<Chart>& out) {
+  DiscChartFlattening fl = flatten(mesh, faces);
+  const std::string what = "base mesh atlas: chart of " + std::to_string(faces.size()) + " faces from face " +
+                           std::to_string(faces.front().idx()) + ": ";
+  if (fl.status == DiscChartFlattening::Status::kTopology)
+    throw TopologyError(what + fl.error + " (non-manifold base mesh?)");
+  if (fl.status != DiscChartFlattening::Status::kOk) throw SolverError(what + fl.error);
+  if (fl.embedded() || faces.size() == 1) {
+    out.push_back(make_chart(std::move(faces), std::move(fl)));
+    return;
+  }
+  std::sort(faces.begin(), faces.end());
+  for (FaceIndex f : faces) free_face[f.idx()] = 1;
+  auto accept = [&](int f) { return free_face[static_cast<std::size_t>(f)] != 0; };
+  std::vector<std::vector<FaceIndex>> parts;
+  for (FaceIndex seed : faces) {
+    if (!free_face[seed.idx()]) continue;
+    parts.emplace_back();
+    for (int f : grow_disc_chart(mesh, static_cast<int>(seed.idx()), accept, (faces.size() + 1) / 2, state)) {
+      free_face[static_cast<std::size_t>(f)] = 0;
+      parts.back().push_back(FaceIndex(static_cast<Mesh::size_type>(f)));
+    }
+  }
+  for (auto& part : parts) flatten_or_split(mesh, std::move(part), state, free_face, out);
+}
+
+// The side of the square the chart boxes pack into with a gap of `margin`
+// times that side around each (shelf slack 1.15, as in step 3):
+// side^2 = 1.15^2 sum (w + g)(h + g), g = margin * side, kept as running sums.
+struct PackedSide {
+  double margin = 0, n = 0, wh = 0, w_plus_h = 0;
+  void add(const Chart& c, double sign) { n += sign, wh += sign * c.w * c.h, w_plus_h += sign * (c.w + c.h); }
+  double gap() const {
+    const double k = 1.15 * 1.15, a = std::max(0.05, 1 - k * n * margin * margin), b = k * margin * w_plus_h;
+    return margin * (b + std::sqrt(b * b + 4 * a * k * wh)) / (2 * a);
+  }
+};
+
+double padded_box(const Chart& c, double gap) {
+  return (c.w + gap) * (c.h + gap);
+}
+
+// Charts sharing edges with `c`, longest shared border first (ties: lower id).
+std::vector<int> neighbours(const Mesh& mesh, const Chart& c, int id, const std::vector<int>& chart_of) {
+  std::map<int, double> shared;
+  for (FaceIndex f : c.faces)
+    for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
+      const FaceIndex g = mesh.face(mesh.opposite(h));
+      if (g != Mesh::null_face() && chart_of[g.idx()] != id)
+        shared[chart_of[g.idx()]] +=
+            std::sqrt(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h))));
+    }
+  std::vector<std::pair<double, int>> order;
+  for (auto [d, len] : shared) order.emplace_back(-len, d);
+  std::sort(order.begin(), order.end());
+  std::vector<int> out;
+  for (auto [len, d] : order) out.push_back(d);
+  return out;
+}
+
+// Chart c merged into chart d when their union is a disc whose flattening is
+// an embedding, no more distorted than max(max_merge_distortion, the parts'
+// area-weighted distortion), whose padded box is smaller than the two.
+bool try_merge(const Mesh& mesh, const BaseMeshAtlasOptions& opt, std::vector<Chart>& charts, int c, int d,
+               std::vector<int>& chart_of, PackedSide& side) {
+  Chart &a = charts[c], &b = charts[d];
+  if (a.faces.size() + b.faces.size() > opt.max_chart_faces) return false;
+  const double gap = side.gap(), before = padded_box(a, gap) + padded_box(b, gap);
+  const double area = a.area3d + b.area3d;
+  if (area + 2 * gap * std::sqrt(area) + gap * gap >= before) return false;  // no box of that area is smaller
+  std::vector<FaceIndex> faces = b.faces;
+  faces.insert(faces.end(), a.faces.begin(), a.faces.end());
+  DiscChartFlattening fl = flatten(mesh, faces);
+  const double parts = (a.distortion * a.area3d + b.distortion * b.area3d) / area;
+  if (!fl.embedded() || fl.area_distortion > std::max(opt.max_merge_distortion, parts)) return false;
+  Chart u = make_chart(std::move(faces), std::move(fl));
+  if (padded_box(u, gap) >= before) return false;
+  side.add(a, -1), side.add(b, -1), side.add(u, 1);
+  for (FaceIndex f : a.faces) chart_of[f.idx()] = d;
+  b = std::move(u);
+  a = Chart();
+  a.alive = false;
+  return true;
+}
+
+// Greedy merging (see header, step 2b; Sander et al. 2001, section 4.1):
+// the smallest chart (3D area) first, into the neighbour sharing the longest
+// border that takes it, until no chart merges.
+void merge_charts(const Mesh& mesh, const BaseMeshAtlasOptions& opt, std::vector<Chart>& charts,
+                  std::vector<int>& chart_of) {
+  PackedSide side;
+  side.margin = opt.margin;
+  using Item = std::pair<double, int>;  // area, chart
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    side.add(charts[c], 1);
+    queue.push({charts[c].area3d, static_cast<int>(c)});
+  }
+  while (!queue.empty()) {
+    const auto [area, c] = queue.top();
+    queue.pop();
+    if (!charts[c].alive || area != charts[c].area3d) continue;  // merged, or queued again since
+    for (int d : neighbours(mesh, charts[c], c, chart_of))
+      if (try_merge(mesh, opt, charts, c, d, chart_of, side)) {
+        queue.push({charts[d].area3d, d});
+        break;
+      }
+  }
+}
+
+// Grown charts flattened (split where LSCM folds them), merged if asked,
+// renumbered in order; chart_of follows.
+std::vector<Chart> make_charts(const Mesh& mesh, const BaseMeshAtlasOptions& opt, std::vector<int>& chart_of,
+                               int num_grown) {
+  std::vector<std::vector<FaceIndex>> grown(num_grown);
+  for (FaceIndex f : mesh.faces()) grown[chart_of[f.idx()]].push_back(f);
+  std::vector<Chart> charts;
+  DiscGrowthState state(mesh);
+  std::vector<char> free_face(mesh.num_faces(), 0);
+  for (auto& faces : grown) flatten_or_split(mesh, std::move(faces), state, free_face, charts);
+  for (std::size_t c = 0; c < charts.size(); ++c)
+    for (FaceIndex f : charts[c].faces) chart_of[f.idx()] = static_cast<int>(c);
+  if (opt.merge_charts) merge_charts(mesh, opt, charts, chart_of);
+  std::vector<Chart> kept;
+  for (Chart& c : charts)
+    if (c.alive) {
+      for (FaceIndex f : c.faces) chart_of[f.idx()] = static_cast<int>(kept.size());
+      kept.push_back(std::move(c));
+    }
+  return kept;
 }
 }  // namespace
 
@@ -98,6 +243,9 @@ BaseMeshAtlasResult compute_base_mesh_atlas(Mesh& mesh, const BaseMeshAtlasOptio
     throw InvalidInputError("base mesh atlas: max_normal_angle_deg must be in (0,180], got " +
                             std::to_string(opt.max_normal_angle_deg));
   if (opt.max_chart_faces < 1) throw InvalidInputError("base mesh atlas: max_chart_faces must be >= 1");
+  if (!(opt.max_merge_distortion >= 1))
+    throw InvalidInputError("base mesh atlas: max_merge_distortion must be >= 1, got " +
+                            std::to_string(opt.max_merge_distortion));
   if (!(opt.margin >= 0 && opt.margin < 0.1))
     throw InvalidInputError("base mesh atlas: margin must be in [0,0.1), got " + std::to_string(opt.margin));
   if (mesh.number_of_faces() == 0) throw InvalidInputError("base mesh atlas: mesh has no faces");
@@ -108,12 +256,12 @@ BaseMeshAtlasResult compute_base_mesh_atlas(Mesh& mesh, const BaseMeshAtlasOptio
       throw InvalidInputError("base mesh atlas: face " + std::to_string(f.idx()) + " is not a triangle");
 
   BaseMeshAtlasResult res;
-  std::vector<int> chart_of = grow_charts(mesh, opt, res.num_charts);
-  std::vector<Chart> charts(res.num_charts);
-  for (FaceIndex f : mesh.faces()) charts[chart_of[f.idx()]].faces.push_back(f);
+  int grown = 0;
+  std::vector<int> chart_of = grow_charts(mesh, opt, grown);
+  std::vector<Chart> charts = make_charts(mesh, opt, chart_of, grown);
+  res.num_charts = static_cast<int>(charts.size());
 
   std::vector<int> local(mesh.num_vertices(), -1);
-  for (int c = 0; c < res.num_charts; ++c) flatten_chart(mesh, charts[c], c);
 
   // Shelf packing (see header, step 3), in 3D length units.
   double box_area = 0, max_w = 0;

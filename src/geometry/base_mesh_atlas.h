@@ -22,7 +22,18 @@
 //    with negative total signed area is mirrored. The chart is then scaled so
 //    that its uv area equals its 3D area (so every chart has the same
 //    uv-per-length scale before packing) and rotated to its minimal-area
-//    bounding box among 16 angles.
+//    bounding box among 16 angles. LSCM can fold a chart over itself (its
+//    border crosses itself); such a chart is regrown into discs of at most half its faces, each flattened
+//    the same way, until every flattening is an embedding.
+// 2b. Merging (`merge_charts`; Sander et al. 2001, "Texture mapping progressive
+//    meshes", section 4.1: greedy merging of adjacent charts into discs): the
+//    chart of smallest 3D area first is merged into the neighbour sharing the
+//    longest border with it for which (a) the union has at most
+//    `max_chart_faces` faces and is a disc, (b) its LSCM flattening is an
+//    embedding, (c) its area distortion is at most max(`max_merge_distortion`,
+//    the parts' area-weighted one), and (d) its bounding box with the packing
+//    gap (`margin` of the estimated side) around it is smaller than the two
+//    parts' together. Many small charts otherwise spend the atlas on gaps.
 // 3. Packing: shelf packing of the chart bounding boxes (tallest first) into a
 //    square-ish strip, a gap of `margin` (as a fraction of the final atlas
 //    side) around every chart, then one uniform scale into [0,1]^2. All
@@ -48,7 +59,13 @@ struct BaseMeshAtlasOptions {
   /// Largest number of faces in a chart (>= 1). Smaller charts flatten with less distortion.
   std::size_t max_chart_faces = 4000;
   /// Gap between charts and around the atlas, as a fraction of the atlas side; in [0, 0.1).
+  /// Also the gap that merging (step 2b) weighs. Default: 0.005.
   double margin = 0.005;
+  /// Merge adjacent charts after flattening (step 2b). Default: off.
+  bool merge_charts = false;
+  /// Largest area distortion of a merged chart (mean_area_distortion's measure, >= 1), unless its
+  /// parts already had more. Default: 1.5.
+  double max_merge_distortion = 1.5;
 };
 
 struct BaseMeshAtlasResult {

@@ -17,6 +17,10 @@
 // disc (one border loop, Euler characteristic 1), flattened by CGAL's
 // LSCM_parameterizer_3 (two vertices pinned by CGAL), mirrored if its signed
 // uv area is negative and scaled so that its uv area equals its 3D area.
+// Validity: the flattening is an embedding (no flips, no overlap) exactly when
+// every face has positive uv area and the border loop is simple (the winding
+// number of the border then counts the faces over every uv point: 0 or 1);
+// both are counted with exact orientation predicates.
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -43,6 +47,11 @@ struct DiscChartFlattening {
   std::vector<int> vertices;                  ///< chart vertex -> mesh vertex index
   std::vector<std::array<double, 2>> uv;      ///< per chart vertex (3D length units)
   double area3d = 0;                          ///< the chart's 3D area
+  /// Area-weighted mean over faces of max(a3d/auv, auv/a3d) (1 = no area distortion).
+  double area_distortion = 0;
+  std::size_t flipped_faces = 0;     ///< faces whose uv orientation is not positive
+  std::size_t border_crossings = 0;  ///< non-adjacent border edge pairs that touch or cross in uv
+  bool embedded() const { return status == Status::kOk && flipped_faces == 0 && border_crossings == 0; }
   enum class Status { kOk, kTopology, kSolver } status = Status::kOk;
   std::string error;                          ///< why not, when status != kOk
 };

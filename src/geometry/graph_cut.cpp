@@ -35,6 +35,203 @@ using Csr = boost::compressed_sparse_row_graph<boost::directedS, boost::no_prope
                                                boost::no_property, std::uint32_t, std::uint32_t>;
 using CsrEdge = boost::graph_traits<Csr>::edge_descriptor;
 
+/// Per-thread buffers of GraphCut::solve: many small cuts (one per vertex in
+/// subdivision synthesis) reuse their storage instead of allocating it every time.
+struct Scratch {
+  std::vector<signed char> forced;    ///< +1 forced to the source, -1 to the sink, 0 free
+  std::vector<std::uint32_t> index;   ///< compact index of a free node
+  std::vector<double> term_s, term_t; ///< folded terminal capacities of the free nodes
+  std::vector<std::uint32_t> start, next, queue;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
+  std::vector<double> capacity, residual;
+  std::vector<CsrEdge> reverse, predecessor;
+  std::vector<boost::default_color_type> color;
+  std::vector<long> distance;
+};
+
+/// The folded graph of one solve: its sizes and constant (the arrays in `scr`).
+struct FoldedGraph {
+  explicit FoldedGraph(Scratch& s) : scr(s) {}
+  Scratch& scr;
+  std::size_t n = 0;       ///< nodes of the GraphCut
+  std::uint32_t nf = 0;    ///< free nodes (compact indices 0..nf-1)
+  std::size_t nn = 0;      ///< free nodes and the two terminals
+  std::uint32_t s = 0, t = 0;  ///< the terminals' indices
+  std::size_t na = 0;      ///< arcs
+  double constant = 0.0;   ///< paid by every cut
+  bool any_source = false, any_sink = false;  ///< some free node keeps a source (sink) link
+};
+
+void add_capped(double& c, double x) { c = std::min(GraphCut::kInfinity, c + x); }
+
+/// Step 1a: forced nodes (an infinite link to one terminal only) marked and
+/// their finite other link paid by every finite cut; the free nodes numbered
+/// compactly with their terminal capacities. Why this keeps the cut: solve().
+void fold_forced_nodes(const std::vector<double>& src_cap, const std::vector<double>& sink_cap, FoldedGraph& g) {
+  constexpr double kInfinity = GraphCut::kInfinity;
+  Scratch& scr = g.scr;
+  const std::size_t n = g.n;
+  auto& forced = scr.forced;
+  auto& index = scr.index;
+  forced.assign(n, 0);
+  index.assign(n, 0);
+  for (std::size_t u = 0; u < n; ++u) {
+    const bool s_inf = src_cap[u] >= kInfinity, t_inf = sink_cap[u] >= kInfinity;
+    if (s_inf && t_inf) g.constant = kInfinity;  // infinite both ways: every cut is infinite
+    if (s_inf && !t_inf) {  // its finite sink link is paid by every finite cut
+      forced[u] = 1;
+      g.constant += sink_cap[u];
+    } else if (t_inf && !s_inf) {
+      forced[u] = -1;
+      g.constant += src_cap[u];
+    } else {
+      index[u] = g.nf++;
+    }
+  }
+  scr.term_s.resize(g.nf);
+  scr.term_t.resize(g.nf);
+  for (std::size_t u = 0; u < n; ++u)
+    if (forced[u] == 0) {
+      scr.term_s[index[u]] = src_cap[u];
+      scr.term_t[index[u]] = sink_cap[u];
+    }
+  g.nn = std::size_t(g.nf) + 2;
+  g.s = g.nf;
+  g.t = g.nf + 1;
+  scr.start.assign(g.nn + 1, 0);  // start[u + 1] counts u's out-arcs first
+}
+
+/// Step 1b: the edges folded: one between two free nodes is counted as two
+/// arcs; one to a forced node becomes a terminal link of the free end; one
+/// between a source-forced and a sink-forced node is a constant. (Templated
+/// on the edge list: GraphCut::Edge is private.)
+template <class Edges>
+void fold_forced_edges(const Edges& edges, FoldedGraph& g) {
+  Scratch& scr = g.scr;
+  auto& term_s = scr.term_s;
+  auto& term_t = scr.term_t;
+  for (const auto& e : edges) {
+    if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
+    const int fu = scr.forced[static_cast<std::size_t>(e.u)], fv = scr.forced[static_cast<std::size_t>(e.v)];
+    const std::uint32_t iu = scr.index[static_cast<std::size_t>(e.u)], iv = scr.index[static_cast<std::size_t>(e.v)];
+    if (fu == 0 && fv == 0) {
+      ++scr.start[iu + 1];
+      ++scr.start[iv + 1];
+    } else if (fu == 0) {  // v forced
+      if (fv > 0) add_capped(term_s[iu], e.cap_vu);
+      else add_capped(term_t[iu], e.cap_uv);
+    } else if (fv == 0) {  // u forced
+      if (fu > 0) add_capped(term_s[iv], e.cap_uv);
+      else add_capped(term_t[iv], e.cap_vu);
+    } else if (fu != fv) {
+      add_capped(g.constant, fu > 0 ? e.cap_uv : e.cap_vu);
+    }
+  }
+}
+
+/// Step 1c: a node's two terminal links: only the part exceeding the smaller
+/// one matters for the cut (min(cs, ct) is paid either way); the links left
+/// are counted as arcs.
+void reduce_terminal_links(FoldedGraph& g) {
+  Scratch& scr = g.scr;
+  auto& term_s = scr.term_s;
+  auto& term_t = scr.term_t;
+  for (std::uint32_t u = 0; u < g.nf; ++u) {
+    const double m = std::min(term_s[u], term_t[u]);
+    if (m >= GraphCut::kInfinity) {
+      g.constant = GraphCut::kInfinity;
+      term_s[u] = term_t[u] = 0.0;
+      continue;
+    }
+    add_capped(g.constant, m);
+    term_s[u] -= m;
+    term_t[u] -= m;
+    if (term_s[u] > 0.0) ++scr.start[g.s + 1], ++scr.start[u + 1], g.any_source = true;
+    if (term_t[u] > 0.0) ++scr.start[u + 1], ++scr.start[g.t + 1], g.any_sink = true;
+  }
+}
+
+/// Step 3: CSR arrays: arcs sorted by source (counting sort; every node's
+/// arcs in the order they are added: terminal links by node, then the
+/// edges), each with its capacity and reverse arc.
+template <class Edges>
+void build_arcs(const Edges& edges, FoldedGraph& g) {
+  Scratch& scr = g.scr;
+  auto& start = scr.start;
+  for (std::size_t u = 0; u < g.nn; ++u) start[u + 1] += start[u];
+  g.na = start[g.nn];
+  auto& next = scr.next;
+  next.assign(start.begin(), start.end() - 1);
+  auto& sorted = scr.sorted;
+  auto& capacity = scr.capacity;
+  auto& reverse = scr.reverse;
+  sorted.resize(g.na);
+  capacity.resize(g.na);
+  reverse.resize(g.na);
+  auto add_pair = [&](std::uint32_t u, std::uint32_t v, double cuv, double cvu) {
+    const std::uint32_t a = next[u]++, b = next[v]++;
+    sorted[a] = {u, v};
+    sorted[b] = {v, u};
+    capacity[a] = cuv;
+    capacity[b] = cvu;
+    reverse[a] = CsrEdge(v, b);
+    reverse[b] = CsrEdge(u, a);
+  };
+  for (std::uint32_t u = 0; u < g.nf; ++u) {
+    if (scr.term_s[u] > 0.0) add_pair(g.s, u, scr.term_s[u], 0.0);
+    if (scr.term_t[u] > 0.0) add_pair(u, g.t, scr.term_t[u], 0.0);
+  }
+  for (const auto& e : edges) {
+    if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
+    if (scr.forced[static_cast<std::size_t>(e.u)] != 0 || scr.forced[static_cast<std::size_t>(e.v)] != 0) continue;
+    add_pair(scr.index[static_cast<std::size_t>(e.u)], scr.index[static_cast<std::size_t>(e.v)], e.cap_uv, e.cap_vu);
+  }
+}
+
+/// No arc enters the sink: flow 0, residual = capacity; the source side is
+/// what a breadth-first search from the source reaches (black in scr.color).
+void reach_from_source(FoldedGraph& g) {
+  Scratch& scr = g.scr;
+  auto& queue = scr.queue;
+  queue.assign(1, g.s);
+  std::vector<boost::default_color_type>& seen = scr.color;
+  seen.assign(g.nn, boost::white_color);
+  seen[g.s] = boost::black_color;
+  for (std::size_t q = 0; q < queue.size(); ++q)
+    for (std::uint32_t a = scr.start[queue[q]]; a < scr.start[queue[q] + 1]; ++a) {
+      const std::uint32_t v = scr.sorted[a].second;
+      if (scr.capacity[a] > 0.0 && seen[v] != boost::black_color) {
+        seen[v] = boost::black_color;
+        queue.push_back(v);
+      }
+    }
+}
+
+/// Boost's Boykov-Kolmogorov max-flow on the CSR graph; the source side is
+/// left black in scr.color. Returns the flow.
+double bk_max_flow(FoldedGraph& g) {
+  Scratch& scr = g.scr;
+  const std::size_t nn = g.nn;
+  const Csr csr(boost::edges_are_sorted, scr.sorted.begin(), scr.sorted.end(), static_cast<std::uint32_t>(nn));
+  auto& residual = scr.residual;
+  residual.assign(g.na, 0.0);
+  std::vector<CsrEdge>& predecessor = scr.predecessor;
+  std::vector<boost::default_color_type>& color = scr.color;
+  std::vector<long>& distance = scr.distance;
+  predecessor.assign(nn, CsrEdge());
+  color.assign(nn, boost::white_color);
+  distance.assign(nn, 0);
+  const auto eidx = boost::get(boost::edge_index, csr);
+  const auto vidx = boost::get(boost::vertex_index, csr);
+  return boost::boykov_kolmogorov_max_flow(
+      csr, boost::make_iterator_property_map(scr.capacity.begin(), eidx),
+      boost::make_iterator_property_map(residual.begin(), eidx),
+      boost::make_iterator_property_map(scr.reverse.begin(), eidx),
+      boost::make_iterator_property_map(predecessor.begin(), vidx),
+      boost::make_iterator_property_map(color.begin(), vidx),
+      boost::make_iterator_property_map(distance.begin(), vidx), vidx, g.s, g.t);
+}
+
 }  // namespace
 
 GraphCut::GraphCut(int num_nodes) : n_(0) { reset(num_nodes); }
@@ -83,22 +280,10 @@ void GraphCut::add_terminal(int u, double cap_source, double cap_sink) {
 double GraphCut::solve() {
   if (solved_) throw InvalidInputError("GraphCut: solve() called twice");
   solved_ = true;
-  const std::size_t n = static_cast<std::size_t>(n_);
-  // Per-thread buffers: many small cuts (one per vertex in subdivision
-  // synthesis) reuse their storage instead of allocating it every time.
-  struct Scratch {
-    std::vector<signed char> forced;    ///< +1 forced to the source, -1 to the sink, 0 free
-    std::vector<std::uint32_t> index;   ///< compact index of a free node
-    std::vector<double> term_s, term_t; ///< folded terminal capacities of the free nodes
-    std::vector<std::uint32_t> start, next, queue;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> sorted;
-    std::vector<double> capacity, residual;
-    std::vector<CsrEdge> reverse, predecessor;
-    std::vector<boost::default_color_type> color;
-    std::vector<long> distance;
-  };
   thread_local Scratch scr;
-
+  FoldedGraph g(scr);
+  g.n = static_cast<std::size_t>(n_);
+  const std::size_t n = g.n;
   // 1. Fold the forced nodes into the terminals. A node with an infinite link
   // to one terminal only (and a finite cut exists) is on that terminal's side
   // of every finite cut, so it is that terminal as far as the cut is
@@ -111,153 +296,28 @@ double GraphCut::solve() {
   // (the nodes reachable from the source in the residual graph of any maximum
   // flow, which is what BK reports and which is unique), hence the same
   // labels, with fewer nodes and edges.
-  auto& forced = scr.forced;
-  auto& index = scr.index;
-  forced.assign(n, 0);
-  index.assign(n, 0);
-  std::uint32_t nf = 0;
-  double constant = 0.0;
-  for (std::size_t u = 0; u < n; ++u) {
-    const bool s_inf = src_cap_[u] >= kInfinity, t_inf = sink_cap_[u] >= kInfinity;
-    if (s_inf && t_inf) constant = kInfinity;  // infinite both ways: every cut is infinite
-    if (s_inf && !t_inf) {  // its finite sink link is paid by every finite cut
-      forced[u] = 1;
-      constant += sink_cap_[u];
-    } else if (t_inf && !s_inf) {
-      forced[u] = -1;
-      constant += src_cap_[u];
-    } else {
-      index[u] = nf++;
-    }
-  }
-  auto& term_s = scr.term_s;
-  auto& term_t = scr.term_t;
-  term_s.resize(nf);
-  term_t.resize(nf);
-  for (std::size_t u = 0; u < n; ++u)
-    if (forced[u] == 0) {
-      term_s[index[u]] = src_cap_[u];
-      term_t[index[u]] = sink_cap_[u];
-    }
-  const std::size_t nn = std::size_t(nf) + 2;
-  const std::uint32_t s = nf, t = nf + 1;
-  auto& start = scr.start;
-  start.assign(nn + 1, 0);  // start[u + 1] counts u's out-arcs first
-  auto add_to = [](double& c, double x) { c = std::min(kInfinity, c + x); };
-  for (const Edge& e : edges_) {
-    if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
-    const int fu = forced[static_cast<std::size_t>(e.u)], fv = forced[static_cast<std::size_t>(e.v)];
-    const std::uint32_t iu = index[static_cast<std::size_t>(e.u)], iv = index[static_cast<std::size_t>(e.v)];
-    if (fu == 0 && fv == 0) {
-      ++start[iu + 1];
-      ++start[iv + 1];
-    } else if (fu == 0) {  // v forced
-      if (fv > 0) add_to(term_s[iu], e.cap_vu);
-      else add_to(term_t[iu], e.cap_uv);
-    } else if (fv == 0) {  // u forced
-      if (fu > 0) add_to(term_s[iv], e.cap_uv);
-      else add_to(term_t[iv], e.cap_vu);
-    } else if (fu != fv) {
-      add_to(constant, fu > 0 ? e.cap_uv : e.cap_vu);
-    }
-  }
-  // A node's two terminal links: only the part exceeding the smaller one
-  // matters for the cut (min(cs, ct) is paid either way).
-  bool any_source = false, any_sink = false;
-  for (std::uint32_t u = 0; u < nf; ++u) {
-    const double m = std::min(term_s[u], term_t[u]);
-    if (m >= kInfinity) {
-      constant = kInfinity;
-      term_s[u] = term_t[u] = 0.0;
-      continue;
-    }
-    add_to(constant, m);
-    term_s[u] -= m;
-    term_t[u] -= m;
-    if (term_s[u] > 0.0) ++start[s + 1], ++start[u + 1], any_source = true;
-    if (term_t[u] > 0.0) ++start[u + 1], ++start[t + 1], any_sink = true;
-  }
+  fold_forced_nodes(src_cap_, sink_cap_, g);
+  fold_forced_edges(edges_, g);
+  reduce_terminal_links(g);
   source_side_.assign(n, 0);
-  for (std::size_t u = 0; u < n; ++u) source_side_[u] = forced[u] > 0 ? 1 : 0;
+  for (std::size_t u = 0; u < n; ++u) source_side_[u] = scr.forced[u] > 0 ? 1 : 0;
   auto finish = [&](double flow) {
-    const double total = flow + constant;
+    const double total = flow + g.constant;
     return total >= kInfinity ? std::numeric_limits<double>::infinity() : total;
   };
   // 2. Without a source link or without a sink link no path joins the
   // terminals: the max flow is 0 and the source side is what the source
   // reaches through positive capacities (BK's source tree when it stops),
   // which is empty without source links. Skip the max-flow then.
-  if (!any_source) return finish(0.0);
-
-  // 3. CSR arrays: arcs sorted by source (counting sort; every node's arcs in
-  // the order they are added: terminal links by node, then the edges).
-  for (std::size_t u = 0; u < nn; ++u) start[u + 1] += start[u];
-  const std::size_t na = start[nn];
-  auto& next = scr.next;
-  next.assign(start.begin(), start.end() - 1);
-  auto& sorted = scr.sorted;
-  auto& capacity = scr.capacity;
-  auto& reverse = scr.reverse;
-  sorted.resize(na);
-  capacity.resize(na);
-  reverse.resize(na);
-  auto add_pair = [&](std::uint32_t u, std::uint32_t v, double cuv, double cvu) {
-    const std::uint32_t a = next[u]++, b = next[v]++;
-    sorted[a] = {u, v};
-    sorted[b] = {v, u};
-    capacity[a] = cuv;
-    capacity[b] = cvu;
-    reverse[a] = CsrEdge(v, b);
-    reverse[b] = CsrEdge(u, a);
-  };
-  for (std::uint32_t u = 0; u < nf; ++u) {
-    if (term_s[u] > 0.0) add_pair(s, u, term_s[u], 0.0);
-    if (term_t[u] > 0.0) add_pair(u, t, term_t[u], 0.0);
-  }
-  for (const Edge& e : edges_) {
-    if (e.cap_uv <= 0.0 && e.cap_vu <= 0.0) continue;
-    if (forced[static_cast<std::size_t>(e.u)] != 0 || forced[static_cast<std::size_t>(e.v)] != 0) continue;
-    add_pair(index[static_cast<std::size_t>(e.u)], index[static_cast<std::size_t>(e.v)], e.cap_uv, e.cap_vu);
-  }
-  if (!any_sink) {
-    // No arc enters the sink: flow 0, residual = capacity; BFS from the source.
-    auto& queue = scr.queue;
-    queue.assign(1, s);
-    std::vector<boost::default_color_type>& seen = scr.color;
-    seen.assign(nn, boost::white_color);
-    seen[s] = boost::black_color;
-    for (std::size_t q = 0; q < queue.size(); ++q)
-      for (std::uint32_t a = start[queue[q]]; a < start[queue[q] + 1]; ++a) {
-        const std::uint32_t v = sorted[a].second;
-        if (capacity[a] > 0.0 && seen[v] != boost::black_color) {
-          seen[v] = boost::black_color;
-          queue.push_back(v);
-        }
-      }
-    for (std::size_t u = 0; u < n; ++u)
-      if (forced[u] == 0) source_side_[u] = seen[index[u]] == boost::black_color ? 1 : 0;
-    return finish(0.0);
-  }
-  const Csr g(boost::edges_are_sorted, sorted.begin(), sorted.end(), static_cast<std::uint32_t>(nn));
-  auto& residual = scr.residual;
-  residual.assign(na, 0.0);
-  std::vector<CsrEdge>& predecessor = scr.predecessor;
-  std::vector<boost::default_color_type>& color = scr.color;
-  std::vector<long>& distance = scr.distance;
-  predecessor.assign(nn, CsrEdge());
-  color.assign(nn, boost::white_color);
-  distance.assign(nn, 0);
-  const auto eidx = boost::get(boost::edge_index, g);
-  const auto vidx = boost::get(boost::vertex_index, g);
-  const double flow = boost::boykov_kolmogorov_max_flow(
-      g, boost::make_iterator_property_map(capacity.begin(), eidx),
-      boost::make_iterator_property_map(residual.begin(), eidx),
-      boost::make_iterator_property_map(reverse.begin(), eidx),
-      boost::make_iterator_property_map(predecessor.begin(), vidx),
-      boost::make_iterator_property_map(color.begin(), vidx),
-      boost::make_iterator_property_map(distance.begin(), vidx), vidx, s, t);
+  if (!g.any_source) return finish(0.0);
+  build_arcs(edges_, g);
+  double flow = 0.0;
+  if (g.any_sink)
+    flow = bk_max_flow(g);
+  else
+    reach_from_source(g);  // no arc enters the sink: flow 0
   for (std::size_t u = 0; u < n; ++u)
-    if (forced[u] == 0) source_side_[u] = color[index[u]] == boost::black_color ? 1 : 0;
+    if (scr.forced[u] == 0) source_side_[u] = scr.color[scr.index[u]] == boost::black_color ? 1 : 0;
   return finish(flow);
 }
 

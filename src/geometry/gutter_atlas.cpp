@@ -66,14 +66,15 @@ struct Candidate {
 };
 
 // Share of the one-texel-gutter density the full mip gutter may cost before
-// it is narrowed (decision 302: at 1/2, armadillo_52k's 818 charts at 2048 px
-// kept mips down to 128 px only).
+// it is narrowed (decision 302).
 constexpr double kMinDensityShare = 0.25;
 
 Candidate pack_candidate(Mesh& mesh, int N, int full_gutter, double cone) {
   Candidate c;
   BaseMeshAtlasOptions ao;
   ao.max_normal_angle_deg = cone;
+  ao.merge_charts = true;  // merges weigh the full gutter's gap (2 g + 3 texels)
+  ao.margin = std::min(0.099, (2.0 * full_gutter + 3.0) / N);
   c.atlas = compute_base_mesh_atlas(mesh, ao);
   auto uv = find(mesh, kCornerUV).first;
   auto patch = find(mesh, kFacePatch).first;
@@ -93,12 +94,14 @@ Candidate pack_candidate(Mesh& mesh, int N, int full_gutter, double cone) {
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return c.box[a].v1 - c.box[a].v0 > c.box[b].v1 - c.box[b].v0; });
+  double largest_side = 1e-300;
+  for (const Box& b : c.box) largest_side = std::max({largest_side, b.u1 - b.u0, b.v1 - b.v0});
   // Charts 2 * gutter + 1 texels apart plus the raster's one-texel band on
   // both sides: the largest scale whose packing fits (bisection; 0 = none).
   auto best_scale = [&](int gutter, std::vector<std::array<double, 2>>& best) {
     const double gap = 2.0 * gutter + 3.0;
     std::vector<std::array<double, 2>> at(c.box.size());
-    double lo = 0, hi = N;  // texels per uv unit of the base atlas ([0,1]^2 -> N texels at most)
+    double lo = 0, hi = N / largest_side;  // texels per uv unit of the base atlas (largest box fits)
     best.clear();
     for (int it = 0; it < 40; ++it) {
       const double mid = 0.5 * (lo + hi);
@@ -127,11 +130,12 @@ GutterAtlas compute_gutter_atlas(Mesh& mesh, int N, int min_mip_size) {
   Timer t;
   GutterAtlas g;
   const int full = atlas_gutter_texels(N, min_mip_size);
-  // Charts grown in base_mesh_atlas's default 50-degree normal cone, and in
-  // an 85-degree one (fewer, larger charts: less gutter, more distortion);
-  // the one with the higher texel density (discounted by its distortion) wins.
+  // Charts grown in base_mesh_atlas's default 50-degree normal cone and
+  // merged; if they cannot keep the full gutter, also in an 85-degree one
+  // (fewer, larger charts: less gutter, more distortion); the one with the
+  // higher texel density (discounted by its distortion) wins.
   Candidate c = pack_candidate(mesh, N, full, 50.0);
-  if (c.gutter < full || c.atlas.num_charts > 16) {
+  if (c.gutter < full) {
     Candidate wide = pack_candidate(mesh, N, full, 85.0);
     if (wide.scale > 0 && (c.scale <= 0 || wide.density() > c.density())) c = std::move(wide);
   }

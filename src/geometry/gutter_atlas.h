@@ -2,11 +2,12 @@
 #pragma once
 // A multi-chart uv atlas of a triangle mesh ready for baking at a given
 // texel size with mip-safe gutters (issue 16 item 3): the charts of
-// geometry/base_mesh_atlas.h (segmentation, LSCM, rotation; grown in its
-// default 50-degree normal cone and, for more than 16 charts, also in an
-// 85-degree one: the packing with the higher texel density per mesh length,
-// divided by the square root of the mean area distortion, is kept) repacked
-// in texels: shelf packing of their boxes (tallest first) with 2 g + 3 texels
+// geometry/base_mesh_atlas.h (segmentation, LSCM, rotation, merged while a
+// merge saves atlas area at the full gutter's gap, its step 2b; grown in its
+// default 50-degree normal cone and, when those cannot keep the full gutter,
+// also in an 85-degree one: the packing with the higher texel density per
+// mesh length, divided by the square root of the mean area distortion, is
+// kept) repacked in texels: shelf packing of their boxes (tallest first) with 2 g + 3 texels
 // between boxes and from the border (g = the gutter of geometry/
 // atlas_gutter.h, plus the raster's one-texel band on each side), at the
 // largest common scale that fits (bisection). When the full gutter leaves

@@ -22,6 +22,7 @@
 #include "geometry/mesh_util.h"
 #include "geometry/pgp_curl_correction.h"
 #include "geometry/properties.h"
+#include "geometry/union_find.h"
 #include "geometry/timer.h"
 
 namespace surftex {
@@ -541,20 +542,12 @@ PgpTopology make_topology(const Mesh& mesh) {
   }
   // Components by union-find over the edges (deterministic labels: order of
   // the lowest vertex index).
-  std::vector<std::uint32_t> parent(t.nv);
-  for (std::size_t i = 0; i < t.nv; ++i) parent[i] = static_cast<std::uint32_t>(i);
-  auto find_root = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const auto& ij : t.ends) {
-    const std::uint32_t a = find_root(ij[0]), b = find_root(ij[1]);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
+  UnionFind<std::uint32_t> sets(t.nv);
+  for (const auto& ij : t.ends) sets.unite(ij[0], ij[1]);
   t.component.assign(t.nv, -1);
   std::vector<int> label(t.nv, -1);
   for (VertexIndex v : mesh.vertices()) {
-    const std::uint32_t r = find_root(static_cast<std::uint32_t>(v.idx()));
+    const std::uint32_t r = sets.find(static_cast<std::uint32_t>(v.idx()));
     if (label[r] < 0) label[r] = t.components++;
     t.component[v.idx()] = label[r];
   }
@@ -751,6 +744,55 @@ std::vector<std::uint8_t> corner_matchings(const Mesh& mesh, const std::vector<s
   return cm;
 }
 
+
+/// Working state of one solve (initialisation or local update), handed from
+/// stage to stage of PeriodicGlobalParameterization::Impl::solve.
+struct PgpSolve {
+  const PgpTopology* t = nullptr;
+  const std::vector<char>* free_face = nullptr;  // update: the faces whose field may have changed
+  bool global = false;                           // initialisation (spanning-tree start)
+  PgpResult res;
+  Timer lap;  // the stage times of res.breakdown
+  int n = 0;                                      // free vertices (4 real unknowns each)
+  std::vector<int> natural;                       // unknown per vertex in vertex order (the free set)
+  const std::vector<int>* order_known = nullptr;  // its fill-reducing order, when computed before
+  bool partial = false;   // field quantities refreshed only next to the free faces
+  bool split_st = false;  // s and t uncoupled (the paper's simplified PGP, no swapping)
+  bool separate = false;  // ... and solved as two complex systems (PgpOptions::separate_halves)
+  std::vector<char> face_mask, edge_mask;     // partial: faces and edges whose field may have changed
+  std::vector<int> var;                       // unknown per vertex in the fill-reducing order, -1 locked
+  std::vector<std::array<double, 2>> ealpha;  // per live edge: alpha along halfedge(e, 0)
+  std::vector<std::array<int, 2>> turns;      // per live edge: reference face -> (source, target) frames
+  std::vector<Mat4> maps;                     // per live edge: edge map (where read)
+  bool same_pattern = false;                  // the symbolic analysis is reused
+  double shift = 0;                           // mu of the unit-modulus pull
+  SpMat A;                                    // F_PGP + mu M, lower triangle
+  Eigen::VectorXd b, mass;                    // locked neighbours' terms; free vertices' masses
+  std::string failure;                        // why the solver failed ("" = it did not)
+
+  /// Adds the time since the last split to `into`.
+  void split(double& into) {
+    into += lap.seconds();
+    lap.reset();
+  }
+  int unknown(int v, int r) const { return unknown_index(v, r, n, split_st); }
+};
+
+/// One half's relaxation of the separate-halves solve (its failure, times, steps).
+struct PgpHalfRun {
+  std::string why;
+  double factor_seconds = 0, solve_seconds = 0;
+  int steps = 0;
+};
+
+/// Reference scale of the shift: mean diagonal of F_PGP over mean mass.
+double shift_unit(const PgpTopology& t) {
+  double trace_w = 0, trace_m = 0;
+  for (std::size_t k = 0; k < t.ends.size(); ++k) trace_w += 2 * t.weight[k];
+  for (double m : t.mass) trace_m += m;
+  return trace_m > 0 ? trace_w / trace_m : 1.0;
+}
+
 }  // namespace
 
 struct PeriodicGlobalParameterization::Impl {
@@ -857,6 +899,27 @@ struct PeriodicGlobalParameterization::Impl {
     return natural;
   }
   void write_corners(const std::vector<std::array<double, 2>>& alpha, const std::vector<char>* free_face);
+
+  // Stages of solve(), in order.
+  void number_free_vertices(PgpSolve& s, const std::vector<char>& free_vertex);
+  void order_and_field(PgpSolve& s);
+  void mark_changed_field(PgpSolve& s);
+  void field_quantities(PgpSolve& s);
+  void compute_edge_maps(PgpSolve& s, const std::vector<int>* order);
+  void integrate_start(PgpSolve& s);
+  void build_pattern(PgpSolve& s);
+  void analyze_and_assemble(PgpSolve& s);
+  void assemble(PgpSolve& s);
+  void relax(PgpSolve& s);
+  void relax_halves(PgpSolve& s, Eigen::VectorXd& x, int iterations);
+  void relax_half(PgpSolve& s, int h, Eigen::VectorXd& x, int iterations, PgpHalfRun& run);
+  void relax_coupled(PgpSolve& s, Eigen::VectorXd& x, int iterations);
+  void normalize_solution(PgpSolve& s, const Eigen::VectorXd& x);
+  void edge_energies(PgpSolve& s);
+  /// (Re z_s, Im z_s, Re z_t, Im z_t) of vertex v.
+  Vec4 state(std::size_t v) const { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; }
+  /// Half h of the split system as a complex Hermitian CHOLMOD matrix (lower triangle given).
+  cholmod_sparse half_matrix(int h);
 };
 
 void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::array<double, 2>>& alpha,
@@ -904,432 +967,488 @@ void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::
   });
 }
 
+/// One solve of F_PGP over the free vertices (Ray et al. 2009 s.2.2; the
+/// coupled real form of Ray et al. 2006 when swapping): the field's alphas
+/// (equation 3), the system's order, pattern and values, the Ginzburg-Landau
+/// relaxation, the energies and the corner coordinates (equation 4).
 PgpResult PeriodicGlobalParameterization::Impl::solve(const std::vector<char>& free_vertex,
                                                       const std::vector<char>* free_face, bool global) {
-  Timer timer, lap;
-  PgpResult res;
-  res.blas_core = blas_core;
-  res.concurrent_blas = blas_allows_concurrent_calls();
-  PgpResult::Breakdown& bd = res.breakdown;
-  auto split = [&lap](double& into) {
-    into += lap.seconds();
-    lap.reset();
-  };
+  Timer timer;
+  PgpSolve s;
+  s.free_face = free_face;
+  s.global = global;
+  s.res.blas_core = blas_core;
+  s.res.concurrent_blas = blas_allows_concurrent_calls();
+  PgpResult::Breakdown& bd = s.res.breakdown;
   check_options(opt);
   require_triangle_mesh(mesh, "periodic_global_parameterization");
-  const PgpTopology& t = topology();
-  split(bd.topology);
-  // The free unknowns in vertex order (identifies the free set).
-  int count = 0;
-  const std::vector<int> natural = natural_numbering(mesh, free_vertex, count);
-  res.free_vertices = static_cast<std::size_t>(count);
-  const std::vector<int>* order_known = known_order(natural);
-  split(bd.topology);
+  s.t = &topology();
+  s.split(bd.topology);
+  number_free_vertices(s, free_vertex);
+  s.split(bd.topology);
+  order_and_field(s);
+  s.lap.reset();
+  build_pattern(s);
+  analyze_and_assemble(s);
+  s.lap.reset();
+  relax(s);
+  if (!s.failure.empty())
+    throw SolverError(std::string("periodic_global_parameterization: ") +
+                      (s.split_st ? "s and t systems " : "coupled (s,t) system ") + s.failure + " (" +
+                      std::to_string(s.n) + " free vertices)");
+  analyzed = s.n > 0;
+  // The reference vertices were locked at (1, 1) at initialisation: s = t = 0 there.
+  edge_energies(s);
+  cache_valid = true;
+  s.split(bd.energy);
+  write_corners(alpha, free_face);
+  s.split(bd.corners);
+  s.res.seconds = timer.seconds();
+  return std::move(s.res);
+}
 
-  // Two independent pieces of work side by side: the fill-reducing order
-  // (one serial METIS call; it depends on the free set and the connectivity
-  // only, and is redone only when the free set changed) and the field's
-  // quantities (parallel loops over the faces and edges). Neither reads what
-  // the other writes, so the bytes do not depend on which thread runs what.
-  std::vector<char> face_mask, edge_mask;
+/// The free unknowns in vertex order (identifies the free set), its order if
+/// known, and which form of the system this solve takes.
+void PeriodicGlobalParameterization::Impl::number_free_vertices(PgpSolve& s,
+                                                                const std::vector<char>& free_vertex) {
+  s.natural = natural_numbering(mesh, free_vertex, s.n);
+  s.res.free_vertices = static_cast<std::size_t>(s.n);
+  s.order_known = known_order(s.natural);
   // The curl correction is global (its factor changes a little everywhere
   // when the field changes in the area): all gradients are then refreshed,
   // so that an update equals a full rewrite from the same state.
-  const bool partial = free_face && cache_valid && !opt.curl_correction;
-  std::vector<int> var;
-  std::vector<std::array<double, 2>> ealpha;
-  std::vector<std::array<int, 2>> turns(t.ends.size());
-  // Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
-  // x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
-  // the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
-  // (edge_map): A(i,i) += w I, A(j,j) += w I, A(j,i) = -w M, A(i,j) = -w M^T;
-  // lower triangle stored. `b` collects the locked neighbours' terms.
-  auto state = [&](std::size_t v) -> Vec4 { return {zs[v].real(), zs[v].imag(), zt[v].real(), zt[v].imag()}; };
-  const int n = count;
-  const int n4 = 4 * n;
-  const bool split_st = !opt.swap_coordinates;
+  s.partial = s.free_face && cache_valid && !opt.curl_correction;
+  s.split_st = !opt.swap_coordinates;
   // The two halves as two systems on two tasks (see PgpOptions::separate_halves).
-  const bool separate = split_st && opt.separate_halves;
-  // Half h as a complex Hermitian CHOLMOD matrix (lower triangle given).
-  auto half_matrix = [&](int h) {
-    PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
-    cholmod_sparse a{};
-    a.nrow = a.ncol = static_cast<std::size_t>(pattern->n);
-    a.nzmax = C.row.size();
-    a.p = C.col.data();
-    a.i = C.row.data();
-    a.x = C.x.data();
-    a.stype = -1;
-    a.itype = CHOLMOD_INT;
-    a.xtype = CHOLMOD_COMPLEX;
-    a.dtype = CHOLMOD_DOUBLE;
-    a.sorted = 1;
-    a.packed = 1;
-    return a;
-  };
-  auto analyze_half = [&](int h) -> std::string {
-    return halves[static_cast<std::size_t>(h)].analyze(half_matrix(h)) ? std::string()
-                                                                          : std::string("symbolic analysis failed");
-  };
-  auto unknown = [n, split_st](int v, int r) { return unknown_index(v, r, n, split_st); };
+  s.separate = s.split_st && opt.separate_halves;
+}
+
+/// Two independent pieces of work side by side: the fill-reducing order
+/// (one serial METIS call; it depends on the free set and the connectivity
+/// only, and is redone only when the free set changed) and the field's
+/// quantities (parallel loops over the faces and edges). Neither reads what
+/// the other writes, so the bytes do not depend on which thread runs what.
+void PeriodicGlobalParameterization::Impl::order_and_field(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
+  s.turns.resize(t.ends.size());
   // Edge maps where they are read: edges touching a free vertex, and the
   // edges whose energy is recomputed.
-  std::vector<Mat4> maps(t.ends.size());
-  auto compute_maps = [&](const std::vector<int>* order) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t k = r.begin(); k != r.end(); ++k)
-        if (!order || edge_mask[t.edges[k]] || (*order)[t.ends[k][0]] >= 0 || (*order)[t.ends[k][1]] >= 0)
-          maps[k] = edge_map(turns[k][0], turns[k][1], {ealpha[k][0], ealpha[k][1]});
-    });
-  };
-  auto fill = [&](double shift, SpMat& A, Eigen::VectorXd& b, Eigen::VectorXd& mass) {
-    const PgpPattern& P = *pattern;
-    A = P.A;
-    double* val = A.valuePtr();
-    std::fill(val, val + A.nonZeros(), 0.0);
-    b = Eigen::VectorXd::Zero(n4);
-    mass.resize(n);
-    for (std::size_t v = 0; v < t.nv; ++v)
-      if (P.var[v] >= 0) mass[P.var[v]] = t.mass[v];
-    for (std::size_t k = 0; k < t.ends.size(); ++k) {
-      const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
-      const int vi = P.var[i], vj = P.var[j];
-      if (vi < 0 && vj < 0) continue;
-      const double w = t.weight[k];
-      const Mat4& M = maps[k];
-      for (int r = 0; r < 4; ++r) {
-        if (vi >= 0) val[P.diag[unknown(vi, r)]] += w;
-        if (vj >= 0) val[P.diag[unknown(vj, r)]] += w;
-      }
-      if (vi >= 0 && vj >= 0) {
-        // Only the parity's entries: the others of M are exact zeros (signed
-        // permutations around block-diagonal rotations).
-        for (int r = 0; r < 4; ++r)
-          for (int c = 0; c < 4; ++c) {
-            const std::ptrdiff_t pos = P.off[k][4 * r + c];
-            if (pos >= 0) val[pos] += vj > vi ? -w * M[r][c] : -w * M[c][r];
-          }
-      } else if (vj >= 0) {
-        const Vec4 xi = state(i);
-        for (int r = 0; r < 4; ++r)
-          for (int c = 0; c < 4; ++c) b[unknown(vj, r)] += w * M[r][c] * xi[c];
-      } else {
-        const Vec4 xj = state(j);
-        for (int r = 0; r < 4; ++r)
-          for (int c = 0; c < 4; ++c) b[unknown(vi, r)] += w * M[c][r] * xj[c];
-      }
-    }
-    for (int v = 0; v < n; ++v)
-      for (int r = 0; r < 4; ++r) val[P.diag[unknown(v, r)]] += shift * mass[v];
-  };
-
-  // Reference scale of the shift: mean diagonal of F_PGP over mean mass.
-  double trace_w = 0, trace_m = 0;
-  for (std::size_t k = 0; k < t.ends.size(); ++k) trace_w += 2 * t.weight[k];
-  for (double m : t.mass) trace_m += m;
-  const double unit = trace_m > 0 ? trace_w / trace_m : 1.0;
-
-  auto integrate_start = [&] {
-    if (global) {
-      // Integrate the alphas along a breadth-first spanning tree from each
-      // component's reference vertex (locked_vertex, else the lowest), through
-      // the frames: exact on the tree edges, the holonomy of the field (what
-      // forces singularities) piles up where the tree's branches meet; the
-      // relaxation below spreads it into vortices.
-      std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
-      for (std::size_t k = 0; k < t.ends.size(); ++k) {
-        adj[t.ends[k][0]].push_back({t.ends[k][1], k});
-        adj[t.ends[k][1]].push_back({t.ends[k][0], k});
-      }
-      std::vector<char> seen(t.nv, 0);
-      std::vector<St> st(t.nv, St{0, 0});
-      std::vector<std::uint32_t> q;
-      std::vector<std::uint32_t> roots{opt.locked_vertex};
-      for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
-      for (std::uint32_t v0 : roots) {
-        if (seen[v0]) continue;
-        seen[v0] = 1;
-        q.assign(1, v0);
-        for (std::size_t qi = 0; qi < q.size(); ++qi) {
-          const std::uint32_t i = q[qi];
-          for (auto [j, k] : adj[i]) {
-            if (seen[j]) continue;
-            seen[j] = 1;
-            const int ma = turns[k][0], mb = turns[k][1];
-            if (t.ends[k][0] == i) {
-              const St c = turn_st(st[i], -ma);
-              st[j] = turn_st({c[0] + ealpha[k][0], c[1] + ealpha[k][1]}, mb);
-            } else {
-              const St c = turn_st(st[i], -mb);
-              st[j] = turn_st({c[0] - ealpha[k][0], c[1] - ealpha[k][1]}, ma);
-            }
-            q.push_back(j);
-          }
-        }
-      }
-      for (std::size_t v = 0; v < t.nv; ++v) {
-        zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
-        zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
-      }
-    }
-  };
-
+  s.maps.resize(t.ends.size());
   tbb::parallel_invoke(
       [&] {
         Timer tt;
-        var = order_known ? *order_known : nested_dissection_order(natural, count, t.ends);
-        bd.ordering = tt.seconds();
+        s.var = s.order_known ? *s.order_known : nested_dissection_order(s.natural, s.n, t.ends);
+        s.res.breakdown.ordering = tt.seconds();
       },
-      [&] {
-        Timer tt;
-        // Faces whose gradient may have changed (free faces) and edges whose
-        // alpha may have (edges of free faces): everything when no valid cache.
-        if (partial) {
-          face_mask.assign(t.nf, 0);
-          edge_mask.assign(t.ne, 0);
-          for (std::uint32_t f : t.faces) {
-            if (!(*free_face)[f]) continue;
-            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
-              edge_mask[mesh.edge(h).idx()] = 1;
-              face_mask[f] = 1;
-              // the opposite face's gradient enters the edge's alpha: unchanged
-              // unless free, so it is read from the cache
-            }
-          }
-        }
-        // (the corrector solves with Eigen's own ordering: no METIS, no rand(),
-        // safe beside the ordering)
-        face_gradients_into(mesh, opt, t.frames, partial ? &face_mask : nullptr, grad, corrector());
-        halfedge_alphas_into(mesh, opt, grad, t.frames, partial ? &edge_mask : nullptr, alpha, &quarter);
-        if (partial) {
-          // Only the vertices of edges whose matching may have changed.
-          std::vector<char> vertex_mask(t.nv, 0);
-          for (std::size_t k = 0; k < t.ends.size(); ++k)
-            if (edge_mask[t.edges[k]]) vertex_mask[t.ends[k][0]] = vertex_mask[t.ends[k][1]] = 1;
-          vertex_matchings(&vertex_mask);
-        } else {
-          vertex_matchings(nullptr);
-        }
-        ealpha = edge_alphas(alpha);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t k = r.begin(); k != r.end(); ++k) turns[k] = edge_turns(k);
-        });
-        if (!partial) {
-          // Every edge map is read (no locked region): computed here, beside
-          // the ordering, with the spanning-tree start.
-          compute_maps(nullptr);
-          bd.field = tt.seconds();
-          tt.reset();
-          integrate_start();
-          bd.start = tt.seconds();
-        } else {
-          bd.field = tt.seconds();
-        }
-      });
-  lap.reset();
+      [&] { field_quantities(s); });
+}
 
+/// Faces whose gradient may have changed (free faces) and edges whose alpha
+/// may have (edges of free faces), for a partial refresh.
+void PeriodicGlobalParameterization::Impl::mark_changed_field(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
+  s.face_mask.assign(t.nf, 0);
+  s.edge_mask.assign(t.ne, 0);
+  for (std::uint32_t f : t.faces) {
+    if (!(*s.free_face)[f]) continue;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(FaceIndex(f)), mesh)) {
+      s.edge_mask[mesh.edge(h).idx()] = 1;
+      s.face_mask[f] = 1;
+      // the opposite face's gradient enters the edge's alpha: unchanged
+      // unless free, so it is read from the cache
+    }
+  }
+}
+
+/// The field's quantities (Ray et al. 2009 s.2.2): face gradients, halfedge
+/// alphas (equation 3), matchings, the edges' alphas and turns; on a full
+/// refresh also every edge map and the spanning-tree start. Everything when
+/// no valid cache, else only next to the free faces.
+void PeriodicGlobalParameterization::Impl::field_quantities(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
+  PgpResult::Breakdown& bd = s.res.breakdown;
+  Timer tt;
+  if (s.partial) mark_changed_field(s);
+  // (the corrector solves with Eigen's own ordering: no METIS, no rand(),
+  // safe beside the ordering)
+  face_gradients_into(mesh, opt, t.frames, s.partial ? &s.face_mask : nullptr, grad, corrector());
+  halfedge_alphas_into(mesh, opt, grad, t.frames, s.partial ? &s.edge_mask : nullptr, alpha, &quarter);
+  if (s.partial) {
+    // Only the vertices of edges whose matching may have changed.
+    std::vector<char> vertex_mask(t.nv, 0);
+    for (std::size_t k = 0; k < t.ends.size(); ++k)
+      if (s.edge_mask[t.edges[k]]) vertex_mask[t.ends[k][0]] = vertex_mask[t.ends[k][1]] = 1;
+    vertex_matchings(&vertex_mask);
+  } else {
+    vertex_matchings(nullptr);
+  }
+  s.ealpha = edge_alphas(alpha);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) s.turns[k] = edge_turns(k);
+  });
+  if (!s.partial) {
+    // Every edge map is read (no locked region): computed here, beside
+    // the ordering, with the spanning-tree start.
+    compute_edge_maps(s, nullptr);
+    bd.field = tt.seconds();
+    tt.reset();
+    integrate_start(s);
+    bd.start = tt.seconds();
+  } else {
+    bd.field = tt.seconds();
+  }
+}
+
+/// Edge maps (edge_map) of every live edge, or with `order` only of those
+/// touching a free vertex or whose energy is recomputed.
+void PeriodicGlobalParameterization::Impl::compute_edge_maps(PgpSolve& s, const std::vector<int>* order) {
+  const PgpTopology& t = *s.t;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k)
+      if (!order || s.edge_mask[t.edges[k]] || (*order)[t.ends[k][0]] >= 0 || (*order)[t.ends[k][1]] >= 0)
+        s.maps[k] = edge_map(s.turns[k][0], s.turns[k][1], {s.ealpha[k][0], s.ealpha[k][1]});
+  });
+}
+
+/// Initialisation only: integrate the alphas along a breadth-first spanning
+/// tree from each component's reference vertex (locked_vertex, else the
+/// lowest), through the frames: exact on the tree edges, the holonomy of the
+/// field (what forces singularities) piles up where the tree's branches
+/// meet; the relaxation spreads it into vortices.
+void PeriodicGlobalParameterization::Impl::integrate_start(PgpSolve& s) {
+  if (!s.global) return;
+  const PgpTopology& t = *s.t;
+  std::vector<std::vector<std::pair<std::uint32_t, std::size_t>>> adj(t.nv);
+  for (std::size_t k = 0; k < t.ends.size(); ++k) {
+    adj[t.ends[k][0]].push_back({t.ends[k][1], k});
+    adj[t.ends[k][1]].push_back({t.ends[k][0], k});
+  }
+  std::vector<char> seen(t.nv, 0);
+  std::vector<St> st(t.nv, St{0, 0});
+  std::vector<std::uint32_t> q;
+  std::vector<std::uint32_t> roots{opt.locked_vertex};
+  for (VertexIndex v : mesh.vertices()) roots.push_back(static_cast<std::uint32_t>(v.idx()));
+  for (std::uint32_t v0 : roots) {
+    if (seen[v0]) continue;
+    seen[v0] = 1;
+    q.assign(1, v0);
+    for (std::size_t qi = 0; qi < q.size(); ++qi) {
+      const std::uint32_t i = q[qi];
+      for (auto [j, k] : adj[i]) {
+        if (seen[j]) continue;
+        seen[j] = 1;
+        const int ma = s.turns[k][0], mb = s.turns[k][1];
+        if (t.ends[k][0] == i) {
+          const St c = turn_st(st[i], -ma);
+          st[j] = turn_st({c[0] + s.ealpha[k][0], c[1] + s.ealpha[k][1]}, mb);
+        } else {
+          const St c = turn_st(st[i], -mb);
+          st[j] = turn_st({c[0] - s.ealpha[k][0], c[1] - s.ealpha[k][1]}, ma);
+        }
+        q.push_back(j);
+      }
+    }
+  }
+  for (std::size_t v = 0; v < t.nv; ++v) {
+    zs[v] = std::polar(1.0, 2 * M_PI * st[v][0]);
+    zt[v] = std::polar(1.0, 2 * M_PI * st[v][1]);
+  }
+}
+
+/// The sparsity pattern (it depends on the order and the cut parities only;
+/// rebuilt only when those changed) beside the edge maps of a local update
+/// (only those next to its free vertices).
+void PeriodicGlobalParameterization::Impl::build_pattern(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
+  PgpResult::Breakdown& bd = s.res.breakdown;
   std::vector<std::uint8_t> parity(t.ends.size());
-  for (std::size_t k = 0; k < t.ends.size(); ++k) parity[k] = static_cast<std::uint8_t>((turns[k][0] + turns[k][1]) % 2);
-  const bool rebuild = !pattern || pattern->var != var || pattern->parity != parity || pattern->split_st != split_st;
-  const bool same_pattern = analyzed && !rebuild;
-  res.reused_analysis = same_pattern;
-  analyzed = same_pattern;
-  // Then the sparsity pattern (it depends on the order and the cut parities
-  // only; rebuilt only when those changed) beside the edge maps of a local
-  // update (only those next to its free vertices), and the pattern's
-  // symbolic analysis beside the assembly of the values.
-  std::string failure;
-  SpMat A;
-  Eigen::VectorXd b, mass;
-  const double shift = opt.stiffness * unit;
+  for (std::size_t k = 0; k < t.ends.size(); ++k)
+    parity[k] = static_cast<std::uint8_t>((s.turns[k][0] + s.turns[k][1]) % 2);
+  const bool rebuild =
+      !pattern || pattern->var != s.var || pattern->parity != parity || pattern->split_st != s.split_st;
+  s.same_pattern = analyzed && !rebuild;
+  s.res.reused_analysis = s.same_pattern;
+  analyzed = s.same_pattern;
+  s.shift = opt.stiffness * shift_unit(t);
   tbb::parallel_invoke(
       [&] {
         Timer tt;
         if (rebuild) {
-          pattern = std::make_unique<PgpPattern>(make_pattern(t, var, count, parity, split_st));
-          pattern->natural = natural;
+          pattern = std::make_unique<PgpPattern>(make_pattern(t, s.var, s.n, parity, s.split_st));
+          pattern->natural = s.natural;
         }
         bd.pattern = tt.seconds();
       },
       [&] {
-        if (!partial) return;
+        if (!s.partial) return;
         Timer tt;
-        compute_maps(&var);
+        compute_edge_maps(s, &s.var);
         bd.field += tt.seconds();
       });
+}
+
+cholmod_sparse PeriodicGlobalParameterization::Impl::half_matrix(int h) {
+  PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+  cholmod_sparse a{};
+  a.nrow = a.ncol = static_cast<std::size_t>(pattern->n);
+  a.nzmax = C.row.size();
+  a.p = C.col.data();
+  a.i = C.row.data();
+  a.x = C.x.data();
+  a.stype = -1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_COMPLEX;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+  return a;
+}
+
+/// The pattern's symbolic analysis (skipped when reused) beside the assembly
+/// of the values.
+void PeriodicGlobalParameterization::Impl::analyze_and_assemble(PgpSolve& s) {
+  PgpResult::Breakdown& bd = s.res.breakdown;
   tbb::parallel_invoke(
       [&] {
         Timer tt;
-        if (n > 0 && !same_pattern && separate) {
+        if (s.n > 0 && !s.same_pattern && s.separate) {
           // The s and t halves' own analyses (no BLAS: beside the assembly).
           std::array<std::string, 2> why;
-          for (int h = 0; h < 2; ++h) why[static_cast<std::size_t>(h)] = analyze_half(h);
-          failure = !why[0].empty() ? why[0] : why[1];
+          for (int h = 0; h < 2; ++h)
+            why[static_cast<std::size_t>(h)] = halves[static_cast<std::size_t>(h)].analyze(half_matrix(h))
+                                                   ? std::string()
+                                                   : std::string("symbolic analysis failed");
+          s.failure = !why[0].empty() ? why[0] : why[1];
           factor_size = {halves[0].flops() + halves[1].flops(), halves[0].nonzeros() + halves[1].nonzeros()};
-        } else if (n > 0 && !same_pattern) {
+        } else if (s.n > 0 && !s.same_pattern) {
           // Symbolic analysis of the pattern alone (the values come beside).
           solver.analyzePattern(pattern->A);
-          if (solver.info() != Eigen::Success) failure = "symbolic analysis failed";
+          if (solver.info() != Eigen::Success) s.failure = "symbolic analysis failed";
           factor_size = {solver.cholmod().fl, solver.cholmod().lnz};
         }
         bd.analysis = tt.seconds();
       },
       [&] {
         Timer tt;
-        if (n > 0) fill(shift, A, b, mass);
+        if (s.n > 0) assemble(s);
         bd.assembly = tt.seconds();
       });
-  lap.reset();
-  const PgpPattern& P = *pattern;
   bd.factor_flops = factor_size[0];
   bd.factor_nonzeros = factor_size[1];
+}
 
-  if (n > 0 && failure.empty()) {
-    Eigen::VectorXd x(n4);
-    for (std::size_t v = 0; v < t.nv; ++v)
-      if (P.var[v] >= 0) {
-        const Vec4 xv = state(v);
-        for (int r = 0; r < 4; ++r) x[unknown(P.var[v], r)] = xv[r];
-      }
-    // Ginzburg-Landau relaxation with one factorisation of F_PGP + mu M:
-    // min F + mu sum_i M_i |z_i - u_i|^2, u = z/|z| of the previous iterate
-    // (per complex pair), from the tree-integrated start at initialisation,
-    // from the previous solution in a local update, locked vertices entering
-    // through b. The unit-modulus pull matters: F alone with one locked
-    // vertex has a solution decaying away from it (median |z| ~ 3e-3 on
-    // fandisk), and F's smallest eigenvector localises where the field's curl
-    // is low, its tail not following the field (80% distorted faces on a torus).
-    const int iterations = global ? opt.init_iterations : opt.update_iterations;
-    if (separate) {
-      // The paper's simplified PGP: the s and t systems are independent, and
-      // so are their relaxations (each step normalises s pairs and t pairs
-      // separately), so each half is factored and relaxed on its own, as the
-      // complex Hermitian system its real form stands for (half the real
-      // flops of the 2x2 blocks, half the factor's bytes per solve).
-      std::array<std::string, 2> why;
-      std::array<double, 2> factor_seconds{0, 0}, solve_seconds{0, 0};
-      std::array<int, 2> steps{0, 0};
-      auto run_half = [&](int h) {
-        Timer th;
-        SupernodalHalf& S = halves[static_cast<std::size_t>(h)];
-        PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
-        const double* val = A.valuePtr();
-        for (std::size_t q = 0; q < C.re.size(); ++q) {
-          C.x[2 * q] = val[C.re[q]];
-          C.x[2 * q + 1] = C.im[q] >= 0 ? val[C.im[q]] : 0.0;
+/// Real form of F_PGP with s and t coupled (Ray et al. 2006): per vertex
+/// x = (Re z_s, Im z_s, Re z_t, Im z_t) in the vertex's own frame; per edge
+/// the residual x_j - M x_i with M = P_mj Rot(alpha) P_-mi orthogonal
+/// (edge_map): A(i,i) += w I, A(j,j) += w I, A(j,i) = -w M, A(i,j) = -w M^T;
+/// lower triangle stored, plus shift * mass on the diagonal. `b` collects
+/// the locked neighbours' terms.
+void PeriodicGlobalParameterization::Impl::assemble(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
+  const PgpPattern& P = *pattern;
+  const int n = s.n;
+  SpMat& A = s.A;
+  Eigen::VectorXd &b = s.b, &mass = s.mass;
+  A = P.A;
+  double* val = A.valuePtr();
+  std::fill(val, val + A.nonZeros(), 0.0);
+  b = Eigen::VectorXd::Zero(4 * n);
+  mass.resize(n);
+  for (std::size_t v = 0; v < t.nv; ++v)
+    if (P.var[v] >= 0) mass[P.var[v]] = t.mass[v];
+  for (std::size_t k = 0; k < t.ends.size(); ++k) {
+    const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
+    const int vi = P.var[i], vj = P.var[j];
+    if (vi < 0 && vj < 0) continue;
+    const double w = t.weight[k];
+    const Mat4& M = s.maps[k];
+    for (int r = 0; r < 4; ++r) {
+      if (vi >= 0) val[P.diag[s.unknown(vi, r)]] += w;
+      if (vj >= 0) val[P.diag[s.unknown(vj, r)]] += w;
+    }
+    if (vi >= 0 && vj >= 0) {
+      // Only the parity's entries: the others of M are exact zeros (signed
+      // permutations around block-diagonal rotations).
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) {
+          const std::ptrdiff_t pos = P.off[k][4 * r + c];
+          if (pos >= 0) val[pos] += vj > vi ? -w * M[r][c] : -w * M[c][r];
         }
-        if (!S.factorize(half_matrix(h))) why[h] = "factorisation failed (not positive definite?)";
-        factor_seconds[h] = th.seconds();
-        th.reset();
-        const int m = 2 * n, off = h * m;
-        Eigen::VectorXd xh = x.segment(off, m), rh(m);
-        for (int it = 0; it < iterations && why[h].empty(); ++it) {
-          for (int v = 0; v < n; ++v) {
-            const double re = xh[2 * v], im = xh[2 * v + 1];
-            const double a = std::hypot(re, im);
-            const bool ok = a > 1e-300 && std::isfinite(a);
-            rh[2 * v] = b[off + 2 * v] + shift * mass[v] * (ok ? re / a : 1.0);
-            rh[2 * v + 1] = b[off + 2 * v + 1] + shift * mass[v] * (ok ? im / a : 0.0);
-          }
-          // (re, im) pairs: the complex right-hand side and solution as they are
-          if (!S.solve(rh.data(), static_cast<std::size_t>(n), CHOLMOD_COMPLEX, xh.data())) why[h] = "solve failed";
-          ++steps[h];
-        }
-        x.segment(off, m) = xh;
-        solve_seconds[h] = th.seconds();
-      };
-      // Side by side on two tasks where the BLAS allows concurrent calls, in
-      // turn otherwise (BlasGuard); independent, so the same bytes either way.
-      if (blas_allows_concurrent_calls())
-        tbb::parallel_invoke([&] { run_half(0); }, [&] { run_half(1); });
-      else
-        for (int h = 0; h < 2 && why[0].empty(); ++h) run_half(h);
-      failure = !why[0].empty() ? why[0] : why[1];
-      if (blas_allows_concurrent_calls()) {
-        bd.factorization = std::max(factor_seconds[0], factor_seconds[1]);
-        bd.solves = std::max(solve_seconds[0], solve_seconds[1]);
-      } else {
-        bd.factorization = factor_seconds[0] + factor_seconds[1];
-        bd.solves = solve_seconds[0] + solve_seconds[1];
-      }
-      bd.steps = std::min(steps[0], steps[1]);
-      lap.reset();
+    } else if (vj >= 0) {
+      const Vec4 xi = state(i);
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) b[s.unknown(vj, r)] += w * M[r][c] * xi[c];
     } else {
-      {
-        BlasGuard blas_guard;
-        solver.factorize(A);
-      }
-      if (solver.info() != Eigen::Success) failure = "factorisation failed (not positive definite?)";
-      split(bd.factorization);
+      const Vec4 xj = state(j);
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) b[s.unknown(vi, r)] += w * M[c][r] * xj[c];
     }
-    Eigen::VectorXd rhs(n4);
-    for (int it = 0; it < iterations && failure.empty() && !separate; ++it) {
-      for (int v = 0; v < n; ++v)
-        for (int p = 0; p < 2; ++p) {
-          const int ire = unknown(v, 2 * p), iim = unknown(v, 2 * p + 1);
-          const double re = x[ire], im = x[iim];
-          const double a = std::hypot(re, im);
-          const bool ok = a > 1e-300 && std::isfinite(a);
-          rhs[ire] = b[ire] + shift * mass[v] * (ok ? re / a : 1.0);
-          rhs[iim] = b[iim] + shift * mass[v] * (ok ? im / a : 0.0);
-        }
-      {
-        BlasGuard blas_guard;
-        x = solver.solve(rhs);
-      }
-      if (solver.info() != Eigen::Success) failure = "solve failed";
-      ++bd.steps;
-    }
-    if (failure.empty())
-      for (std::size_t v = 0; v < t.nv; ++v) {
-        if (P.var[v] < 0) continue;
-        const int o = P.var[v];
-        const Cplx a(x[unknown(o, 0)], x[unknown(o, 1)]), c(x[unknown(o, 2)], x[unknown(o, 3)]);
-        const double la = std::abs(a), lc = std::abs(c);
-        zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
-        zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
-      }
-    split(bd.solves);  // (the halves' own times were set above; this adds the write-back)
   }
-  if (!failure.empty())
-    throw SolverError(std::string("periodic_global_parameterization: ") + (split_st ? "s and t systems " : "coupled (s,t) system ") + failure + " (" +
-                      std::to_string(n) + " free vertices)");
-  analyzed = n > 0;
-  // The reference vertices were locked at (1, 1) at initialisation: s = t = 0 there.
+  for (int v = 0; v < n; ++v)
+    for (int r = 0; r < 4; ++r) val[P.diag[s.unknown(v, r)]] += s.shift * mass[v];
+}
 
-  // Energies at the (normalised) solution, in the edge's reference frame:
-  // per edge (only edges of free faces change in an update), then a serial
-  // sum (deterministic).
+/// Ginzburg-Landau relaxation with one factorisation of F_PGP + mu M:
+/// min F + mu sum_i M_i |z_i - u_i|^2, u = z/|z| of the previous iterate
+/// (per complex pair), from the tree-integrated start at initialisation,
+/// from the previous solution in a local update, locked vertices entering
+/// through b. The unit-modulus pull matters: F alone with one locked
+/// vertex has a solution decaying away from it (median |z| ~ 3e-3 on
+/// fandisk), and F's smallest eigenvector localises where the field's curl
+/// is low, its tail not following the field (80% distorted faces on a torus).
+void PeriodicGlobalParameterization::Impl::relax(PgpSolve& s) {
+  if (s.n <= 0 || !s.failure.empty()) return;
+  const PgpTopology& t = *s.t;
+  const PgpPattern& P = *pattern;
+  Eigen::VectorXd x(4 * s.n);
+  for (std::size_t v = 0; v < t.nv; ++v)
+    if (P.var[v] >= 0) {
+      const Vec4 xv = state(v);
+      for (int r = 0; r < 4; ++r) x[s.unknown(P.var[v], r)] = xv[r];
+    }
+  const int iterations = s.global ? opt.init_iterations : opt.update_iterations;
+  if (s.separate)
+    relax_halves(s, x, iterations);
+  else
+    relax_coupled(s, x, iterations);
+  if (s.failure.empty()) normalize_solution(s, x);
+  s.split(s.res.breakdown.solves);  // (the halves' own times were set before; this adds the write-back)
+}
+
+/// The paper's simplified PGP: the s and t systems are independent, and so
+/// are their relaxations (each step normalises s pairs and t pairs
+/// separately), so each half is factored and relaxed on its own, as the
+/// complex Hermitian system its real form stands for (half the real flops of
+/// the 2x2 blocks, half the factor's bytes per solve).
+void PeriodicGlobalParameterization::Impl::relax_halves(PgpSolve& s, Eigen::VectorXd& x, int iterations) {
+  PgpResult::Breakdown& bd = s.res.breakdown;
+  std::array<PgpHalfRun, 2> run;
+  // Side by side on two tasks where the BLAS allows concurrent calls, in
+  // turn otherwise (BlasGuard); independent, so the same bytes either way.
+  if (blas_allows_concurrent_calls())
+    tbb::parallel_invoke([&] { relax_half(s, 0, x, iterations, run[0]); },
+                         [&] { relax_half(s, 1, x, iterations, run[1]); });
+  else
+    for (int h = 0; h < 2 && run[0].why.empty(); ++h)
+      relax_half(s, h, x, iterations, run[static_cast<std::size_t>(h)]);
+  s.failure = !run[0].why.empty() ? run[0].why : run[1].why;
+  if (blas_allows_concurrent_calls()) {
+    bd.factorization = std::max(run[0].factor_seconds, run[1].factor_seconds);
+    bd.solves = std::max(run[0].solve_seconds, run[1].solve_seconds);
+  } else {
+    bd.factorization = run[0].factor_seconds + run[1].factor_seconds;
+    bd.solves = run[0].solve_seconds + run[1].solve_seconds;
+  }
+  bd.steps = std::min(run[0].steps, run[1].steps);
+  s.lap.reset();
+}
+
+/// Half h (s: 0, t: 1) of the separate-halves relaxation: its values into
+/// the complex matrix, its factorisation, then the relaxation steps on its
+/// segment of x ((re, im) pairs: the complex right-hand side and solution).
+void PeriodicGlobalParameterization::Impl::relax_half(PgpSolve& s, int h, Eigen::VectorXd& x, int iterations,
+                                                      PgpHalfRun& run) {
+  const int n = s.n;
+  Timer th;
+  SupernodalHalf& S = halves[static_cast<std::size_t>(h)];
+  PgpPattern::ComplexHalf& C = pattern->half[static_cast<std::size_t>(h)];
+  const double* val = s.A.valuePtr();
+  for (std::size_t q = 0; q < C.re.size(); ++q) {
+    C.x[2 * q] = val[C.re[q]];
+    C.x[2 * q + 1] = C.im[q] >= 0 ? val[C.im[q]] : 0.0;
+  }
+  if (!S.factorize(half_matrix(h))) run.why = "factorisation failed (not positive definite?)";
+  run.factor_seconds = th.seconds();
+  th.reset();
+  const int m = 2 * n, off = h * m;
+  Eigen::VectorXd xh = x.segment(off, m), rh(m);
+  for (int it = 0; it < iterations && run.why.empty(); ++it) {
+    for (int v = 0; v < n; ++v) {
+      const double re = xh[2 * v], im = xh[2 * v + 1];
+      const double a = std::hypot(re, im);
+      const bool ok = a > 1e-300 && std::isfinite(a);
+      rh[2 * v] = s.b[off + 2 * v] + s.shift * s.mass[v] * (ok ? re / a : 1.0);
+      rh[2 * v + 1] = s.b[off + 2 * v + 1] + s.shift * s.mass[v] * (ok ? im / a : 0.0);
+    }
+    // (re, im) pairs: the complex right-hand side and solution as they are
+    if (!S.solve(rh.data(), static_cast<std::size_t>(n), CHOLMOD_COMPLEX, xh.data())) run.why = "solve failed";
+    ++run.steps;
+  }
+  x.segment(off, m) = xh;
+  run.solve_seconds = th.seconds();
+}
+
+/// The coupled (or split, not separate) system: one factorisation, then the
+/// relaxation steps, each normalising every complex pair of x.
+void PeriodicGlobalParameterization::Impl::relax_coupled(PgpSolve& s, Eigen::VectorXd& x, int iterations) {
+  PgpResult::Breakdown& bd = s.res.breakdown;
+  {
+    BlasGuard blas_guard;
+    solver.factorize(s.A);
+  }
+  if (solver.info() != Eigen::Success) s.failure = "factorisation failed (not positive definite?)";
+  s.split(bd.factorization);
+  Eigen::VectorXd rhs(4 * s.n);
+  for (int it = 0; it < iterations && s.failure.empty(); ++it) {
+    for (int v = 0; v < s.n; ++v)
+      for (int p = 0; p < 2; ++p) {
+        const int ire = s.unknown(v, 2 * p), iim = s.unknown(v, 2 * p + 1);
+        const double re = x[ire], im = x[iim];
+        const double a = std::hypot(re, im);
+        const bool ok = a > 1e-300 && std::isfinite(a);
+        rhs[ire] = s.b[ire] + s.shift * s.mass[v] * (ok ? re / a : 1.0);
+        rhs[iim] = s.b[iim] + s.shift * s.mass[v] * (ok ? im / a : 0.0);
+      }
+    {
+      BlasGuard blas_guard;
+      x = solver.solve(rhs);
+    }
+    if (solver.info() != Eigen::Success) s.failure = "solve failed";
+    ++bd.steps;
+  }
+}
+
+/// z_s and z_t of every free vertex from x, normalised to unit modulus.
+void PeriodicGlobalParameterization::Impl::normalize_solution(PgpSolve& s, const Eigen::VectorXd& x) {
+  const PgpPattern& P = *pattern;
+  for (std::size_t v = 0; v < s.t->nv; ++v) {
+    if (P.var[v] < 0) continue;
+    const int o = P.var[v];
+    const Cplx a(x[s.unknown(o, 0)], x[s.unknown(o, 1)]), c(x[s.unknown(o, 2)], x[s.unknown(o, 3)]);
+    const double la = std::abs(a), lc = std::abs(c);
+    zs[v] = (la > 1e-300 && std::isfinite(la)) ? a / la : Cplx(1, 0);
+    zt[v] = (lc > 1e-300 && std::isfinite(lc)) ? c / lc : Cplx(1, 0);
+  }
+}
+
+/// Energies at the (normalised) solution, in the edge's reference frame:
+/// per edge (only edges of free faces change in an update), then a serial
+/// sum (deterministic).
+void PeriodicGlobalParameterization::Impl::edge_energies(PgpSolve& s) {
+  const PgpTopology& t = *s.t;
   edge_energy.resize(t.ends.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, t.ends.size(), 4096),
                     [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
-      if (partial && !edge_mask[t.edges[k]]) continue;
+      if (s.partial && !s.edge_mask[t.edges[k]]) continue;
       const std::uint32_t i = t.ends[k][0], j = t.ends[k][1];
       const double w = t.weight[k];
       const Vec4 xi = state(i), xj = state(j);
       Vec4 d{};
       for (int a = 0; a < 4; ++a) {
         d[a] = xj[a];
-        for (int c = 0; c < 4; ++c) d[a] -= maps[k][a][c] * xi[c];
+        for (int c = 0; c < 4; ++c) d[a] -= s.maps[k][a][c] * xi[c];
       }
-      d = turn_z(d, -turns[k][1]);  // s and t of the edge's reference frame
+      d = turn_z(d, -s.turns[k][1]);  // s and t of the edge's reference frame
       edge_energy[k] = {w * (d[0] * d[0] + d[1] * d[1]), w * (d[2] * d[2] + d[3] * d[3])};
     }
   });
   for (const auto& en : edge_energy) {
-    res.energy_s += en[0];
-    res.energy_t += en[1];
+    s.res.energy_s += en[0];
+    s.res.energy_t += en[1];
   }
-  cache_valid = true;
-  split(bd.energy);
-
-  write_corners(alpha, free_face);
-  split(bd.corners);
-  res.seconds = timer.seconds();
-  return res;
 }
 
 std::vector<char> PeriodicGlobalParameterization::Impl::initial_free_set() {

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/rasterizer.h"
+#include "geometry/vec3.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -19,14 +20,12 @@ namespace {
 // ---------------------------------------------------------------- vectors
 using V3 = std::array<double, 3>;
 V3 to_d(const Vec3f& a) { return {a[0], a[1], a[2]}; }
-V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-V3 mul(const V3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const V3& a) { return std::sqrt(dot(a, a)); }
+using vec3::add;
+using vec3::cross;
+using vec3::dot;
+using vec3::mul;
+using vec3::norm;
+using vec3::sub;
 bool finite3(const Vec3f& a) {
   return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
 }

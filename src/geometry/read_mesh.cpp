@@ -301,11 +301,23 @@ struct OriginVisitor {
   void after_subface_creations() {}
 };
 
-}  // namespace
+/// The soup's per-point colours, per-corner UVs and per-polygon materials,
+/// keyed by exact position (polygon keys: polygon_key) so that they survive
+/// the repair's renumbering.
+struct SoupAttributes {
+  bool colors = false, uvs = false, materials = false;
+  std::unordered_map<Pos, std::array<float, 3>, PositionHash> color_of;
+  /// polygon key -> its corners (position, uv); the first polygon wins.
+  std::map<std::vector<Pos>, std::vector<std::pair<Pos, UV>>> uv_source;
+  /// polygon key -> its material; the first polygon wins.
+  std::map<std::vector<Pos>, int> material_source;
+};
 
-void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, SoupRepairCounts* out) {
-  SoupRepairCounts c;
-  const std::string& src = soup.source.empty() ? std::string("polygon soup") : soup.source;
+/// Checks the soup's indices and attribute arrays (throws TopologyError for
+/// no face, InvalidInputError for an index out of range or a size mismatch);
+/// counts the input; says which attributes it carries.
+SoupAttributes check_soup(const PolygonSoup& soup, const std::string& src, SoupRepairCounts& c) {
+  SoupAttributes a;
   c.input_points = soup.points.size();
   c.input_polygons = soup.polygons.size();
   c.short_polygons_dropped = soup.short_polygons_dropped;
@@ -321,11 +333,10 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
         throw InvalidInputError("'" + src + "' polygon " + std::to_string(i) + ": index " +
                                 std::to_string(v) + " out of range (" +
                                 std::to_string(soup.points.size()) + " points)");
-  const bool has_colors = !soup.colors.empty();
-  if (has_colors && soup.colors.size() != soup.points.size())
+  a.colors = !soup.colors.empty();
+  if (a.colors && soup.colors.size() != soup.points.size())
     throw InvalidInputError("'" + src + "': " + std::to_string(soup.colors.size()) + " colours for " +
                             std::to_string(soup.points.size()) + " points");
-  bool has_uvs = false;
   if (!soup.polygon_uvs.empty()) {
     if (soup.polygon_uvs.size() != soup.polygons.size())
       throw InvalidInputError("'" + src + "': polygon_uvs does not match polygons");
@@ -339,12 +350,11 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
         if (t >= soup.uvs.size())
           throw InvalidInputError("'" + src + "' polygon " + std::to_string(i) + ": UV index " +
                                   std::to_string(t) + " out of range");
-      has_uvs = true;
+      a.uvs = true;
     }
   }
-
-  const bool has_materials = !soup.polygon_material.empty();
-  if (has_materials) {
+  a.materials = !soup.polygon_material.empty();
+  if (a.materials) {
     if (soup.polygon_material.size() != soup.polygons.size())
       throw InvalidInputError("'" + src + "': polygon_material does not match polygons");
     for (std::size_t i = 0; i < soup.polygons.size(); ++i)
@@ -353,40 +363,37 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
                                 std::to_string(soup.polygon_material[i]) + " out of range (" +
                                 std::to_string(soup.materials.size()) + " materials)");
   }
+  return a;
+}
 
-  std::vector<Point3> pts;
-  pts.reserve(soup.points.size());
-  for (const auto& p : soup.points) pts.emplace_back(p[0], p[1], p[2]);
-
-  // Attributes keyed by exact position, to map them through the renumbering.
-  std::unordered_map<Pos, std::array<float, 3>, PositionHash> color_of;
-  if (has_colors)
+/// Keys the soup's attributes by exact position, to map them through the
+/// renumbering of the repair.
+void key_attributes(const PolygonSoup& soup, const std::vector<Point3>& pts, SoupAttributes& a) {
+  if (a.colors)
     for (std::size_t i = 0; i < soup.points.size(); ++i)
-      color_of.emplace(canonical_position(soup.points[i]), soup.colors[i]);
-  // polygon key -> its corners (position, uv); the first polygon wins.
-  std::map<std::vector<Pos>, std::vector<std::pair<Pos, UV>>> uv_source;
-  if (has_uvs)
+      a.color_of.emplace(canonical_position(soup.points[i]), soup.colors[i]);
+  if (a.uvs)
     for (std::size_t i = 0; i < soup.polygons.size(); ++i) {
       if (soup.polygon_uvs[i].empty()) continue;
       auto key = polygon_key(pts, soup.polygons[i]);
-      if (uv_source.count(key)) continue;
+      if (a.uv_source.count(key)) continue;
       std::vector<std::pair<Pos, UV>> corners;
       for (std::size_t k = 0; k < soup.polygons[i].size(); ++k) {
         const auto& uv = soup.uvs[soup.polygon_uvs[i][k]];
         corners.emplace_back(canonical_position(soup.points[soup.polygons[i][k]]), UV{uv[0], uv[1]});
       }
-      uv_source.emplace(std::move(key), std::move(corners));
+      a.uv_source.emplace(std::move(key), std::move(corners));
     }
-
-  // polygon key -> its material; the first polygon wins.
-  std::map<std::vector<Pos>, int> material_source;
-  if (has_materials)
+  if (a.materials)
     for (std::size_t i = 0; i < soup.polygons.size(); ++i)
-      material_source.emplace(polygon_key(pts, soup.polygons[i]), soup.polygon_material[i]);
+      a.material_source.emplace(polygon_key(pts, soup.polygons[i]), soup.polygon_material[i]);
+}
 
-  auto& polys = soup.polygons;
-  // The steps of PMP::repair_polygon_soup (CGAL 5.5, Polygon_soup_fixer), in
-  // its order, called one by one so that each is counted.
+/// The steps of PMP::repair_polygon_soup (CGAL 5.5, Polygon_soup_fixer), in
+/// its order, called one by one so that each is counted. Throws TopologyError
+/// when no face is left.
+void repair_soup(std::vector<Point3>& pts, std::vector<std::vector<std::size_t>>& polys, const std::string& src,
+                 SoupRepairCounts& c) {
   c.duplicate_points_merged = PMP::merge_duplicate_points_in_polygon_soup(pts, polys);
   c.polygons_simplified = PMP::internal::simplify_polygons_in_polygon_soup(pts, polys, Kernel());
   std::size_t before_split = polys.size();
@@ -402,13 +409,18 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
                         std::to_string(c.input_polygons) + " polygons, " +
                         std::to_string(c.degenerate_polygons_removed) + " degenerate, " +
                         std::to_string(c.duplicate_polygons_removed) + " duplicates)");
+}
 
+/// Orients the repaired soup (duplicating the points it must) and converts it
+/// into `mesh`: one vertex per point and one face per polygon, in order.
+/// Throws TopologyError if it is still not a polygon mesh or loses elements.
+void orient_and_convert(std::vector<Point3>& pts, std::vector<std::vector<std::size_t>>& polys,
+                        const std::string& src, Mesh& mesh, SoupRepairCounts& c) {
   std::size_t before_orient = pts.size();
   c.oriented = PMP::orient_polygon_soup(pts, polys);
   c.points_duplicated_to_orient = pts.size() - before_orient;
   if (!PMP::is_polygon_soup_a_polygon_mesh(polys))
     throw TopologyError("'" + src + "': the repaired, oriented soup is still not a polygon mesh");
-
   mesh.clear();
   PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
   if (mesh.number_of_vertices() != pts.size() || mesh.number_of_faces() != polys.size())
@@ -417,25 +429,29 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
                         std::to_string(polys.size()) + " faces)");
   // polygon_soup_to_polygon_mesh adds one vertex per point, in order, and one
   // face per polygon, in order, to the (empty) mesh.
+}
 
-  if (has_colors) {
+/// The keyed attributes onto the mesh: vertex colours, corner UVs (counted:
+/// found or dropped) and face materials.
+void restore_attributes(const SoupAttributes& a, const std::vector<Point3>& pts,
+                        const std::vector<std::vector<std::size_t>>& polys, Mesh& mesh, SoupRepairCounts& c) {
+  if (a.colors) {
     auto cmap = get_or_add(mesh, kVertexColor, Color3f{0.f, 0.f, 0.f});
     for (VertexIndex v : mesh.vertices()) {
       const Point3& p = mesh.point(v);
-      auto it = color_of.find(canonical_position({p.x(), p.y(), p.z()}));
-      if (it != color_of.end()) cmap[v] = it->second;
+      auto it = a.color_of.find(canonical_position({p.x(), p.y(), p.z()}));
+      if (it != a.color_of.end()) cmap[v] = it->second;
     }
   }
-
-  if (has_uvs) {
+  if (a.uvs) {
     auto uvmap = get_or_add(mesh, kCornerUV, UV{0.0, 0.0});
     for (FaceIndex f : mesh.faces()) {
-      auto it = uv_source.find(polygon_key(pts, polys[f.idx()]));
+      auto it = a.uv_source.find(polygon_key(pts, polys[f.idx()]));
       for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
         const Point3& p = mesh.point(mesh.target(h));
         const Pos key = canonical_position({p.x(), p.y(), p.z()});
         bool found = false;
-        if (it != uv_source.end())
+        if (it != a.uv_source.end())
           for (const auto& [pos, uv] : it->second)
             if (pos == key) {
               uvmap[h] = uv;
@@ -446,76 +462,97 @@ void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, So
       }
     }
   }
-
-  if (has_materials) {
+  if (a.materials) {
     auto mat = get_or_add(mesh, kFaceMaterial, -1);
     for (FaceIndex f : mesh.faces()) {
-      auto it = material_source.find(polygon_key(pts, polys[f.idx()]));
-      mat[f] = it == material_source.end() ? -1 : it->second;
+      auto it = a.material_source.find(polygon_key(pts, polys[f.idx()]));
+      mat[f] = it == a.material_source.end() ? -1 : it->second;
     }
   }
+}
 
-  if (opt.triangulate) {
-    std::vector<std::size_t> origin(mesh.number_of_faces(), SIZE_MAX);
-    std::vector<int> material_before;  // by face index, before splitting
-    if (has_materials) {
-      auto mat = find(mesh, kFaceMaterial).first;
-      for (FaceIndex f : mesh.faces()) material_before.push_back(mat[f]);
+/// Fan triangulation, from its first corner, of every face triangulate_faces
+/// left (it tries every face and leaves the ones it cannot split: degenerate
+/// projection): possibly folded geometry, but valid topology, and counted so
+/// that repair reports it.
+void fan_triangulate_left(Mesh& mesh, OriginVisitor& vis, SoupRepairCounts& c) {
+  std::vector<FaceIndex> left;
+  for (FaceIndex f : mesh.faces())
+    if (mesh.degree(f) > 3) left.push_back(f);
+  for (FaceIndex f : left) {
+    vis.before_subface_creations(f);
+    HalfedgeIndex h0 = mesh.halfedge(f);
+    while (mesh.next(mesh.next(mesh.next(h0))) != h0) {
+      // Cut the triangle (h0's source, target(h0), target(next(h0))) off.
+      HalfedgeIndex cut = CGAL::Euler::split_face(mesh.prev(h0), mesh.next(h0), mesh);
+      vis.after_subface_created(mesh.face(h0));
+      h0 = cut;  // split_face keeps the rest of the polygon on the new halfedge
     }
-    std::size_t current = 0, split = 0;
-    // UVs of the corners of each non-triangular face, before it is split.
-    std::unordered_map<std::size_t, std::vector<std::pair<VertexIndex, UV>>> face_uvs;
-    auto uvm = find(mesh, kCornerUV);
-    if (uvm.second)
-      for (FaceIndex f : mesh.faces()) {
-        if (mesh.degree(f) == 3) continue;
-        auto& list = face_uvs[f.idx()];
-        for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f)))
-          list.emplace_back(mesh.target(h), uvm.first[h]);
-      }
-    OriginVisitor vis{&origin, &current, &split};
-    if (!PMP::triangulate_faces(mesh, CGAL::parameters::visitor(vis))) {
-      // triangulate_faces tries every face and leaves the ones it cannot
-      // split (degenerate projection). Those get a fan from their first
-      // corner: possibly folded geometry, but valid topology, and counted so
-      // that repair reports it.
-      std::vector<FaceIndex> left;
-      for (FaceIndex f : mesh.faces())
-        if (mesh.degree(f) > 3) left.push_back(f);
-      for (FaceIndex f : left) {
-        vis.before_subface_creations(f);
-        HalfedgeIndex h0 = mesh.halfedge(f);
-        while (mesh.next(mesh.next(mesh.next(h0))) != h0) {
-          // Cut the triangle (h0's source, target(h0), target(next(h0))) off.
-          HalfedgeIndex cut = CGAL::Euler::split_face(mesh.prev(h0), mesh.next(h0), mesh);
-          vis.after_subface_created(mesh.face(h0));
-          h0 = cut;  // split_face keeps the rest of the polygon on the new halfedge
-        }
-        vis.after_subface_created(mesh.face(h0));
-        ++c.faces_fan_triangulated;
-      }
-    }
-    c.faces_triangulated = split;
-    if (has_materials) {
-      auto mat = find(mesh, kFaceMaterial).first;
-      for (FaceIndex f : mesh.faces()) {
-        std::size_t i = f.idx();
-        if (i < origin.size() && origin[i] != SIZE_MAX) mat[f] = material_before[origin[i]];
-      }
-    }
-    if (uvm.second)
-      for (FaceIndex f : mesh.faces()) {
-        std::size_t i = f.idx();
-        if (i >= origin.size() || origin[i] == SIZE_MAX) continue;
-        const auto& list = face_uvs[origin[i]];
-        for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f)))
-          for (const auto& [v, uv] : list)
-            if (v == mesh.target(h)) {
-              uvm.first[h] = uv;
-              break;
-            }
-      }
+    vis.after_subface_created(mesh.face(h0));
+    ++c.faces_fan_triangulated;
   }
+}
+
+/// Triangulates the non-triangular faces (PMP::triangulate_faces, then a fan
+/// for those it leaves), each triangle keeping its face's material and
+/// corner UVs.
+void triangulate_keeping_attributes(Mesh& mesh, bool has_materials, SoupRepairCounts& c) {
+  std::vector<std::size_t> origin(mesh.number_of_faces(), SIZE_MAX);
+  std::vector<int> material_before;  // by face index, before splitting
+  if (has_materials) {
+    auto mat = find(mesh, kFaceMaterial).first;
+    for (FaceIndex f : mesh.faces()) material_before.push_back(mat[f]);
+  }
+  std::size_t current = 0, split = 0;
+  // UVs of the corners of each non-triangular face, before it is split.
+  std::unordered_map<std::size_t, std::vector<std::pair<VertexIndex, UV>>> face_uvs;
+  auto uvm = find(mesh, kCornerUV);
+  if (uvm.second)
+    for (FaceIndex f : mesh.faces()) {
+      if (mesh.degree(f) == 3) continue;
+      auto& list = face_uvs[f.idx()];
+      for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f)))
+        list.emplace_back(mesh.target(h), uvm.first[h]);
+    }
+  OriginVisitor vis{&origin, &current, &split};
+  if (!PMP::triangulate_faces(mesh, CGAL::parameters::visitor(vis))) fan_triangulate_left(mesh, vis, c);
+  c.faces_triangulated = split;
+  if (has_materials) {
+    auto mat = find(mesh, kFaceMaterial).first;
+    for (FaceIndex f : mesh.faces()) {
+      std::size_t i = f.idx();
+      if (i < origin.size() && origin[i] != SIZE_MAX) mat[f] = material_before[origin[i]];
+    }
+  }
+  if (uvm.second)
+    for (FaceIndex f : mesh.faces()) {
+      std::size_t i = f.idx();
+      if (i >= origin.size() || origin[i] == SIZE_MAX) continue;
+      const auto& list = face_uvs[origin[i]];
+      for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f)))
+        for (const auto& [v, uv] : list)
+          if (v == mesh.target(h)) {
+            uvm.first[h] = uv;
+            break;
+          }
+    }
+}
+
+}  // namespace
+
+void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt, SoupRepairCounts* out) {
+  SoupRepairCounts c;
+  const std::string& src = soup.source.empty() ? std::string("polygon soup") : soup.source;
+  SoupAttributes attributes = check_soup(soup, src, c);
+  std::vector<Point3> pts;
+  pts.reserve(soup.points.size());
+  for (const auto& p : soup.points) pts.emplace_back(p[0], p[1], p[2]);
+  key_attributes(soup, pts, attributes);
+  auto& polys = soup.polygons;
+  repair_soup(pts, polys, src, c);
+  orient_and_convert(pts, polys, src, mesh, c);
+  restore_attributes(attributes, pts, polys, mesh, c);
+  if (opt.triangulate) triangulate_keeping_attributes(mesh, attributes.materials, c);
   c.output_vertices = mesh.number_of_vertices();
   c.output_faces = mesh.number_of_faces();
   if (out) *out = c;

@@ -133,9 +133,36 @@ class BodyReader {
   std::size_t ti_ = 0;
 };
 
-}  // namespace
+/// The header: the body's encoding, the elements with their properties, and
+/// where the body starts (byte offset and line number).
+struct PlyHeader {
+  Encoding enc = Encoding::Ascii;
+  std::vector<Element> elements;
+  std::size_t body_offset = 0, body_line = 0;
+};
 
-PolygonSoup read_ply(const std::string& path, std::string_view data) {
+/// One 'property' line into the last element (throws IOError when malformed).
+void parse_property(const std::string& path, const std::string& where, std::string_view line,
+                    const std::vector<std::string_view>& tok, std::vector<Element>& elements) {
+  if (elements.empty()) fail_io(path, where, "property before any element");
+  Property p;
+  if (tok.size() >= 2 && tok[1] == "list") {
+    if (tok.size() < 5 || !parse_type(tok[2], p.count_type) || !parse_type(tok[3], p.type))
+      fail_io(path, where, "expected 'property list COUNT_TYPE INDEX_TYPE NAME', got " + show(line));
+    if (is_float(p.count_type)) fail_io(path, where, "list count type must be an integer type");
+    p.is_list = true;
+    p.name = std::string(tok[4]);
+  } else {
+    if (tok.size() < 3 || !parse_type(tok[1], p.type))
+      fail_io(path, where, "expected 'property TYPE NAME', got " + show(line));
+    p.name = std::string(tok[2]);
+  }
+  elements.back().props.push_back(std::move(p));
+}
+
+/// The header from the magic line to end_header: format, elements and their
+/// properties; comments skipped. Throws IOError for anything else.
+PlyHeader parse_header(const std::string& path, std::string_view data) {
   TextLines header(path, data, utf8_bom_length(data));
   std::string_view line;
   std::vector<std::string_view> tok;
@@ -146,9 +173,8 @@ PolygonSoup read_ply(const std::string& path, std::string_view data) {
     magic = tok.size() == 1 && tok[0] == "ply";
   }
   if (!magic) fail_io(path, at_line(1), "not a PLY file (no 'ply' magic)");
-  Encoding enc = Encoding::Ascii;
+  PlyHeader h;
   bool have_format = false, ended = false;
-  std::vector<Element> elements;
   while (header.next(line)) {
     const std::string where = at_line(header.line_no());
     split_blanks(line, tok);
@@ -160,9 +186,9 @@ PolygonSoup read_ply(const std::string& path, std::string_view data) {
     }
     if (tok[0] == "format") {
       if (tok.size() < 2) fail_io(path, where, "format line without an encoding");
-      if (tok[1] == "ascii") enc = Encoding::Ascii;
-      else if (tok[1] == "binary_little_endian") enc = Encoding::Little;
-      else if (tok[1] == "binary_big_endian") enc = Encoding::Big;
+      if (tok[1] == "ascii") h.enc = Encoding::Ascii;
+      else if (tok[1] == "binary_little_endian") h.enc = Encoding::Little;
+      else if (tok[1] == "binary_big_endian") h.enc = Encoding::Big;
       else fail_io(path, where, "unknown PLY format " + show(tok[1]));
       have_format = true;
     } else if (tok[0] == "element") {
@@ -171,38 +197,30 @@ PolygonSoup read_ply(const std::string& path, std::string_view data) {
         fail_io(path, where, "expected 'element NAME COUNT', got " + show(line));
       e.name = std::string(tok[1]);
       e.header_line = header.line_no();
-      elements.push_back(std::move(e));
+      h.elements.push_back(std::move(e));
     } else if (tok[0] == "property") {
-      if (elements.empty()) fail_io(path, where, "property before any element");
-      Property p;
-      if (tok.size() >= 2 && tok[1] == "list") {
-        if (tok.size() < 5 || !parse_type(tok[2], p.count_type) || !parse_type(tok[3], p.type))
-          fail_io(path, where, "expected 'property list COUNT_TYPE INDEX_TYPE NAME', got " + show(line));
-        if (is_float(p.count_type)) fail_io(path, where, "list count type must be an integer type");
-        p.is_list = true;
-        p.name = std::string(tok[4]);
-      } else {
-        if (tok.size() < 3 || !parse_type(tok[1], p.type))
-          fail_io(path, where, "expected 'property TYPE NAME', got " + show(line));
-        p.name = std::string(tok[2]);
-      }
-      elements.back().props.push_back(std::move(p));
+      parse_property(path, where, line, tok, h.elements);
     } else {
       fail_io(path, where, "unexpected header line " + show(line));
     }
   }
   if (!ended) fail_io(path, "", "no 'end_header' (truncated or not a PLY file)");
   if (!have_format) fail_io(path, "", "no 'format' line in the header");
+  h.body_offset = header.offset();
+  h.body_line = header.line_no() + 1;
+  return h;
+}
 
-  // Refuse counts the rest of the file cannot hold: binary elements need at
-  // least the sum of their fixed sizes (lists: the count), ascii ones two
-  // bytes per value.
-  const std::uint64_t body = data.size() - header.offset();
+/// Refuses counts the rest of the file cannot hold: binary elements need at
+/// least the sum of their fixed sizes (lists: the count), ascii ones two
+/// bytes per value.
+void check_element_counts(const std::string& path, const PlyHeader& h, std::size_t data_size) {
+  const std::uint64_t body = data_size - h.body_offset;
   std::uint64_t total_min = 0;
-  for (const Element& e : elements) {
+  for (const Element& e : h.elements) {
     std::uint64_t min_bytes = 0;
     for (const Property& p : e.props)
-      min_bytes += enc == Encoding::Ascii ? 2 : type_size(p.is_list ? p.count_type : p.type);
+      min_bytes += h.enc == Encoding::Ascii ? 2 : type_size(p.is_list ? p.count_type : p.type);
     if (min_bytes == 0 || e.count == 0) continue;
     if (e.count > (body + 1) / min_bytes || total_min + e.count * min_bytes > body + 1)
       fail_io(path, at_line(e.header_line),
@@ -210,108 +228,151 @@ PolygonSoup read_ply(const std::string& path, std::string_view data) {
                   std::to_string(body) + " bytes of data follow (truncated file or corrupt header)");
     total_min += e.count * min_bytes;
   }
+}
 
+/// What the body reading has gathered so far.
+struct PlyBody {
   PolygonSoup soup;
   std::uint64_t nv = 0;
   bool seen_vertex = false;
   std::vector<std::string> face_where;  // ascii faces: for out-of-range messages
-  BodyReader in(path, data, header.offset(), enc, header.line_no() + 1);
-  for (const Element& e : elements) {
-    if (e.props.empty()) continue;
-    const bool is_vertex = e.name == "vertex" && !seen_vertex;
-    const bool is_face = e.name == "face";
-    int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1, ilist = -1;
+};
+
+/// The properties of an element that surftex reads (-1: absent): x/y/z and
+/// colour of the first vertex element, the index list of a face element.
+struct ElementRoles {
+  bool is_vertex = false, is_face = false, colors = false;
+  int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1, ilist = -1;
+};
+
+ElementRoles element_roles(const Element& e, bool seen_vertex) {
+  ElementRoles r;
+  r.is_vertex = e.name == "vertex" && !seen_vertex;
+  r.is_face = e.name == "face";
+  for (std::size_t k = 0; k < e.props.size(); ++k) {
+    const Property& p = e.props[k];
+    const int ki = static_cast<int>(k);
+    if (r.is_vertex && !p.is_list) {
+      if (p.name == "x") r.ix = ki;
+      else if (p.name == "y") r.iy = ki;
+      else if (p.name == "z") r.iz = ki;
+      else if (p.name == "red" || p.name == "diffuse_red") r.ir = ki;
+      else if (p.name == "green" || p.name == "diffuse_green") r.ig = ki;
+      else if (p.name == "blue" || p.name == "diffuse_blue") r.ib = ki;
+    }
+    if (r.is_face && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index") && r.ilist < 0)
+      r.ilist = ki;
+  }
+  r.colors = r.is_vertex && r.ir >= 0 && r.ig >= 0 && r.ib >= 0;
+  return r;
+}
+
+/// List property k of item i: its length checked against the bytes left;
+/// the face list kept as a polygon (a face of fewer than 3 vertices dropped
+/// and counted), any other list skipped.
+void read_list(const std::string& path, const Element& e, std::size_t k, std::uint64_t i, Encoding enc,
+               const ElementRoles& r, BodyReader& in, PlyBody& b) {
+  const Property& p = e.props[k];
+  PolygonSoup& soup = b.soup;
+  const std::string where_count = in.where(e.name, i);
+  double cnt = in.read(p.count_type, e.name, i);
+  if (cnt < 0) fail_io(path, where_count, "negative list length " + std::to_string(cnt));
+  const std::uint64_t n = static_cast<std::uint64_t>(cnt);
+  const std::size_t item = enc == Encoding::Ascii ? 2 : type_size(p.type);
+  if (n > in.remaining() / item + 1)
+    fail_io(path, where_count,
+            "list of " + std::to_string(n) + " values does not fit in the " +
+                std::to_string(in.remaining()) + " bytes left (truncated or corrupt)");
+  if (static_cast<int>(k) != r.ilist) {
+    for (std::uint64_t m = 0; m < n; ++m) in.read(p.type, e.name, i);
+    return;
+  }
+  std::vector<std::size_t> poly(n);
+  for (std::uint64_t m = 0; m < n; ++m) {
+    double v = in.read(p.type, e.name, i);
+    if (!(v >= 0) || v != std::floor(v) || v >= 18446744073709551616.0)
+      fail_input(path, where_count, "vertex index " + std::to_string(v) + " is negative or not an integer");
+    poly[m] = static_cast<std::size_t>(v);
+  }
+  if (n < 3) {  // bounds no area: dropped and counted (indices checked below only for kept faces)
+    for (std::size_t v : poly)
+      if (v >= b.nv)
+        fail_input(path, where_count, "vertex index " + std::to_string(v) + " out of range");
+    if (soup.short_polygons_dropped++ == 0)
+      soup.first_short_polygon = where_count + ": " + std::to_string(n) + "-vertex face";
+    return;
+  }
+  soup.polygons.push_back(std::move(poly));
+  if (enc == Encoding::Ascii) b.face_where.push_back(where_count);
+}
+
+/// Vertex i from its scalar properties: the position (finite) and the colour
+/// if any (integers as 0-255, floats as 0-1, clamped).
+void append_vertex(const std::string& path, const Element& e, std::uint64_t i, const std::vector<double>& scalar,
+                   const ElementRoles& r, BodyReader& in, PolygonSoup& soup) {
+  std::array<double, 3> pt{scalar[r.ix], scalar[r.iy], scalar[r.iz]};
+  check_finite(path, in.where(e.name, i), pt);
+  soup.points.push_back(pt);
+  if (!r.colors) return;
+  std::array<float, 3> c{};
+  const int idx[3] = {r.ir, r.ig, r.ib};
+  for (int q = 0; q < 3; ++q) {
+    double v = scalar[idx[q]];
+    if (!std::isfinite(v)) fail_input(path, in.where(e.name, i), "colour component is not finite");
+    if (!is_float(e.props[idx[q]].type)) v /= 255.0;
+    c[q] = static_cast<float>(std::clamp(v, 0.0, 1.0));
+  }
+  soup.colors.push_back(c);
+}
+
+/// Every item of one element, in order: the vertices and faces kept, the
+/// rest read past.
+void read_element(const std::string& path, const Element& e, Encoding enc, BodyReader& in, PlyBody& b) {
+  const ElementRoles r = element_roles(e, b.seen_vertex);
+  PolygonSoup& soup = b.soup;
+  if (r.is_vertex) {
+    if (r.ix < 0 || r.iy < 0 || r.iz < 0)
+      fail_io(path, at_line(e.header_line), "vertex element lacks an x, y or z property");
+    b.seen_vertex = true;
+    b.nv = e.count;
+    soup.points.reserve(e.count);
+  }
+  if (r.colors) soup.colors.reserve(e.count);
+  if (r.is_face && r.ilist < 0)
+    fail_io(path, at_line(e.header_line), "face element has no vertex_indices list");
+  if (r.is_face) soup.polygons.reserve(soup.polygons.size() + e.count);
+
+  std::vector<double> scalar(e.props.size(), 0.0);
+  for (std::uint64_t i = 0; i < e.count; ++i) {
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       const Property& p = e.props[k];
-      const int ki = static_cast<int>(k);
-      if (is_vertex && !p.is_list) {
-        if (p.name == "x") ix = ki;
-        else if (p.name == "y") iy = ki;
-        else if (p.name == "z") iz = ki;
-        else if (p.name == "red" || p.name == "diffuse_red") ir = ki;
-        else if (p.name == "green" || p.name == "diffuse_green") ig = ki;
-        else if (p.name == "blue" || p.name == "diffuse_blue") ib = ki;
-      }
-      if (is_face && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index") && ilist < 0)
-        ilist = ki;
+      if (!p.is_list)
+        scalar[k] = in.read(p.type, e.name, i);
+      else
+        read_list(path, e, k, i, enc, r, in, b);
     }
-    if (is_vertex) {
-      if (ix < 0 || iy < 0 || iz < 0)
-        fail_io(path, at_line(e.header_line), "vertex element lacks an x, y or z property");
-      seen_vertex = true;
-      nv = e.count;
-      soup.points.reserve(e.count);
-    }
-    const bool colors = is_vertex && ir >= 0 && ig >= 0 && ib >= 0;
-    if (colors) soup.colors.reserve(e.count);
-    if (is_face && ilist < 0)
-      fail_io(path, at_line(e.header_line), "face element has no vertex_indices list");
-    if (is_face) soup.polygons.reserve(soup.polygons.size() + e.count);
-
-    std::vector<double> scalar(e.props.size(), 0.0);
-    for (std::uint64_t i = 0; i < e.count; ++i) {
-      for (std::size_t k = 0; k < e.props.size(); ++k) {
-        const Property& p = e.props[k];
-        if (!p.is_list) {
-          scalar[k] = in.read(p.type, e.name, i);
-          continue;
-        }
-        const std::string where_count = in.where(e.name, i);
-        double cnt = in.read(p.count_type, e.name, i);
-        if (cnt < 0) fail_io(path, where_count, "negative list length " + std::to_string(cnt));
-        const std::uint64_t n = static_cast<std::uint64_t>(cnt);
-        const std::size_t item = enc == Encoding::Ascii ? 2 : type_size(p.type);
-        if (n > in.remaining() / item + 1)
-          fail_io(path, where_count,
-                  "list of " + std::to_string(n) + " values does not fit in the " +
-                      std::to_string(in.remaining()) + " bytes left (truncated or corrupt)");
-        if (static_cast<int>(k) == ilist) {
-          std::vector<std::size_t> poly(n);
-          for (std::uint64_t m = 0; m < n; ++m) {
-            double v = in.read(p.type, e.name, i);
-            if (!(v >= 0) || v != std::floor(v) || v >= 18446744073709551616.0)
-              fail_input(path, where_count, "vertex index " + std::to_string(v) + " is negative or not an integer");
-            poly[m] = static_cast<std::size_t>(v);
-          }
-          if (n < 3) {  // bounds no area: dropped and counted (indices checked below only for kept faces)
-            for (std::size_t v : poly)
-              if (v >= nv)
-                fail_input(path, where_count, "vertex index " + std::to_string(v) + " out of range");
-            if (soup.short_polygons_dropped++ == 0)
-              soup.first_short_polygon = where_count + ": " + std::to_string(n) + "-vertex face";
-            continue;
-          }
-          soup.polygons.push_back(std::move(poly));
-          if (enc == Encoding::Ascii) face_where.push_back(where_count);
-        } else {
-          for (std::uint64_t m = 0; m < n; ++m) in.read(p.type, e.name, i);
-        }
-      }
-      if (is_vertex) {
-        std::array<double, 3> pt{scalar[ix], scalar[iy], scalar[iz]};
-        check_finite(path, in.where(e.name, i), pt);
-        soup.points.push_back(pt);
-        if (colors) {
-          std::array<float, 3> c{};
-          const int idx[3] = {ir, ig, ib};
-          for (int q = 0; q < 3; ++q) {
-            double v = scalar[idx[q]];
-            if (!std::isfinite(v)) fail_input(path, in.where(e.name, i), "colour component is not finite");
-            if (!is_float(e.props[idx[q]].type)) v /= 255.0;
-            c[q] = static_cast<float>(std::clamp(v, 0.0, 1.0));
-          }
-          soup.colors.push_back(c);
-        }
-      }
-    }
+    if (r.is_vertex) append_vertex(path, e, i, scalar, r, in, soup);
   }
-  if (!seen_vertex) fail_io(path, "", "no vertex element");
-  for (std::size_t j = 0; j < soup.polygons.size(); ++j)
-    for (std::size_t v : soup.polygons[j])
-      if (v >= nv)
-        fail_input(path, j < face_where.size() ? face_where[j] : "face " + std::to_string(j),
-                   "vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(nv) + ")");
-  return soup;
+}
+
+}  // namespace
+
+PolygonSoup read_ply(const std::string& path, std::string_view data) {
+  const PlyHeader h = parse_header(path, data);
+  check_element_counts(path, h, data.size());
+  PlyBody b;
+  BodyReader in(path, data, h.body_offset, h.enc, h.body_line);
+  for (const Element& e : h.elements) {
+    if (e.props.empty()) continue;
+    read_element(path, e, h.enc, in, b);
+  }
+  if (!b.seen_vertex) fail_io(path, "", "no vertex element");
+  for (std::size_t j = 0; j < b.soup.polygons.size(); ++j)
+    for (std::size_t v : b.soup.polygons[j])
+      if (v >= b.nv)
+        fail_input(path, j < b.face_where.size() ? b.face_where[j] : "face " + std::to_string(j),
+                   "vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(b.nv) + ")");
+  return std::move(b.soup);
 }
 
 }  // namespace surftex::mesh_io

@@ -346,7 +346,11 @@ class Repairer {
           continue;
         }
         std::vector<FaceIndex> patch;
-        PMP::triangulate_hole(m_, h, std::back_inserter(patch));
+        // The full (cubic) search, not CGAL's default Delaunay search space:
+        // that one's result depended on the heap layout (the same hole was
+        // filled differently in one process and the next; decision 605).
+        PMP::triangulate_hole(m_, h, std::back_inserter(patch),
+                              CGAL::parameters::use_delaunay_triangulation(false));
         if (patch.empty()) {
           ++r_.done.holes_skipped;
         } else {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Per-vertex tangent frames (see vertex_tangents.h).
 #include "geometry/vertex_tangents.h"
+#include "geometry/vec3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,12 +14,10 @@ namespace surftex {
 namespace {
 
 using D3 = std::array<double, 3>;
-D3 sub(const D3& a, const D3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(const D3& a, const D3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-D3 cross(const D3& a, const D3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-D3 scale(const D3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+using vec3::cross;
+using vec3::dot;
+using vec3::sub;
+D3 scale(const D3& a, double s) { return vec3::mul(a, s); }
 D3 unit(const D3& a) {
   const double l = std::sqrt(dot(a, a));
   return l > 0 ? scale(a, 1 / l) : D3{0, 0, 0};

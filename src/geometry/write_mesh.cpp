@@ -430,17 +430,11 @@ std::string png_bytes(const std::string& beside, const Image& img) {
   return ss.str();
 }
 
-void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
-  Gathered g = gather(path, mesh, opt, true);
-  MaterialGroups groups = material_groups(path, mesh, opt);
-  if (groups.materials.empty()) groups.materials.push_back({"surftex_material", {1.f, 1.f, 1.f}, nullptr});
-  for (const auto& m : groups.materials)
-    if (m.texture && !g.has_uv)
-      throw InvalidInputError("cannot write '" + path + "': material '" + m.name +
-                              "' has a texture but the mesh has no texture coordinates to map it with");
-  // One glTF vertex per distinct (vertex, uv) pair: vertices are split at UV seams.
-  GltfVertexSplit split;
-  // Triangles per material: one primitive each, sharing the vertex attributes.
+// The triangles of every material (one glTF primitive each), as indices of
+// glTF vertices: one per distinct (vertex, uv) pair, so that vertices are
+// split at UV seams; polygons are fanned.
+std::vector<std::vector<std::uint32_t>> gltf_triangles(const Gathered& g, const MaterialGroups& groups,
+                                                       GltfVertexSplit& split) {
   std::vector<std::vector<std::uint32_t>> indices(groups.materials.size());
   auto vid = [&](std::size_t v, HalfedgeIndex h) -> std::uint32_t {
     std::array<double, 2> uv{0.0, 0.0};
@@ -457,29 +451,37 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
       out.push_back(vid(fv[k + 1], g.corners[f][k + 1]));
     }
   }
-  const std::vector<std::size_t>& src = split.source();        // glTF vertex -> mesh vertex (compact id)
-  const std::vector<std::array<float, 2>>& tc = split.texcoord();  // glTF TEXCOORD_0 (v flipped)
-  if (src.size() > 0xffffffffu) throw InvalidInputError("cannot write '" + path + "': too many vertices for glTF");
+  return indices;
+}
 
+// A glTF model over one buffer: views (4-byte aligned), accessors and
+// embedded PNG textures appended in call order.
+struct GlbBuilder {
   tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "surftex";
-  model.buffers.emplace_back();
-  auto& buf = model.buffers[0].data;
-  auto add_view = [&](const void* data, std::size_t bytes, int target) -> int {
-    while (buf.size() % 4) buf.push_back(0);
+
+  GlbBuilder() {
+    model.asset.version = "2.0";
+    model.asset.generator = "surftex";
+    model.buffers.emplace_back();
+  }
+  std::vector<unsigned char>& buf() { return model.buffers[0].data; }
+  void align() {
+    while (buf().size() % 4) buf().push_back(0);
+  }
+  int add_view(const void* data, std::size_t bytes, int target) {
+    align();
     tinygltf::BufferView bv;
     bv.buffer = 0;
-    bv.byteOffset = buf.size();
+    bv.byteOffset = buf().size();
     bv.byteLength = bytes;
     bv.target = target;
     const auto* b = static_cast<const unsigned char*>(data);
-    buf.insert(buf.end(), b, b + bytes);
+    buf().insert(buf().end(), b, b + bytes);
     model.bufferViews.push_back(bv);
     return static_cast<int>(model.bufferViews.size() - 1);
-  };
-  auto add_accessor = [&](int view, int comp, int type, std::size_t count, std::vector<double> mn = {},
-                          std::vector<double> mx = {}) -> int {
+  }
+  int add_accessor(int view, int comp, int type, std::size_t count, std::vector<double> mn = {},
+                   std::vector<double> mx = {}) {
     tinygltf::Accessor a;
     a.bufferView = view;
     a.componentType = comp;
@@ -489,65 +491,20 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     a.maxValues = std::move(mx);
     model.accessors.push_back(a);
     return static_cast<int>(model.accessors.size() - 1);
-  };
-  tinygltf::Primitive prim;
-  prim.mode = TINYGLTF_MODE_TRIANGLES;
-  {
-    std::vector<float> p(src.size() * 3);
-    std::vector<double> mn(3, HUGE_VAL), mx(3, -HUGE_VAL);
-    for (std::size_t i = 0; i < src.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        float v = static_cast<float>(g.pos[src[i]][c]);
-        p[3 * i + c] = v;
-        mn[c] = std::min<double>(mn[c], v);
-        mx[c] = std::max<double>(mx[c], v);
-      }
-    int view = add_view(p.data(), p.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["POSITION"] =
-        add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size(), mn, mx);
   }
-  if (!g.normals.empty()) {
-    std::vector<float> n(src.size() * 3);
-    for (std::size_t i = 0; i < src.size(); ++i)
-      for (int c = 0; c < 3; ++c) n[3 * i + c] = g.normals[src[i]][c];
-    int view = add_view(n.data(), n.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["NORMAL"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
+  // A float vertex attribute of `count` elements of glTF type `type`.
+  int add_float_attribute(const void* data, std::size_t bytes, int type, std::size_t count) {
+    const int view = add_view(data, bytes, TINYGLTF_TARGET_ARRAY_BUFFER);
+    return add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, type, count);
   }
-  if (g.has_uv) {
-    int view = add_view(tc.data(), tc.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["TEXCOORD_0"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, src.size());
-  }
-  if (opt.texture != nullptr && !opt.texture->empty() && g.has_uv && !g.normals.empty() &&
-      opt.normal_texture != nullptr && !opt.normal_texture->empty()) {
-    // TANGENT for the normal map (geometry/gltf_vertex_frames.h).
-    std::vector<std::uint32_t> all;
-    for (const auto& part : indices) all.insert(all.end(), part.begin(), part.end());
-    const std::vector<std::array<float, 4>> tan = gltf_vertex_tangents(g.pos, g.normals, split, all);
-    int view = add_view(tan.data(), tan.size() * 16, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["TANGENT"] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, src.size());
-  }
-  if (!g.colors.empty()) {
-    std::vector<float> c(src.size() * 3);
-    for (std::size_t i = 0; i < src.size(); ++i)
-      for (int k = 0; k < 3; ++k) c[3 * i + k] = std::clamp(g.colors[src[i]][k], 0.f, 1.f);
-    int view = add_view(c.data(), c.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes[opt.color_attribute] = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size());
-  }
-  if (!g.scalar.empty()) {
-    std::vector<float> sv(src.size());
-    for (std::size_t i = 0; i < src.size(); ++i) sv[i] = static_cast<float>(g.scalar[src[i]]);
-    int view = add_view(sv.data(), sv.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["_" + opt.vertex_scalar_property] =
-        add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, src.size());
-  }
-
-  // One embedded PNG per map, all through one sampler.
-  auto add_texture = [&](const Image& img, const char* name) -> int {
+  // One embedded PNG per map (written beside `path` while encoded), all
+  // through one sampler.
+  int add_texture(const std::string& path, const Image& img, const char* name, bool repeat) {
     if (model.samplers.empty()) {
       tinygltf::Sampler smp;
       smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
       smp.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-      smp.wrapS = smp.wrapT = opt.texture_repeat ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      smp.wrapS = smp.wrapT = repeat ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       model.samplers.push_back(smp);
     }
     std::string png = png_bytes(path, img);
@@ -563,9 +520,73 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     tex.sampler = 0;
     model.textures.push_back(tex);
     return static_cast<int>(model.textures.size() - 1);
-  };
-  // One glTF material per material (metallic 0, roughness 1, double-sided),
-  // its texture embedded as PNG. The PBR maps go with WriteMeshOptions::texture.
+  }
+};
+
+// POSITION (with its bounds) and NORMAL of the glTF vertices.
+void add_position_normal(GlbBuilder& b, const Gathered& g, const std::vector<std::size_t>& src,
+                         tinygltf::Primitive& prim) {
+  std::vector<float> p(src.size() * 3);
+  std::vector<double> mn(3, HUGE_VAL), mx(3, -HUGE_VAL);
+  for (std::size_t i = 0; i < src.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      float v = static_cast<float>(g.pos[src[i]][c]);
+      p[3 * i + c] = v;
+      mn[c] = std::min<double>(mn[c], v);
+      mx[c] = std::max<double>(mx[c], v);
+    }
+  int view = b.add_view(p.data(), p.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+  prim.attributes["POSITION"] =
+      b.add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, src.size(), mn, mx);
+  if (g.normals.empty()) return;
+  std::vector<float> n(src.size() * 3);
+  for (std::size_t i = 0; i < src.size(); ++i)
+    for (int c = 0; c < 3; ++c) n[3 * i + c] = g.normals[src[i]][c];
+  prim.attributes["NORMAL"] = b.add_float_attribute(n.data(), n.size() * 4, TINYGLTF_TYPE_VEC3, src.size());
+}
+
+// The vertex attributes every primitive shares: POSITION, NORMAL,
+// TEXCOORD_0, TANGENT (for a normal map, geometry/gltf_vertex_frames.h),
+// the colour attribute and the scalar (as "_<name>").
+tinygltf::Primitive vertex_attributes(GlbBuilder& b, const Gathered& g, const GltfVertexSplit& split,
+                                      const std::vector<std::vector<std::uint32_t>>& indices,
+                                      const WriteMeshOptions& opt) {
+  const std::vector<std::size_t>& src = split.source();            // glTF vertex -> mesh vertex (compact id)
+  const std::vector<std::array<float, 2>>& tc = split.texcoord();  // glTF TEXCOORD_0 (v flipped)
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  add_position_normal(b, g, src, prim);
+  if (g.has_uv)
+    prim.attributes["TEXCOORD_0"] =
+        b.add_float_attribute(tc.data(), tc.size() * 8, TINYGLTF_TYPE_VEC2, src.size());
+  if (opt.texture != nullptr && !opt.texture->empty() && g.has_uv && !g.normals.empty() &&
+      opt.normal_texture != nullptr && !opt.normal_texture->empty()) {
+    std::vector<std::uint32_t> all;
+    for (const auto& part : indices) all.insert(all.end(), part.begin(), part.end());
+    const std::vector<std::array<float, 4>> tan = gltf_vertex_tangents(g.pos, g.normals, split, all);
+    prim.attributes["TANGENT"] =
+        b.add_float_attribute(tan.data(), tan.size() * 16, TINYGLTF_TYPE_VEC4, src.size());
+  }
+  if (!g.colors.empty()) {
+    std::vector<float> c(src.size() * 3);
+    for (std::size_t i = 0; i < src.size(); ++i)
+      for (int k = 0; k < 3; ++k) c[3 * i + k] = std::clamp(g.colors[src[i]][k], 0.f, 1.f);
+    prim.attributes[opt.color_attribute] =
+        b.add_float_attribute(c.data(), c.size() * 4, TINYGLTF_TYPE_VEC3, src.size());
+  }
+  if (!g.scalar.empty()) {
+    std::vector<float> sv(src.size());
+    for (std::size_t i = 0; i < src.size(); ++i) sv[i] = static_cast<float>(g.scalar[src[i]]);
+    prim.attributes["_" + opt.vertex_scalar_property] =
+        b.add_float_attribute(sv.data(), sv.size() * 4, TINYGLTF_TYPE_SCALAR, src.size());
+  }
+  return prim;
+}
+
+// One glTF material per material (metallic 0, roughness 1, double-sided),
+// its texture embedded as PNG. The PBR maps go with WriteMeshOptions::texture.
+void add_materials(GlbBuilder& b, const std::string& path, const MaterialGroups& groups,
+                   const WriteMeshOptions& opt) {
   for (std::size_t k = 0; k < groups.materials.size(); ++k) {
     const OutMaterial& om = groups.materials[k];
     tinygltf::Material mat;
@@ -575,42 +596,67 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
     mat.pbrMetallicRoughness.roughnessFactor = 1.0;
     mat.doubleSided = true;
     if (om.texture) {
-      const std::string name = model.images.empty() ? "texture" : "texture_" + std::to_string(model.images.size());
-      mat.pbrMetallicRoughness.baseColorTexture.index = add_texture(*om.texture, name.c_str());
+      const std::string name =
+          b.model.images.empty() ? "texture" : "texture_" + std::to_string(b.model.images.size());
+      mat.pbrMetallicRoughness.baseColorTexture.index =
+          b.add_texture(path, *om.texture, name.c_str(), opt.texture_repeat);
     }
     if (om.texture != nullptr && om.texture == opt.texture) {
       if (opt.normal_texture != nullptr && !opt.normal_texture->empty())
-        mat.normalTexture.index = add_texture(*opt.normal_texture, "normal");
+        mat.normalTexture.index = b.add_texture(path, *opt.normal_texture, "normal", opt.texture_repeat);
       if (opt.metallic_roughness_texture != nullptr && !opt.metallic_roughness_texture->empty())
         mat.pbrMetallicRoughness.metallicRoughnessTexture.index =
-            add_texture(*opt.metallic_roughness_texture, "metallic_roughness");
+            b.add_texture(path, *opt.metallic_roughness_texture, "metallic_roughness", opt.texture_repeat);
     }
-    model.materials.push_back(mat);
+    b.model.materials.push_back(mat);
   }
+}
+
+// One primitive per non-empty material (the shared attributes, its own
+// indices), the mesh in one node of the default scene.
+void add_mesh_and_scene(GlbBuilder& b, const std::vector<std::vector<std::uint32_t>>& indices,
+                        const tinygltf::Primitive& prim) {
   tinygltf::Mesh gm;
   gm.name = "surftex_mesh";
   for (std::size_t k = 0; k < indices.size(); ++k) {
     if (indices[k].empty()) continue;
-    int view = add_view(indices[k].data(), indices[k].size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    int view = b.add_view(indices[k].data(), indices[k].size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     tinygltf::Primitive p = prim;
-    p.indices = add_accessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices[k].size());
+    p.indices =
+        b.add_accessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices[k].size());
     p.material = static_cast<int>(k);
     gm.primitives.push_back(p);
   }
-  while (buf.size() % 4) buf.push_back(0);
-
-  model.meshes.push_back(gm);
+  b.align();
+  b.model.meshes.push_back(gm);
   tinygltf::Node node;
   node.mesh = 0;
-  model.nodes.push_back(node);
+  b.model.nodes.push_back(node);
   tinygltf::Scene scene;
   scene.nodes.push_back(0);
-  model.scenes.push_back(scene);
-  model.defaultScene = 0;
+  b.model.scenes.push_back(scene);
+  b.model.defaultScene = 0;
+}
 
+void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
+  Gathered g = gather(path, mesh, opt, true);
+  MaterialGroups groups = material_groups(path, mesh, opt);
+  if (groups.materials.empty()) groups.materials.push_back({"surftex_material", {1.f, 1.f, 1.f}, nullptr});
+  for (const auto& m : groups.materials)
+    if (m.texture && !g.has_uv)
+      throw InvalidInputError("cannot write '" + path + "': material '" + m.name +
+                              "' has a texture but the mesh has no texture coordinates to map it with");
+  GltfVertexSplit split;
+  const std::vector<std::vector<std::uint32_t>> indices = gltf_triangles(g, groups, split);
+  if (split.source().size() > 0xffffffffu)
+    throw InvalidInputError("cannot write '" + path + "': too many vertices for glTF");
+  GlbBuilder b;
+  const tinygltf::Primitive prim = vertex_attributes(b, g, split, indices, opt);
+  add_materials(b, path, groups, opt);
+  add_mesh_and_scene(b, indices, prim);
   tinygltf::TinyGLTF writer;
   std::ostringstream os;
-  if (!writer.WriteGltfSceneToStream(&model, os, false, true))
+  if (!writer.WriteGltfSceneToStream(&b.model, os, false, true))
     throw IOError("cannot encode glTF for '" + path + "'");
   write_file_atomic(path, os.str(), opt.overwrite);
 }

@@ -531,14 +531,112 @@ std::size_t trim_overlapping_ends(const ElementMesh& pa, const std::vector<std::
   return deleted;
 }
 
+/// Pairs the cut loops of A with those of B greedily by centroid distance:
+/// pair_of[i] = the loop of B zipped to loop i of A.
+std::vector<int> pair_loops(const ElementMesh& pa, const std::vector<std::vector<int>>& la, const ElementMesh& pb,
+                            const std::vector<std::vector<int>>& lb) {
+  std::vector<std::tuple<double, int, int>> cand;
+  for (std::size_t i = 0; i < la.size(); ++i)
+    for (std::size_t j = 0; j < lb.size(); ++j)
+      cand.emplace_back(dist(loop_centroid(pa, la[i]), loop_centroid(pb, lb[j])), static_cast<int>(i),
+                        static_cast<int>(j));
+  std::sort(cand.begin(), cand.end());
+  std::vector<int> pair_of(la.size(), -1);
+  std::vector<char> bused(lb.size(), 0);
+  for (auto& [d, i, j] : cand)
+    if (pair_of[i] < 0 && !bused[j]) pair_of[i] = j, bused[j] = 1;
+  return pair_of;
+}
+
+/// Zips loop A to loop B (both as vertex indices of `merged`, B reversed)
+/// with a strip of triangles, from B's vertex nearest A's first, always
+/// advancing on the side whose next vertex is nearer the other's current one.
+void zip_loops(ElementMesh& merged, const std::vector<int>& A, const std::vector<int>& B) {
+  const int na = static_cast<int>(A.size()), nb = static_cast<int>(B.size());
+  auto P = [&](int v) { return merged.points[v]; };
+  int j0 = 0;
+  for (int j = 1; j < nb; ++j)
+    if (dist(P(A[0]), P(B[j])) < dist(P(A[0]), P(B[j0]))) j0 = j;
+  int ia = 0, ib = 0;
+  auto a_at = [&](int k) { return A[k % na]; };
+  auto b_at = [&](int k) { return B[(j0 + k) % nb]; };
+  while (ia < na || ib < nb) {
+    bool adv_a;
+    if (ia == na)
+      adv_a = false;
+    else if (ib == nb)
+      adv_a = true;
+    else
+      adv_a = dist(P(a_at(ia + 1)), P(b_at(ib))) <= dist(P(a_at(ia)), P(b_at(ib + 1)));
+    if (adv_a) {
+      merged.tris.push_back({a_at(ia + 1), a_at(ia), b_at(ib)});
+      ++ia;
+    } else {
+      merged.tris.push_back({b_at(ib), b_at(ib + 1), a_at(ia)});
+      ++ib;
+    }
+  }
+}
+
+/// The axis of a loop pair (difference of their unit area vectors) when
+/// MergeOptions::average_across_axis_only, else zero.
+P3 loop_pair_axis(const ElementMesh& pa, const std::vector<int>& la, const ElementMesh& pb,
+                  const std::vector<int>& lb, const MergeOptions& opt) {
+  P3 axis{0, 0, 0};
+  if (opt.average_across_axis_only) {
+    const P3 na = loop_area_vector(pa, la), nb = loop_area_vector(pb, lb);
+    const double len_a = dist(na, P3{0, 0, 0}), len_b = dist(nb, P3{0, 0, 0});
+    if (len_a > 0 && len_b > 0) {
+      for (int d = 0; d < 3; ++d) axis[d] = nb[d] / len_b - na[d] / len_a;
+      const double l = dist(axis, P3{0, 0, 0});
+      for (double& x : axis) x = l > 0 ? x / l : 0.0;
+    }
+  }
+  return axis;
+}
+
+/// "Average boundary points" as position constraints (eq. 5): each loop
+/// vertex pulled to the midpoint with its nearest vertex on the other loop,
+/// less the midpoint's component along `axis`.
+void average_boundary_constraints(const ElementMesh& merged, const std::vector<int>& A, const std::vector<int>& B,
+                                  const P3& axis, std::vector<DeformConstraint>& cons) {
+  auto P = [&](int v) { return merged.points[v]; };
+  auto nearest = [&](int v, const std::vector<int>& L) {
+    int best = L[0];
+    for (int u : L)
+      if (dist(P(v), P(u)) < dist(P(v), P(best))) best = u;
+    return best;
+  };
+  auto target = [&](const P3& p, const P3& q) {
+    P3 h{(q[0] - p[0]) / 2, (q[1] - p[1]) / 2, (q[2] - p[2]) / 2};
+    const double al = h[0] * axis[0] + h[1] * axis[1] + h[2] * axis[2];
+    for (int d = 0; d < 3; ++d) h[d] -= al * axis[d];
+    return P3{p[0] + h[0], p[1] + h[1], p[2] + h[2]};
+  };
+  for (int v : A) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, B)))});
+  for (int v : B) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, A)))});
+}
+
+/// Why the zipped element is refused on topology ("" if it is not): new
+/// borders, a non-manifold border, or an opened closed element.
+std::string zip_topology_refusal(const ElementMesh& a, const ElementMesh& b, const ElementMesh& merged) {
+  const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
+  if (count_border_edges(merged) > border_before) return "stitching would open new borders";
+  if (!is_manifold_oriented(merged)) return "stitched element is not manifold (border)";
+  if (border_before == 0 && !is_closed_oriented(merged))
+    return "stitched element is not closed and consistently oriented";
+  return "";
+}
+
 // Zips the kept parts of A and B (labellings keep_a, keep_b) into `r` (see
-// merge_elements). If `trimmed` is given and the stitch is refused for
-// crossing itself, the trimmed labelling of B is written there (see
-// trim_overlapping_ends).
+// merge_elements; Zhou et al. 2006 s.2.7): their cut loops paired and
+// checked, zipped, the zip deformed towards the averaged boundary points
+// (eq. 5) with the points outside the overlap locked. If `trimmed` is given
+// and the stitch is refused for crossing itself, the trimmed labelling of B
+// is written there (see trim_overlapping_ends).
 void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, const ElementMesh& b,
                        const std::vector<char>& keep_b, const RegionFn& region, const MergeOptions& opt,
                        MergeResult& r, std::vector<char>* trimmed) {
-  auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
   ElementMesh pa, pb;
   std::vector<std::vector<int>> la, lb;
   bool oka = false, okb = false;
@@ -553,17 +651,7 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
     r.reason = "cuts opened " + std::to_string(la.size()) + " and " + std::to_string(lb.size()) + " loops";
     return;
   }
-  // Pair loops greedily by centroid distance.
-  std::vector<std::tuple<double, int, int>> cand;
-  for (std::size_t i = 0; i < la.size(); ++i)
-    for (std::size_t j = 0; j < lb.size(); ++j)
-      cand.emplace_back(dist(loop_centroid(pa, la[i]), loop_centroid(pb, lb[j])), static_cast<int>(i),
-                        static_cast<int>(j));
-  std::sort(cand.begin(), cand.end());
-  std::vector<int> pair_of(la.size(), -1);
-  std::vector<char> bused(lb.size(), 0);
-  for (auto& [d, i, j] : cand)
-    if (pair_of[i] < 0 && !bused[j]) pair_of[i] = j, bused[j] = 1;
+  const std::vector<int> pair_of = pair_loops(pa, la, pb, lb);
   for (std::size_t i = 0; i < la.size(); ++i) {
     const std::string why = loop_pair_mismatch(pa, la[i], pb, lb[pair_of[i]], opt);
     if (!why.empty()) {
@@ -579,71 +667,16 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
     const std::vector<int>& A = la[i];
     std::vector<int> B(lb[pair_of[i]].rbegin(), lb[pair_of[i]].rend());
     for (int& v : B) v += off;
-    const int na = static_cast<int>(A.size()), nb = static_cast<int>(B.size());
-    auto P = [&](int v) { return merged.points[v]; };
-    int j0 = 0;
-    for (int j = 1; j < nb; ++j)
-      if (dist(P(A[0]), P(B[j])) < dist(P(A[0]), P(B[j0]))) j0 = j;
-    int ia = 0, ib = 0;
-    auto a_at = [&](int k) { return A[k % na]; };
-    auto b_at = [&](int k) { return B[(j0 + k) % nb]; };
-    while (ia < na || ib < nb) {
-      bool adv_a;
-      if (ia == na)
-        adv_a = false;
-      else if (ib == nb)
-        adv_a = true;
-      else
-        adv_a = dist(P(a_at(ia + 1)), P(b_at(ib))) <= dist(P(a_at(ia)), P(b_at(ib + 1)));
-      if (adv_a) {
-        merged.tris.push_back({a_at(ia + 1), a_at(ia), b_at(ib)});
-        ++ia;
-      } else {
-        merged.tris.push_back({b_at(ib), b_at(ib + 1), a_at(ia)});
-        ++ib;
-      }
-    }
-    // "Average boundary points" as position constraints (eq. 5).
-    auto nearest = [&](int v, const std::vector<int>& L) {
-      int best = L[0];
-      for (int u : L)
-        if (dist(P(v), P(u)) < dist(P(v), P(best))) best = u;
-      return best;
-    };
-    // The constraint targets (see MergeOptions::average_across_axis_only):
-    // the midpoint, less its component along the pair's axis.
-    P3 axis{0, 0, 0};
-    if (opt.average_across_axis_only) {
-      const P3 na = loop_area_vector(pa, la[i]), nb = loop_area_vector(pb, lb[pair_of[i]]);
-      const double len_a = dist(na, P3{0, 0, 0}), len_b = dist(nb, P3{0, 0, 0});
-      if (len_a > 0 && len_b > 0) {
-        for (int d = 0; d < 3; ++d) axis[d] = nb[d] / len_b - na[d] / len_a;
-        const double l = dist(axis, P3{0, 0, 0});
-        for (double& x : axis) x = l > 0 ? x / l : 0.0;
-      }
-    }
-    auto target = [&](const P3& p, const P3& q) {
-      P3 h{(q[0] - p[0]) / 2, (q[1] - p[1]) / 2, (q[2] - p[2]) / 2};
-      const double al = h[0] * axis[0] + h[1] * axis[1] + h[2] * axis[2];
-      for (int d = 0; d < 3; ++d) h[d] -= al * axis[d];
-      return P3{p[0] + h[0], p[1] + h[1], p[2] + h[2]};
-    };
-    for (int v : A) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, B)))});
-    for (int v : B) cons.push_back({{v, v, v}, {1, 0, 0}, target(P(v), P(nearest(v, A)))});
+    zip_loops(merged, A, B);
+    const P3 axis = loop_pair_axis(pa, la[i], pb, lb[pair_of[i]], opt);
+    average_boundary_constraints(merged, A, B, axis, cons);
   }
-  const std::size_t border_before = count_border_edges(a) + count_border_edges(b);
-  if (count_border_edges(merged) > border_before) {
-    r.reason = "stitching would open new borders";
+  const std::string refusal = zip_topology_refusal(a, b, merged);
+  if (!refusal.empty()) {
+    r.reason = refusal;
     return;
   }
-  if (!is_manifold_oriented(merged)) {
-    r.reason = "stitched element is not manifold (border)";
-    return;
-  }
-  if (border_before == 0 && !is_closed_oriented(merged)) {
-    r.reason = "stitched element is not closed and consistently oriented";
-    return;
-  }
+  auto in_overlap = [&](const P3& p) { return region(p) == Region::kOverlap; };
   std::vector<char> locked(merged.points.size(), 0);
   for (std::size_t v = 0; v < merged.points.size(); ++v) locked[v] = !in_overlap(merged.points[v]);
   try {
@@ -668,7 +701,6 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
   r.stitched = true;
   r.loops = static_cast<int>(la.size());
   r.merged = std::move(merged);
-  return;
 }
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
+#include "geometry/union_find.h"
 
 namespace surftex {
 namespace {
@@ -17,25 +18,17 @@ std::uint64_t edge_key(int a, int b) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
          static_cast<std::uint32_t>(b);
 }
-int find_root(std::vector<int>& p, int x) {
-  while (p[x] != x) x = p[x] = p[p[x]];
-  return x;
-}
 }  // namespace
 
 int triangle_components(const ElementMesh& m, std::vector<int>& comp) {
-  std::vector<int> parent(m.points.size());
-  std::iota(parent.begin(), parent.end(), 0);
+  UnionFind<int> sets(m.points.size());
   for (const Tri& t : m.tris)
-    for (int k = 1; k < 3; ++k) {
-      int a = find_root(parent, t[0]), b = find_root(parent, t[k]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+    for (int k = 1; k < 3; ++k) sets.unite(t[0], t[k]);
   std::vector<int> id(m.points.size(), -1);
   comp.assign(m.tris.size(), -1);
   int n = 0;
   for (std::size_t i = 0; i < m.tris.size(); ++i) {
-    int r = find_root(parent, m.tris[i][0]);
+    const int r = sets.find(m.tris[i][0]);
     if (id[r] < 0) id[r] = n++;
     comp[i] = id[r];
   }

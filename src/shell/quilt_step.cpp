@@ -13,6 +13,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/timer.h"
+#include "geometry/union_find.h"
 #include "shell/element_correspondence.h"
 #include "shell/element_clearance.h"
 #include "shell/element_deformation.h"
@@ -84,10 +85,6 @@ std::string reason_kind(const std::string& reason) {
     }
   }
   return out;
-}
-int find_root(std::vector<int>& p, int x) {
-  while (p[x] != x) x = p[x] = p[p[x]];
-  return x;
 }
 // Keeps the relations (C_out, C_in) that are each other's strongest: the most
 // vertex-face pairs among the relations of C_out and among those of C_in (ties:
@@ -350,236 +347,324 @@ QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& 
 
 }
 
+namespace {
+
+/// One quilt step's state, stage to stage: the placement, the placed input
+/// elements M_in(t), the overlap, the correspondences and their groups, and
+/// what the step commits at the end.
+struct QuiltStepState {
+  QuiltStepState(const Swatch& sw, QuiltGrid& g, std::vector<ElementMesh>& el, std::vector<char>& al,
+                 const QuiltStepOptions& o, QuiltStepStats& st)
+      : swatch(sw), grid(g), elements(el), alive(al), opt(o), stats(st) {}
+  const Swatch& swatch;
+  QuiltGrid& grid;
+  std::vector<ElementMesh>& elements;  // M_out
+  std::vector<char>& alive;
+  const QuiltStepOptions& opt;
+  QuiltStepStats& stats;
+  int sx = 0, sy = 0;  // footprint in cells
+  int oi = 0, oj = 0;  // its first cell
+  double dx = 0, dy = 0;
+  std::vector<ElementMesh> placed;     // M_in(t)
+  std::vector<char> processed_before;  // the grid's processed cells before this step
+  std::vector<int> near;               // live output elements near the footprint
+  ElementCorrespondences corr;
+  std::vector<std::pair<int, int>> related;  // (output, input) element pairs
+  int no = 0, ni = 0;                        // output and input elements
+  UnionFind<int> sets;                       // over outputs, then inputs
+  std::map<int, std::pair<std::vector<int>, std::vector<int>>> groups;  // root -> (outs, ins)
+  std::vector<char> add_in;                                            // per input: added as is
+  std::vector<std::pair<int, ElementMesh>> replacements;               // output elements replaced
+  std::vector<ElementMesh> cut_inputs;  // refused inputs' closed kept parts (keep_cut_refused_inputs)
+  double t_deform = 0, t_merge = 0;
+
+  bool in_footprint_cell(int cc) const {
+    const int i = cc % grid.nx, j = cc / grid.nx;
+    return i >= oi && i < oi + sx && j >= oj && j < oj + sy;
+  }
+  bool in_overlap(const P3& p) const {
+    const int cc = grid.cell_of(p[0], p[1]);
+    return cc >= 0 && processed_before[cc] && in_footprint_cell(cc);
+  }
+  Region region(const P3& p) const {
+    const int cc = grid.cell_of(p[0], p[1]);
+    if (cc < 0) return Region::kNone;
+    if (!processed_before[cc]) return Region::kNew;
+    return in_footprint_cell(cc) ? Region::kOverlap : Region::kOld;
+  }
+  bool entirely_in_overlap(const ElementMesh& m) const {
+    for (const P3& p : m.points)
+      if (!in_overlap(p)) return false;
+    return true;
+  }
+};
+
+/// The placed input elements M_in(t): the swatch's elements moved by t.
+void place_input_elements(QuiltStepState& s, const P3& t) {
+  const Swatch& swatch = s.swatch;
+  std::vector<std::vector<int>> etris(swatch.elements.size());
+  for (std::size_t f = 0; f < swatch.face_element.size(); ++f) etris[swatch.face_element[f]].push_back(static_cast<int>(f));
+  s.placed.resize(swatch.elements.size());
+  for (std::size_t e = 0; e < s.placed.size(); ++e) {
+    s.placed[e] = extract_triangles(swatch.mesh, etris[e]);
+    for (P3& p : s.placed[e].points)
+      for (int d = 0; d < 3; ++d) p[d] += t[d];
+  }
+  s.processed_before = s.grid.processed;
+}
+
+/// Live output elements whose bounding box meets the footprint.
+void find_near_outputs(QuiltStepState& s) {
+  const double c = s.grid.cell;
+  const double fx0 = s.grid.x0 + s.oi * c, fy0 = s.grid.y0 + s.oj * c, fx1 = fx0 + s.sx * c, fy1 = fy0 + s.sy * c;
+  for (std::size_t e = 0; e < s.elements.size(); ++e) {
+    if (!s.alive[e]) continue;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const P3& p : s.elements[e].points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
+    if (hi[0] >= fx0 && lo[0] <= fx1 && hi[1] >= fy0 && lo[1] <= fy1) s.near.push_back(static_cast<int>(e));
+  }
+}
+
+/// Zhou et al. 2006 s.2.5, element correspondences: vertex-face pairs in the
+/// overlap between the near output elements and the placed inputs, and the
+/// related element pairs (the strongest one per element with one_to_one).
+void correspond_elements(QuiltStepState& s) {
+  if (!s.near.empty()) {
+    CorrespondenceOptions co;
+    co.lambda = s.opt.lambda;
+    co.prune_factor = s.opt.prune_factor;
+    s.corr = find_element_correspondences(s.elements, s.near, s.placed,
+                                          [&s](const P3& p) { return s.in_overlap(p); }, co);
+    s.related = s.opt.one_to_one ? strongest_relations(s.corr) : s.corr.related;
+  }
+  s.stats.pairs += s.corr.pairs.size();
+  s.stats.related += s.related.size();
+  s.stats.pruned_normal += s.corr.pruned_normal;
+  s.stats.pruned_distance += s.corr.pruned_distance;
+  s.stats.pruned_projection += s.corr.pruned_projection;
+}
+
+/// Groups of related elements (connected components of the relation):
+/// union-find over the output elements, then the input elements.
+void group_related(QuiltStepState& s) {
+  s.no = static_cast<int>(s.elements.size());
+  s.ni = static_cast<int>(s.placed.size());
+  const int no = s.no, ni = s.ni;
+  s.sets.reset(no + ni);
+  for (auto& r : s.related) s.sets.unite(r.first, no + r.second);
+  std::vector<char> in_related(ni, 0), out_related(no, 0);
+  for (auto& r : s.related) out_related[r.first] = 1, in_related[r.second] = 1;
+  for (int e = 0; e < no; ++e)
+    if (out_related[e]) s.groups[s.sets.find(e)].first.push_back(e);
+  for (int e = 0; e < ni; ++e)
+    if (in_related[e]) s.groups[s.sets.find(no + e)].second.push_back(e);
+}
+
+/// Zhou et al. 2006 s.2.6, element deformation of both sides of a group
+/// (equations 5 and 6): each pair pulls its output vertex and input face
+/// point to their midpoint; output vertices outside the overlap stay put.
+/// Returns the deformed output elements; the inputs are deformed in place.
+std::map<int, ElementMesh> deform_group(QuiltStepState& s, int root) {
+  std::map<int, std::vector<DeformConstraint>> cout_, cin_;
+  for (const VertexFacePair& p : s.corr.pairs) {
+    if (s.sets.find(p.out_element) != root) continue;
+    const P3& v = s.elements[p.out_element].points[p.vertex];
+    const P3 cpt{(v[0] + p.closest[0]) / 2, (v[1] + p.closest[1]) / 2, (v[2] + p.closest[2]) / 2};
+    cout_[p.out_element].push_back({{p.vertex, p.vertex, p.vertex}, {1, 0, 0}, cpt});
+    const Tri& f = s.placed[p.in_element].tris[p.face];
+    cin_[p.in_element].push_back({{f[0], f[1], f[2]}, {p.bary[0], p.bary[1], p.bary[2]}, cpt});
+  }
+  LaplacianDeformOptions lo;
+  lo.mu = s.opt.mu;
+  std::map<int, ElementMesh> deformed_out;
+  for (auto& [e, cons] : cout_) {
+    ElementMesh m = s.elements[e];
+    std::vector<char> locked(m.points.size());
+    for (std::size_t v = 0; v < m.points.size(); ++v) locked[v] = !s.in_overlap(m.points[v]);
+    try {
+      m.points = laplacian_deform(m, cons, locked, lo);
+    } catch (const SolverError&) {
+    }
+    deformed_out[e] = std::move(m);
+  }
+  for (auto& [e, cons] : cin_) {
+    try {
+      s.placed[e].points = laplacian_deform(s.placed[e], cons, {}, lo);
+    } catch (const SolverError&) {
+    }
+  }
+  return deformed_out;
+}
+
+/// An input element not merged: its closed kept parts are added (counted in
+/// `kept`) when asked for and there are any, else it is dropped.
+void keep_capped_or_drop(QuiltStepState& s, MergeResult& r, std::size_t& kept) {
+  if (s.opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
+    ++kept;
+    s.stats.in_cut_components += r.capped_b.size();
+    for (ElementMesh& part : r.capped_b) s.cut_inputs.push_back(std::move(part));
+  } else {
+    ++s.stats.in_dropped;
+  }
+}
+
+/// Counts a refused stitch under its reason.
+void count_refusal(QuiltStepStats& stats, const std::string& reason) {
+  ++stats.stitch_refused;
+  ++stats.refused_reasons[reason_kind(reason)];
+  if (reason.find("infeasible") != std::string::npos)
+    ++stats.refused_infeasible;
+  else if (reason.rfind("misaligned", 0) == 0 || reason.rfind("self-intersecting", 0) == 0)
+    ++stats.refused_geometry;
+  else if (reason.find("loops") != std::string::npos)
+    ++stats.refused_loops;
+  else
+    ++stats.refused_border;
+}
+
+/// Zhou et al. 2006 s.2.7, merging one group: the first output element
+/// absorbs the group's inputs, then its other outputs, one by one (graph-cut
+/// stitching); what could not be stitched is kept, replaced or dropped.
+void merge_group(QuiltStepState& s, const std::vector<int>& outs, const std::vector<int>& ins,
+                 std::map<int, ElementMesh>& deformed_out) {
+  const QuiltStepOptions& opt = s.opt;
+  QuiltStepStats& stats = s.stats;
+  const int first = outs.front();
+  ElementMesh acc = deformed_out.count(first) ? deformed_out[first] : s.elements[first];
+  Side acc_side = Region::kOld;
+  std::vector<std::pair<bool, int>> others;  // (is_out, index)
+  for (int e : ins) others.emplace_back(false, e);
+  for (std::size_t k = 1; k < outs.size(); ++k) others.emplace_back(true, outs[k]);
+  for (auto& [is_out, e] : others) {
+    const ElementMesh& x = is_out ? (deformed_out.count(e) ? deformed_out[e] : s.elements[e]) : s.placed[e];
+    MergeOptions mo = opt.merge;
+    mo.mu = opt.mu;
+    if (!opt.check_stitch_geometry) {
+      mo.max_loop_offset = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;
+      mo.refuse_self_intersecting = false;
+    }
+    MergeResult r = merge_elements(acc, acc_side, x, is_out ? Region::kOld : Region::kNew,
+                                   [&s](const P3& p) { return s.region(p); }, mo);
+    if (r.stitched) {
+      acc = std::move(r.merged);
+      if (!is_out) acc_side = Region::kOverlap;  // now owns old and new parts
+      ++stats.stitched;
+      if (r.trimmed) ++stats.stitched_trimmed;
+      if (is_out)
+        s.alive[e] = 0;
+      else
+        s.add_in[e] = 0;
+    } else if (r.coincident) {  // nothing to stitch: keep the output element whole
+      ++stats.coincident;
+      if (is_out && deformed_out.count(e)) s.replacements.emplace_back(e, deformed_out[e]);
+      if (!is_out && s.add_in[e]) {
+        s.add_in[e] = 0;
+        keep_capped_or_drop(s, r, stats.coincident_cut_added);
+      }
+    } else {
+      count_refusal(stats, r.reason);
+      if (is_out && deformed_out.count(e)) s.replacements.emplace_back(e, deformed_out[e]);
+      if (!is_out && opt.drop_refused_inputs && s.add_in[e]) {  // keep C_out rather than overlap it
+        s.add_in[e] = 0;
+        keep_capped_or_drop(s, r, stats.in_cut_added);
+      }
+    }
+  }
+  s.replacements.emplace_back(first, std::move(acc));
+}
+
+/// Each group of related elements in turn (s.2.7): a group whose output side
+/// lies entirely within the overlap is replaced by its inputs, one whose
+/// input side does keeps its outputs; the others are deformed (s.2.6) and
+/// merged.
+void merge_groups(QuiltStepState& s) {
+  s.add_in.assign(s.ni, 1);
+  for (auto& [root, g] : s.groups) {
+    auto& [outs, ins] = g;
+    bool outs_inside = true, ins_inside = true;
+    for (int e : outs) outs_inside = outs_inside && s.entirely_in_overlap(s.elements[e]);
+    for (int e : ins) ins_inside = ins_inside && s.entirely_in_overlap(s.placed[e]);
+    if (outs_inside) {  // 2.7: C_out entirely within the overlap: C_in instead
+      for (int e : outs) s.alive[e] = 0;
+      s.stats.out_replaced += outs.size();
+      continue;
+    }
+    if (ins_inside) {  // C_in entirely within the overlap: keep C_out
+      for (int e : ins) s.add_in[e] = 0;
+      s.stats.in_dropped += ins.size();
+      continue;
+    }
+    Timer td;
+    std::map<int, ElementMesh> deformed_out = deform_group(s, root);
+    s.t_deform += td.seconds();
+    Timer tm;
+    merge_group(s, outs, ins, deformed_out);
+    s.t_merge += tm.seconds();
+  }
+}
+
+/// Commits the step: the replaced output elements, the added inputs (and
+/// kept parts of refused ones) after resolving their crossings with the
+/// output, and the footprint's cells marked processed.
+void commit_step(QuiltStepState& s) {
+  QuiltStepStats& stats = s.stats;
+  for (auto& [e, m] : s.replacements) s.elements[e] = std::move(m);
+  std::vector<ElementMesh> adds;
+  for (int e = 0; e < s.ni; ++e)
+    if (s.add_in[e]) {
+      adds.push_back(std::move(s.placed[e]));
+      ++stats.in_added;
+    }
+  for (ElementMesh& m : s.cut_inputs) adds.push_back(std::move(m));
+  if (s.opt.resolve_crossings) {
+    Timer tr;
+    QuiltStepOptions ro = s.opt;
+    if (ro.clearance < 0) ro.clearance = 0.5 * s.swatch.min_gap;
+    adds = resolve_crossings(s.elements, s.alive, std::move(adds), ro, stats);
+    stats.seconds_resolve += tr.seconds();
+  }
+  for (ElementMesh& m : adds) {
+    s.elements.push_back(std::move(m));
+    s.alive.push_back(1);
+  }
+  QuiltGrid& grid = s.grid;
+  for (int j = std::max(0, s.oj); j < std::min(grid.ny, s.oj + s.sy); ++j)
+    for (int i = std::max(0, s.oi); i < std::min(grid.nx, s.oi + s.sx); ++i) grid.processed[j * grid.nx + i] = 1;
+}
+
+}  // namespace
+
 QuiltPlacement quilt_step(const Swatch& swatch, const TriangleDistance& swatch_tree, QuiltGrid& grid,
                           std::vector<ElementMesh>& elements, std::vector<char>& alive, std::mt19937_64& rng,
                           const QuiltStepOptions& opt, QuiltStepStats& stats, const QuiltMatch* given) {
   Timer timer;
   const QuiltMatch match =
       given ? *given : match_swatch_placement(swatch, swatch_tree, grid, elements, alive, rng, opt);
+  QuiltStepState s(swatch, grid, elements, alive, opt, stats);
   const double c = grid.cell;
-  const int sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
-  const int sy = std::max(1, static_cast<int>(std::ceil(swatch.width() / c - 1e-9)));
-  const int oi = match.placement.oi, oj = match.placement.oj;
-  const double dx = match.placement.dx, dy = match.placement.dy;
-  const P3 t{grid.x0 + oi * c - swatch.bbox_min[0] + dx, grid.y0 + oj * c - swatch.bbox_min[1] + dy, 0.0};
+  s.sx = std::max(1, static_cast<int>(std::ceil(swatch.length() / c - 1e-9)));
+  s.sy = std::max(1, static_cast<int>(std::ceil(swatch.width() / c - 1e-9)));
+  s.oi = match.placement.oi;
+  s.oj = match.placement.oj;
+  s.dx = match.placement.dx;
+  s.dy = match.placement.dy;
+  const P3 t{grid.x0 + s.oi * c - swatch.bbox_min[0] + s.dx, grid.y0 + s.oj * c - swatch.bbox_min[1] + s.dy, 0.0};
   stats.candidates += match.candidates;
   stats.best_cost = match.cost;
   stats.seconds_match += timer.seconds();
   timer.reset();
-
-  // Placed input elements M_in(t).
-  std::vector<std::vector<int>> etris(swatch.elements.size());
-  for (std::size_t f = 0; f < swatch.face_element.size(); ++f) etris[swatch.face_element[f]].push_back(static_cast<int>(f));
-  std::vector<ElementMesh> placed(swatch.elements.size());
-  for (std::size_t e = 0; e < placed.size(); ++e) {
-    placed[e] = extract_triangles(swatch.mesh, etris[e]);
-    for (P3& p : placed[e].points)
-      for (int d = 0; d < 3; ++d) p[d] += t[d];
-  }
-  const std::vector<char> processed_before = grid.processed;
-  auto in_footprint_cell = [&](int cc) {
-    const int i = cc % grid.nx, j = cc / grid.nx;
-    return i >= oi && i < oi + sx && j >= oj && j < oj + sy;
-  };
-  auto in_overlap = [&](const P3& p) {
-    const int cc = grid.cell_of(p[0], p[1]);
-    return cc >= 0 && processed_before[cc] && in_footprint_cell(cc);
-  };
-  auto region = [&](const P3& p) {
-    const int cc = grid.cell_of(p[0], p[1]);
-    if (cc < 0) return Region::kNone;
-    if (!processed_before[cc]) return Region::kNew;
-    return in_footprint_cell(cc) ? Region::kOverlap : Region::kOld;
-  };
-  auto entirely_in_overlap = [&](const ElementMesh& m) {
-    for (const P3& p : m.points)
-      if (!in_overlap(p)) return false;
-    return true;
-  };
-  // Output elements near the footprint.
-  const double fx0 = grid.x0 + oi * c, fy0 = grid.y0 + oj * c, fx1 = fx0 + sx * c, fy1 = fy0 + sy * c;
-  std::vector<int> near;
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    if (!alive[e]) continue;
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-    for (const P3& p : elements[e].points)
-      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
-    if (hi[0] >= fx0 && lo[0] <= fx1 && hi[1] >= fy0 && lo[1] <= fy1) near.push_back(static_cast<int>(e));
-  }
-
-  // --- 2.5 Element correspondences.
-  std::vector<std::pair<int, int>> related;
-  ElementCorrespondences corr;
-  if (!near.empty()) {
-    CorrespondenceOptions co;
-    co.lambda = opt.lambda;
-    co.prune_factor = opt.prune_factor;
-    corr = find_element_correspondences(elements, near, placed, in_overlap, co);
-    related = opt.one_to_one ? strongest_relations(corr) : corr.related;
-  }
-  stats.pairs += corr.pairs.size();
-  stats.related += related.size();
-  stats.pruned_normal += corr.pruned_normal;
-  stats.pruned_distance += corr.pruned_distance;
-  stats.pruned_projection += corr.pruned_projection;
+  place_input_elements(s, t);
+  find_near_outputs(s);
+  correspond_elements(s);
   stats.seconds_correspond += timer.seconds();
   timer.reset();
-
-  // Groups of related elements: nodes = output elements, then input elements.
-  const int no = static_cast<int>(elements.size()), ni = static_cast<int>(placed.size());
-  std::vector<int> parent(no + ni);
-  std::iota(parent.begin(), parent.end(), 0);
-  for (auto& r : related) {
-    int a = find_root(parent, r.first), b = find_root(parent, no + r.second);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-  std::map<int, std::pair<std::vector<int>, std::vector<int>>> groups;  // root -> (outs, ins)
-  std::vector<char> in_related(ni, 0), out_related(no, 0);
-  for (auto& r : related) out_related[r.first] = 1, in_related[r.second] = 1;
-  for (int e = 0; e < no; ++e)
-    if (out_related[e]) groups[find_root(parent, e)].first.push_back(e);
-  for (int e = 0; e < ni; ++e)
-    if (in_related[e]) groups[find_root(parent, no + e)].second.push_back(e);
-
-  std::vector<char> add_in(ni, 1);
-  std::vector<std::pair<int, ElementMesh>> replacements;
-  std::vector<ElementMesh> cut_inputs;  // refused inputs' closed kept parts (keep_cut_refused_inputs)
-  // An input element not merged: its closed kept parts are added (counted in
-  // `kept`) when asked for and there are any, else it is dropped.
-  auto keep_capped_or_drop = [&](MergeResult& r, std::size_t& kept) {
-    if (opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
-      ++kept;
-      stats.in_cut_components += r.capped_b.size();
-      for (ElementMesh& part : r.capped_b) cut_inputs.push_back(std::move(part));
-    } else {
-      ++stats.in_dropped;
-    }
-  };
-  double t_deform = 0, t_merge = 0;
-  for (auto& [root, g] : groups) {
-    auto& [outs, ins] = g;
-    bool outs_inside = true, ins_inside = true;
-    for (int e : outs) outs_inside = outs_inside && entirely_in_overlap(elements[e]);
-    for (int e : ins) ins_inside = ins_inside && entirely_in_overlap(placed[e]);
-    if (outs_inside) {  // 2.7: C_out entirely within the overlap: C_in instead
-      for (int e : outs) alive[e] = 0;
-      stats.out_replaced += outs.size();
-      continue;
-    }
-    if (ins_inside) {  // C_in entirely within the overlap: keep C_out
-      for (int e : ins) add_in[e] = 0;
-      stats.in_dropped += ins.size();
-      continue;
-    }
-    // --- 2.6 Element deformation of both sides (eq. 5 and 6).
-    Timer td;
-    std::map<int, std::vector<DeformConstraint>> cout_, cin_;
-    for (const VertexFacePair& p : corr.pairs) {
-      if (find_root(parent, p.out_element) != root) continue;
-      const P3& v = elements[p.out_element].points[p.vertex];
-      const P3 cpt{(v[0] + p.closest[0]) / 2, (v[1] + p.closest[1]) / 2, (v[2] + p.closest[2]) / 2};
-      cout_[p.out_element].push_back({{p.vertex, p.vertex, p.vertex}, {1, 0, 0}, cpt});
-      const Tri& f = placed[p.in_element].tris[p.face];
-      cin_[p.in_element].push_back({{f[0], f[1], f[2]}, {p.bary[0], p.bary[1], p.bary[2]}, cpt});
-    }
-    LaplacianDeformOptions lo;
-    lo.mu = opt.mu;
-    std::map<int, ElementMesh> deformed_out;
-    for (auto& [e, cons] : cout_) {
-      ElementMesh m = elements[e];
-      std::vector<char> locked(m.points.size());
-      for (std::size_t v = 0; v < m.points.size(); ++v) locked[v] = !in_overlap(m.points[v]);
-      try {
-        m.points = laplacian_deform(m, cons, locked, lo);
-      } catch (const SolverError&) {
-      }
-      deformed_out[e] = std::move(m);
-    }
-    for (auto& [e, cons] : cin_) {
-      try {
-        placed[e].points = laplacian_deform(placed[e], cons, {}, lo);
-      } catch (const SolverError&) {
-      }
-    }
-    t_deform += td.seconds();
-    // --- 2.7 Merging: the first output element absorbs the others one by one.
-    Timer tm;
-    const int first = outs.front();
-    ElementMesh acc = deformed_out.count(first) ? deformed_out[first] : elements[first];
-    Side acc_side = Region::kOld;
-    std::vector<std::pair<bool, int>> others;  // (is_out, index)
-    for (int e : ins) others.emplace_back(false, e);
-    for (std::size_t k = 1; k < outs.size(); ++k) others.emplace_back(true, outs[k]);
-    for (auto& [is_out, e] : others) {
-      const ElementMesh& x = is_out ? (deformed_out.count(e) ? deformed_out[e] : elements[e]) : placed[e];
-      MergeOptions mo = opt.merge;
-      mo.mu = opt.mu;
-      if (!opt.check_stitch_geometry) {
-        mo.max_loop_offset = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;
-        mo.refuse_self_intersecting = false;
-      }
-      MergeResult r = merge_elements(acc, acc_side, x, is_out ? Region::kOld : Region::kNew, region, mo);
-      if (r.stitched) {
-        acc = std::move(r.merged);
-        if (!is_out) acc_side = Region::kOverlap;  // now owns old and new parts
-        ++stats.stitched;
-        if (r.trimmed) ++stats.stitched_trimmed;
-        if (is_out)
-          alive[e] = 0;
-        else
-          add_in[e] = 0;
-      } else if (r.coincident) {  // nothing to stitch: keep the output element whole
-        ++stats.coincident;
-        if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
-        if (!is_out && add_in[e]) {
-          add_in[e] = 0;
-          keep_capped_or_drop(r, stats.coincident_cut_added);
-        }
-      } else {
-        ++stats.stitch_refused;
-        ++stats.refused_reasons[reason_kind(r.reason)];
-        if (r.reason.find("infeasible") != std::string::npos)
-          ++stats.refused_infeasible;
-        else if (r.reason.rfind("misaligned", 0) == 0 || r.reason.rfind("self-intersecting", 0) == 0)
-          ++stats.refused_geometry;
-        else if (r.reason.find("loops") != std::string::npos)
-          ++stats.refused_loops;
-        else
-          ++stats.refused_border;
-        if (is_out && deformed_out.count(e)) replacements.emplace_back(e, deformed_out[e]);
-        if (!is_out && opt.drop_refused_inputs && add_in[e]) {  // keep C_out rather than overlap it
-          add_in[e] = 0;
-          keep_capped_or_drop(r, stats.in_cut_added);
-        }
-      }
-    }
-    replacements.emplace_back(first, std::move(acc));
-    t_merge += tm.seconds();
-  }
-  for (auto& [e, m] : replacements) elements[e] = std::move(m);
-  std::vector<ElementMesh> adds;
-  for (int e = 0; e < ni; ++e)
-    if (add_in[e]) {
-      adds.push_back(std::move(placed[e]));
-      ++stats.in_added;
-    }
-  for (ElementMesh& m : cut_inputs) adds.push_back(std::move(m));
-  if (opt.resolve_crossings) {
-    Timer tr;
-    QuiltStepOptions ro = opt;
-    if (ro.clearance < 0) ro.clearance = 0.5 * swatch.min_gap;
-    adds = resolve_crossings(elements, alive, std::move(adds), ro, stats);
-    stats.seconds_resolve += tr.seconds();
-  }
-  for (ElementMesh& m : adds) {
-    elements.push_back(std::move(m));
-    alive.push_back(1);
-  }
-  for (int j = std::max(0, oj); j < std::min(grid.ny, oj + sy); ++j)
-    for (int i = std::max(0, oi); i < std::min(grid.nx, oi + sx); ++i) grid.processed[j * grid.nx + i] = 1;
-  stats.seconds_deform += t_deform;
-  stats.seconds_merge += t_merge;
-  return {oi, oj, dx, dy};
+  group_related(s);
+  merge_groups(s);
+  commit_step(s);
+  stats.seconds_deform += s.t_deform;
+  stats.seconds_merge += s.t_merge;
+  return {s.oi, s.oj, s.dx, s.dy};
 }
 
 }  // namespace surftex

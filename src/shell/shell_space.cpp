@@ -24,18 +24,17 @@ bool positive(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 }
 
 std::string vstr(double x) { return std::to_string(x); }
-}  // namespace
+/// The base mesh, its atlas maps, and the prisms' bottom shell vertices, as
+/// build_shell_space's stages share them.
+struct ShellBuild {
+  const Mesh& base;
+  PropertyMap<HalfedgeIndex, UV> uvmap;
+  PropertyMap<FaceIndex, int> patch;
+  std::map<std::pair<int, int>, int> index;       // (chart, base vertex) -> bottom shell vertex
+  std::vector<std::array<int, 3>> face_bottom;    // per base face: its corners' bottom shell vertices
+};
 
-double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-          u[2] * (v[0] * w[1] - v[1] * w[0])) /
-         6.0;
-}
-
-ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
+void check_shell_inputs(const Mesh& base, const ShellSpaceOptions& opt) {
   if (!(opt.height > 0 && std::isfinite(opt.height)))
     throw InvalidInputError("shell space: height must be positive, got " + vstr(opt.height));
   if (!(opt.shrink_factor > 0 && opt.shrink_factor < 1))
@@ -45,25 +44,24 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
                             std::to_string(opt.max_shrink_steps));
   if (base.number_of_faces() == 0) throw InvalidInputError("shell space: base mesh has no faces");
   if (base.has_garbage()) throw InvalidInputError("shell space: base mesh has removed elements (collect garbage)");
-  auto [uvmap, has_uv] = find(base, kCornerUV);
-  auto [patch, has_patch] = find(base, kFacePatch);
-  if (!has_uv || !has_patch)
-    throw InvalidInputError(std::string("shell space: base mesh needs the ") + kCornerUV.name + " and " +
-                            kFacePatch.name + " maps (compute_base_mesh_atlas)");
+}
 
-  ShellSpace s;
-  // Atlas scale and nominal height.
+/// Atlas scale (uv per unit length, from the 3D and uv areas) and nominal
+/// height (relative: times the mean edge length); w_scale converts heights to
+/// texture units. Throws for a non-triangle, an uncharted face, zero area.
+void scale_and_height(const ShellBuild& b, const ShellSpaceOptions& opt, ShellSpace& s) {
+  const Mesh& base = b.base;
   double a3 = 0, auv = 0, edge_sum = 0;
   for (FaceIndex f : base.faces()) {
     if (base.degree(f) != 3)
       throw InvalidInputError("shell space: face " + std::to_string(f.idx()) + " is not a triangle");
-    if (patch[f] < 0) throw InvalidInputError("shell space: face " + std::to_string(f.idx()) + " has no chart");
+    if (b.patch[f] < 0) throw InvalidInputError("shell space: face " + std::to_string(f.idx()) + " has no chart");
     HalfedgeIndex h = base.halfedge(f);
     a3 += std::sqrt(CGAL::squared_area(base.point(base.source(h)), base.point(base.target(h)),
                                        base.point(base.target(base.next(h)))));
-    const UV& p = uvmap[base.prev(h)];
-    const UV& q = uvmap[h];
-    const UV& r = uvmap[base.next(h)];
+    const UV& p = b.uvmap[base.prev(h)];
+    const UV& q = b.uvmap[h];
+    const UV& r = b.uvmap[base.next(h)];
     auv += std::abs(0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])));
   }
   for (EdgeIndex e : base.edges()) edge_sum += std::sqrt(CGAL::squared_distance(
@@ -73,22 +71,21 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
   s.height = opt.relative_height ? opt.height * edge_sum / static_cast<double>(base.number_of_edges())
                                  : opt.height;
   s.w_scale = s.height * s.uv_per_length;
+}
 
-  // Vertex normals.
-  std::vector<Vector3> normal(base.num_vertices(), Vector3(0, 0, 0));
-  for (VertexIndex v : base.vertices())
-    if (!base.is_isolated(v)) normal[v.idx()] = PMP::compute_vertex_normal(v, base);
-
-  // Shell vertices per (chart, base vertex).
-  std::map<std::pair<int, int>, int> index;  // (chart, base vertex) -> bottom shell vertex
-  std::vector<std::array<int, 3>> face_bottom(base.num_faces());
+/// Shell vertices per (chart, base vertex): a bottom and a top one, at the
+/// base position and the corner's uv (w = 0 and 1); throws when a vertex has
+/// two uvs inside one chart.
+void create_shell_vertices(ShellBuild& b, ShellSpace& s) {
+  const Mesh& base = b.base;
+  b.face_bottom.resize(base.num_faces());
   for (FaceIndex f : base.faces()) {
-    const int c = patch[f];
+    const int c = b.patch[f];
     int k = 0;
     for (HalfedgeIndex h : base.halfedges_around_face(base.halfedge(f))) {
       const VertexIndex v = base.target(h);
-      const UV uv = uvmap[h];
-      auto [it, inserted] = index.try_emplace({c, static_cast<int>(v.idx())}, static_cast<int>(s.shell_points.size()));
+      const UV uv = b.uvmap[h];
+      auto [it, inserted] = b.index.try_emplace({c, static_cast<int>(v.idx())}, static_cast<int>(s.shell_points.size()));
       if (inserted) {
         const Point3& p = base.point(v);
         for (int layer = 0; layer < 2; ++layer) {
@@ -106,32 +103,42 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
           throw InvalidInputError("shell space: vertex " + std::to_string(v.idx()) + " has two different uvs in chart " +
                                   std::to_string(c) + " (charts must be seamless inside)");
       }
-      face_bottom[f.idx()][k++] = it->second;
+      b.face_bottom[f.idx()][k++] = it->second;
     }
   }
-  // Mark lateral vertices (second pass: every shell vertex now exists).
+}
+
+/// Marks the lateral vertices, both layers: those on a chart's border (second
+/// pass: every shell vertex now exists).
+void mark_lateral_vertices(const ShellBuild& b, ShellSpace& s) {
+  const Mesh& base = b.base;
   for (FaceIndex f : base.faces()) {
-    const int c = patch[f];
+    const int c = b.patch[f];
     for (HalfedgeIndex h : base.halfedges_around_face(base.halfedge(f))) {
       HalfedgeIndex o = base.opposite(h);
-      if (base.is_border(o) || patch[base.face(o)] != c) {
+      if (base.is_border(o) || b.patch[base.face(o)] != c) {
         for (VertexIndex v : {base.source(h), base.target(h)}) {
-          const int b = index.at({c, static_cast<int>(v.idx())});
-          s.lateral[static_cast<std::size_t>(b)] = 1;
-          s.lateral[static_cast<std::size_t>(b) + 1] = 1;
+          const int bv = b.index.at({c, static_cast<int>(v.idx())});
+          s.lateral[static_cast<std::size_t>(bv)] = 1;
+          s.lateral[static_cast<std::size_t>(bv) + 1] = 1;
         }
       }
     }
   }
+}
 
-  // Tets per prism, ordered by base vertex index, oriented positively in texture space.
+/// Three tets per prism, ordered by base vertex index (so that neighbouring
+/// prisms split their shared side alike), oriented positively in texture
+/// space. Throws SolverError for a degenerate uv triangle.
+void build_prism_tets(const ShellBuild& b, ShellSpace& s) {
+  const Mesh& base = b.base;
   const std::size_t nf = base.num_faces();
   s.tets.reserve(3 * nf);
   s.tet_face.reserve(3 * nf);
   for (FaceIndex f : base.faces()) {
-    std::array<int, 3> b = face_bottom[f.idx()];
-    std::sort(b.begin(), b.end(), [&](int x, int y) { return s.base_vertex[x] < s.base_vertex[y]; });
-    const int a = b[0], bb = b[1], c = b[2], A = a + 1, B = bb + 1, C = c + 1;
+    std::array<int, 3> fb = b.face_bottom[f.idx()];
+    std::sort(fb.begin(), fb.end(), [&](int x, int y) { return s.base_vertex[x] < s.base_vertex[y]; });
+    const int a = fb[0], bb = fb[1], c = fb[2], A = a + 1, B = bb + 1, C = c + 1;
     std::array<Tet, 3> t = {Tet{a, bb, c, C}, Tet{a, bb, B, C}, Tet{a, A, B, C}};
     for (Tet& tet : t) {
       CGAL::Orientation o = CGAL::orientation(to_point(s.texture_points[tet[0]]), to_point(s.texture_points[tet[1]]),
@@ -144,8 +151,47 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
       s.tet_face.push_back(static_cast<int>(f.idx()));
     }
   }
+}
 
-  // Offset with local clamping.
+/// The prisms inverted by the current offset: a tet not positive in world
+/// space, or a top triangle turned over against its base triangle. Their base
+/// vertices are set in `bad`; returns their count.
+std::size_t mark_inverted_prisms(const ShellSpace& s, const std::vector<std::array<int, 3>>& face_bottom,
+                                 std::vector<std::uint8_t>& bad) {
+  std::fill(bad.begin(), bad.end(), 0);
+  std::size_t nbad = 0;
+  for (std::size_t t = 0; t < s.tets.size(); t += 3) {
+    bool ok = true;
+    for (std::size_t k = t; k < t + 3 && ok; ++k) {
+      const Tet& q = s.tets[k];
+      ok = positive(s.shell_points[q[0]], s.shell_points[q[1]], s.shell_points[q[2]], s.shell_points[q[3]]);
+    }
+    // Top triangle must not turn over against its base triangle.
+    const std::array<int, 3>& b = face_bottom[static_cast<std::size_t>(s.tet_face[t])];
+    if (ok) {
+      auto cross = [&](int i0, int i1, int i2) {
+        const Vec3 &p = s.shell_points[i0], &q = s.shell_points[i1], &r = s.shell_points[i2];
+        const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        return Vec3{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      };
+      const Vec3 n0 = cross(b[0], b[1], b[2]), n1 = cross(b[0] + 1, b[1] + 1, b[2] + 1);
+      ok = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] > 0;
+    }
+    if (!ok) {
+      ++nbad;
+      for (int i : b) bad[static_cast<std::size_t>(s.base_vertex[i])] = 1;
+    }
+  }
+  return nbad;
+}
+
+/// Offset with local clamping: every top vertex at its base vertex moved
+/// along the vertex normal by the vertex's height; the heights of the
+/// vertices of inverted prisms shrink by shrink_factor per round until none
+/// is left. Throws SolverError after max_shrink_steps rounds.
+void offset_with_clamping(const Mesh& base, const std::vector<Vector3>& normal,
+                          const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
+                          ShellSpace& s) {
   s.vertex_height.assign(base.num_vertices(), s.height);
   std::vector<std::uint8_t> shrunk(base.num_vertices(), 0);
   std::vector<std::uint8_t> bad(base.num_vertices(), 0);
@@ -157,30 +203,7 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
       const Vec3& p = s.shell_points[i];
       s.shell_points[i + 1] = {p[0] + hv * n.x(), p[1] + hv * n.y(), p[2] + hv * n.z()};
     }
-    std::fill(bad.begin(), bad.end(), 0);
-    std::size_t nbad = 0;
-    for (std::size_t t = 0; t < s.tets.size(); t += 3) {
-      bool ok = true;
-      for (std::size_t k = t; k < t + 3 && ok; ++k) {
-        const Tet& q = s.tets[k];
-        ok = positive(s.shell_points[q[0]], s.shell_points[q[1]], s.shell_points[q[2]], s.shell_points[q[3]]);
-      }
-      // Top triangle must not turn over against its base triangle.
-      const std::array<int, 3>& b = face_bottom[static_cast<std::size_t>(s.tet_face[t])];
-      if (ok) {
-        auto cross = [&](int i0, int i1, int i2) {
-          const Vec3 &p = s.shell_points[i0], &q = s.shell_points[i1], &r = s.shell_points[i2];
-          const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-          return Vec3{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-        };
-        const Vec3 n0 = cross(b[0], b[1], b[2]), n1 = cross(b[0] + 1, b[1] + 1, b[2] + 1);
-        ok = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] > 0;
-      }
-      if (!ok) {
-        ++nbad;
-        for (int i : b) bad[static_cast<std::size_t>(s.base_vertex[i])] = 1;
-      }
-    }
+    const std::size_t nbad = mark_inverted_prisms(s, face_bottom, bad);
     if (nbad == 0) {
       s.shrink_rounds = round;
       break;
@@ -193,6 +216,39 @@ ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
       if (bad[v]) s.vertex_height[v] *= opt.shrink_factor, shrunk[v] = 1;
   }
   for (auto x : shrunk) s.clamped_vertices += x;
+}
+}  // namespace
+
+double tet_signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+          u[2] * (v[0] * w[1] - v[1] * w[0])) /
+         6.0;
+}
+
+/// Zhou et al. 2006 s.3.1: per chart of the base atlas, a prism of two shell
+/// vertices per corner over every face, cut into three tets; the top layer
+/// offset along the vertex normals, shrunk locally where prisms invert.
+ShellSpace build_shell_space(const Mesh& base, const ShellSpaceOptions& opt) {
+  check_shell_inputs(base, opt);
+  auto [uvmap, has_uv] = find(base, kCornerUV);
+  auto [patch, has_patch] = find(base, kFacePatch);
+  if (!has_uv || !has_patch)
+    throw InvalidInputError(std::string("shell space: base mesh needs the ") + kCornerUV.name + " and " +
+                            kFacePatch.name + " maps (compute_base_mesh_atlas)");
+  ShellBuild b{base, uvmap, patch, {}, {}};
+  ShellSpace s;
+  scale_and_height(b, opt, s);
+  // Vertex normals.
+  std::vector<Vector3> normal(base.num_vertices(), Vector3(0, 0, 0));
+  for (VertexIndex v : base.vertices())
+    if (!base.is_isolated(v)) normal[v.idx()] = PMP::compute_vertex_normal(v, base);
+  create_shell_vertices(b, s);
+  mark_lateral_vertices(b, s);
+  build_prism_tets(b, s);
+  offset_with_clamping(base, normal, b.face_bottom, opt, s);
   return s;
 }
 

@@ -14,9 +14,17 @@
 // (geometry/uv_raster.h, one texel band around each chart), the lookups, and
 // the gutter: every chart dilated by 2^K texels for the K mip levels down to
 // `min_mip_size`, background filled by the dilation (geometry/atlas_gutter.h).
-// The height map is the tile's luminance through the very same lookups
-// (Ray et al.: "this can be also applied to additional attributes, such as
-// normal maps"), for the PBR set (texture/pbr_maps.h).
+// The tile's map layers go through the very same lookups (Ray et al.: "this
+// can be also applied to additional attributes, such as normal maps"), for
+// the PBR set (texture/pbr_maps.h): height (the tile's height layers, else
+// its luminance), roughness, and the normal. A tile normal is tangent-space
+// in the tile's frame (+x = +s, +y = up in the tile image = -t); per lookup
+// it becomes the object-space normal x S + y U + z N, with N the
+// interpolated vertex normal (kVertexNormal, else area-weighted as the mesh
+// writers compute it), S the surface direction of increasing s (dP/ds of the
+// lookup's chart on the face) made orthogonal to N and U that of decreasing t
+// made orthogonal to N and S; a singular face's three lookups are blended by
+// the barycentrics and renormalised, as the colour.
 //
 // Reads the singularities' charts (computed on this mesh), writes kCornerUV
 // (atlas uv) and kFacePatch (chart id). Throws InvalidInputError (size not in
@@ -40,7 +48,13 @@ struct MaterialBakeOptions {
 
 struct MaterialBakeResult {
   Image color;               ///< size x size x 3, linear RGB
-  Image height;              ///< size x size x 1, tile luminance in [0,1]
+  Image height;              ///< size x size x 1, [0,1]: the tile's height layers, else its luminance
+  bool height_from_tile = false;  ///< height from the tile's height layers
+  Image roughness;           ///< size x size x 1, [0,1], from the tile's roughness layers (else empty)
+  /// size x size x 3, the unit object-space normal (not encoded) on the
+  /// rasterised texels (raster triangle >= 0), 0 elsewhere (not dilated),
+  /// from the tile's normal layers (else empty).
+  Image object_normal;
   std::vector<int> chart;    ///< per texel before dilation: chart id, -1 = gutter/background
   std::vector<int> owner;    ///< per texel after dilation: the chart it belongs to
   int charts = 0;
@@ -55,6 +69,14 @@ struct MaterialBakeResult {
 
 MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile,
                                        const MaterialBakeOptions& options = {});
+
+/// The tangent-space normal map (3 channels, (n + 1) / 2) a glTF viewer needs
+/// to show `bake.object_normal` on the GLB that write_mesh writes of the baked
+/// `mesh` (its kCornerUV, kFacePatch, normals): per texel n_ts = (n.T, n.B,
+/// n.N) in the frame texture/tangent_space_bake.h rebuilds from the file's
+/// NORMAL and TANGENT, normalised; gutters filled by dilating the charts'
+/// values. Throws InvalidInputError if the bake has no object normals.
+Image material_space_tangent_normals(const Mesh& mesh, const MaterialBakeResult& bake);
 
 /// The colour of the mapping at barycentrics `bary` of `face` (what the
 /// fixed render shows): one lookup, or three blended on a singular face.

@@ -417,6 +417,14 @@ class Synthesizer {
   void synthesize_pixel(int p);
   void seed_patch(int p);
   void mark_filled(int p);
+  struct PixelCounts {
+    std::size_t known = 0, to_fill = 0;
+  };
+  PixelCounts init_canvas();
+  void seed_at_centre();
+  void report_fill_progress(std::size_t to_fill) const;
+  void fill_onion_peel(std::size_t to_fill);
+  void fill_direction_sweep(std::size_t to_fill);
 
   const ElInput& in_;
   const ElOptions& opt_;
@@ -858,9 +866,10 @@ void Synthesizer::synthesize_pixel(int p) {
   ++synthesized_;
 }
 
-ElResult Synthesizer::run() {
-  Timer timer;
-  validate();
+// The canvas from the input: sizes, windows, pixel states, the target's
+// values, the Known pixels (values checked finite). Returns the counts of
+// Known and Fill pixels.
+Synthesizer::PixelCounts Synthesizer::init_canvas() {
   W = in_.target.width;
   H = in_.target.height;
   C = in_.target.channels;
@@ -872,114 +881,134 @@ ElResult Synthesizer::run() {
   out_ = in_.target;
   known_.assign(n, 0);
   src_.assign(n, -1);
-  std::size_t any_known = 0, to_fill = 0;
+  PixelCounts counts;
   for (std::size_t p = 0; p < n; ++p) {
     if (state_[p] == PixelState::Known) {
       known_[p] = 1;
-      ++any_known;
+      ++counts.known;
       for (int c = 0; c < C; ++c)
         if (!std::isfinite(out_.data[p * C + c]))
           throw InvalidInputError("efros_leung: target holds a non-finite value at Known pixel (" +
                                   std::to_string(p % W) + ", " + std::to_string(p / W) + ")");
     }
-    if (state_[p] == PixelState::Fill) ++to_fill;
+    if (state_[p] == PixelState::Fill) ++counts.to_fill;
   }
+  // The second pass's Gaussian weight per full-window offset.
   const int lo = lo_of(window_), hi = hi_of(window_);
   for (int dy = lo; dy <= hi; ++dy)
     for (int dx = lo; dx <= hi; ++dx)
       gauss_.push_back(static_cast<float>(std::exp(-(dx * dx + dy * dy) / (2.0 * sigma_ * sigma_))));
+  return counts;
+}
+
+// Onion peel on an empty target: the first seed goes to the Fill pixel
+// nearest the centre of the Fill pixels' bounding box. (A direction sweep
+// seeds at its first pixel instead.)
+void Synthesizer::seed_at_centre() {
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  int x0 = W, y0 = H, x1 = -1, y1 = -1;
+  for (std::size_t p = 0; p < n; ++p)
+    if (state_[p] == PixelState::Fill) {
+      x0 = std::min<int>(x0, p % W);
+      x1 = std::max<int>(x1, p % W);
+      y0 = std::min<int>(y0, p / W);
+      y1 = std::max<int>(y1, p / W);
+    }
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  int best = -1;
+  double bd = std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < n; ++p) {
+    if (state_[p] != PixelState::Fill) continue;
+    const double d = (p % W - cx) * (p % W - cx) + (p / W - cy) * (p / W - cy);
+    if (d < bd) {
+      bd = d;
+      best = static_cast<int>(p);
+    }
+  }
+  onion_ = false;  // counts are initialised by fill_onion_peel, after the seed
+  seed_patch(best);
+}
+
+// Progress after a pixel: every percent of the Fill pixels, and at the end.
+void Synthesizer::report_fill_progress(std::size_t to_fill) const {
+  const std::size_t done = synthesized_ + seeded_;
+  const std::size_t step = std::max<std::size_t>(1, to_fill / 100);
+  if (opt_.progress && (done % step == 0 || done == to_fill))
+    opt_.progress("synthesis", static_cast<double>(done) / to_fill);
+}
+
+// Onion-peel order (Efros & Leung): the unfilled Fill pixel with the most
+// known 8-neighbours first (ties: the lowest index), counts kept current as
+// pixels are filled (stale queue entries skipped).
+void Synthesizer::fill_onion_peel(std::size_t to_fill) {
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  count_.assign(n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    if (state_[p] != PixelState::Fill || known_[p]) continue;
+    const int px = p % W, py = p / W;
+    int cnt = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int x = px + dx, y = py + dy;
+        if ((dx || dy) && x >= 0 && y >= 0 && x < W && y < H && known_[y * W + x]) ++cnt;
+      }
+    count_[p] = static_cast<std::uint8_t>(cnt);
+    queue_.push({cnt, -static_cast<int>(p)});
+  }
+  while (!queue_.empty()) {
+    const auto [cnt, negp] = queue_.top();
+    queue_.pop();
+    const int p = -negp;
+    if (known_[p] || cnt != count_[p]) continue;  // stale entry
+    synthesize_pixel(p);
+    report_fill_progress(to_fill);
+  }
+}
+
+// Direction sweep (ElOptions::direction_x/y; Gorla 2003 section 4): Fill
+// pixels in increasing position along the direction, then across it.
+void Synthesizer::fill_direction_sweep(std::size_t to_fill) {
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  std::vector<int> order;
+  for (std::size_t p = 0; p < n; ++p)
+    if (state_[p] == PixelState::Fill && !known_[p]) order.push_back(static_cast<int>(p));
+  const double dx = opt_.direction_x, dy = opt_.direction_y;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    const double ka = (a % W) * dx + (a / W) * dy, kb = (b % W) * dx + (b / W) * dy;
+    if (ka != kb) return ka < kb;
+    const double pa = -(a % W) * dy + (a / W) * dx, pb = -(b % W) * dy + (b / W) * dx;
+    return pa < pb;
+  });
+  for (int p : order) {
+    if (known_[p]) continue;  // filled by a seed patch
+    synthesize_pixel(p);
+    report_fill_progress(to_fill);
+  }
+}
+
+ElResult Synthesizer::run() {
+  Timer timer;
+  validate();
+  const PixelCounts counts = init_canvas();
   rng_.seed(opt_.seed);
   prepare_search_images();
-
   ElResult res;
   res.window = window_;
   res.first_pass_window = first_;
   res.rotations_used = static_cast<int>(search_.size());
-  if (to_fill == 0) {
-    res.image = std::move(out_);
-    res.source = std::move(source_);
-    res.seconds = timer.seconds();
-    return res;
-  }
-  // Onion peel on an empty target: the first seed goes to the Fill pixel
-  // nearest the centre of the Fill pixels' bounding box. (A direction sweep
-  // seeds at its first pixel instead.)
-  if (any_known == 0 && opt_.order == FillOrder::OnionPeel) {
-    int x0 = W, y0 = H, x1 = -1, y1 = -1;
-    for (std::size_t p = 0; p < n; ++p)
-      if (state_[p] == PixelState::Fill) {
-        x0 = std::min<int>(x0, p % W);
-        x1 = std::max<int>(x1, p % W);
-        y0 = std::min<int>(y0, p / W);
-        y1 = std::max<int>(y1, p / W);
-      }
-    const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-    int best = -1;
-    double bd = std::numeric_limits<double>::infinity();
-    for (std::size_t p = 0; p < n; ++p) {
-      if (state_[p] != PixelState::Fill) continue;
-      const double d = (p % W - cx) * (p % W - cx) + (p / W - cy) * (p / W - cy);
-      if (d < bd) {
-        bd = d;
-        best = static_cast<int>(p);
-      }
-    }
-    onion_ = false;  // counts are initialised below, after the seed
-    seed_patch(best);
-  }
-  onion_ = opt_.order == FillOrder::OnionPeel;
-  std::size_t done = synthesized_ + seeded_;
-  const std::size_t step = std::max<std::size_t>(1, to_fill / 100);
-  auto progress = [&] {
-    if (opt_.progress && (done % step == 0 || done == to_fill))
-      opt_.progress("synthesis", static_cast<double>(done) / to_fill);
-  };
-  if (onion_) {
-    count_.assign(n, 0);
-    for (std::size_t p = 0; p < n; ++p) {
-      if (state_[p] != PixelState::Fill || known_[p]) continue;
-      const int px = p % W, py = p / W;
-      int cnt = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int x = px + dx, y = py + dy;
-          if ((dx || dy) && x >= 0 && y >= 0 && x < W && y < H && known_[y * W + x]) ++cnt;
-        }
-      count_[p] = static_cast<std::uint8_t>(cnt);
-      queue_.push({cnt, -static_cast<int>(p)});
-    }
-    while (!queue_.empty()) {
-      const auto [cnt, negp] = queue_.top();
-      queue_.pop();
-      const int p = -negp;
-      if (known_[p] || cnt != count_[p]) continue;  // stale entry
-      synthesize_pixel(p);
-      done = synthesized_ + seeded_;
-      progress();
-    }
-  } else {
-    std::vector<int> order;
-    for (std::size_t p = 0; p < n; ++p)
-      if (state_[p] == PixelState::Fill && !known_[p]) order.push_back(static_cast<int>(p));
-    const double dx = opt_.direction_x, dy = opt_.direction_y;
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      const double ka = (a % W) * dx + (a / W) * dy, kb = (b % W) * dx + (b / W) * dy;
-      if (ka != kb) return ka < kb;
-      const double pa = -(a % W) * dy + (a / W) * dx, pb = -(b % W) * dy + (b / W) * dx;
-      return pa < pb;
-    });
-    for (int p : order) {
-      if (known_[p]) continue;  // filled by a seed patch
-      synthesize_pixel(p);
-      done = synthesized_ + seeded_;
-      progress();
-    }
+  if (counts.to_fill > 0) {
+    if (counts.known == 0 && opt_.order == FillOrder::OnionPeel) seed_at_centre();
+    onion_ = opt_.order == FillOrder::OnionPeel;
+    if (onion_)
+      fill_onion_peel(counts.to_fill);
+    else
+      fill_direction_sweep(counts.to_fill);
+    res.synthesized = synthesized_;
+    res.seeded = seeded_;
+    res.pass1_candidates = pass1_candidates_;
   }
   res.image = std::move(out_);
   res.source = std::move(source_);
-  res.synthesized = synthesized_;
-  res.seeded = seeded_;
-  res.pass1_candidates = pass1_candidates_;
   res.seconds = timer.seconds();
   return res;
 }

@@ -792,161 +792,236 @@ class GraphcutSynthesizer {
     return j - source_natural_jump(ex_, ax, ay, bx, by, dx, dy, j);  // 0 when no exemplar neighbour
   }
 
+  // The straight-seam repair's sizes: the footprint's side, the stretch of
+  // line replaced, the forced band's half-width and the exclusion radius of
+  // candidate offsets.
+  struct SeamRepairSizes {
+    int side, seg, band, radius;
+  };
+  SeamRepairSizes seam_repair_sizes() const {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const int side = std::min({pw_, ph_, std::max(16, std::min(W, H) / 4)});
+    return {side, std::max(2, side / 2),  // stretch of the line replaced
+            std::max(1, side / 8),        // forced pixels on each side of the line
+            std::max(2, side / 8)};       // offsets this close to a patch in the footprint are skipped
+  }
+
+  // A stretch of an output line: a column (x = line) or a row (y = line),
+  // `seg` pixels from `start` along it (wrapping); start -1 = none.
+  struct Stretch {
+    bool column = true;
+    int line = -1, start = -1;
+  };
+  // tried[orientation][line * length + start]: stretches already attempted.
+  struct TriedStretches {
+    std::vector<char> col, row;
+  };
+
+  // The worst untried stretch: over the lines above the threshold, worst
+  // first (ties: columns, lower index), the untried start of largest summed
+  // pair excess of the first line that has one.
+  Stretch worst_untried_stretch(const SourceMatchedLineProfile& prof, int seg,
+                                const TriedStretches& tried) const {
+    const int W = canvas_.w_, H = canvas_.h_;
+    std::vector<std::pair<double, int>> lines;  // (ratio, code): code < W column x, else row code - W
+    for (int x = 0; x < W; ++x)
+      if (prof.column[static_cast<std::size_t>(x)] > opt_.straight_seam_ratio)
+        lines.emplace_back(prof.column[static_cast<std::size_t>(x)], x);
+    for (int y = 0; y < H; ++y)
+      if (prof.row[static_cast<std::size_t>(y)] > opt_.straight_seam_ratio)
+        lines.emplace_back(prof.row[static_cast<std::size_t>(y)], W + y);
+    std::stable_sort(lines.begin(), lines.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    Stretch s;
+    for (const auto& l : lines) {
+      s.column = l.second < W;
+      s.line = s.column ? l.second : l.second - W;
+      const int len = s.column ? H : W;
+      const std::vector<char>& t = s.column ? tried.col : tried.row;
+      // Excess of each pair of the line, then the best untried stretch.
+      std::vector<double> ex(static_cast<std::size_t>(len));
+      for (int k = 0; k < len; ++k)
+        ex[static_cast<std::size_t>(k)] = s.column ? pair_excess((s.line + W - 1) % W, k, 1, 0)
+                                                   : pair_excess(k, (s.line + H - 1) % H, 0, 1);
+      double best = 0.0;
+      s.start = -1;
+      for (int k = 0; k < len; ++k) {
+        if (t[static_cast<std::size_t>(s.line) * len + k]) continue;
+        double sum = 0.0;
+        for (int i = 0; i < seg; ++i) sum += ex[static_cast<std::size_t>((k + i) % len)];
+        if (sum > best) {
+          best = sum;
+          s.start = k;
+        }
+      }
+      if (s.start >= 0) break;
+    }
+    return s;
+  }
+
+  // The footprint of a stretch's repair: a side x side window centred on
+  // the stretch, straddling the line, with the band of the line there
+  // forced (mask 0; window coordinates i, j).
+  struct SeamFootprint {
+    int x0 = 0, y0 = 0;
+    Image win;
+    std::vector<float> mask;
+    std::vector<std::pair<int, int>> forced;  // output pixels
+  };
+  SeamFootprint seam_footprint(const Stretch& st, const SeamRepairSizes& z) const {
+    const int W = canvas_.w_, H = canvas_.h_;
+    const int side = z.side, seg = z.seg, band = z.band;
+    SeamFootprint f;
+    const int along0 = st.start + seg / 2 - side / 2, across0 = st.line - side / 2;
+    f.x0 = st.column ? across0 : along0;
+    f.y0 = st.column ? along0 : across0;
+    window(f.x0, f.y0, side, side, f.win, f.mask);
+    const int b0 = side / 2 - band, b1 = side / 2 + band;  // across the line
+    const int s0 = side / 2 - seg / 2, s1 = s0 + seg;      // along it
+    // Lens-shaped band: `band` pixels each side at the middle of the
+    // stretch, 1 at its ends, so that its own border is not a straight
+    // line parallel to the one being repaired (measured on the 7 tiles with
+    // straight seams: a rectangular band fixed as many, 6/7, at a higher
+    // eq.-1 cost, 482.7 vs 468.2, with higher worst lines).
+    for (int a = s0; a < s1; ++a)
+      for (int c = b0; c < b1; ++c) {
+        const double t = std::abs((a - s0) + 0.5 - seg / 2.0) / (seg / 2.0);
+        const int hw = 1 + static_cast<int>((band - 1) * (1.0 - t) + 0.5);
+        if (c < side / 2 - hw || c >= side / 2 + hw) continue;
+        const int i = st.column ? c : a, j = st.column ? a : c;
+        f.mask[static_cast<std::size_t>(j) * side + i] = 0.f;
+        f.forced.emplace_back(((f.x0 + i) % W + W) % W, ((f.y0 + j) % H + H) % H);
+      }
+    return f;
+  }
+
+  // Up to 8 exemplar offsets for the footprint (codes uy * nx + ux): the
+  // best by masked SSD per unmasked pixel, none within `radius` of a
+  // translation already present in the footprint or of one already chosen.
+  std::vector<int> seam_candidates(const SeamFootprint& f, const SeamRepairSizes& z, int& nx) {
+    constexpr int kCandidates = 8;
+    const int W = canvas_.w_, H = canvas_.h_;
+    const int side = z.side, radius = z.radius;
+    if (!matcher_) matcher_ = std::make_unique<MaskedSsdMatcher>(ex_, std::vector<float>{}, false);
+    const double area = std::accumulate(f.mask.begin(), f.mask.end(), 0.0);
+    const SsdMap m = matcher_->match(f.win, f.mask);
+    nx = m.nx;
+    std::vector<std::pair<int, int>> present;  // exemplar translations of the footprint's pixels
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i) {
+        const int x = ((f.x0 + i) % W + W) % W, y = ((f.y0 + j) % H + H) % H;
+        const std::pair<int, int> e{canvas_.source_x(x, y) - i, canvas_.source_y(x, y) - j};
+        if (std::find(present.begin(), present.end(), e) == present.end()) present.push_back(e);
+      }
+    std::vector<std::pair<double, int>> ranked;
+    ranked.reserve(m.ssd.size());
+    for (std::size_t k = 0; k < m.ssd.size(); ++k) {
+      const int ux = static_cast<int>(k) % m.nx, uy = static_cast<int>(k) / m.nx;
+      bool near = false;
+      for (const auto& e : present)
+        if (std::abs(ux - e.first) <= radius && std::abs(uy - e.second) <= radius) {
+          near = true;
+          break;
+        }
+      if (!near) ranked.emplace_back(m.ssd[k] / std::max(area, 1.0), static_cast<int>(k));
+    }
+    std::sort(ranked.begin(), ranked.end());
+    std::vector<int> chosen;
+    for (const auto& r : ranked) {
+      if (static_cast<int>(chosen.size()) >= kCandidates) break;
+      const int ux = r.second % m.nx, uy = r.second / m.nx;
+      bool close = false;
+      for (int c : chosen)
+        if (std::abs(ux - c % m.nx) <= radius && std::abs(uy - c / m.nx) <= radius) close = true;
+      if (!close) chosen.push_back(r.second);
+    }
+    return chosen;
+  }
+
+  // The limits a repair paste must keep: the eq.-1 cost budget, the initial
+  // cost, and the wrap lines' roughness.
+  struct SeamRepairLimits {
+    double budget, cost0, wrap0;
+  };
+
+  // Pastes each candidate with a gradient-normalised cut (eq. 5) that keeps
+  // the forced band, and keeps the most efficient one (line penalty removed
+  // per unit of eq.-1 cost added) that stays within the budget, lowers the
+  // penalty without raising the worst line, and does not roughen the wrap
+  // lines; the sources are restored otherwise. Returns whether one was kept
+  // (then `prof` and `score` are its).
+  bool paste_best_candidate(const SeamFootprint& f, const std::vector<int>& chosen, int nx, int side,
+                            const SeamRepairLimits& lim, SourceMatchedLineProfile& prof, LineScore& score) {
+    const std::vector<int> keep_x = canvas_.sx_, keep_y = canvas_.sy_;
+    std::vector<int> best_x, best_y;
+    LineScore best_score = score;
+    SourceMatchedLineProfile best_prof;
+    double best_eff = 0.0;
+    const double cost_now = canvas_.seam_cost();
+    for (int c : chosen) {
+      const PatchPlacement p{f.x0, f.y0, c % nx, c / nx, side, side};
+      const bool gn = canvas_.gradient_normalized_;
+      canvas_.gradient_normalized_ = true;  // eq. 5 for this cut only
+      canvas_.place_graphcut(p, f.forced);
+      canvas_.gradient_normalized_ = gn;
+      const double cost = canvas_.seam_cost();
+      SourceMatchedLineProfile np = line_profile();
+      const LineScore ns = line_score(np);
+      // Efficiency: penalty removed per unit of eq.-1 cost added (a paste
+      // that lowers the cost counts as if it added 0.1% of the initial cost).
+      const double eff = (score.penalty - ns.penalty) / std::max(cost - cost_now, 1e-3 * lim.cost0 + 1e-9);
+      const bool better = best_x.empty() || eff > best_eff;
+      if (cost <= lim.budget && ns.worst <= score.worst && ns.penalty < score.penalty && better &&
+          wrap_seam_ratio(canvas_.render()) <= lim.wrap0) {
+        best_eff = eff;
+        best_x = canvas_.sx_;
+        best_y = canvas_.sy_;
+        best_score = ns;
+        best_prof = std::move(np);
+      }
+      canvas_.sx_ = keep_x;
+      canvas_.sy_ = keep_y;
+    }
+    if (best_x.empty()) return false;
+    canvas_.sx_ = std::move(best_x);
+    canvas_.sy_ = std::move(best_y);
+    prof = std::move(best_prof);
+    score = best_score;
+    return true;
+  }
+
+  // Up to straight_seam_steps repairs: each takes the worst untried stretch
+  // of a line above the threshold and pastes the best candidate over it
+  // with the line's band forced; stops when no line is above the threshold
+  // or every stretch of every bad line was tried.
   void repair_straight_seams(GraphcutResult& res) {
     if (!canvas_.periodic_ || opt_.straight_seam_steps <= 0) return;
     const int W = canvas_.w_, H = canvas_.h_;
     const double budget = canvas_.seam_cost() * (1.0 + opt_.straight_seam_cost_tolerance);
-    const int side = std::min({pw_, ph_, std::max(16, std::min(W, H) / 4)});
-    const int seg = std::max(2, side / 2);      // stretch of the line replaced
-    const int band = std::max(1, side / 8);     // forced pixels on each side of the line
-    const int radius = std::max(2, side / 8);   // offsets this close to a patch in the footprint are skipped
-    constexpr int kCandidates = 8;
+    const SeamRepairSizes z = seam_repair_sizes();
     const double cost0 = canvas_.seam_cost();
     // The output's own wrap lines (its border when it is not rolled) may not
     // get rougher than they were, or than the threshold if they were smoother.
     const double wrap0 = std::max(wrap_seam_ratio(canvas_.render()), opt_.straight_seam_ratio);
-    // tried[orientation][line * length + start]: stretches already attempted.
-    std::vector<char> tried_col(static_cast<std::size_t>(W) * H, 0), tried_row(tried_col.size(), 0);
+    TriedStretches tried{std::vector<char>(static_cast<std::size_t>(W) * H, 0),
+                         std::vector<char>(static_cast<std::size_t>(W) * H, 0)};
     SourceMatchedLineProfile prof = line_profile();
     LineScore score = line_score(prof);
     for (int step = 0; step < opt_.straight_seam_steps; ++step) {
       if (!(score.worst > opt_.straight_seam_ratio)) break;
-      // Lines above the threshold, worst first (ties: columns, lower index).
-      std::vector<std::pair<double, int>> lines;  // (ratio, code): code < W column x, else row code - W
-      for (int x = 0; x < W; ++x)
-        if (prof.column[static_cast<std::size_t>(x)] > opt_.straight_seam_ratio)
-          lines.emplace_back(prof.column[static_cast<std::size_t>(x)], x);
-      for (int y = 0; y < H; ++y)
-        if (prof.row[static_cast<std::size_t>(y)] > opt_.straight_seam_ratio)
-          lines.emplace_back(prof.row[static_cast<std::size_t>(y)], W + y);
-      std::stable_sort(lines.begin(), lines.end(),
-                       [](const auto& a, const auto& b) { return a.first > b.first; });
-      bool column = true;
-      int line = -1, start = -1;
-      for (const auto& l : lines) {
-        column = l.second < W;
-        line = column ? l.second : l.second - W;
-        const int len = column ? H : W;
-        std::vector<char>& tried = column ? tried_col : tried_row;
-        // Excess of each pair of the line, then the best untried stretch.
-        std::vector<double> ex(static_cast<std::size_t>(len));
-        for (int k = 0; k < len; ++k)
-          ex[static_cast<std::size_t>(k)] =
-              column ? pair_excess((line + W - 1) % W, k, 1, 0) : pair_excess(k, (line + H - 1) % H, 0, 1);
-        double best = 0.0;
-        start = -1;
-        for (int k = 0; k < len; ++k) {
-          if (tried[static_cast<std::size_t>(line) * len + k]) continue;
-          double t = 0.0;
-          for (int i = 0; i < seg; ++i) t += ex[static_cast<std::size_t>((k + i) % len)];
-          if (t > best) {
-            best = t;
-            start = k;
-          }
-        }
-        if (start >= 0) break;
-      }
-      if (start < 0) break;  // every stretch of every bad line tried
+      const Stretch st = worst_untried_stretch(prof, z.seg, tried);
+      if (st.start < 0) break;  // every stretch of every bad line tried
       ++res.straight_seam_tried;
-      {
-        const int len = column ? H : W;
-        std::vector<char>& tried = column ? tried_col : tried_row;
-        for (int d = -seg / 2; d <= seg / 2; ++d)
-          tried[static_cast<std::size_t>(line) * len + static_cast<std::size_t>(((start + d) % len + len) % len)] = 1;
-      }
-      // Footprint centred on the stretch, straddling the line; the band of
-      // the line there is forced (window coordinates i, j).
-      const int along0 = start + seg / 2 - side / 2, across0 = line - side / 2;
-      const int x0 = column ? across0 : along0, y0 = column ? along0 : across0;
-      std::vector<std::pair<int, int>> forced;
-      Image win;
-      std::vector<float> mask;
-      window(x0, y0, side, side, win, mask);
-      const int b0 = side / 2 - band, b1 = side / 2 + band;         // across the line
-      const int s0 = side / 2 - seg / 2, s1 = s0 + seg;             // along it
-      // Lens-shaped band: `band` pixels each side at the middle of the
-      // stretch, 1 at its ends, so that its own border is not a straight
-      // line parallel to the one being repaired (measured on the 7 tiles with
-      // straight seams: a rectangular band fixed as many, 6/7, at a higher
-      // eq.-1 cost, 482.7 vs 468.2, with higher worst lines).
-      for (int a = s0; a < s1; ++a)
-        for (int c = b0; c < b1; ++c) {
-          const double t = std::abs((a - s0) + 0.5 - seg / 2.0) / (seg / 2.0);
-          const int hw = 1 + static_cast<int>((band - 1) * (1.0 - t) + 0.5);
-          if (c < side / 2 - hw || c >= side / 2 + hw) continue;
-          const int i = column ? c : a, j = column ? a : c;
-          mask[static_cast<std::size_t>(j) * side + i] = 0.f;
-          forced.emplace_back(((x0 + i) % W + W) % W, ((y0 + j) % H + H) % H);
-        }
-      if (!matcher_) matcher_ = std::make_unique<MaskedSsdMatcher>(ex_, std::vector<float>{}, false);
-      const double area = std::accumulate(mask.begin(), mask.end(), 0.0);
-      const SsdMap m = matcher_->match(win, mask);
-      std::vector<std::pair<int, int>> present;  // exemplar translations of the footprint's pixels
-      for (int j = 0; j < side; ++j)
-        for (int i = 0; i < side; ++i) {
-          const int x = ((x0 + i) % W + W) % W, y = ((y0 + j) % H + H) % H;
-          const std::pair<int, int> e{canvas_.source_x(x, y) - i, canvas_.source_y(x, y) - j};
-          if (std::find(present.begin(), present.end(), e) == present.end()) present.push_back(e);
-        }
-      std::vector<std::pair<double, int>> ranked;
-      ranked.reserve(m.ssd.size());
-      for (std::size_t k = 0; k < m.ssd.size(); ++k) {
-        const int ux = static_cast<int>(k) % m.nx, uy = static_cast<int>(k) / m.nx;
-        bool near = false;
-        for (const auto& e : present)
-          if (std::abs(ux - e.first) <= radius && std::abs(uy - e.second) <= radius) {
-            near = true;
-            break;
-          }
-        if (!near) ranked.emplace_back(m.ssd[k] / std::max(area, 1.0), static_cast<int>(k));
-      }
-      std::sort(ranked.begin(), ranked.end());
-      std::vector<int> chosen;
-      for (const auto& r : ranked) {
-        if (static_cast<int>(chosen.size()) >= kCandidates) break;
-        const int ux = r.second % m.nx, uy = r.second / m.nx;
-        bool close = false;
-        for (int c : chosen)
-          if (std::abs(ux - c % m.nx) <= radius && std::abs(uy - c / m.nx) <= radius) close = true;
-        if (!close) chosen.push_back(r.second);
-      }
-      const std::vector<int> keep_x = canvas_.sx_, keep_y = canvas_.sy_;
-      std::vector<int> best_x, best_y;
-      LineScore best_score = score;
-      SourceMatchedLineProfile best_prof;
-      double best_eff = 0.0;
-      const double cost_now = canvas_.seam_cost();
-      for (int c : chosen) {
-        const PatchPlacement p{x0, y0, c % m.nx, c / m.nx, side, side};
-        const bool gn = canvas_.gradient_normalized_;
-        canvas_.gradient_normalized_ = true;  // eq. 5 for this cut only
-        canvas_.place_graphcut(p, forced);
-        canvas_.gradient_normalized_ = gn;
-        const double cost = canvas_.seam_cost();
-        SourceMatchedLineProfile np = line_profile();
-        const LineScore ns = line_score(np);
-        // Efficiency: penalty removed per unit of eq.-1 cost added (a paste
-        // that lowers the cost counts as if it added 0.1% of the initial cost).
-        const double eff = (score.penalty - ns.penalty) / std::max(cost - cost_now, 1e-3 * cost0 + 1e-9);
-        const bool better = best_x.empty() || eff > best_eff;
-        if (cost <= budget && ns.worst <= score.worst && ns.penalty < score.penalty && better &&
-            wrap_seam_ratio(canvas_.render()) <= wrap0) {
-          best_eff = eff;
-          best_x = canvas_.sx_;
-          best_y = canvas_.sy_;
-          best_score = ns;
-          best_prof = std::move(np);
-        }
-        canvas_.sx_ = keep_x;
-        canvas_.sy_ = keep_y;
-      }
-      if (!best_x.empty()) {
-        canvas_.sx_ = std::move(best_x);
-        canvas_.sy_ = std::move(best_y);
-        prof = std::move(best_prof);
-        score = best_score;
+      const int len = st.column ? H : W;
+      std::vector<char>& t = st.column ? tried.col : tried.row;
+      for (int d = -z.seg / 2; d <= z.seg / 2; ++d)
+        t[static_cast<std::size_t>(st.line) * len +
+          static_cast<std::size_t>(((st.start + d) % len + len) % len)] = 1;
+      const SeamFootprint f = seam_footprint(st, z);
+      int nx = 0;
+      const std::vector<int> chosen = seam_candidates(f, z, nx);
+      if (paste_best_candidate(f, chosen, nx, z.side, {budget, cost0, wrap0}, prof, score))
         ++res.straight_seam_accepted;
-      }
       report_progress(opt_.progress, "graphcut straight seams",
                       static_cast<double>(step + 1) / opt_.straight_seam_steps);
     }

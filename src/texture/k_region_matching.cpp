@@ -5,8 +5,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "geometry/errors.h"
@@ -491,6 +493,111 @@ inline void accumulate(float* d, const float* r, const float* g, const float* b,
   }
 }
 
+// The region as a sparse stencil over one candidate row (ExemplarIndex::
+// match): per group its offset (wrapped into [0, W) x [0, H) when the level
+// wraps) and the R, G, B planes of its level; candidates x0 .. x0 + nx - 1.
+struct RowStencil {
+  const std::vector<SampleGroup>& groups;
+  const float* const* planes;  // 3 per group
+  const int* gx;
+  const int* gy;
+  int W, H, x0, nx;
+  bool wraps;
+  // The R, G, B rows of group g's level that candidate row y reads.
+  std::array<const float*, 3> row(std::size_t g, int y) const {
+    int yy = y + gy[g];
+    if (yy >= H) yy -= H;
+    const std::size_t r = static_cast<std::size_t>(yy) * W;
+    return {planes[3 * g] + r, planes[3 * g + 1] + r, planes[3 * g + 2] + r};
+  }
+};
+
+// The starting value of every candidate's sum of row y: its repetition
+// penalty bin, or 0.
+void start_row(const MatchBox& box, int y, int sc, int x0, int nx, std::vector<float>& d) {
+  if (box.bin_penalty) {
+    const float* prow = box.bin_penalty + static_cast<std::size_t>((y * sc) / box.bin) * box.bins_x;
+    for (int x = 0; x < nx; ++x) d[x] = prow[((x0 + x) * sc) / box.bin];
+  } else {
+    std::fill(d.begin(), d.end(), 0.0f);
+  }
+}
+
+// Phase 1 of a row (vectorised): the heaviest groups add their terms to all
+// candidates of the row from one contiguous (periodic: wrapped in two
+// pieces) run of their level's planes; after 1, 2, 4, ... groups the row is
+// dropped if every partial sum reached bd, and phase 1 ends once few
+// candidates (an eighth) survive. Returns the groups added, or none when
+// the row is dropped.
+std::optional<std::size_t> add_leading_groups(const RowStencil& s, int y, float bd, float* d) {
+  const std::size_t G = s.groups.size();
+  std::size_t g = 0, next_check = 1;
+  while (g < G) {
+    const auto [r, gg, b] = s.row(g, y);
+    if (s.wraps) {
+      int st = s.x0 + s.gx[g];  // candidate x0 + i reads texel x0 + i + dx (mod W)
+      if (st >= s.W) st -= s.W;
+      const int first = std::min(s.nx, s.W - st);
+      accumulate(d, r + st, gg + st, b + st, first, s.groups[g]);
+      accumulate(d + first, r, gg, b, s.nx - first, s.groups[g]);
+    } else {
+      const int st = s.x0 + s.gx[g];
+      accumulate(d, r + st, gg + st, b + st, s.nx, s.groups[g]);
+    }
+    ++g;
+    if (g == next_check && g < G) {
+      next_check *= 2;
+      int na = 0;
+      for (int x = 0; x < s.nx; ++x) na += d[x] < bd ? 1 : 0;
+      if (na == 0) return std::nullopt;
+      if (8 * na <= s.nx) break;  // few survivors: phase 2
+    }
+  }
+  return g;
+}
+
+// The best candidate so far (row-major: the first of equal minima is kept)
+// and the candidates whose sum was completed.
+struct RowBest {
+  float bd = std::numeric_limits<float>::infinity();
+  int bi = -1;
+  std::size_t scored = 0;
+};
+
+// Phase 2 of a row: each candidate still below the best adds the groups
+// from g on alone and is abandoned as soon as its partial sum reaches the
+// best distance. alive and rowp are scratch (nx and 3 G entries).
+void finish_survivors(const RowStencil& s, int y, std::size_t g, const float* d, int* alive,
+                      const float** rowp, RowBest& best) {
+  const std::size_t G = s.groups.size();
+  int na = 0;
+  for (int x = 0; x < s.nx; ++x)
+    if (d[x] < best.bd) alive[na++] = x;
+  for (std::size_t h = g; h < G; ++h) {
+    const auto r = s.row(h, y);
+    rowp[3 * h] = r[0];
+    rowp[3 * h + 1] = r[1];
+    rowp[3 * h + 2] = r[2];
+  }
+  for (int a = 0; a < na; ++a) {
+    const int x = alive[a];
+    float dx = d[x];
+    std::size_t h = g;
+    for (; h < G; ++h) {
+      const SampleGroup& grp = s.groups[h];
+      int xx = s.x0 + x + s.gx[h];
+      if (s.wraps && xx >= s.W) xx -= s.W;
+      const float e0 = rowp[3 * h][xx] - grp.color[0], e1 = rowp[3 * h + 1][xx] - grp.color[1],
+                  e2 = rowp[3 * h + 2][xx] - grp.color[2];
+      dx += grp.weight * (e0 * e0 + e1 * e1 + e2 * e2);
+      if (dx >= best.bd) break;
+    }
+    if (h < G) continue;  // abandoned
+    ++best.scored;
+    if (dx < best.bd) best.bd = dx, best.bi = y * s.W + s.x0 + x;  // x increasing: the first of equal minima
+  }
+}
+
 }  // namespace
 
 MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int center_level) const {
@@ -514,116 +621,50 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
   const int sc = ex.scale(center_level);
   const std::size_t G = groups.size();
   thread_local std::vector<float> d;
-  thread_local std::vector<int> gx, gy;
+  thread_local std::vector<int> gx, gy, alive;
+  thread_local std::vector<const float*> planes, rowp;
   d.resize(nx);
   gx.resize(G);
   gy.resize(G);
-  // Periodic: offsets wrapped into [0, W); non-periodic: as they are (the box keeps them inside).
-  for (std::size_t g = 0; g < G; ++g)
-    gx[g] = wraps ? wrap(groups[g].dx, W) : groups[g].dx, gy[g] = wraps ? wrap(groups[g].dy, H) : groups[g].dy;
-  thread_local std::vector<int> alive;
-  thread_local std::vector<const float*> rowp;
   alive.resize(nx);
+  planes.resize(3 * G);
   rowp.resize(3 * G);
-  float bd = std::numeric_limits<float>::infinity();
-  int bi = -1;
-  std::size_t scored = 0;
-  // Row by row, the region as a sparse stencil. Phase 1 (vectorised): the
-  // heaviest groups add their terms to all candidates of the row from one
-  // contiguous (periodic: wrapped in two pieces) run of their level's planes;
-  // the row is dropped as soon as every partial sum reaches the best distance
-  // so far (terms are >= 0, and a later candidate must be strictly better to
-  // win). Phase 2 (once few candidates of the row survive): each survivor
-  // alone adds the remaining terms and is abandoned as soon as its partial
-  // sum reaches the best distance. Both phases add the same terms in the same
-  // order with the same arithmetic, so every finished sum equals the full
-  // scan's, bit for bit, and so does the argmin (first of equal minima). A
+  // Periodic: offsets wrapped into [0, W); non-periodic: as they are (the box keeps them inside).
+  for (std::size_t g = 0; g < G; ++g) {
+    gx[g] = wraps ? wrap(groups[g].dx, W) : groups[g].dx,
+    gy[g] = wraps ? wrap(groups[g].dy, H) : groups[g].dy;
+    for (int c = 0; c < 3; ++c) planes[3 * g + c] = levels_[groups[g].level].plane[c].data();
+  }
+  const RowStencil s{groups, planes.data(), gx.data(), gy.data(), W, H, x0, nx, wraps};
+  RowBest best;
+  // Row by row: phase 1 adds the heaviest groups to the whole row, phase 2
+  // finishes the few survivors one by one. Both phases add the same terms
+  // in the same order with the same arithmetic, so every finished sum
+  // equals the full scan's, bit for bit, and so does the argmin (first of
+  // equal minima). Terms are >= 0 and a later candidate must be strictly
+  // better to win, so dropping a sum that reached the best is exact. A
   // repetition penalty is the starting value of each sum (>= 0).
   for (int y = box.y0; y <= box.y1; ++y) {
-    if (box.bin_penalty) {
-      const float* prow = box.bin_penalty + static_cast<std::size_t>((y * sc) / box.bin) * box.bins_x;
-      for (int x = 0; x < nx; ++x) d[x] = prow[((x0 + x) * sc) / box.bin];
-    } else {
-      std::fill(d.begin(), d.end(), 0.0f);
-    }
-    bool dropped = false;
-    int na = nx;
-    std::size_t g = 0, next_check = 1;
-    while (g < G) {
-      const Level& L = levels_[groups[g].level];
-      int yy = y + gy[g];
-      if (yy >= H) yy -= H;
-      const std::size_t row = static_cast<std::size_t>(yy) * W;
-      const float* r = L.plane[0].data() + row;
-      const float* gg = L.plane[1].data() + row;
-      const float* b = L.plane[2].data() + row;
-      if (wraps) {
-        int s = x0 + gx[g];  // candidate x0 + i reads texel x0 + i + dx (mod W)
-        if (s >= W) s -= W;
-        const int first = std::min(nx, W - s);
-        accumulate(d.data(), r + s, gg + s, b + s, first, groups[g]);
-        accumulate(d.data() + first, r, gg, b, nx - first, groups[g]);
-      } else {
-        const int s = x0 + gx[g];
-        accumulate(d.data(), r + s, gg + s, b + s, nx, groups[g]);
-      }
-      ++g;
-      if (g == next_check && g < G) {
-        next_check *= 2;
-        na = 0;
-        for (int x = 0; x < nx; ++x) na += d[x] < bd ? 1 : 0;
-        if (na == 0) {
-          dropped = true;
-          break;
-        }
-        if (8 * na <= nx) break;  // few survivors: phase 2
-      }
-    }
-    if (dropped) continue;
-    if (g >= G) {  // every term added over the whole row
-      for (int x = 0; x < nx; ++x)
-        if (d[x] < bd) bd = d[x], bi = y * W + x0 + x;  // row-major: the first of equal minima is kept
-      scored += static_cast<std::size_t>(nx);
+    start_row(box, y, sc, x0, nx, d);
+    const std::optional<std::size_t> g = add_leading_groups(s, y, best.bd, d.data());
+    if (!g) continue;  // dropped
+    if (*g < G) {
+      finish_survivors(s, y, *g, d.data(), alive.data(), rowp.data(), best);
       continue;
     }
-    // Phase 2: survivors one by one over the remaining groups.
-    na = 0;
-    for (int x = 0; x < nx; ++x)
-      if (d[x] < bd) alive[na++] = x;
-    for (std::size_t h = g; h < G; ++h) {
-      const Level& L = levels_[groups[h].level];
-      int yy = y + gy[h];
-      if (yy >= H) yy -= H;
-      const std::size_t row = static_cast<std::size_t>(yy) * W;
-      rowp[3 * h] = L.plane[0].data() + row;
-      rowp[3 * h + 1] = L.plane[1].data() + row;
-      rowp[3 * h + 2] = L.plane[2].data() + row;
-    }
-    for (int a = 0; a < na; ++a) {
-      const int x = alive[a];
-      float dx = d[x];
-      std::size_t h = g;
-      for (; h < G; ++h) {
-        const SampleGroup& grp = groups[h];
-        int xx = x0 + x + gx[h];
-        if (wraps && xx >= W) xx -= W;
-        const float e0 = rowp[3 * h][xx] - grp.color[0], e1 = rowp[3 * h + 1][xx] - grp.color[1],
-                    e2 = rowp[3 * h + 2][xx] - grp.color[2];
-        dx += grp.weight * (e0 * e0 + e1 * e1 + e2 * e2);
-        if (dx >= bd) break;
-      }
-      if (h < G) continue;  // abandoned
-      ++scored;
-      if (dx < bd) bd = dx, bi = y * W + x0 + x;  // x increasing: the first of equal minima is kept
-    }
+    for (int x = 0; x < nx; ++x)  // every term added over the whole row
+      if (d[x] < best.bd)
+        best.bd = d[x], best.bi = y * W + x0 + x;  // row-major: the first of equal minima is kept
+    best.scored += static_cast<std::size_t>(nx);
   }
-  if (bi < 0) bi = box.y0 * W + x0, bd = 0;  // only NaN colours: degenerate, take the box's first texel
+  if (best.bi < 0)
+    best.bi = box.y0 * W + x0, best.bd = 0;  // only NaN colours: degenerate, take the box's first texel
   res.found = true;
-  res.qx = bi % W;
-  res.qy = bi / W;
-  res.distance = bd;
+  res.qx = best.bi % W;
+  res.qy = best.bi / W;
+  res.distance = best.bd;
   res.comparisons = G;
-  res.candidates = scored;
+  res.candidates = best.scored;
   return res;
 }
 

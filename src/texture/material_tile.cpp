@@ -33,11 +33,108 @@ Image remap(const Image& src, const IndirectionMap& m) {
   return out;
 }
 
-struct KeyTile {
-  Image tile, mask;
+// The keys' maps travel packed in one image per key and layer, channels
+// [normal x y z][height][roughness] for the kinds present, through the very
+// operations the colour goes through (each is per channel).
+struct MapLayout {
+  int normal = -1, height = -1, roughness = -1;  // first channel, -1 = absent
+  int channels = 0;
 };
 
-KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTileOptions& opt) {
+MapLayout map_layout(const std::vector<MaterialKey>& keys) {
+  MapLayout L;
+  auto kind = [&](const char* name, const Image MaterialKey::*map, int width, int& slot) {
+    std::size_t given = 0;
+    for (const MaterialKey& k : keys) given += !(k.*map).empty();
+    if (given == 0) return;
+    if (given != keys.size())
+      throw InvalidInputError(std::string(name) + " map given for " + std::to_string(given) + " of " +
+                              std::to_string(keys.size()) + " keys (give one for every key, or none)");
+    slot = L.channels;
+    L.channels += width;
+  };
+  kind("normal", &MaterialKey::normal, 3, L.normal);
+  kind("height", &MaterialKey::height, 1, L.height);
+  kind("roughness", &MaterialKey::roughness, 1, L.roughness);
+  return L;
+}
+
+Image pack_maps(const MaterialKey& key, const MapLayout& L, const std::string& what) {
+  if (L.channels == 0) return {};
+  const int W = key.texture.width, H = key.texture.height;
+  Image out(W, H, L.channels);
+  auto put = [&](const Image& m, int slot, const char* name) {
+    if (slot < 0) return;
+    if (m.width != W || m.height != H)
+      throw InvalidInputError(what + ": " + name + " map " + std::to_string(m.width) + "x" +
+                              std::to_string(m.height) + " differs from texture " + std::to_string(W) + "x" +
+                              std::to_string(H));
+    const bool normal = slot == L.normal;
+    if (normal && m.channels < 3)
+      throw InvalidInputError(what + ": normal map has " + std::to_string(m.channels) + " channels, needs RGB");
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float* p = m.pixel(x, y);
+        float* o = out.pixel(x, y) + slot;
+        if (normal)
+          std::copy(p, p + 3, o);
+        else  // grey, or the luminance of RGB (texture/pbr_maps.h's weights)
+          *o = std::clamp(m.channels >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0], 0.f, 1.f);
+      }
+  };
+  put(key.normal, L.normal, "normal");
+  put(key.height, L.height, "height");
+  put(key.roughness, L.roughness, "roughness");
+  return out;
+}
+
+// Unit normals again after a resample or a blend (encoded (n + 1) / 2; a
+// vanishing vector becomes the flat normal).
+void renormalise_normals(Image& maps, const MapLayout& L) {
+  if (L.normal < 0 || maps.empty()) return;
+  for (int y = 0; y < maps.height; ++y)
+    for (int x = 0; x < maps.width; ++x) {
+      float* p = maps.pixel(x, y) + L.normal;
+      double n[3] = {2.0 * p[0] - 1, 2.0 * p[1] - 1, 2.0 * p[2] - 1};
+      const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (l > 1e-12)
+        for (double& c : n) c /= l;
+      else
+        n[0] = n[1] = 0, n[2] = 1;
+      for (int c = 0; c < 3; ++c) p[c] = static_cast<float>(0.5 * n[c] + 0.5);
+    }
+}
+
+// One channel range [first, first + n) of every packed layer.
+std::vector<Image> unpack_layers(const std::vector<Image>& packed, int first, int n) {
+  std::vector<Image> out;
+  if (first < 0) return out;
+  for (const Image& p : packed) {
+    Image img(p.width, p.height, n);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(p.width) * p.height; ++i)
+      std::copy(&p.data[i * p.channels + first], &p.data[i * p.channels + first + n], &img.data[i * n]);
+    out.push_back(std::move(img));
+  }
+  return out;
+}
+
+// A size x size image of `src` read at the given source texels.
+Image gather(const Image& src, const std::vector<int>& sx, const std::vector<int>& sy, int size) {
+  Image out(size, size, src.channels);
+  for (std::size_t i = 0; i < sx.size(); ++i) {
+    if (sx[i] < 0 || sy[i] < 0) throw InvalidInputError("material tile: a key tile texel has no source");
+    const float* p = src.pixel(sx[i], sy[i]);
+    std::copy(p, p + src.channels, &out.data[i * src.channels]);
+  }
+  return out;
+}
+
+struct KeyTile {
+  Image tile, mask;
+  Image maps;  // packed (MapLayout), empty without maps
+};
+
+KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTileOptions& opt, const MapLayout& L) {
   const std::string what = "key " + std::to_string(index) + (key.name.empty() ? "" : " ('" + key.name + "')");
   if (key.texture.empty()) throw InvalidInputError(what + ": empty texture");
   if (!key.mask.empty() && (key.mask.width != key.texture.width || key.mask.height != key.texture.height))
@@ -46,12 +143,18 @@ KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTil
                             std::to_string(key.texture.width) + "x" + std::to_string(key.texture.height));
   KeyTile k;
   k.tile = square_resample(key.texture, opt.size);
+  if (L.channels > 0) {
+    k.maps = square_resample(pack_maps(key, L, what), opt.size);
+    renormalise_normals(k.maps, L);
+  }
   if (!key.mask.empty()) k.mask = binarize_mask(square_resample(binarize_mask(key.mask), opt.size));
   if (!opt.keys_are_tileable && k.mask.empty()) {
     // Tileable version: graph-cut textures on the torus (the paper's [KdE*03]).
     TileOptions to;
     to.seed = derive_seed(opt.seed, 1000 + index);
-    k.tile = make_tileable(k.tile, opt.size, to);
+    TileResult tr = make_tileable_detailed(k.tile, opt.size, to);
+    k.tile = std::move(tr.tile);
+    if (!k.maps.empty()) k.maps = gather(k.maps, tr.source_x, tr.source_y, opt.size);
   } else if (!opt.keys_are_tileable) {
     // Tileable version carrying a painted mask: unconstrained toroidal synthesis from the square itself.
     ConstrainedSynthesisOptions so = opt.synthesis;
@@ -64,9 +167,17 @@ KeyTile prepare_key(const MaterialKey& key, std::size_t index, const MaterialTil
     const IndirectionMap& m = r.maps[0].back();
     k.tile = std::move(r.layers[0]);
     if (!k.mask.empty()) k.mask = remap(carried, m);
+    if (!k.maps.empty()) k.maps = remap(k.maps, m);
   }
   if (k.mask.empty()) k.mask = compute_feature_mask(k.tile, opt.auto_mask).mask;
   return k;
+}
+
+void split_maps(MaterialTileResult& res, const std::vector<Image>& packed, const MapLayout& L) {
+  if (L.channels == 0) return;
+  res.normal_layers = unpack_layers(packed, L.normal, 3);
+  res.height_layers = unpack_layers(packed, L.height, 1);
+  res.roughness_layers = unpack_layers(packed, L.roughness, 1);
 }
 
 // One pair of consecutive keys (a, b), p its index among the K - 1 pairs:
@@ -139,6 +250,8 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
   // Channel count: the largest among the keys (grey keys are broadcast).
   int channels = 0;
   for (const auto& k : keys) channels = std::max(channels, std::min(k.texture.channels, 4));
+  const MapLayout L = map_layout(keys);
+  std::vector<Image> packed;  // the map layers, packed as MapLayout
   std::vector<KeyTile> tiles(K);
   tbb::parallel_for(std::size_t(0), K, [&](std::size_t i) {
     MaterialKey k = keys[i];
@@ -152,7 +265,7 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
                                                      : k.texture.at(x, y, 0);
       k.texture = std::move(c);
     }
-    tiles[i] = prepare_key(k, i, opt);
+    tiles[i] = prepare_key(k, i, opt, L);
   });
   for (auto& k : tiles) {
     res.key_tiles.push_back(k.tile);
@@ -165,6 +278,7 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
     res.layers.assign(M + 1, Image());
     res.mask_agreement.assign(M + 1, 1.0);
     res.layers[0] = tiles[0].tile;
+    packed.assign(M + 1, tiles[0].maps);
     t.reset();
     tbb::parallel_for(1, M + 1, [&](int m) {
       ConstrainedSynthesisOptions so = opt.synthesis;
@@ -177,6 +291,7 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
       ConstrainedSynthesisResult r = synthesize_constrained_tiles(tiles[0].tile, tiles[0].mask, {tiles[0].mask}, so);
       res.layers[m] = std::move(r.layers[0]);
       res.mask_agreement[m] = r.mask_agreement[0];
+      if (!tiles[0].maps.empty()) packed[m] = remap(tiles[0].maps, r.maps[0].back());
     });
     res.seconds_synthesis = t.seconds();
     for (int m = 0; m <= M; ++m) {
@@ -184,6 +299,7 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
       res.material.push_back(double(m) / M);
       res.sign_changes.push_back(0);
     }
+    split_maps(res, packed, L);
     res.seconds_total = total.seconds();
     return res;
   }
@@ -205,12 +321,21 @@ MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys, cons
       Image out(A.width, A.height, A.channels);
       for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] = wa * A.data[i] + wb * B.data[i];
       res.layers.push_back(std::move(out));
+      if (L.channels > 0) {  // the maps read where A_m and B_m read, blended alike
+        const Image MA = remap(tiles[p].maps, pt.ra.maps[m].back());
+        const Image MB = remap(tiles[p + 1].maps, pt.rb.maps[M - m].back());
+        Image mo(MA.width, MA.height, MA.channels);
+        for (std::size_t i = 0; i < mo.data.size(); ++i) mo.data[i] = wa * MA.data[i] + wb * MB.data[i];
+        renormalise_normals(mo, L);
+        packed.push_back(std::move(mo));
+      }
       res.masks.push_back(pt.morph.masks[m]);
       res.material.push_back(double(p) + double(m) / M);
       res.sign_changes.push_back(m == 0 ? 0 : pt.morph.sign_changes[m - 1]);
       res.mask_agreement.push_back(std::min(pt.ra.mask_agreement[m], pt.rb.mask_agreement[M - m]));
     }
   }
+  split_maps(res, packed, L);
   res.seconds_total = total.seconds();
   report_progress(opt.progress, "material tile", 1.0);
   return res;

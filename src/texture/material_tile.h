@@ -15,6 +15,16 @@
 // Pairs are chained (A to B to C): the last layer of a pair is the first of the
 // next. Same-mask mode (one key): M+1 different tiles of the one texture that
 // share its mask, to hide periodicity (Figure 14).
+//
+// Maps of the keys (normal, height, roughness; issue 16 item 2; the paper:
+// "this can be also applied to additional attributes, such as normal maps")
+// go through the same coordinates as the colour: the same square resample,
+// the texel each key-tile texel was copied from (graph-cut sources, or the
+// toroidal synthesis's indirection), each layer's indirection maps, and the
+// same blend; normals are renormalised after the resample and the blend.
+// A normal map is tangent-space in the image's frame: RGB = (n + 1) / 2, +x
+// right, +y up (the image's up, i.e. towards smaller t of the tile lookup),
+// as patches' exemplar normals.
 
 #include <cstdint>
 #include <string>
@@ -34,6 +44,10 @@ struct MaterialKey {
   Image texture;
   Image mask;
   std::string name;  ///< for reports (file name)
+  /// Optional maps of the texture's size (empty = none); a kind given for one
+  /// key must be given for every key. normal: >= 3 channels, (n + 1) / 2, +y
+  /// up; height, roughness: grey (or the luminance of RGB), [0, 1].
+  Image normal{}, height{}, roughness{};
 };
 
 struct MaterialTileOptions {
@@ -66,15 +80,21 @@ struct MaterialTileResult {
   std::vector<long long> sign_changes;  ///< per layer: texels changing sign since the previous layer (0 for the first)
   std::vector<double> mask_agreement;   ///< per layer: min over the two syntheses of the mask agreement
   std::vector<Image> key_tiles, key_masks;  ///< T and F of every key
+  /// The keys' maps through the same coordinates, one per layer (empty when
+  /// the keys have none): normal 3 channels (n + 1) / 2 unit, height and
+  /// roughness 1 channel.
+  std::vector<Image> normal_layers, height_layers, roughness_layers;
   /// Wall seconds per stage; morph and synthesis are summed over the key
   /// pairs, which run in parallel (so their sum may exceed seconds_total).
   double seconds_keys = 0, seconds_morph = 0, seconds_synthesis = 0, seconds_total = 0;
 };
 
 /// Builds the 3D tile. `keys`: 1 (same-mask mode) or more key textures.
-/// Deterministic for a seed, whatever the thread count. Throws
-/// InvalidInputError for no keys, an empty texture, a mask whose size differs
-/// from its texture, or options out of range; errors of the stages propagate.
+/// Deterministic for a seed, whatever the thread count; the colour layers do
+/// not depend on the maps. Throws InvalidInputError for no keys, an empty
+/// texture, a mask or map whose size differs from its texture, a map kind
+/// given for some keys only, a normal map of fewer than 3 channels, or options
+/// out of range; errors of the stages propagate.
 MaterialTileResult make_material_tile(const std::vector<MaterialKey>& keys,
                                       const MaterialTileOptions& opt = {});
 
@@ -91,13 +111,18 @@ struct MaterialTileInfo {
   std::vector<std::string> masks;    ///< mask file per key ("" = automatic)
   std::uint64_t seed = 1;
   int layers_per_pair = 0;           ///< M
+  /// Map files per key (empty = none), recorded as "source_maps".
+  std::vector<std::string> normal_sources{}, height_sources{}, roughness_sources{};
 };
 
 /// Writes the 3D tile into folder `dir`: layer_000.png ... (one PNG per
 /// layer, 8-bit), mask_000.png ... (the constraint masks), layers.tif (all
-/// layers as the subimages of one multi-page TIFF) and tile.json (global: size,
-/// layer count, M, sources, masks, seed, files; per layer: index, m, file, mask
-/// file, sign-change count since the previous layer, mask agreement). Files are
+/// layers as the subimages of one multi-page TIFF), the map layers when the
+/// tile has them (normal_000.png 8-bit RGB, height_000.png 16-bit grey,
+/// roughness_000.png 8-bit grey) and tile.json (global: size, layer count, M,
+/// sources, masks, seed, files, "maps": the kinds present; per layer: index,
+/// m, file, mask file, one file per map kind under its name, sign-change count
+/// since the previous layer, mask agreement). Files are
 /// written into a staging folder beside `dir` which is then renamed onto it, so
 /// a failure leaves nothing half-written. Throws IOError if `dir` exists and
 /// !overwrite, or on any write failure.

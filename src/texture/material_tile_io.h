@@ -8,7 +8,11 @@
 // "surftex material tile", "size", "channels", "layers" (count),
 // "layers_per_pair" (M), and "layer_list": per layer {index, m, file, mask,
 // ...}; the layers are read from their PNG files (layer_NNN.png), which are
-// authoritative (layers.tif is a convenience copy and is not read).
+// authoritative (layers.tif is a convenience copy and is not read). Optional
+// map layers: "maps" lists the kinds present ("normal", "height",
+// "roughness"), and every layer entry then names its file of each kind under
+// the kind's name (normal_NNN.png: 3 channels, (n + 1) / 2, +x = +s, +y = up
+// in the image = -t; height_NNN.png, roughness_NNN.png: 1 channel).
 //
 // Lookup convention: layer texel (x, y) is centred at s = (x + 0.5) / size,
 // t = (y + 0.5) / size (row y = 0 at the top of the image, t grows downwards
@@ -27,6 +31,9 @@ namespace surftex {
 /// A 3D tile in memory: L layers, each size x size, same channel count.
 struct MaterialTile {
   std::vector<Image> layers;
+  /// Optional maps, one per layer of the layers' size, or empty (none):
+  /// normal 3 channels, height and roughness 1 channel.
+  std::vector<Image> normal_layers, height_layers, roughness_layers;
   std::vector<double> material;  ///< m recorded per layer in tile.json (key index + fraction)
   int size = 0;
   int layers_per_pair = 0;  ///< M
@@ -35,22 +42,29 @@ struct MaterialTile {
 /// Reads `dir`/tile.json and every layer file it lists. Every field and every
 /// layer file's header is checked before any pixel is decoded: "size" at
 /// most image_limits().max_side(), "channels" 1..16, "layers" 1..4096, a
-/// layer within the per-image decoded limit and the tile within 4 times it,
-/// layer files plain names inside `dir`. Throws IOError (no tile.json, larger
-/// than 16 MiB, unreadable or missing layer file: names the file) and
-/// InvalidInputError "tile.json: line L: field F: what" (malformed JSON,
-/// wrong format tag, a missing, ill-typed or out-of-range field, a layer
-/// whose size or channel count differs from the declared size/channels, a
-/// layer count that differs from "layers").
+/// layer within the per-image decoded limit and the tile (maps included)
+/// within 4 times it, layer and map files plain names inside `dir`. Throws
+/// IOError (no tile.json, larger than 16 MiB, unreadable or missing layer
+/// file: names the file) and InvalidInputError "tile.json: line L: field F:
+/// what" (malformed JSON, wrong format tag, a missing, ill-typed or
+/// out-of-range field, an unknown or repeated map kind, a missing map file or
+/// one whose size or channel count differs from the tile's, a layer whose size
+/// or channel count differs from the declared size/channels, a layer count
+/// that differs from "layers").
 MaterialTile read_material_tile(const std::string& dir);
 
 /// Checks a tile made in memory the same way (non-empty, square, equal sizes
-/// and channels >= 1). Throws InvalidInputError.
+/// and channels >= 1; map stacks empty or one per layer of the layers' size,
+/// normal >= 3 channels, height and roughness 1). Throws InvalidInputError.
 void validate_material_tile(const MaterialTile& tile);
 
 /// Trilinear lookup: bilinear in (s,t) with wrap-around (period 1) in each of
 /// the two layers nearest to m (clamped to [0,1]), linear between them.
 /// 1 channel = grey, >= 3 = the first three. Assumes a valid tile.
 Vec3f sample_material_tile(const MaterialTile& tile, double s, double t, double m);
+
+/// The same lookup in any stack of layers (the tile's or one of its map
+/// stacks): 1 channel = grey in all three, >= 3 = the first three.
+Vec3f sample_material_layers(const std::vector<Image>& layers, double s, double t, double m);
 
 }  // namespace surftex

@@ -37,6 +37,26 @@ void write_material_tile(const std::string& dir, const MaterialTileResult& tile,
   j["source_masks"] = info.masks;
   j["seed"] = info.seed;
   j["multilayer_file"] = "layers.tif";
+  // Map layers (material_tile.h): kind, layers, sources; height as 16-bit PNG.
+  struct MapKind {
+    const char* name;
+    const std::vector<Image>* layers;
+    const std::vector<std::string>* sources;
+    bool sixteen_bit;
+  };
+  const MapKind kinds[] = {{"normal", &tile.normal_layers, &info.normal_sources, false},
+                           {"height", &tile.height_layers, &info.height_sources, true},
+                           {"roughness", &tile.roughness_layers, &info.roughness_sources, false}};
+  nlohmann::json maps = nlohmann::json::array();
+  for (const MapKind& k : kinds) {
+    if (k.layers->empty()) continue;
+    if (k.layers->size() != tile.layers.size())
+      throw InvalidInputError(std::string("write_material_tile: ") + std::to_string(k.layers->size()) + " " + k.name +
+                              " layers for " + std::to_string(tile.layers.size()) + " layers");
+    maps.push_back(k.name);
+    if (!k.sources->empty()) j["source_maps"][k.name] = *k.sources;
+  }
+  if (!maps.empty()) j["maps"] = maps;
   nlohmann::json list = nlohmann::json::array();
   for (std::size_t i = 0; i < tile.layers.size(); ++i) {
     char name[64], mname[64];
@@ -49,6 +69,15 @@ void write_material_tile(const std::string& dir, const MaterialTileResult& tile,
     l["m"] = tile.material[i];
     l["file"] = name;
     l["mask"] = mname;
+    for (const MapKind& k : kinds) {
+      if (k.layers->empty()) continue;
+      char kname[64];
+      std::snprintf(kname, sizeof kname, "%s_%03zu.png", k.name, i);
+      WriteImageOptions io;
+      io.sixteen_bit = k.sixteen_bit;
+      write_image((stage / kname).string(), (*k.layers)[i], io);
+      l[k.name] = kname;
+    }
     l["sign_changes"] = tile.sign_changes[i];
     l["mask_agreement"] = tile.mask_agreement[i];
     list.push_back(l);

@@ -15,6 +15,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include "geometry/adaptive_sqrt2_subdivide.h"
@@ -451,6 +452,264 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
   job.t_transfer = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
 }
 
+// Throws unless the order and the caller's per-vertex records fit the
+// mesh's nv vertices.
+void check_pass_inputs(std::size_t nv, const std::vector<std::size_t>& order,
+                       const std::vector<char>& colored, const std::vector<int>* color_level_io,
+                       const std::vector<std::array<int, 2>>* source_io,
+                       const std::vector<ExemplarLookup>* lookup_io) {
+  if (source_io && source_io->size() != nv)
+    throw InvalidInputError("synthesis_pass: source has " + std::to_string(source_io->size()) + " entries for " +
+                            std::to_string(nv) + " vertices");
+  if (colored.size() != nv) throw InvalidInputError("synthesis_pass: colored has the wrong size");
+  if (lookup_io && lookup_io->size() != nv)
+    throw InvalidInputError("synthesis_pass: lookup has " + std::to_string(lookup_io->size()) + " entries for " +
+                            std::to_string(nv) + " vertices");
+  if (color_level_io && color_level_io->size() != nv)
+    throw InvalidInputError("synthesis_pass: color_level has " + std::to_string(color_level_io->size()) +
+                            " entries for " + std::to_string(nv) + " vertices");
+  for (std::size_t p : order)
+    if (p >= nv) throw InvalidInputError("synthesis_pass: order names vertex " + std::to_string(p));
+}
+
+// The summed channel variance of the exemplar's level 0 (the scale of the
+// repetition term).
+double level0_variance(const Image& l0) {
+  double sigma2 = 0;
+  for (int c = 0; c < 3; ++c) {
+    double m = 0, m2 = 0;
+    const std::size_t n = static_cast<std::size_t>(l0.width) * l0.height;
+    for (std::size_t i = 0; i < n; ++i)
+      m += l0.data[3 * i + c], m2 += double(l0.data[3 * i + c]) * l0.data[3 * i + c];
+    sigma2 += std::max(0.0, m2 / n - (m / n) * (m / n));
+  }
+  return sigma2;
+}
+
+// One synthesis pass over a vertex order (sections 3.1.2 and 3.3.1): each
+// vertex's k-region is matched against the exemplar and its colours taken
+// through the graph cut (3.4); the very first vertex gets a random texel.
+//
+// Speculative parallel matching, sequential commit (exactly the sequential
+// pass): the order is cut into chunks of consecutive vertices; every vertex
+// of a chunk is matched (and its cut solved) in parallel against the colours
+// at the start of the chunk; the results are then committed one by one in
+// the pass order. A vertex whose region received a colour from an earlier
+// commit of the same chunk read stale colours: its job is recomputed at
+// commit time against the current colours. Every committed result is thus
+// the one the sequential pass would compute, whatever the thread count. The
+// chunk size adapts to the conflict rate, deterministically (it depends only
+// on the data).
+class SynthesisPass {
+ public:
+  SynthesisPass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index, const PassGeometry& geo,
+                std::vector<char>& colored, double r_scale, int hierarchy_level,
+                const SubdivisionSynthesisOptions& opt, std::vector<int>* color_level_io,
+                std::vector<std::array<int, 2>>* source_io, std::vector<ExemplarLookup>* lookup_io)
+      : mesh_(mesh),
+        ex_(ex),
+        graph_(geo.graph),
+        opt_(opt),
+        colored_(colored),
+        col_(get_or_add(mesh, kVertexColor, Color3f{0.5f, 0.5f, 0.5f})) {
+    const std::size_t nv = mesh.number_of_vertices();
+    color_.resize(nv);
+    for (VertexIndex v : mesh.vertices()) color_[v.idx()] = col_[v];
+    const int nlev = static_cast<int>(ex.levels.size());
+    const int fixed_level = std::clamp(hierarchy_level, 0, nlev - 1);
+    level_.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i)
+      level_[i] = opt.antialias ? antialias_level(ex, r_scale, geo.frames.mean_edge[i]) : fixed_level;
+    // Without a caller's record, every colour is taken to represent its vertex's level.
+    if (!color_level_io) own_level_ = level_;
+    color_level_ = color_level_io ? color_level_io : &own_level_;
+    for (int& l : *color_level_) l = std::clamp(l, 0, nlev - 1);
+    if (!source_io) own_source_.assign(nv, {-1, -1});
+    source_ = source_io ? source_io : &own_source_;
+    if (!lookup_io) own_lookup_.assign(nv, {});
+    lookup_ = lookup_io ? lookup_io : &own_lookup_;
+    // The repetition counts (see SubdivisionSynthesisOptions::repetition_penalty);
+    // they are updated after every chunk's commits, so every job of a chunk
+    // reads the counts as they were at the chunk's start (whatever the threads).
+    if (source_io && opt.repetition_penalty > 0) {
+      const Image& l0 = ex.levels[0];
+      sigma2_ = level0_variance(l0);
+      grid_ = std::make_unique<RepetitionGrid>(std::max(l0.width, l0.height) / r_scale, l0.width, l0.height);
+      for (std::size_t v = 0; v < nv; ++v)
+        if (colored[v]) grid_->add(graph_.position[v], (*source_)[v], 1);
+    }
+    patched_.assign(nv, 0);
+    written_.assign(nv, 0);
+    any_colored_ = std::any_of(colored.begin(), colored.end(), [](char c) { return c != 0; });
+    const bool coherent = source_io && geo.mesh_level >= opt.exhaustive_levels;
+    ctx_.emplace(PassContext{graph_, geo.frames, ex, index, level_, colored, color_, *color_level_, *source_,
+                             *lookup_, grid_.get(), sigma2_, r_scale, opt, coherent});
+  }
+
+  // The pass over `order` (setup_seconds: the time spent before it); the
+  // colours are written back to the mesh.
+  SynthesisPassStats run(const std::vector<std::size_t>& order, std::mt19937_64& rng, double setup_seconds) {
+    st_.seconds_setup = setup_seconds;
+    std::size_t chunk = 16;
+    for (std::size_t begin = 0; begin < order.size();) {
+      const std::size_t end = std::min(order.size(), begin + chunk);
+      const std::size_t conflicts = run_chunk(order, begin, end, rng);
+      st_.recomputed += conflicts;
+      const std::size_t n = end - begin;
+      if (16 * conflicts > n)
+        chunk = std::max<std::size_t>(1, chunk / 2);
+      else if (64 * conflicts < n)
+        chunk = std::min<std::size_t>(1024, chunk * 2);
+      begin = end;
+    }
+    for (VertexIndex v : mesh_.vertices()) col_[v] = color_[v.idx()];
+    if (st_.matched) {
+      st_.mean_k = sum_k_ / st_.matched;
+      st_.mean_region = sum_region_ / st_.matched;
+      st_.mean_groups = sum_groups_ / st_.matched;
+    }
+    return st_;
+  }
+
+ private:
+  struct SourceChange {
+    std::size_t vertex;
+    std::array<int, 2> before, after;
+  };
+
+  bool needs_job(std::size_t p) const {
+    return !(opt_.skip_patched && patched_[p]) && graph_.offset[p] != graph_.offset[p + 1] && any_colored_;
+  }
+
+  // One chunk order[begin, end): matched in parallel, committed in order;
+  // returns the jobs recomputed at commit time.
+  std::size_t run_chunk(const std::vector<std::size_t>& order, std::size_t begin, std::size_t end,
+                        std::mt19937_64& rng) {
+    ++stamp_;
+    if (jobs_.size() < end - begin) jobs_.resize(end - begin);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        JobScratch& s = scratch_.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const std::size_t p = order[i];
+                          jobs_[i - begin].p = static_cast<std::size_t>(-1);
+                          if (needs_job(p)) run_job(*ctx_, p, jobs_[i - begin], s);
+                        }
+                      });
+    std::size_t conflicts = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::size_t p = order[i];
+      if (opt_.skip_patched && patched_[p]) continue;
+      if (graph_.offset[p] == graph_.offset[p + 1]) continue;  // isolated
+      if (!any_colored_) {                                     // the very first vertex: a random texel
+        seed_vertex(p, rng);
+        continue;
+      }
+      VertexJob& job = jobs_[i - begin];
+      if (is_stale(p, job)) {
+        ++conflicts;
+        run_job(*ctx_, p, job, serial_);
+      }
+      commit(p, job);
+    }
+    if (grid_) {
+      for (const SourceChange& ch : changed_) {
+        grid_->add(graph_.position[ch.vertex], ch.before, -1);
+        grid_->add(graph_.position[ch.vertex], ch.after, 1);
+      }
+    }
+    changed_.clear();
+    return conflicts;
+  }
+
+  // A random texel of the vertex's level for the pass's first vertex.
+  void seed_vertex(std::size_t p, std::mt19937_64& rng) {
+    const int lp = level_[p];
+    std::uniform_int_distribution<int> ux(0, ex_.width(lp) - 1), uy(0, ex_.height(lp) - 1);
+    const int x = ux(rng), y = uy(rng);
+    const auto t = texel(ex_, lp, x, y);
+    color_[p] = {t[0], t[1], t[2]};
+    (*color_level_)[p] = lp;
+    (*source_)[p] = {x * ex_.scale(lp), y * ex_.scale(lp)};
+    (*lookup_)[p] = {lp, double(x), double(y)};
+    if (grid_) changed_.push_back({p, {-1, -1}, (*source_)[p]});
+    colored_[p] = 1;
+    written_[p] = stamp_;
+    any_colored_ = true;
+    ++st_.seeded;
+  }
+
+  // Whether the job of p is missing or read a colour an earlier commit of
+  // this chunk wrote.
+  bool is_stale(std::size_t p, const VertexJob& job) const {
+    if (job.p != p) return true;
+    for (std::size_t v : job.reg.vertices)
+      if (written_[v] == stamp_) return true;
+    return false;
+  }
+
+  // The job's colours written (centre first), with its figures.
+  void commit(std::size_t p, const VertexJob& job) {
+    st_.seconds_region += job.t_region;
+    st_.seconds_match += job.t_match;
+    st_.seconds_transfer += job.t_transfer;
+    if (!job.has_samples) {
+      ++st_.skipped;
+      return;
+    }
+    ++st_.matched;
+    sum_k_ += job.k;
+    sum_region_ += job.reg.vertices.size();
+    sum_groups_ += job.groups;
+    st_.candidates += job.m.candidates;
+    std::vector<std::array<int, 2>>& source = *source_;
+    for (const auto& w : job.writes) {
+      color_[w.vertex] = {w.color[0], w.color[1], w.color[2]};
+      (*color_level_)[w.vertex] = w.level;
+      if (grid_)
+        changed_.push_back(
+            {w.vertex, colored_[w.vertex] ? source[w.vertex] : std::array<int, 2>{-1, -1}, w.source});
+      source[w.vertex] = w.source;
+      (*lookup_)[w.vertex] = w.lookup;
+      colored_[w.vertex] = 1;
+      written_[w.vertex] = stamp_;
+      if (w.vertex != p) {
+        patched_[w.vertex] = 1;
+        ++st_.patched;
+      }
+    }
+  }
+
+  Mesh& mesh_;
+  const ExemplarLevels& ex_;
+  const RegionGraph& graph_;
+  const SubdivisionSynthesisOptions& opt_;
+  std::vector<char>& colored_;
+  PropertyMap<VertexIndex, Color3f> col_;
+  std::vector<Color3f> color_;
+  std::vector<int> level_;
+  // The caller's records, or the pass's own when the caller keeps none.
+  std::vector<int> own_level_;
+  std::vector<int>* color_level_ = nullptr;
+  std::vector<std::array<int, 2>> own_source_;
+  std::vector<std::array<int, 2>>* source_ = nullptr;
+  std::vector<ExemplarLookup> own_lookup_;
+  std::vector<ExemplarLookup>* lookup_ = nullptr;
+  std::unique_ptr<RepetitionGrid> grid_;
+  double sigma2_ = 0;
+  std::vector<char> patched_;
+  std::vector<std::uint32_t> written_;  // chunk stamp of the last write
+  bool any_colored_ = false;
+  std::optional<PassContext> ctx_;
+  std::vector<SourceChange> changed_;  // this chunk's, applied to the grid after its commits
+  std::vector<VertexJob> jobs_;
+  tbb::enumerable_thread_specific<JobScratch> scratch_;
+  JobScratch serial_;
+  std::uint32_t stamp_ = 0;
+  SynthesisPassStats st_;
+  double sum_k_ = 0, sum_region_ = 0, sum_groups_ = 0;
+};
+
 }  // namespace
 
 PassGeometry make_pass_geometry(const Mesh& mesh) {
@@ -468,24 +727,13 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
 }
 
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
-                                  const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
-                                  int hierarchy_level, const SubdivisionSynthesisOptions& opt,
+                                  const std::vector<std::size_t>& order, std::vector<char>& colored,
+                                  double r_scale, int hierarchy_level, const SubdivisionSynthesisOptions& opt,
                                   std::mt19937_64& rng, std::vector<int>* color_level_io,
                                   std::vector<std::array<int, 2>>* source_io, const PassGeometry* geometry,
                                   std::vector<ExemplarLookup>* lookup_io) {
   const std::size_t nv = mesh.number_of_vertices();
-  if (source_io && source_io->size() != nv)
-    throw InvalidInputError("synthesis_pass: source has " + std::to_string(source_io->size()) + " entries for " +
-                            std::to_string(nv) + " vertices");
-  if (colored.size() != nv) throw InvalidInputError("synthesis_pass: colored has the wrong size");
-  if (lookup_io && lookup_io->size() != nv)
-    throw InvalidInputError("synthesis_pass: lookup has " + std::to_string(lookup_io->size()) + " entries for " +
-                            std::to_string(nv) + " vertices");
-  if (color_level_io && color_level_io->size() != nv)
-    throw InvalidInputError("synthesis_pass: color_level has " + std::to_string(color_level_io->size()) +
-                            " entries for " + std::to_string(nv) + " vertices");
-  for (std::size_t p : order)
-    if (p >= nv) throw InvalidInputError("synthesis_pass: order names vertex " + std::to_string(p));
+  check_pass_inputs(nv, order, colored, color_level_io, source_io, lookup_io);
   auto t_setup = std::chrono::steady_clock::now();
   PassGeometry own_geometry;
   if (!geometry) own_geometry = make_pass_geometry(mesh);
@@ -493,171 +741,10 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const Ex
   if (geo.graph.size() != nv)
     throw InvalidInputError("synthesis_pass: the pass geometry belongs to another mesh (" +
                             std::to_string(geo.graph.size()) + " vs " + std::to_string(nv) + " vertices)");
-  const SurfaceFrames& fr = geo.frames;
-  const RegionGraph& graph = geo.graph;
-  auto col = get_or_add(mesh, kVertexColor, Color3f{0.5f, 0.5f, 0.5f});
-  std::vector<Color3f> color(nv);
-  for (VertexIndex v : mesh.vertices()) color[v.idx()] = col[v];
-  const int nlev = static_cast<int>(ex.levels.size());
-  const int fixed_level = std::clamp(hierarchy_level, 0, nlev - 1);
-  std::vector<int> level(nv);
-  for (std::size_t i = 0; i < nv; ++i)
-    level[i] = opt.antialias ? antialias_level(ex, r_scale, fr.mean_edge[i]) : fixed_level;
-  // Without a caller's record, every colour is taken to represent its vertex's level.
-  std::vector<int> own_level;
-  if (!color_level_io) own_level = level;
-  std::vector<int>& color_level = color_level_io ? *color_level_io : own_level;
-  for (int& l : color_level) l = std::clamp(l, 0, nlev - 1);
-  std::vector<std::array<int, 2>> own_source;
-  if (!source_io) own_source.assign(nv, {-1, -1});
-  std::vector<std::array<int, 2>>& source = source_io ? *source_io : own_source;
-  std::vector<ExemplarLookup> own_lookup;
-  if (!lookup_io) own_lookup.assign(nv, {});
-  std::vector<ExemplarLookup>& lookup = lookup_io ? *lookup_io : own_lookup;
-  // The repetition counts (see SubdivisionSynthesisOptions::repetition_penalty);
-  // they are updated after every chunk's commits, so every job of a chunk
-  // reads the counts as they were at the chunk's start (whatever the threads).
-  std::unique_ptr<RepetitionGrid> grid;
-  double sigma2 = 0;
-  if (source_io && opt.repetition_penalty > 0) {
-    const Image& l0 = ex.levels[0];
-    for (int c = 0; c < 3; ++c) {
-      double m = 0, m2 = 0;
-      const std::size_t n = static_cast<std::size_t>(l0.width) * l0.height;
-      for (std::size_t i = 0; i < n; ++i) m += l0.data[3 * i + c], m2 += double(l0.data[3 * i + c]) * l0.data[3 * i + c];
-      sigma2 += std::max(0.0, m2 / n - (m / n) * (m / n));
-    }
-    grid = std::make_unique<RepetitionGrid>(std::max(l0.width, l0.height) / r_scale, l0.width, l0.height);
-    for (std::size_t v = 0; v < nv; ++v)
-      if (colored[v]) grid->add(graph.position[v], source[v], 1);
-  }
-  std::vector<char> patched(nv, 0);
-  std::vector<std::uint32_t> written(nv, 0);  // chunk stamp of the last write
-  bool any_colored = std::any_of(colored.begin(), colored.end(), [](char c) { return c != 0; });
-  SynthesisPassStats st;
-  st.seconds_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
-  const bool coherent = source_io && geo.mesh_level >= opt.exhaustive_levels;
-  const PassContext ctx{graph,  fr,     ex,         index,  level,   colored, color, color_level,
-                        source, lookup, grid.get(), sigma2, r_scale, opt,     coherent};
-  struct SourceChange {
-    std::size_t vertex;
-    std::array<int, 2> before, after;
-  };
-  std::vector<SourceChange> changed;  // this chunk's, applied to the grid after its commits
-  double sum_k = 0, sum_region = 0, sum_groups = 0;
-
-  // Speculative parallel matching, sequential commit (exactly the sequential
-  // pass of sections 3.1.2 and 3.3.1): the order is cut into chunks of
-  // consecutive vertices; every vertex of a chunk is matched (and its cut
-  // solved) in parallel against the colours at the start of the chunk; the
-  // results are then committed one by one in the pass order. A vertex whose
-  // region received a colour from an earlier commit of the same chunk read
-  // stale colours: its job is recomputed at commit time against the current
-  // colours. Every committed result is thus the one the sequential pass would
-  // compute, whatever the thread count. The chunk size adapts to the conflict
-  // rate, deterministically (it depends only on the data).
-  std::vector<VertexJob> jobs;
-  tbb::enumerable_thread_specific<JobScratch> scratch;
-  JobScratch serial;
-  std::size_t chunk = 16;
-  std::uint32_t stamp = 0;
-  for (std::size_t begin = 0; begin < order.size();) {
-    const std::size_t end = std::min(order.size(), begin + chunk);
-    ++stamp;
-    if (jobs.size() < end - begin) jobs.resize(end - begin);
-    auto needs_job = [&](std::size_t p) {
-      return !(opt.skip_patched && patched[p]) && graph.offset[p] != graph.offset[p + 1] && any_colored;
-    };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      JobScratch& s = scratch.local();
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const std::size_t p = order[i];
-        jobs[i - begin].p = static_cast<std::size_t>(-1);
-        if (needs_job(p)) run_job(ctx, p, jobs[i - begin], s);
-      }
-    });
-    std::size_t conflicts = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t p = order[i];
-      if (opt.skip_patched && patched[p]) continue;
-      if (graph.offset[p] == graph.offset[p + 1]) continue;  // isolated
-      if (!any_colored) {  // the very first vertex: a random texel
-        const int lp = level[p];
-        std::uniform_int_distribution<int> ux(0, ex.width(lp) - 1), uy(0, ex.height(lp) - 1);
-        const int x = ux(rng), y = uy(rng);
-        const auto t = texel(ex, lp, x, y);
-        color[p] = {t[0], t[1], t[2]};
-        color_level[p] = lp;
-        source[p] = {x * ex.scale(lp), y * ex.scale(lp)};
-        lookup[p] = {lp, double(x), double(y)};
-        if (grid) changed.push_back({p, {-1, -1}, source[p]});
-        colored[p] = 1;
-        written[p] = stamp;
-        any_colored = true;
-        ++st.seeded;
-        continue;
-      }
-      VertexJob& job = jobs[i - begin];
-      bool stale = job.p != p;
-      if (!stale)
-        for (std::size_t v : job.reg.vertices)
-          if (written[v] == stamp) {
-            stale = true;
-            break;
-          }
-      if (stale) {
-        ++conflicts;
-        run_job(ctx, p, job, serial);
-      }
-      st.seconds_region += job.t_region;
-      st.seconds_match += job.t_match;
-      st.seconds_transfer += job.t_transfer;
-      if (!job.has_samples) {
-        ++st.skipped;
-        continue;
-      }
-      ++st.matched;
-      sum_k += job.k;
-      sum_region += job.reg.vertices.size();
-      sum_groups += job.groups;
-      st.candidates += job.m.candidates;
-      for (const auto& w : job.writes) {
-        color[w.vertex] = {w.color[0], w.color[1], w.color[2]};
-        color_level[w.vertex] = w.level;
-        if (grid)
-          changed.push_back({w.vertex, colored[w.vertex] ? source[w.vertex] : std::array<int, 2>{-1, -1}, w.source});
-        source[w.vertex] = w.source;
-        lookup[w.vertex] = w.lookup;
-        colored[w.vertex] = 1;
-        written[w.vertex] = stamp;
-        if (w.vertex != p) {
-          patched[w.vertex] = 1;
-          ++st.patched;
-        }
-      }
-    }
-    if (grid) {
-      for (const SourceChange& ch : changed) {
-        grid->add(graph.position[ch.vertex], ch.before, -1);
-        grid->add(graph.position[ch.vertex], ch.after, 1);
-      }
-    }
-    changed.clear();
-    st.recomputed += conflicts;
-    const std::size_t n = end - begin;
-    if (16 * conflicts > n)
-      chunk = std::max<std::size_t>(1, chunk / 2);
-    else if (64 * conflicts < n)
-      chunk = std::min<std::size_t>(1024, chunk * 2);
-    begin = end;
-  }
-  for (VertexIndex v : mesh.vertices()) col[v] = color[v.idx()];
-  if (st.matched) {
-    st.mean_k = sum_k / st.matched;
-    st.mean_region = sum_region / st.matched;
-    st.mean_groups = sum_groups / st.matched;
-  }
-  return st;
+  SynthesisPass pass(mesh, ex, index, geo, colored, r_scale, hierarchy_level, opt, color_level_io, source_io,
+                     lookup_io);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
+  return pass.run(order, rng, setup);
 }
 
 namespace {

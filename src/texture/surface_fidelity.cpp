@@ -17,6 +17,8 @@
 #include "geometry/polygon_util.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
+#include "geometry/union_find.h"
+#include "geometry/vec3.h"
 #include "texture/graphcut_synthesis.h"
 #include "texture/image_ops.h"
 #include "texture/material_tile_io.h"
@@ -25,14 +27,12 @@ namespace surftex {
 namespace {
 
 using V3 = std::array<double, 3>;
-inline V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline V3 add(const V3& a, const V3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-inline V3 mul(const V3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-inline double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double len(const V3& a) { return std::sqrt(dot(a, a)); }
+using vec3::add;
+using vec3::cross;
+using vec3::dot;
+using vec3::mul;
+using vec3::norm;
+using vec3::sub;
 inline V3 point(const Mesh& m, VertexIndex v) { return {m.point(v).x(), m.point(v).y(), m.point(v).z()}; }
 
 void fail(const std::string& m) { throw InvalidInputError("surface_fidelity: " + m); }
@@ -62,7 +62,7 @@ std::vector<FanTriangle> fan_triangles(const Mesh& mesh) {
         t.p[k] = point(mesh, mesh.target(c[k]));
       }
       const V3 nn = cross(sub(t.p[1], t.p[0]), sub(t.p[2], t.p[0]));
-      const double l = len(nn);
+      const double l = norm(nn);
       t.area = 0.5 * l;
       if (l > 0 && std::isfinite(l)) t.n = mul(nn, 1.0 / l);
       tris.push_back(t);
@@ -110,16 +110,16 @@ struct Chart {
 // Chart frame at triangle t: the seed normal, the frame's x projected onto
 // the tangent plane, y the frame's y made orthogonal to x (its sign kept).
 bool chart_frame(const FanTriangle& t, const TextureFrames& fr, Chart& c) {
-  if (len(t.n) == 0) return false;
+  if (norm(t.n) == 0) return false;
   c.n = t.n;
   V3 x = fr.x_axis[t.face], y = fr.y_axis[t.face];
   x = sub(x, mul(c.n, dot(x, c.n)));
-  const double lx = len(x);
+  const double lx = norm(x);
   if (!(lx > 1e-12) || !std::isfinite(lx)) return false;
   c.ex = mul(x, 1.0 / lx);
   y = sub(y, mul(c.n, dot(y, c.n)));
   y = sub(y, mul(c.ex, dot(y, c.ex)));
-  const double ly = len(y);
+  const double ly = norm(y);
   if (!(ly > 1e-12) || !std::isfinite(ly)) {
     c.ey = cross(c.ex, c.n);  // no y given: the subdivision/patch convention
   } else {
@@ -214,7 +214,7 @@ std::vector<Chart> place_charts(const std::vector<FanTriangle>& tris, const Text
     const FanTriangle& tr = tris[t];
     const V3 p = add(tr.p[0], add(mul(sub(tr.p[1], tr.p[0]), s1), mul(sub(tr.p[2], tr.p[0]), s2)));
     bool near = false;
-    for (const V3& s : seeds) near = near || len(sub(s, p)) < side;
+    for (const V3& s : seeds) near = near || norm(sub(s, p)) < side;
     if (near) continue;
     Chart c;
     c.origin = p;
@@ -399,7 +399,7 @@ double texel_size_of_frames(const Mesh& mesh, const TextureFrames& fr) {
   std::vector<std::pair<double, double>> v;  // (texel, area)
   for (FaceIndex f : mesh.faces()) {
     if (f.idx() >= fr.x_axis.size()) break;
-    const double t = std::sqrt(len(fr.x_axis[f.idx()]) * len(fr.y_axis[f.idx()]));
+    const double t = std::sqrt(norm(fr.x_axis[f.idx()]) * norm(fr.y_axis[f.idx()]));
     const double a = polygon_area(mesh, f);
     if (t > 0 && std::isfinite(t) && a > 0) v.push_back({t, a});
   }
@@ -474,12 +474,8 @@ SurfaceSeamRatio surface_seam_ratio(const Mesh& mesh, const SurfaceColorFn& colo
   if (!color) fail("no colour source");
   SurfaceSeamRatio r;
   // Islands: faces joined across unflagged edges (union-find); flagged face pairs.
-  std::vector<std::size_t> parent(mesh.number_of_faces());
-  std::iota(parent.begin(), parent.end(), std::size_t(0));
-  auto root = [&](std::size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  UnionFind<std::size_t> islands(mesh.number_of_faces());
+  auto root = [&](std::size_t x) { return islands.find(x); };
   std::unordered_map<std::uint64_t, char> flagged;
   for (EdgeIndex e : mesh.edges()) {
     if (mesh.is_border(e)) continue;
@@ -488,7 +484,7 @@ SurfaceSeamRatio surface_seam_ratio(const Mesh& mesh, const SurfaceColorFn& colo
       ++r.seam_edges;
       flagged[(std::min(f, g) << 32) | std::max(f, g)] = 1;
     } else {
-      parent[root(f)] = root(g);
+      islands.unite(f, g);
     }
   }
   // Charts in an arbitrary tangent frame (the ratio is orientation-matched).

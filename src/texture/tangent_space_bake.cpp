@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Object-space normals -> tangent-space normal atlas (see tangent_space_bake.h).
 #include "texture/tangent_space_bake.h"
+#include "geometry/vec3.h"
 
 #include <cmath>
 #include <string>
@@ -15,7 +16,7 @@ namespace surftex {
 
 namespace {
 using D3 = std::array<double, 3>;
-double dot(const D3& a, const D3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using vec3::dot;
 D3 unit(const D3& a) {
   const double l = std::sqrt(dot(a, a));
   return l > 0 ? D3{a[0] / l, a[1] / l, a[2] / l} : D3{0, 0, 0};

@@ -81,6 +81,14 @@ TileResult make_tileable_detailed(const Image& exemplar, int size, const TileOpt
     t.shift_y = c.shift_y;
     if (c.shift_x != 0 || c.shift_y != 0) t.tile = crop(t.tile, c.shift_x, c.shift_y, size, size, true);
   }
+  t.source_x.resize(std::size_t(size) * size);
+  t.source_y.resize(t.source_x.size());
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const std::size_t from = std::size_t((y + t.shift_y) % size) * size + (x + t.shift_x) % size;
+      t.source_x[std::size_t(y) * size + x] = r.source_x[from];
+      t.source_y[std::size_t(y) * size + x] = r.source_y[from];
+    }
   t.wrap_seam_ratio = wrap_seam_ratio(t.tile);
   t.seam_cost = r.seam_cost_final;
   return t;

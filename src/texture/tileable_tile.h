@@ -38,6 +38,7 @@
 // every line <= 1.3 at +6% summed seam cost.
 
 #include <cstdint>
+#include <vector>
 
 #include "geometry/image.h"
 #include "geometry/progress.h"
@@ -133,6 +134,10 @@ struct TileResult {
   /// The roll applied (TorusCut of the synthesised tile; 0, 0 without
   /// choose_cut): tile(x, y) = synthesised((x + shift_x) mod size, (y + shift_y) mod size).
   int shift_x = 0, shift_y = 0;
+  /// The exemplar pixel every tile texel was copied from (after the roll),
+  /// row-major size x size: tile(x, y) = exemplar(source_x[i], source_y[i]),
+  /// i = y size + x. Other maps of the exemplar follow the colour through them.
+  std::vector<int> source_x, source_y;
   double seam_cost = 0;        ///< final total seam cost (graph-cut units, unchanged by the roll)
   /// texture/wrap_seam_ratio.h worst_line_ratio of the tile: the highest
   /// line jump of the torus over the mean of its orientation, the same for

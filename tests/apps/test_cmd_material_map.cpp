@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // `surftex material-map`: outputs, and the local update through the CLI path.
 #include <gtest/gtest.h>
+#include <tiny_gltf.h>
 
 #include <cmath>
 #include <filesystem>
@@ -22,30 +23,40 @@ using namespace surftex;
 
 namespace {
 
+// Appends one layer (colour, an empty mask) to a tile result.
+void add_layer(MaterialTileResult& r, const Image& img, int material) {
+  r.layers.push_back(img);
+  r.masks.push_back(Image(img.width, img.height, 1, 0.f));
+  r.material.push_back(material);
+  r.sign_changes.push_back(0);
+  r.mask_agreement.push_back(1);
+}
+
+// Writes a two-layer tile of sources "a" and "b" into path.
+void write_two_layer_tile(const std::string& path, const MaterialTileResult& r) {
+  MaterialTileInfo info;
+  info.sources = {"a", "b"};
+  info.masks = {"", ""};
+  info.layers_per_pair = 1;
+  write_material_tile(path, r, info, true);
+}
+
 std::string make_inputs(const std::string& dir) {
   Mesh m;
   make_torus(m, 3.0, 1.0, 48, 20);
   write_mesh(dir + "/torus.ply", m);
   MaterialTileResult r;
   for (int l = 0; l < 2; ++l) {
-    Image img(16, 16, 3), mask(16, 16, 1, 0.f);
+    Image img(16, 16, 3);
     for (int y = 0; y < 16; ++y)
       for (int x = 0; x < 16; ++x) {
         img.at(x, y, 0) = ((x / 4 + y / 4) % 2) ? 1.f : 0.f;
         img.at(x, y, 1) = static_cast<float>(l);
         img.at(x, y, 2) = 0.5f;
       }
-    r.layers.push_back(img);
-    r.masks.push_back(mask);
-    r.material.push_back(l);
-    r.sign_changes.push_back(0);
-    r.mask_agreement.push_back(1);
+    add_layer(r, img, l);
   }
-  MaterialTileInfo info;
-  info.sources = {"a", "b"};
-  info.masks = {"", ""};
-  info.layers_per_pair = 1;
-  write_material_tile(dir + "/tile", r, info, true);
+  write_two_layer_tile(dir + "/tile", r);
   std::ofstream(dir + "/c1.json") << R"({"strokes": [{"polyline": [[4, 0, 1], [0, 4, 1], [-4, 0, 1]]}],
     "material": [{"point": [4, 0, 0], "value": 1}, {"point": [-4, 0, 0], "value": 0}]})";
   std::ofstream(dir + "/c2.json") << R"({"effect_radius": 1.5,
@@ -223,4 +234,103 @@ TEST(CmdMaterialMap, BakedAssetRendersLikeTheFixedRender) {
   EXPECT_EQ(rep["atlas"]["size"], 1024);
   EXPECT_EQ(rep["atlas"]["gutter"], 16);
   EXPECT_EQ(rep["atlas"]["gutter_violations"], 0);
+}
+
+namespace {
+
+// A tile like make_inputs' with map layers that are functions of its colour:
+// height = 1 - red, roughness = 0.25 + 0.5 red; and flat normal layers.
+void write_tile_with_maps(const std::string& dir) {
+  MaterialTileResult r;
+  for (int l = 0; l < 2; ++l) {
+    Image img(16, 16, 3), h(16, 16, 1), rough(16, 16, 1);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        img.at(x, y, 0) = static_cast<float>(((x + 3 * y + 5 * l) % 16) / 15.0);
+        img.at(x, y, 1) = static_cast<float>(l);
+        img.at(x, y, 2) = 0.5f;
+        h.at(x, y) = 1.f - img.at(x, y, 0);
+        rough.at(x, y) = 0.25f + 0.5f * img.at(x, y, 0);
+      }
+    add_layer(r, img, l);
+    r.height_layers.push_back(h);
+    r.roughness_layers.push_back(rough);
+    Image flat(16, 16, 3, 0.5f);
+    for (int i = 0; i < 16 * 16; ++i) flat.data[3 * i + 2] = 1.f;
+    r.normal_layers.push_back(flat);
+  }
+  write_two_layer_tile(dir + "/tile_maps", r);
+}
+
+}  // namespace
+
+// Issue 16 item 2: a tile's map layers are baked through the same (s,t,m)
+// lookups as the colour (material blend, section 3's three lookups):
+// mesh_height.png is 1 - red of mesh.png, the roughness lands in the GLB's
+// metallicRoughnessTexture (G) and the MTL's map_Pr, flat tile normals give a
+// flat tangent-space map, and the report names the sources.
+TEST(CmdMaterialMap, TileMapsAreBakedThroughTheColourLookups) {
+  const std::string dir = make_inputs(test::temp_dir("cmd-matmap-maps"));
+  write_tile_with_maps(dir);
+  const std::string out = dir + "/out";
+  test::RunResult r = test::run_surftex("material-map '" + dir + "/torus.ply' --tile '" + dir +
+                                        "/tile_maps' --render-size 64 --atlas-size 128 -q --constraints '" + dir +
+                                        "/c1.json' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image colour = read_image(out + "/mesh.png"), height = read_image(out + "/mesh_height.png");
+  ASSERT_EQ(colour.width, height.width);
+  const std::vector<char> inside = test::chart_interior(out + "/mesh.obj", colour.width, colour.height);
+  std::size_t texels = 0, same = 0;
+  for (int y = 0; y < colour.height; ++y)
+    for (int x = 0; x < colour.width; ++x) {
+      if (!inside[static_cast<std::size_t>(y) * colour.width + x]) continue;
+      ++texels;
+      same += std::abs(height.at(x, y, 0) - (1.f - colour.at(x, y, 0))) < 1.0 / 255;
+    }
+  ASSERT_GT(texels, 1000u);
+  EXPECT_GT(same, texels * 999 / 1000) << "height is not baked through the colour's lookups";
+  const Image normal = read_image(out + "/mesh_normal.png");
+  std::size_t flat = 0;
+  for (int y = 0; y < normal.height; ++y)
+    for (int x = 0; x < normal.width; ++x)
+      flat += inside[static_cast<std::size_t>(y) * normal.width + x] && std::abs(normal.at(x, y, 0) - 0.5f) < 0.01f &&
+              std::abs(normal.at(x, y, 1) - 0.5f) < 0.01f && normal.at(x, y, 2) > 0.99f;
+  EXPECT_GT(flat, texels * 999 / 1000);
+  // The roughness, read back from the GLB as a viewer would.
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model model;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, out + "/mesh.glb")) << err;
+  ASSERT_FALSE(model.materials.empty());
+  const int t = model.materials[0].pbrMetallicRoughness.metallicRoughnessTexture.index;
+  ASSERT_GE(t, 0);
+  const auto& img = model.images[static_cast<std::size_t>(model.textures[static_cast<std::size_t>(t)].source)];
+  ASSERT_EQ(img.width, colour.width);
+  ASSERT_GE(img.component, 3);
+  std::size_t rough_ok = 0;
+  for (int y = 0; y < colour.height; ++y)
+    for (int x = 0; x < colour.width; ++x) {
+      if (!inside[static_cast<std::size_t>(y) * colour.width + x]) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * img.width + x;
+      const double g = img.image[i * img.component + 1] / 255.0, b = img.image[i * img.component + 2] / 255.0;
+      rough_ok += std::abs(g - (0.25 + 0.5 * colour.at(x, y, 0))) < 1.5 / 255 && b == 0;
+    }
+  EXPECT_GT(rough_ok, texels * 999 / 1000);
+  EXPECT_NE(test::file_bytes(out + "/mesh.mtl").find("map_Pr"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out + "/mesh_roughness.png"));
+  EXPECT_TRUE(test::duplicate_files(out).empty()) << test::duplicate_files(out).front();
+  const nlohmann::json rep = nlohmann::json::parse(std::ifstream(out + "/report.json"));
+  EXPECT_EQ(rep["atlas"]["height_source"], "exemplar_height");
+  EXPECT_EQ(rep["atlas"]["normal_source"], "exemplar_normal");
+  EXPECT_EQ(rep["atlas"]["roughness"], true);
+  EXPECT_EQ(rep["tile"]["maps"], nlohmann::json({"normal", "height", "roughness"}));
+  // Without maps: the luminance, no roughness.
+  r = test::run_surftex("material-map '" + dir + "/torus.ply' --tile '" + dir +
+                        "/tile' --render-size 64 --atlas-size 128 -q -o '" + dir + "/plain'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json plain = nlohmann::json::parse(std::ifstream(dir + "/plain/report.json"));
+  EXPECT_EQ(plain["atlas"]["height_source"], "luminance");
+  EXPECT_EQ(plain["atlas"]["normal_source"], "height");
+  EXPECT_EQ(plain["atlas"]["roughness"], false);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/plain/mesh_roughness.png"));
 }

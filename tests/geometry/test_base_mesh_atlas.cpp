@@ -1,14 +1,18 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <set>
 
+#include "atlas_checks.h"
 #include "geometry/base_mesh_atlas.h"
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "test_support.h"
 
 using namespace surftex;
 
@@ -81,6 +85,17 @@ void expect_uvs_in_unit_square_and_consistent(const Mesh& m) {
         EXPECT_EQ(it->second, p) << "corner uvs of one vertex differ inside chart " << patch[f];
       }
     }
+}
+
+// An icosphere with radial bumps: its normals turn within a few faces, so the
+// 50-degree growth leaves many small charts.
+void make_bumpy_sphere(Mesh& m) {
+  make_icosphere(m, 4);
+  for (VertexIndex v : m.vertices()) {
+    const Point3 p = m.point(v);
+    const double r = 1 + 0.15 * std::sin(9 * p.x()) * std::sin(9 * p.y()) * std::sin(9 * p.z());
+    m.point(v) = Point3(p.x() * r, p.y() * r, p.z() * r);
+  }
 }
 
 // Triangles of different charts must not overlap in uv: chart bounding boxes are disjoint.
@@ -165,6 +180,60 @@ TEST(BaseMeshAtlas, FaceBudgetSplitsChartsAndIsDeterministic) {
   expect_disc_charts(a, ra.num_charts);
 }
 
+// Regression: LSCM folded charts over themselves (fish_blub's largest chart,
+// elephant's: thousands of texels of a 2048 grid covered twice), unseen by
+// the flip count. Every flattening is now an embedding.
+TEST(BaseMeshAtlas, FlatteningsNeverFoldOverThemselves) {
+  for (const char* name : {"meshes/fish_blub.obj", "meshes/elephant.off"}) {
+    SCOPED_TRACE(name);
+    Mesh m;
+    read_mesh(test::shared_data(name), m);
+    const BaseMeshAtlasResult r = compute_base_mesh_atlas(m);
+    EXPECT_EQ(r.flipped_faces, 0u);
+    EXPECT_EQ(test::uv_flipped_faces(m), 0u);
+    EXPECT_EQ(test::uv_overlap_texels(m, 2048), 0u);
+    expect_disc_charts(m, r.num_charts);
+  }
+}
+
+TEST(BaseMeshAtlas, MergingLeavesFewerDiscChartsThatNeitherFlipNorOverlap) {
+  Mesh plain, merged, again;
+  make_bumpy_sphere(plain);
+  make_bumpy_sphere(merged);
+  make_bumpy_sphere(again);
+  BaseMeshAtlasOptions opt;
+  opt.margin = 0.03;  // a 2048 px atlas's 32-texel gutter
+  const BaseMeshAtlasResult p = compute_base_mesh_atlas(plain, opt);
+  opt.merge_charts = true;
+  const BaseMeshAtlasResult r = compute_base_mesh_atlas(merged, opt);
+  std::cout << "[ atlas ] bumpy sphere: " << p.num_charts << " -> " << r.num_charts << " charts, distortion "
+            << p.mean_area_distortion << " -> " << r.mean_area_distortion << ", uv per length "
+            << p.uv_per_length << " -> " << r.uv_per_length << "\n";
+  EXPECT_GE(p.num_charts, 50);  // the case merging is for
+  EXPECT_LT(r.num_charts, p.num_charts / 4);
+  EXPECT_GT(r.uv_per_length, p.uv_per_length);  // fewer gaps: more uv per mesh length
+  EXPECT_LE(r.mean_area_distortion, std::max(opt.max_merge_distortion, p.mean_area_distortion));
+  std::size_t total = 0;
+  for (auto n : r.chart_faces) {
+    EXPECT_LE(n, opt.max_chart_faces);
+    total += n;
+  }
+  EXPECT_EQ(total, merged.number_of_faces());
+  EXPECT_EQ(r.flipped_faces, 0u);
+  EXPECT_EQ(test::uv_flipped_faces(merged), 0u);
+  EXPECT_EQ(test::uv_overlap_texels(merged, 2048), 0u);
+  expect_disc_charts(merged, r.num_charts);
+  expect_uvs_in_unit_square_and_consistent(merged);
+  expect_disjoint_chart_boxes(merged, r.num_charts);
+  // Deterministic: the same input gives the same charts and uvs.
+  ASSERT_EQ(compute_base_mesh_atlas(again, opt).num_charts, r.num_charts);
+  auto ua = find(merged, kCornerUV).first, ub = find(again, kCornerUV).first;
+  for (HalfedgeIndex h : merged.halfedges())
+    if (!merged.is_border(h)) {
+      ASSERT_EQ(ua[h], ub[h]);
+    }
+}
+
 TEST(BaseMeshAtlas, RejectsBadOptions) {
   Mesh m;
   make_grid(m, 2, 2);
@@ -173,6 +242,9 @@ TEST(BaseMeshAtlas, RejectsBadOptions) {
   EXPECT_THROW(compute_base_mesh_atlas(m, opt), InvalidInputError);
   opt = {};
   opt.margin = 0.5;
+  EXPECT_THROW(compute_base_mesh_atlas(m, opt), InvalidInputError);
+  opt = {};
+  opt.max_merge_distortion = 0.9;
   EXPECT_THROW(compute_base_mesh_atlas(m, opt), InvalidInputError);
   Mesh empty;
   EXPECT_THROW(compute_base_mesh_atlas(empty), InvalidInputError);

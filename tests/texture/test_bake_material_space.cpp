@@ -9,7 +9,9 @@
 #include <cstdio>
 
 #include "geometry/atlas_gutter.h"
+#include "geometry/bake_vertex_colors.h"
 #include "geometry/errors.h"
+#include "geometry/gltf_vertex_frames.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
@@ -116,8 +118,7 @@ TEST(BakeMaterialSpace, PlainLookupsDoNotMatchTheFixedRender) {
 
 // Every mip level k = 0..K (down to 64 px): a 2^k block that holds a texel of
 // chart c holds only texels owned by c, and no texel is left as background.
-// Elephant (187 charts at 512 texels) may take a smaller gutter than 2^K
-// (geometry/gutter_atlas.h); fish_blub keeps the full one.
+// Both meshes keep the full gutter (elephant's merged charts too).
 void expect_clean_mips(const char* name, int full_gutter) {
   SCOPED_TRACE(name);
   Mesh mesh;
@@ -156,7 +157,7 @@ void expect_clean_mips(const char* name, int full_gutter) {
 
 TEST(BakeMaterialSpace, GutterKeepsEveryMipLevelClean) {
   expect_clean_mips("meshes/fish_blub.obj", 8);  // 512 -> 64 px: 3 halvings
-  expect_clean_mips("meshes/elephant.off", 0);
+  expect_clean_mips("meshes/elephant.off", 8);
 }
 
 TEST(BakeMaterialSpace, RefusesBadSizesAndForeignSingularities) {
@@ -209,6 +210,143 @@ TEST(MaterialMapping, StateRoundTripAndLocalUpdate) {
   make_torus(small, 3.0, 1.0, 20, 8);
   MaterialMapping wrong(small);
   EXPECT_THROW(wrong.load_state(dir + "/s.json"), InvalidInputError);
+}
+
+namespace {
+
+// The singularities of a planar grid parameterised by hand: (s, t) = st(x, y)
+// at every corner, m = 0; `singular` makes every face take the three-lookup
+// path (its three charts equal to its corners).
+PgpSingularities grid_parameterization(const Mesh& mesh, std::array<double, 2> (*st)(double, double), bool singular) {
+  PgpSingularities s;
+  const std::size_t F = mesh.num_faces();
+  s.distorted_face.assign(F, 0);
+  s.singular_face.assign(F, singular ? 1 : 0);
+  s.singular_vertex.assign(mesh.num_vertices(), singular ? 1 : 0);
+  s.mismatched_edge.assign(mesh.num_edges(), 0);
+  s.corners.resize(F);
+  s.charts.resize(F);
+  for (FaceIndex f : mesh.faces()) {
+    int k = 0;
+    for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
+      const Point3& p = mesh.point(mesh.target(h));
+      const auto c = st(p.x(), p.y());
+      s.corners[f.idx()][k++] = {c[0], c[1], 0.0};
+    }
+    for (auto& chart : s.charts[f.idx()]) chart = s.corners[f.idx()];
+  }
+  return s;
+}
+
+// A one-layer 8x8 grey tile whose normal layer holds the unit normal (nx, ny, nz) everywhere.
+MaterialTile tile_with_normal(double nx, double ny, double nz) {
+  MaterialTile t;
+  t.size = 8;
+  t.layers = {Image(8, 8, 3, 0.5f)};
+  t.material = {0.0};
+  Image n(8, 8, 3);
+  for (int i = 0; i < 64; ++i)
+    n.data[3 * i] = static_cast<float>(0.5 + 0.5 * nx), n.data[3 * i + 1] = static_cast<float>(0.5 + 0.5 * ny),
+    n.data[3 * i + 2] = static_cast<float>(0.5 + 0.5 * nz);
+  t.normal_layers = {n};
+  return t;
+}
+
+}  // namespace
+
+// A tile normal is tangent-space in the tile's (s, t) frame (+x = +s, +y = up
+// in the tile image = -t): on a plane, a constant tile normal tilted towards
+// +s points along the world direction of increasing s, one tilted up along
+// decreasing t, whatever the parameterisation's orientation, with one lookup
+// or three.
+TEST(BakeMaterialSpace, TileNormalsTurnAlongTheParameterization) {
+  Mesh mesh;
+  make_grid(mesh, 4, 4, 1.0, 1.0);  // z = 0, normal +z
+  const double a = 0.5, sa = std::sin(a), ca = std::cos(a);
+  struct Case {
+    std::array<double, 2> (*st)(double, double);
+    std::array<double, 3> towards_s, up;  // world directions of +s and of -t
+  };
+  const Case cases[] = {
+      {[](double x, double y) { return std::array<double, 2>{2 * x, 2 * y}; }, {1, 0, 0}, {0, -1, 0}},
+      {[](double x, double y) { return std::array<double, 2>{2 * y, -2 * x}; }, {0, 1, 0}, {1, 0, 0}},
+      {[](double x, double y) { return std::array<double, 2>{x + y, x - y}; }, {M_SQRT1_2, M_SQRT1_2, 0},
+       {-M_SQRT1_2, M_SQRT1_2, 0}}};
+  for (const Case& c : cases)
+    for (bool singular : {false, true})
+      for (int dir = 0; dir < 2; ++dir) {
+        const PgpSingularities sing = grid_parameterization(mesh, c.st, singular);
+        const MaterialTile tile = dir == 0 ? tile_with_normal(sa, 0, ca) : tile_with_normal(0, sa, ca);
+        MaterialBakeOptions bo;
+        bo.size = 64;
+        const MaterialBakeResult r = bake_material_space(mesh, sing, tile, bo);
+        ASSERT_EQ(r.object_normal.channels, 3);
+        const auto& d = dir == 0 ? c.towards_s : c.up;
+        const std::array<double, 3> want{sa * d[0], sa * d[1], ca};
+        std::size_t texels = 0;
+        for (std::size_t i = 0; i < r.chart.size(); ++i) {
+          if (r.chart[i] < 0) continue;
+          ++texels;
+          for (int k = 0; k < 3; ++k)
+            ASSERT_NEAR(r.object_normal.data[3 * i + k], want[k], 1e-4) << "texel " << i << " singular " << singular;
+        }
+        EXPECT_GT(texels, 64u * 64 / 8);
+        EXPECT_TRUE(r.roughness.empty());
+        EXPECT_FALSE(r.height_from_tile);
+      }
+}
+
+// The tile normal reaches a glTF viewer: the tangent-space map, read in the
+// frames the viewer rebuilds from the GLB (NORMAL and TANGENT of the glTF
+// vertices interpolated per texel, B = cross(N, T) w), gives back on a plane
+// the world direction of increasing s for a tile normal tilted towards +s.
+TEST(BakeMaterialSpace, TileNormalsReachTheGlbTangentSpace) {
+  Mesh mesh;
+  make_grid(mesh, 4, 4, 1.0, 1.0);
+  const double a = 0.5;
+  const MaterialTile tile = tile_with_normal(std::sin(a), 0, std::cos(a));
+  // s along world +y, t along world -x.
+  const PgpSingularities sing =
+      grid_parameterization(mesh, [](double x, double y) { return std::array<double, 2>{2 * y, -2 * x}; }, false);
+  MaterialBakeOptions bo;
+  bo.size = 64;
+  const MaterialBakeResult r = bake_material_space(mesh, sing, tile, bo);
+  const Image ts = material_space_tangent_normals(mesh, r);
+  ASSERT_EQ(ts.width, 64);
+  const GltfVertexFrames fr = gltf_vertex_frames(mesh);
+  const AtlasTexels at = rasterize_atlas(mesh, 64);
+  std::size_t texels = 0;
+  for (std::size_t i = 0; i < at.raster.triangle.size(); ++i) {
+    const int t = at.raster.triangle[i];
+    if (t < 0 || r.chart[i] < 0) continue;
+    std::array<double, 3> N{0, 0, 0}, T{0, 0, 0};
+    double w = 0;
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t g = fr.corner[at.corner[t][c]];
+      for (int k = 0; k < 3; ++k) {
+        N[k] += at.raster.bary[i][c] * fr.normal[g][k];
+        T[k] += at.raster.bary[i][c] * fr.tangent[g][k];
+      }
+      w += at.raster.bary[i][c] * fr.tangent[g][3];
+    }
+    const double ln = std::sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    for (double& v : N) v /= ln;
+    const double tn = T[0] * N[0] + T[1] * N[1] + T[2] * N[2];
+    for (int k = 0; k < 3; ++k) T[k] -= tn * N[k];
+    const double lt = std::sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]);
+    for (double& v : T) v /= lt;
+    const double sw = w < 0 ? -1 : 1;
+    const std::array<double, 3> B{sw * (N[1] * T[2] - N[2] * T[1]), sw * (N[2] * T[0] - N[0] * T[2]),
+                                  sw * (N[0] * T[1] - N[1] * T[0])};
+    const double x = 2.0 * ts.data[3 * i] - 1, y = 2.0 * ts.data[3 * i + 1] - 1, z = 2.0 * ts.data[3 * i + 2] - 1;
+    const std::array<double, 3> world{x * T[0] + y * B[0] + z * N[0], x * T[1] + y * B[1] + z * N[1],
+                                      x * T[2] + y * B[2] + z * N[2]};
+    ASSERT_NEAR(world[0], 0.0, 1e-3) << "texel " << i;
+    ASSERT_NEAR(world[1], std::sin(a), 1e-3) << "texel " << i;
+    ASSERT_NEAR(world[2], std::cos(a), 1e-3) << "texel " << i;
+    ++texels;
+  }
+  EXPECT_GT(texels, 64u * 64 / 8);
 }
 
 TEST(PbrMaps, NormalFromHeightTiltsAgainstTheSlope) {

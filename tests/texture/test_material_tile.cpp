@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -245,4 +246,87 @@ TEST(MaterialTile, InvalidInputsThrow) {
   EXPECT_THROW(make_material_tile({bad}, o), InvalidInputError);
   o.layers = 0;
   EXPECT_THROW(make_material_tile(cells_to_stripes(64), o), InvalidInputError);
+}
+
+namespace {
+// Maps of a key that are known functions of its colour: height = 1 - red,
+// roughness = green, normal = a tilt whose x is the red (in the image's frame).
+void add_maps(MaterialKey& k) {
+  const Image& c = k.texture;
+  k.height = Image(c.width, c.height, 1);
+  k.roughness = Image(c.width, c.height, 1);
+  k.normal = Image(c.width, c.height, 3);
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      const float r = c.at(x, y, 0), g = c.at(x, y, std::min(1, c.channels - 1));
+      k.height.at(x, y) = 1.f - r;
+      k.roughness.at(x, y) = g;
+      const double nx = 0.6 * r, nz = std::sqrt(1 - nx * nx);
+      k.normal.at(x, y, 0) = static_cast<float>(0.5 + 0.5 * nx);
+      k.normal.at(x, y, 1) = 0.5f;
+      k.normal.at(x, y, 2) = static_cast<float>(0.5 + 0.5 * nz);
+    }
+}
+
+// Every map layer is the same function of its colour layer (float precision;
+// normals are renormalised after the resample and the blend, so only layers
+// that are not blends (`unblended`) have their tilt checked, within the
+// renormalisation's change).
+void expect_maps_follow_colour(const MaterialTileResult& r, const std::vector<std::size_t>& unblended) {
+  ASSERT_EQ(r.height_layers.size(), r.layers.size());
+  ASSERT_EQ(r.roughness_layers.size(), r.layers.size());
+  ASSERT_EQ(r.normal_layers.size(), r.layers.size());
+  for (std::size_t m = 0; m < r.layers.size(); ++m) {
+    const Image& c = r.layers[m];
+    ASSERT_EQ(r.height_layers[m].width, c.width);
+    ASSERT_EQ(r.height_layers[m].channels, 1);
+    ASSERT_EQ(r.normal_layers[m].channels, 3);
+    for (int y = 0; y < c.height; ++y)
+      for (int x = 0; x < c.width; ++x) {
+        ASSERT_NEAR(r.height_layers[m].at(x, y), 1.f - c.at(x, y, 0), 1e-5) << "layer " << m << " " << x << "," << y;
+        ASSERT_NEAR(r.roughness_layers[m].at(x, y), c.at(x, y, 1), 1e-5) << "layer " << m;
+        const double nx = 2.0 * r.normal_layers[m].at(x, y, 0) - 1, ny = 2.0 * r.normal_layers[m].at(x, y, 1) - 1,
+                     nz = 2.0 * r.normal_layers[m].at(x, y, 2) - 1;
+        ASSERT_NEAR(nx * nx + ny * ny + nz * nz, 1.0, 1e-5) << "layer " << m;
+        ASSERT_NEAR(ny, 0.0, 1e-6);
+        ASSERT_GE(nx, -1e-6);
+        if (std::find(unblended.begin(), unblended.end(), m) != unblended.end()) {
+          ASSERT_NEAR(nx, 0.6 * c.at(x, y, 0), 0.02) << "layer " << m;  // the resample renormalised
+        }
+      }
+  }
+}
+}  // namespace
+
+// Issue 16 item 2: the key maps go through the colour's coordinates at every
+// stage (square resample, tileable graph-cut sources, the toroidal synthesis
+// of a painted-mask key, the layers' indirection maps, the blend), and the
+// colour layers do not change when maps are given.
+TEST(MaterialTile, KeyMapsFollowTheColourThroughEveryStage) {
+  MaterialTileOptions o = small_options();
+  o.size = 32;
+  o.layers = 2;
+  o.keys_are_tileable = false;
+  // Two keys of other sizes than the tile (resample), synthesised tileable (graph cut); blend.
+  std::vector<MaterialKey> keys = {{make_noise(40, 4, 7), {}, "noise"}, {make_cells(48, 4, 3), {}, "cells"}};
+  const MaterialTileResult plain = make_material_tile(keys, o);
+  EXPECT_TRUE(plain.height_layers.empty());
+  for (auto& k : keys) add_maps(k);
+  const MaterialTileResult r = make_material_tile(keys, o);
+  ASSERT_EQ(r.layers.size(), plain.layers.size());
+  for (std::size_t m = 0; m < r.layers.size(); ++m) EXPECT_EQ(r.layers[m].data, plain.layers[m].data) << m;
+  expect_maps_follow_colour(r, {0, r.layers.size() - 1});
+  // One key with a painted mask (toroidal synthesis carrying it), same-mask mode.
+  MaterialKey painted{make_noise(32, 4, 11), Image(32, 32, 1, 0.f), "painted"};
+  for (int y = 8; y < 20; ++y)
+    for (int x = 4; x < 24; ++x) painted.mask.at(x, y) = 1.f;
+  add_maps(painted);
+  expect_maps_follow_colour(make_material_tile({painted}, o), {0, 1, 2});
+  // Refusals: a map of another size, a kind given for one key only.
+  std::vector<MaterialKey> bad = keys;
+  bad[1].height = Image(47, 48, 1);
+  EXPECT_THROW(make_material_tile(bad, o), InvalidInputError);
+  bad = keys;
+  bad[0].roughness = Image();
+  EXPECT_THROW(make_material_tile(bad, o), InvalidInputError);
 }

@@ -129,5 +129,80 @@ TEST(MaterialTileIO, PreciseErrors) {
   EXPECT_THROW(read_material_tile(test::temp_dir("tileio-none")), IOError);
 }
 
+// Map layers (issue 16 item 2): written beside the colour layers, read back
+// in float, sampled like the colour; a missing map file, one of the wrong
+// size or channel count, or an unknown kind is refused naming tile.json's
+// line and field, before any layer is decoded.
+TEST(MaterialTileIO, MapLayersRoundTripAndPreciseErrors) {
+  auto with_maps = [](const std::string& tag) {
+    MaterialTileResult r = tiny_tile(2);
+    for (const Image& l : r.layers) {
+      Image h(8, 8, 1), rough(8, 8, 1, 0.25f), n(8, 8, 3);
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          h.at(x, y) = 1.f - l.at(x, y, 0);
+          n.at(x, y, 0) = 0.8f, n.at(x, y, 1) = 0.5f, n.at(x, y, 2) = 0.9f;
+        }
+      r.height_layers.push_back(h);
+      r.roughness_layers.push_back(rough);
+      r.normal_layers.push_back(n);
+    }
+    const std::string dir = test::temp_dir(tag) + "/tile";
+    MaterialTileInfo info;
+    info.sources = {"a", "b"};
+    info.masks = {"", ""};
+    info.layers_per_pair = 1;
+    write_material_tile(dir, r, info, true);
+    return dir;
+  };
+  {
+    const MaterialTile t = read_material_tile(with_maps("tileio-maps"));
+    ASSERT_EQ(t.height_layers.size(), 2u);
+    ASSERT_EQ(t.normal_layers.size(), 2u);
+    ASSERT_EQ(t.roughness_layers.size(), 2u);
+    EXPECT_EQ(t.normal_layers[1].channels, 3);
+    for (std::size_t i = 0; i < t.layers[1].data.size() / 3; ++i)
+      ASSERT_NEAR(t.height_layers[1].data[i], 1.f - t.layers[1].data[3 * i], 1.0 / 255);
+    EXPECT_NEAR(sample_material_layers(t.roughness_layers, 0.3, 0.7, 0.5)[0], 0.25f, 1.0 / 255);
+    EXPECT_NEAR(sample_material_layers(t.height_layers, 3.5 / 8, 0.5, 0.0)[0], 1.f - 3 / 8.f, 1e-3);
+  }
+  auto expect_refused = [](const std::string& dir, const std::string& what) {
+    try {
+      read_material_tile(dir);
+      FAIL() << "no throw, expected " << what;
+    } catch (const InvalidInputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  {
+    const std::string dir = with_maps("tileio-maps-missing");
+    fs::remove(dir + "/height_001.png");
+    expect_refused(dir, "field layer_list[1].height: map file '" + dir + "/height_001.png' missing");
+  }
+  {
+    const std::string dir = with_maps("tileio-maps-size");
+    write_image(dir + "/normal_000.png", Image(8, 4, 3, 0.5f));
+    expect_refused(dir, "field layer_list[0].normal: map file '" + dir + "/normal_000.png' is 8x4x3, the tile needs 8x8x3");
+    write_image(dir + "/normal_000.png", Image(8, 8, 1, 0.5f));
+    expect_refused(dir, "is 8x8x1, the tile needs 8x8x3");
+  }
+  {
+    const std::string dir = with_maps("tileio-maps-kind");
+    std::ofstream(dir + "/tile.json") << R"({"format": "surftex material tile", "size": 8, "channels": 3,
+      "layers": 1, "layers_per_pair": 1, "maps": ["height", "gloss"],
+      "layer_list": [{"m": 0, "file": "layer_000.png", "height": "height_000.png"}]})";
+    expect_refused(dir, "tile.json: line 2: field maps[1]: must be \"normal\", \"height\" or \"roughness\"");
+    std::ofstream(dir + "/tile.json") << R"({"format": "surftex material tile", "size": 8, "channels": 3,
+      "layers": 1, "layers_per_pair": 1, "maps": ["roughness"],
+      "layer_list": [{"m": 0, "file": "layer_000.png",
+                      "roughness": "../roughness_000.png"}]})";
+    expect_refused(dir, "tile.json: line 4: field layer_list[0].roughness: must be a file name inside the tile folder");
+    std::ofstream(dir + "/tile.json") << R"({"format": "surftex material tile", "size": 8, "channels": 3,
+      "layers": 1, "layers_per_pair": 1, "maps": ["roughness"],
+      "layer_list": [{"m": 0, "file": "layer_000.png"}]})";
+    expect_refused(dir, "tile.json: line 3: field layer_list[0].roughness: missing");
+  }
+}
+
 }  // namespace
 }  // namespace surftex
