@@ -4,13 +4,12 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 
 #include "geometry/errors.h"
+#include "geometry/image_container.h"
 #include "geometry/output_file.h"
 
 namespace surftex {
@@ -66,110 +65,22 @@ Image read_current(OIIO::ImageInput& in, const std::string& path) {
   return img;
 }
 
-// CRC-32 of the PNG specification (ISO/IEC 15948, annex D: polynomial
-// 0xEDB88320, reflected, initial and final value 0xFFFFFFFF).
-std::uint32_t png_crc(const unsigned char* p, std::size_t n, std::uint32_t crc = 0xFFFFFFFFu) {
-  static const std::array<std::uint32_t, 256> table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  for (std::size_t i = 0; i < n; ++i) crc = table[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
-  return crc;
-}
-
-std::uint32_t be32(const unsigned char* p) {
-  return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
-}
-
-// The IHDR fields (PNG specification, section 11.2.2): libpng refuses
-// invalid ones by printing "libpng error: Invalid IHDR data" itself.
-void check_png_header(const unsigned char* d, std::uint32_t len, const std::string& what, const std::string& path,
-                      const ImageLimits& lim) {
-  if (len != 13) throw IOError(what + "the PNG header (IHDR) has " + std::to_string(len) + " bytes, not 13");
-  const std::uint32_t w = be32(d), h = be32(d + 4);
-  const int depth = d[8], type = d[9];
-  if (w == 0 || h == 0 || w > 0x7FFFFFFFu || h > 0x7FFFFFFFu)
-    throw IOError(what + "the PNG header claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
-  const bool ok_type = (type == 0 && (depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16)) ||
-                       (type == 3 && (depth == 1 || depth == 2 || depth == 4 || depth == 8)) ||
-                       ((type == 2 || type == 4 || type == 6) && (depth == 8 || depth == 16));
-  if (!ok_type)
-    throw IOError(what + "the PNG header's colour type " + std::to_string(type) + " with bit depth " +
-                  std::to_string(depth) + " is not a PNG format");
-  if (d[10] != 0 || d[11] != 0 || d[12] > 1)
-    throw IOError(what + "the PNG header's compression, filter or interlace method is unknown");
-  // Our limits before libpng's own (1,000,000 px a side, refused with its own text).
-  const long long side = std::min(lim.max_side(), 1000000LL);
-  if (w > side || h > side || static_cast<long long>(w) * h > lim.max_pixels)
-    throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) +
-                            " (PNG header); the limit is " + std::to_string(side) + " px a side and " +
-                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
-                            " MiB decoded): pass --max-image-pixels to raise it");
-}
-
-// A PNG file's chunk structure checked before libpng sees it: every chunk
-// inside the file with a matching CRC, IHDR first and IEND last (PNG
-// specification, sections 5.3-5.6). libpng reports a truncated or damaged
-// file by printing "libpng error: ..." to stderr itself and longjmp-ing
-// through OpenImageIO's reader (which leaks a string on the way); caught
-// here, the user gets one `error:` line naming the chunk and the byte
-// offset instead. Damage inside the compressed pixel data with a valid CRC
-// (rare: the CRC covers it) still reaches libpng. Files that do not start
-// with the PNG signature are left to OpenImageIO.
-void check_png_structure(const std::string& path, const ImageLimits& lim) {
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return;  // OpenImageIO reports it
-  unsigned char sig[8];
-  if (!f.read(reinterpret_cast<char*>(sig), 8) || !std::equal(sig, sig + 8, kSignature)) return;
-  const std::uintmax_t size = std::filesystem::file_size(path);
-  const std::string what = "cannot decode image '" + path + "' (truncated or corrupt): ";
-  std::uintmax_t at = 8;
-  std::vector<unsigned char> buf;
-  bool first = true;
-  for (;;) {
-    unsigned char head[8];
-    if (size - at < 12 || !f.read(reinterpret_cast<char*>(head), 8))
-      throw IOError(what + "the file ends at byte " + std::to_string(size) +
-                    " before the PNG end chunk (IEND)");
-    const std::uint32_t len = be32(head);
-    const std::string type(reinterpret_cast<const char*>(head + 4), 4);
-    if (len > 0x7FFFFFFFu || len > size - at - 12)
-      throw IOError(what + "PNG chunk '" + type + "' at byte " + std::to_string(at) + " claims " +
-                    std::to_string(len) + " bytes, past the end of the file (" + std::to_string(size) +
-                    " bytes)");
-    if (first && type != "IHDR")
-      throw IOError(what + "the first PNG chunk is '" + type + "', not IHDR");
-    buf.resize(static_cast<std::size_t>(len) + 4);
-    f.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
-    std::uint32_t crc = png_crc(head + 4, 4);
-    crc = png_crc(buf.data(), len, crc) ^ 0xFFFFFFFFu;
-    if (crc != be32(buf.data() + len))
-      throw IOError(what + "PNG chunk '" + type + "' at byte " + std::to_string(at) +
-                    " fails its CRC check");
-    if (first) check_png_header(buf.data(), len, what, path, lim);
-    first = false;
-    at += 12 + static_cast<std::uintmax_t>(len);
-    if (type == "IEND") return;
-  }
-}
-
 std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const ImageLimits& lim) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw IOError("image '" + path + "' does not exist");
   if (std::filesystem::is_directory(path, ec)) throw IOError("image '" + path + "' is a folder");
   if (std::filesystem::file_size(path, ec) == 0 && !ec)
     throw IOError("image '" + path + "' is empty (0 bytes)");
-  check_png_structure(path, lim);
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    const std::string why = take_errors(nullptr);
-    throw IOError("cannot read image '" + path + "'" + (why.empty() ? "" : ": " + why));
+  // The format from the file's first bytes, one decoder only: OpenImageIO
+  // alone would try every plugin it has (DICOM, RAW, video, ...) on a file
+  // its extension does not name.
+  const std::string format = sniff_image_format(path);
+  check_image_container(path, format, lim);
+  auto in = OIIO::ImageInput::create(format);
+  OIIO::ImageSpec spec;
+  if (!in || !in->open(path, spec)) {
+    const std::string why = take_errors(in.get());
+    throw IOError("cannot read image '" + path + "' as " + format + (why.empty() ? "" : ": " + why));
   }
   (void)take_errors(in.get());  // warnings of a header that opened
   return in;

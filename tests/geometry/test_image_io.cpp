@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -157,4 +158,144 @@ TEST(OutputFile, UncommittedTemporaryIsRemoved) {
 
 TEST(OutputFile, MissingFolderIsAnError) {
   EXPECT_THROW(AtomicOutputFile("/nonexistent-dir/x.obj"), IOError);
+}
+
+namespace {
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+void spit(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+// The message of the error read_image throws on `path` ("" when it reads).
+template <class E>
+std::string refusal(const std::string& path) {
+  try {
+    read_image(path);
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "";
+}
+// Overwrites the 4 little-endian bytes at `at`.
+void put_le32(std::string& b, std::size_t at, std::uint32_t v) {
+  for (int k = 0; k < 4; ++k) b[at + k] = static_cast<char>((v >> (8 * k)) & 0xFFu);
+}
+}  // namespace
+
+// Every format the gate lets through (by its first bytes) still reads, whatever
+// the file is called.
+TEST(ImageFormatGate, EveryWrittenFormatReadsBackByItsFirstBytes) {
+  std::string dir = test::temp_dir("img");
+  for (const std::string ext : {"png", "jpg", "tif", "exr", "bmp", "hdr", "ppm", "tga"}) {
+    const std::string path = dir + "/a." + ext;
+    write_image(path, ramp(8, 6, 3));
+    const Image back = read_image(path);
+    EXPECT_EQ(back.width, 8) << ext;
+    EXPECT_EQ(back.height, 6) << ext;
+    if (ext == "tga") continue;  // Targa has no signature: read by its name only
+    fs::copy_file(path, dir + "/noext_" + ext);
+    EXPECT_EQ(read_image(dir + "/noext_" + ext).width, 8) << ext << " without its extension";
+  }
+}
+
+// A file that is no image format surftex reads is refused by its first bytes,
+// not handed to every OpenImageIO plugin in turn (DICOM's among them).
+TEST(ImageFormatGate, NonImageBytesAreRefusedByName) {
+  std::string dir = test::temp_dir("img");
+  spit(dir + "/notes.png", "just some text, not a picture\n");
+  std::string dicom(128, '\0');
+  dicom += "DICM";
+  dicom += std::string(64, '\x02');
+  spit(dir + "/scan.dcm", dicom);
+  for (const std::string name : {"notes.png", "scan.dcm"}) {
+    const std::string msg = refusal<IOError>(dir + "/" + name);
+    EXPECT_NE(msg.find("it is not a PNG, JPEG, TIFF, OpenEXR"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(name), std::string::npos) << msg;
+  }
+}
+
+// An OpenEXR header attribute claiming more bytes than the file holds made
+// OpenEXR allocate that much (fuzz_image_header, 342 MB for a 2 kB file):
+// refused before OpenEXR reads it, naming the attribute.
+TEST(ImageFormatGate, ExrAttributeLongerThanTheFileIsRefused) {
+  std::string dir = test::temp_dir("img");
+  write_image(dir + "/a.exr", ramp(4, 4, 3));
+  std::string b = slurp(dir + "/a.exr");
+  const auto name = b.find(std::string("channels\0chlist\0", 16));
+  ASSERT_NE(name, std::string::npos);
+  put_le32(b, name + 16, 400u << 20);
+  spit(dir + "/b.exr", b);
+  const std::string msg = refusal<IOError>(dir + "/b.exr");
+  EXPECT_NE(msg.find("OpenEXR attribute 'channels'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("claims 419430400 bytes"), std::string::npos) << msg;
+  EXPECT_EQ(read_image(dir + "/a.exr").width, 4);  // the intact file still reads
+}
+
+// A data window beyond the image limits, and one whose offset table would
+// need more bytes than the file has, are refused from the header alone.
+TEST(ImageFormatGate, ExrDataWindowAndOffsetTableAreCheckedAgainstTheFile) {
+  std::string dir = test::temp_dir("img");
+  write_image(dir + "/a.exr", ramp(4, 4, 3));
+  const std::string a = slurp(dir + "/a.exr");
+  const auto win = a.find(std::string("dataWindow\0box2i\0", 17));
+  ASSERT_NE(win, std::string::npos);
+  const std::size_t box = win + 17 + 4;  // xmin ymin xmax ymax after the size
+  std::string huge = a;
+  put_le32(huge, box + 8, 3000000u);  // xmax
+  spit(dir + "/huge.exr", huge);
+  const std::string big = refusal<InvalidInputError>(dir + "/huge.exr");
+  EXPECT_NE(big.find("OpenEXR data window"), std::string::npos) << big;
+  EXPECT_NE(big.find("--max-image-pixels"), std::string::npos) << big;
+
+  // 4 x 16000 lines, within the limits, but its offsets cannot fit in the file.
+  std::string tall = a;
+  put_le32(tall, box + 12, 15999u);  // ymax
+  const auto disp = tall.find(std::string("displayWindow\0box2i\0", 20));
+  ASSERT_NE(disp, std::string::npos);
+  put_le32(tall, disp + 20 + 4 + 12, 15999u);
+  spit(dir + "/tall.exr", tall);
+  const std::string off = refusal<IOError>(dir + "/tall.exr");
+  EXPECT_NE(off.find("OpenEXR offset table"), std::string::npos) << off;
+}
+
+// OpenEXR reads a box2i as 16 bytes whatever size the file declares; a
+// declared 0 made it read on from the wrong place (a later "size" of 1.7 GB,
+// fuzz_image_header). A known type must fill its declared size exactly.
+TEST(ImageFormatGate, ExrAttributeOfAKnownTypeMustFillItsDeclaredSize) {
+  std::string dir = test::temp_dir("img");
+  write_image(dir + "/a.exr", ramp(4, 4, 3));
+  std::string b = slurp(dir + "/a.exr");
+  const auto win = b.find(std::string("dataWindow\0box2i\0", 17));
+  ASSERT_NE(win, std::string::npos);
+  put_le32(b, win + 17, 0u);
+  spit(dir + "/b.exr", b);
+  const std::string msg = refusal<IOError>(dir + "/b.exr");
+  EXPECT_NE(msg.find("OpenEXR attribute 'dataWindow' of type box2i has 0 bytes, not 16"), std::string::npos) << msg;
+}
+
+// OpenImageIO 2.4 copies a Photoshop (APP13) segment's IPTC block by the size
+// the block declares, past the segment's end (a heap overflow under ASan,
+// fuzz_image_header): refused when the block does not fit its segment. A
+// well-formed block still reads.
+TEST(ImageFormatGate, JpegIptcBlockMustFitItsSegment) {
+  std::string dir = test::temp_dir("img");
+  write_image(dir + "/a.jpg", ramp(8, 8, 3));
+  const std::string a = slurp(dir + "/a.jpg");
+  auto with_app13 = [&](std::uint16_t declared, std::size_t held) {
+    std::string payload = std::string("Photoshop 3.0\0", 14) + "8BIM" + std::string("\x04\x04\0\0\0\0", 6);
+    payload += static_cast<char>(declared >> 8);
+    payload += static_cast<char>(declared & 0xFF);
+    payload += std::string(held, 'x');
+    const std::size_t len = payload.size() + 2;
+    std::string seg = "\xFF\xED";
+    seg += static_cast<char>(len >> 8);
+    seg += static_cast<char>(len & 0xFF);
+    return a.substr(0, 2) + seg + payload + a.substr(2);
+  };
+  spit(dir + "/ok.jpg", with_app13(0, 0));
+  EXPECT_EQ(read_image(dir + "/ok.jpg").width, 8);
+  spit(dir + "/bad.jpg", with_app13(60000, 8));
+  const std::string msg = refusal<IOError>(dir + "/bad.jpg");
+  EXPECT_NE(msg.find("the Photoshop (APP13) segment at byte 2 holds an IPTC block of 60000 bytes"), std::string::npos)
+      << msg;
 }
