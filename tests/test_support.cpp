@@ -20,14 +20,12 @@ namespace fs = std::filesystem;
 
 namespace surftex::test {
 
-namespace {
-std::string read_all(const std::string& p) {
+std::string file_bytes(const std::string& p) {
   std::ifstream f(p, std::ios::binary);
   std::stringstream ss;
   ss << f.rdbuf();
   return ss.str();
 }
-}  // namespace
 
 std::string shared_data(const std::string& rel) {
   const char* env = std::getenv("SURFTEX_SHARED_DATA");
@@ -181,8 +179,8 @@ RunResult run_surftex(const std::string& args) {
   int status = std::system(cmd.c_str());
   RunResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-  r.out = read_all(out);
-  r.err = read_all(err);
+  r.out = file_bytes(out);
+  r.err = file_bytes(err);
   fs::remove_all(dir);
   return r;
 }

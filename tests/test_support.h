@@ -14,6 +14,8 @@ std::string shared_data(const std::string& rel);
 std::string cgal_data(const std::string& name);
 /// A fresh empty temporary folder, unique per call.
 std::string temp_dir(const std::string& tag);
+/// The whole file, bytes as they are ("" if it cannot be read).
+std::string file_bytes(const std::string& path);
 
 struct RunResult {
   int exit_code = -1;

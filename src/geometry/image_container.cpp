@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "geometry/errors.h"
+#include "geometry/file_extension.h"
 
 namespace surftex {
 
@@ -404,12 +405,6 @@ void check_gif_screen(const std::string& path, const ImageLimits& lim) {
   if (w * h * 4 > 0x7FFFFFFFLL)
     throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) +
                             " (GIF logical screen): OpenImageIO reads at most 2^29 GIF pixels");
-}
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
 }
 
 }  // namespace

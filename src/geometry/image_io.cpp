@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "geometry/errors.h"
+#include "geometry/file_extension.h"
 #include "geometry/image_container.h"
 #include "geometry/output_file.h"
 
@@ -87,8 +88,7 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const Imag
 }
 
 OIIO::ImageSpec spec_for(const Image& img, const std::string& path, bool eight_bit, bool sixteen_bit = false) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lower_extension(path);
   bool float_ok = (ext == ".exr" || ext == ".tif" || ext == ".tiff" || ext == ".hdr" || ext == ".pfm");
   OIIO::TypeDesc fmt = (eight_bit || !float_ok) ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
   if (ext == ".exr" && fmt == OIIO::TypeDesc::UINT8) fmt = OIIO::TypeDesc::HALF;

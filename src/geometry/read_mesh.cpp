@@ -18,6 +18,7 @@
 #include <unordered_map>
 
 #include "geometry/errors.h"
+#include "geometry/file_extension.h"
 #include "geometry/face_material.h"
 #include "geometry/mesh.h"
 #include "geometry/mesh_parsers.h"
@@ -154,11 +155,6 @@ using namespace mesh_io;
 
 enum class Format { Off, Obj, Ply, Stl, Glb, Gltf, Unknown };
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 bool is_off_keyword(std::string_view t) {
   if (t.size() < 3 || t.substr(t.size() - 3) != "OFF") return false;
   std::string_view pre = t.substr(0, t.size() - 3);
@@ -229,7 +225,7 @@ std::string read_whole_file(const std::string& path) {
 PolygonSoup read_polygon_soup(const std::string& path) {
   std::string bytes = read_whole_file(path);
   if (bytes.empty()) throw IOError("'" + path + "' is empty (0 bytes)");
-  std::string ext = lower(fs::path(path).extension().string());
+  std::string ext = lower_extension(path);
   Format fmt = ext == ".off"    ? Format::Off
                : ext == ".obj"  ? Format::Obj
                : ext == ".ply"  ? Format::Ply

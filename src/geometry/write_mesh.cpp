@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "geometry/errors.h"
+#include "geometry/file_extension.h"
 #include "geometry/face_material.h"
 #include "geometry/gltf_vertex_frames.h"
 #include "geometry/image_io.h"
@@ -28,11 +29,6 @@ namespace fs = std::filesystem;
 namespace surftex {
 
 namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 /// Shortest decimal that reads back to the same double.
 void append_num(std::string& out, double v) {
@@ -664,7 +660,7 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
 }  // namespace
 
 std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
-  const std::string ext = lower(fs::path(path).extension().string());
+  const std::string ext = lower_extension(path);
   if (ext == ".obj") return write_obj(path, mesh, opt);
   if (ext == ".ply") write_ply(path, mesh, opt);
   else if (ext == ".off") write_off(path, mesh, opt);

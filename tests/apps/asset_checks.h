@@ -11,7 +11,6 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,15 +19,9 @@
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/uv_raster.h"
+#include "test_support.h"
 
 namespace surftex::test {
-
-inline std::string file_bytes(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// Names of files in `dir` whose bytes equal another file's there ("a = b").
 inline std::vector<std::string> duplicate_files(const std::string& dir) {

@@ -4,7 +4,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
@@ -105,11 +104,7 @@ TEST(ImageIO, TruncatedPngIsRefused) {
 TEST(ImageIO, PngWithADamagedChunkIsRefusedNamingTheChunk) {
   std::string dir = test::temp_dir("img");
   write_image(dir + "/a.png", ramp(64, 64, 3));
-  std::string bytes;
-  {
-    std::ifstream f(dir + "/a.png", std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(f), {});
-  }
+  std::string bytes = test::file_bytes(dir + "/a.png");
   const auto idat = bytes.find("IDAT");
   ASSERT_NE(idat, std::string::npos);
   bytes[idat + 10] = static_cast<char>(bytes[idat + 10] ^ 0x5A);  // one byte of compressed data
@@ -161,10 +156,6 @@ TEST(OutputFile, MissingFolderIsAnError) {
 }
 
 namespace {
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
 void spit(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 // The message of the error read_image throws on `path` ("" when it reads).
 template <class E>
@@ -175,6 +166,13 @@ std::string refusal(const std::string& path) {
     return e.what();
   }
   return "";
+}
+// Where the 4-byte size of OpenEXR attribute `name` of `type` sits in `bytes`
+// (its value follows it); npos when the header has no such attribute.
+std::size_t exr_size_field(const std::string& bytes, const std::string& name, const std::string& type) {
+  const std::string key = name + '\0' + type + '\0';
+  const auto at = bytes.find(key);
+  return at == std::string::npos ? at : at + key.size();
 }
 // Overwrites the 4 little-endian bytes at `at`.
 void put_le32(std::string& b, std::size_t at, std::uint32_t v) {
@@ -220,10 +218,10 @@ TEST(ImageFormatGate, NonImageBytesAreRefusedByName) {
 TEST(ImageFormatGate, ExrAttributeLongerThanTheFileIsRefused) {
   std::string dir = test::temp_dir("img");
   write_image(dir + "/a.exr", ramp(4, 4, 3));
-  std::string b = slurp(dir + "/a.exr");
-  const auto name = b.find(std::string("channels\0chlist\0", 16));
-  ASSERT_NE(name, std::string::npos);
-  put_le32(b, name + 16, 400u << 20);
+  std::string b = test::file_bytes(dir + "/a.exr");
+  const auto size = exr_size_field(b, "channels", "chlist");
+  ASSERT_NE(size, std::string::npos);
+  put_le32(b, size, 400u << 20);
   spit(dir + "/b.exr", b);
   const std::string msg = refusal<IOError>(dir + "/b.exr");
   EXPECT_NE(msg.find("OpenEXR attribute 'channels'"), std::string::npos) << msg;
@@ -236,10 +234,10 @@ TEST(ImageFormatGate, ExrAttributeLongerThanTheFileIsRefused) {
 TEST(ImageFormatGate, ExrDataWindowAndOffsetTableAreCheckedAgainstTheFile) {
   std::string dir = test::temp_dir("img");
   write_image(dir + "/a.exr", ramp(4, 4, 3));
-  const std::string a = slurp(dir + "/a.exr");
-  const auto win = a.find(std::string("dataWindow\0box2i\0", 17));
+  const std::string a = test::file_bytes(dir + "/a.exr");
+  const auto win = exr_size_field(a, "dataWindow", "box2i");
   ASSERT_NE(win, std::string::npos);
-  const std::size_t box = win + 17 + 4;  // xmin ymin xmax ymax after the size
+  const std::size_t box = win + 4;  // xmin ymin xmax ymax after the size
   std::string huge = a;
   put_le32(huge, box + 8, 3000000u);  // xmax
   spit(dir + "/huge.exr", huge);
@@ -250,9 +248,9 @@ TEST(ImageFormatGate, ExrDataWindowAndOffsetTableAreCheckedAgainstTheFile) {
   // 4 x 16000 lines, within the limits, but its offsets cannot fit in the file.
   std::string tall = a;
   put_le32(tall, box + 12, 15999u);  // ymax
-  const auto disp = tall.find(std::string("displayWindow\0box2i\0", 20));
+  const auto disp = exr_size_field(tall, "displayWindow", "box2i");
   ASSERT_NE(disp, std::string::npos);
-  put_le32(tall, disp + 20 + 4 + 12, 15999u);
+  put_le32(tall, disp + 4 + 12, 15999u);
   spit(dir + "/tall.exr", tall);
   const std::string off = refusal<IOError>(dir + "/tall.exr");
   EXPECT_NE(off.find("OpenEXR offset table"), std::string::npos) << off;
@@ -264,10 +262,10 @@ TEST(ImageFormatGate, ExrDataWindowAndOffsetTableAreCheckedAgainstTheFile) {
 TEST(ImageFormatGate, ExrAttributeOfAKnownTypeMustFillItsDeclaredSize) {
   std::string dir = test::temp_dir("img");
   write_image(dir + "/a.exr", ramp(4, 4, 3));
-  std::string b = slurp(dir + "/a.exr");
-  const auto win = b.find(std::string("dataWindow\0box2i\0", 17));
+  std::string b = test::file_bytes(dir + "/a.exr");
+  const auto win = exr_size_field(b, "dataWindow", "box2i");
   ASSERT_NE(win, std::string::npos);
-  put_le32(b, win + 17, 0u);
+  put_le32(b, win, 0u);
   spit(dir + "/b.exr", b);
   const std::string msg = refusal<IOError>(dir + "/b.exr");
   EXPECT_NE(msg.find("OpenEXR attribute 'dataWindow' of type box2i has 0 bytes, not 16"), std::string::npos) << msg;
@@ -280,7 +278,7 @@ TEST(ImageFormatGate, ExrAttributeOfAKnownTypeMustFillItsDeclaredSize) {
 TEST(ImageFormatGate, JpegIptcBlockMustFitItsSegment) {
   std::string dir = test::temp_dir("img");
   write_image(dir + "/a.jpg", ramp(8, 8, 3));
-  const std::string a = slurp(dir + "/a.jpg");
+  const std::string a = test::file_bytes(dir + "/a.jpg");
   auto with_app13 = [&](std::uint16_t declared, std::size_t held) {
     std::string payload = std::string("Photoshop 3.0\0", 14) + "8BIM" + std::string("\x04\x04\0\0\0\0", 6);
     payload += static_cast<char>(declared >> 8);

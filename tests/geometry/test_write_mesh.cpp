@@ -7,7 +7,6 @@
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
@@ -55,13 +54,6 @@ Image checker() {
     for (int x = 0; x < 8; ++x)
       for (int c = 0; c < 3; ++c) img.at(x, y, c) = ((x + y) % 2) ? 1.f : (c == 0 ? 0.8f : 0.f);
   return img;
-}
-
-std::string slurp(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 void expect_same_positions(const Mesh& a, const Mesh& b, double tol) {
@@ -114,7 +106,7 @@ TEST(WriteMesh, PlyColoursAndScalarRoundTrip) {
   WriteMeshOptions opt;
   opt.vertex_scalar_property = "v:material";
   write_mesh(d + "/c.ply", m, opt);
-  const std::string bytes = slurp(d + "/c.ply");
+  const std::string bytes = test::file_bytes(d + "/c.ply");
   EXPECT_NE(bytes.find("property float v:material"), std::string::npos);
   auto soup = read_polygon_soup(d + "/c.ply");
   ASSERT_EQ(soup.colors.size(), 6u);
@@ -136,7 +128,7 @@ TEST(WriteMesh, ObjUvsRoundTripWithDeduplicatedVt) {
   Mesh m = seamed_strip();
   auto d = test::temp_dir("wm");
   write_mesh(d + "/s.obj", m);
-  const std::string text = slurp(d + "/s.obj");
+  const std::string text = test::file_bytes(d + "/s.obj");
   std::size_t vt = 0, pos = 0;
   while ((pos = text.find("\nvt ", pos)) != std::string::npos) ++vt, ++pos;
   // Distinct (u,v): (0,0) (0.5,0) (1,0) (0,0.75) (0.5,0.75) (1,0.75); the seam
@@ -192,8 +184,8 @@ TEST(WriteMesh, ObjWithTextureWritesMtlAndPngBesideIt) {
   write_mesh(d + "/tex.obj", m, opt);
   ASSERT_TRUE(fs::exists(d + "/tex.mtl"));
   ASSERT_TRUE(fs::exists(d + "/tex.png"));
-  EXPECT_NE(slurp(d + "/tex.obj").find("mtllib tex.mtl"), std::string::npos);
-  EXPECT_NE(slurp(d + "/tex.mtl").find("map_Kd tex.png"), std::string::npos);
+  EXPECT_NE(test::file_bytes(d + "/tex.obj").find("mtllib tex.mtl"), std::string::npos);
+  EXPECT_NE(test::file_bytes(d + "/tex.mtl").find("map_Kd tex.png"), std::string::npos);
   Image back = read_image(d + "/tex.png");
   EXPECT_EQ(back.width, 8);
   EXPECT_EQ(back.height, 4);
@@ -293,7 +285,7 @@ TEST(WriteMesh, FailedWriteLeavesNoFile) {
   WriteMeshOptions keep;
   keep.overwrite = false;
   EXPECT_THROW(write_mesh(d + "/keep.ply", m, keep), IOError);
-  EXPECT_EQ(slurp(d + "/keep.ply"), "original");
+  EXPECT_EQ(test::file_bytes(d + "/keep.ply"), "original");
   Mesh empty;
   EXPECT_THROW(write_mesh(d + "/empty.glb", empty), InvalidInputError);
   // The PNG's name is taken by a folder: the OBJ and MTL must not appear.

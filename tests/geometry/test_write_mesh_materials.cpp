@@ -7,7 +7,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "geometry/errors.h"
 #include "geometry/face_material.h"
@@ -47,13 +46,6 @@ Mesh three_material_torus(std::vector<MeshMaterial>& mats) {
   mats[2].name = "green";
   mats[2].base_color = {0.f, 1.f, 0.f};
   return m;
-}
-
-std::string slurp(const std::string& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 }  // namespace
@@ -99,7 +91,7 @@ TEST(WriteMeshMaterials, ObjWritesUsemtlGroupsAndATextureEach) {
   wo.materials = &mats;
   const auto files = write_mesh(d + "/t.obj", m, wo);
   EXPECT_EQ(files, (std::vector<std::string>{d + "/t.obj", d + "/t.mtl", d + "/t_0.png", d + "/t_1.png"}));
-  const std::string mtl = slurp(d + "/t.mtl");
+  const std::string mtl = test::file_bytes(d + "/t.mtl");
   EXPECT_NE(mtl.find("newmtl red_paint\n"), std::string::npos) << mtl;
   EXPECT_NE(mtl.find("map_Kd t_1.png"), std::string::npos) << mtl;
   EXPECT_NE(mtl.find("newmtl green\nKa 1 1 1\nKd 0 1 0\n"), std::string::npos) << mtl;
