@@ -5,7 +5,7 @@
 Three families, each run through the CLI one process at a time:
   meshes  mutated OFF/OBJ/PLY/STL files        -> surftex repair IN -o OUT/r.ply --report OUT/r.json
   images  mutated PNG/JPEG/TIFF/EXR/BMP files  -> surftex render MESH --texture IN -o OUT/r.png --size 24
-  json    mutated constraints and tile.json    -> surftex material-map MESH --tile T --constraints IN -o OUT/m
+  json    mutated constraints and tile.json    -> surftex material-map MESH --tile T --constraints IN -o OUT/m --atlas-size 128
 
 Every run is classified:
   clean_error    exit 2, one `error: ...` line, nothing left in OUT
@@ -436,7 +436,8 @@ def campaign_json(args, rnd, work, log):
         shutil.rmtree(out, ignore_errors=True)
         os.makedirs(out)
         status, err, sec, rss = run(args.binary, ["material-map", mesh, "--tile", tile, "--constraints", inp, "-o",
-                                                  os.path.join(out, "m"), "--render-size", "16", "-q"], out,
+                                                  os.path.join(out, "m"), "--render-size", "16", "--atlas-size", "128", "-q"],
+                                    out,
                                     args.timeout)
         expected = ["m/" + f for f in ("mesh.obj", "mesh.mtl", "mesh.glb", "mesh.ply", "render_plain.png",
                                         "render_fixed.png", "render_normalmap.png", "report.json", "state.json")]

@@ -12,8 +12,8 @@
 set -euo pipefail
 build="$1"; shift
 sizes=("$@"); ((${#sizes[@]})) || sizes=(2000 8000 32000)
-bin="$build/apps/surftex"
-[[ -x "$bin" ]] || bin="$build/surftex"
+bin="$build/bin/surftex"
+[[ -x "$bin" ]] || { echo "error: no surftex binary at $bin" >&2; exit 2; }
 data="${SURFTEX_SHARED_DATA:-$(dirname "$0")/../../shared/data}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
@@ -46,7 +46,8 @@ measure() {  # measure NAME FACES ARGS...
   # shellcheck disable=SC2086
   nice -n 10 timeout 1800 /usr/bin/time -f "%M %U %S" -o "$work/time" "$bin" "$@" ${SURFTEX_EXTRA_ARGS:-} >"$work/stdout" 2>"$work/stderr" || rc=$?
   local wall; wall=$(echo "$(date +%s.%N) - $t0" | bc)
-  read -r rss user sys <"$work/time" || true
+  # GNU time writes "Command exited with non-zero status N" before its figures.
+  read -r rss user sys < <(tail -n 1 "$work/time") || true
   local est; est=$(grep -m1 "^note: estimate" "$work/stderr" | sed 's/"/\\"/g' || true)
   local err; err=$(grep -m1 "^error" "$work/stderr" | sed 's/"/\\"/g' | cut -c1-300 || true)
   echo "{\"bench\":\"work_estimates\",\"command\":\"$name\",\"faces\":$faces,\"exit\":$rc,\"max_rss_mib\":$((${rss:-0} / 1024)),\"user_s\":${user:-0},\"sys_s\":${sys:-0},\"wall_s\":$wall,\"load\":$(cut -d' ' -f1 /proc/loadavg),\"estimate\":\"$est\",\"error\":\"$err\"}"

@@ -225,7 +225,7 @@ int run(const Args& a) {
   rep["vertices"] = mesh.number_of_vertices();
   rep["faces"] = mesh.number_of_faces();
   check_budget(estimate_material_map(mesh.number_of_faces(), tile.layers.size() * tile.layers[0].data.size() * 4,
-                                     a.render_size),
+                                     a.render_size, a.atlas_size),
                a.common);
 
   MaterialMapping mapping(mesh, mapping_options(a));

@@ -150,13 +150,17 @@ WorkEstimate estimate_subdiv(std::size_t faces, int exemplar_width, int exemplar
   return e;
 }
 
-WorkEstimate estimate_material_map(std::size_t faces, std::size_t tile_bytes, int render_size) {
+WorkEstimate estimate_material_map(std::size_t faces, std::size_t tile_bytes, int render_size, int atlas_size) {
   const double F = static_cast<double>(faces);
+  const double atlas_texels = static_cast<double>(atlas_size) * atlas_size;
   WorkEstimate e;
-  e.what = "material-map on " + std::to_string(faces) + " faces";
-  e.bytes = kBase + 5000.0 * F + 2.0 * static_cast<double>(tile_bytes) + static_cast<double>(render_size) * render_size * 100.0;
-  e.seconds = 1.0 + 2e-4 * F + 3e-6 * static_cast<double>(render_size) * render_size;
-  e.shrink = "a smaller mesh";
+  e.what = "material-map on " + std::to_string(faces) + " faces with a " + std::to_string(atlas_size) + "^2 atlas";
+  // The baked atlas (colour, normal, height, lookup and gutter buffers) costs
+  // about 49 bytes per texel; 96 MiB covers the mapping's fixed cost.
+  e.bytes = kBase + 96.0 * 1048576.0 + 5000.0 * F + 2.0 * static_cast<double>(tile_bytes) +
+            static_cast<double>(render_size) * render_size * 100.0 + 56.0 * atlas_texels;
+  e.seconds = 1.0 + 2e-4 * F + 3e-6 * static_cast<double>(render_size) * render_size + 1.2e-6 * atlas_texels;
+  e.shrink = "--atlas-size, a smaller mesh";
   return e;
 }
 

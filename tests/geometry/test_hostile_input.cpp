@@ -25,6 +25,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/read_mesh.h"
 #include "geometry/split_pinched_polygons.h"
+#include "geometry/work_budget.h"
 #include "test_support.h"
 
 using namespace surftex;
@@ -423,4 +424,19 @@ TEST(PinchedPolygons, TheHugeFaceFileLoadsQuickly) {
   SoupRepairCounts counts;
   read_mesh(p, m, {}, &counts);  // was 26 s at 400K corners, quadratic
   EXPECT_EQ(m.number_of_faces(), 2u);  // one quad left after duplicates merge, triangulated
+}
+
+// material-map's baked atlas is most of its memory at small meshes: 977 MB
+// peak was measured for a 128-face sphere with a 4096^2 atlas (decision 602),
+// 376 MB at 2048^2. The estimate must cover what the atlas costs.
+TEST(WorkBudget, MaterialMapEstimateCoversTheBakedAtlas) {
+  const double MiB = 1048576.0;
+  const auto small = surftex::estimate_material_map(128, 9 * 256 * 256 * 12, 512, 512);
+  const auto base = surftex::estimate_material_map(128, 9 * 256 * 256 * 12, 512, 2048);
+  const auto big = surftex::estimate_material_map(128, 9 * 256 * 256 * 12, 512, 4096);
+  EXPECT_GE(small.bytes, 246.0 * MiB);
+  EXPECT_GE(base.bytes, 368.0 * MiB);
+  EXPECT_GE(big.bytes, 955.0 * MiB);
+  EXPECT_LT(big.bytes, 2.0 * 955.0 * MiB);  // not so far above that it refuses what fits
+  EXPECT_NE(big.shrink.find("--atlas-size"), std::string::npos);
 }
