@@ -3,7 +3,6 @@
 // 2006, section 3: surface quilting, shell-map embedding) or a plane (section
 // 2); `surftex elements`: edit the elements of a result by id; the demo step
 // "quilt".
-#include <CGAL/Polygon_mesh_processing/bbox.h>
 
 #include <algorithm>
 #include <array>
@@ -266,18 +265,9 @@ void quilt_on_plane(const QuiltArgs& a, Mesh& sm, double w, double h, Mesh& out,
 // needed are the base area over the scaled swatch's xy area (the base mesh
 // is triangulated by load_method_mesh).
 void check_surface_quilt_size(const QuiltArgs& a, const Mesh& base, const Swatch& s, double relative_size) {
-  double area = 0;
-  for (FaceIndex f : base.faces()) area += face_area(base, f);
-  const CGAL::Bbox_3 bb = CGAL::Polygon_mesh_processing::bbox(base);
-  const double diag = std::sqrt(CGAL::square(bb.xmax() - bb.xmin()) + CGAL::square(bb.ymax() - bb.ymin()) +
-                                CGAL::square(bb.zmax() - bb.zmin()));
-  const double side = relative_size * diag, big = std::max(s.length(), s.width());
-  const double swatch_area = s.length() * s.width() * (side / big) * (side / big);
-  check_quilt_size(s, a.cell, swatch_area > 0 ? area / swatch_area : 0.0,
-                   "--scale " + std::to_string(relative_size));
-  check_budget(estimate_quilt(base.number_of_faces(), (swatch_area > 0 ? area / swatch_area : 0.0) *
-                                                          static_cast<double>(s.mesh.tris.size())),
-               a.common);
+  const double placements = surface_quilt_placements(base, s, relative_size);
+  check_quilt_size(s, a.cell, placements, "--scale " + std::to_string(relative_size));
+  check_budget(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())), a.common);
 }
 
 // The options of quilt_surface from the command line (the relative size set by the caller).

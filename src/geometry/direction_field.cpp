@@ -48,7 +48,7 @@ Eigen::VectorXcd solve_hermitian(const Eigen::SparseMatrix<Cplx>& A, const Eigen
   if (solver.info() != Eigen::Success) throw SolverError("interpolate_direction_field: " + step + "solve failed");
   return x;
 }
-using FaceDirMap = Mesh::Property_map<FaceIndex, Vector3>;
+using FaceDirs = std::vector<Vector3>;  // one direction per face index
 
 /// What interpolate_direction_field knows about every face, stage to stage.
 struct FieldState {
@@ -108,7 +108,7 @@ void frame_relevant_faces(FieldState& s) {
 
 /// Locks the constrained faces (their direction projected on the face, as an
 /// angle in its frame) and the faces outside the area (their stored direction).
-void lock_faces(FieldState& s, const std::vector<DirectionConstraint>& constraints, const FaceDirMap& dir,
+void lock_faces(FieldState& s, const std::vector<DirectionConstraint>& constraints, const FaceDirs& dir,
                 DirectionFieldResult& res) {
   const Mesh& mesh = s.mesh;
   const std::size_t nf = s.nf;
@@ -135,7 +135,7 @@ void lock_faces(FieldState& s, const std::vector<DirectionConstraint>& constrain
     if (s.is_free(f)) continue;
     s.locked[f.idx()] = 1;
     if (!s.relevant[f.idx()]) continue;  // never read
-    const Vector3 d = dir[f];
+    const Vector3 d = dir[f.idx()];
     s.theta[f.idx()] = norm(d) > 0 ? s.frames[f.idx()].angle_of(d) : 0.0;
   }
 }
@@ -349,14 +349,14 @@ void comb_field(FieldState& s) {
 /// The directions of the free faces: the combed angle in the face frame, or
 /// e1 on a component without constraints; faces outside the area keep
 /// theirs bit for bit.
-void write_directions(const FieldState& s, FaceDirMap& dir) {
+void write_directions(const FieldState& s, FaceDirs& dir) {
   for (FaceIndex f : s.mesh.faces()) {
     if (!s.is_free(f)) continue;  // bit for bit unchanged outside the area
     if (!s.locked[f.idx()] && !s.reach[f.idx()]) {
-      dir[f] = s.frames[f.idx()].e1;
+      dir[f.idx()] = s.frames[f.idx()].e1;
       continue;
     }
-    dir[f] = s.frames[f.idx()].direction(s.final_theta[f.idx()]);
+    dir[f.idx()] = s.frames[f.idx()].direction(s.final_theta[f.idx()]);
   }
 }
 
@@ -365,8 +365,21 @@ void write_directions(const FieldState& s, FaceDirMap& dir) {
 DirectionFieldResult interpolate_direction_field(Mesh& mesh,
                                                  const std::vector<DirectionConstraint>& constraints,
                                                  const DirectionFieldOptions& opt) {
+  auto map = get_or_add(mesh, opt.direction_map, Vector3(0, 0, 0));
+  FaceDirs dir(mesh.num_faces(), Vector3(0, 0, 0));
+  for (FaceIndex f : mesh.faces()) dir[f.idx()] = map[f];
+  const DirectionFieldResult res = interpolate_direction_field(mesh, constraints, dir, opt);
+  for (FaceIndex f : mesh.faces()) map[f] = dir[f.idx()];
+  return res;
+}
+
+DirectionFieldResult interpolate_direction_field(const Mesh& mesh,
+                                                 const std::vector<DirectionConstraint>& constraints,
+                                                 std::vector<Vector3>& dir, const DirectionFieldOptions& opt) {
   check_field_inputs(mesh, opt);
-  FaceDirMap dir = mesh.add_property_map<FaceIndex, Vector3>(opt.direction_map, Vector3(0, 0, 0)).first;
+  if (dir.size() != mesh.num_faces())
+    throw InvalidInputError("interpolate_direction_field: " + std::to_string(dir.size()) + " directions for " +
+                            std::to_string(mesh.num_faces()) + " face indices");
   FieldState s(mesh, opt);
   DirectionFieldResult res;
   frame_relevant_faces(s);

@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
+#include "geometry/property_names.h"
 
 namespace surftex {
 
@@ -58,7 +59,7 @@ struct DirectionConstraint {
 
 struct DirectionFieldOptions {
   int symmetry = 4;                     ///< N in {1, 2, 4}
-  std::string direction_map = "f:dir";  ///< face map written (kFaceDirection)
+  PropertyName<FaceIndex, Vector3> direction_map = kFaceDirection;  ///< face map written
   /// Free faces; nullptr = the whole mesh. Faces outside are locked to the
   /// current content of direction_map.
   const EffectArea* area = nullptr;
@@ -80,6 +81,13 @@ struct DirectionFieldResult {
 
 DirectionFieldResult interpolate_direction_field(Mesh& mesh,
                                                  const std::vector<DirectionConstraint>& constraints,
+                                                 const DirectionFieldOptions& options = {});
+/// The same field without a property map: `directions` (one per face index,
+/// mesh.num_faces()) holds the current directions on entry (kept outside the
+/// area) and the field on return. options.direction_map is not used.
+DirectionFieldResult interpolate_direction_field(const Mesh& mesh,
+                                                 const std::vector<DirectionConstraint>& constraints,
+                                                 std::vector<Vector3>& directions,
                                                  const DirectionFieldOptions& options = {});
 
 /// Constraints from principal directions: the faces whose mean curvature

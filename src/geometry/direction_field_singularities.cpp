@@ -15,9 +15,9 @@ std::vector<int> direction_field_indices(const Mesh& mesh, const FieldIndexOptio
   if (N != 1 && N != 2 && N != 4)
     throw InvalidInputError("direction_field_indices: symmetry must be 1, 2 or 4, got " +
                             std::to_string(N));
-  auto found = mesh.property_map<FaceIndex, Vector3>(opt.direction_map);
+  auto found = find(mesh, opt.direction_map);
   if (!found.second)
-    throw InvalidInputError("direction_field_indices: face map '" + opt.direction_map +
+    throw InvalidInputError("direction_field_indices: face map '" + std::string(opt.direction_map.name) +
                             "' absent");
   const auto& dir = found.first;
   std::vector<int> index(mesh.num_vertices(), 0);

@@ -17,12 +17,13 @@
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
+#include "geometry/property_names.h"
 
 namespace surftex {
 
 struct FieldIndexOptions {
   int symmetry = 4;
-  std::string direction_map = "f:dir";
+  PropertyName<FaceIndex, Vector3> direction_map = kFaceDirection;
 };
 
 /// Per vertex index (by `.idx()`): N times the field index.

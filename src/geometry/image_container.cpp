@@ -19,16 +19,6 @@ namespace surftex {
 
 namespace {
 
-// The limit refusal shared by the PNG header and the OpenEXR data window.
-void check_size_claim(long long w, long long h, long long side, const std::string& where, const std::string& path,
-                      const ImageLimits& lim) {
-  if (w > side || h > side || w * h > lim.max_pixels)
-    throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) + " (" + where +
-                            "); the limit is " + std::to_string(side) + " px a side and " +
-                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
-                            " MiB decoded): pass --max-image-pixels to raise it");
-}
-
 // CRC-32 of the PNG specification (ISO/IEC 15948, annex D: polynomial
 // 0xEDB88320, reflected, initial and final value 0xFFFFFFFF).
 std::uint32_t png_crc(const unsigned char* p, std::size_t n, std::uint32_t crc = 0xFFFFFFFFu) {
@@ -67,7 +57,7 @@ void check_png_header(const unsigned char* d, std::uint32_t len, const std::stri
   if (d[10] != 0 || d[11] != 0 || d[12] > 1)
     throw IOError(what + "the PNG header's compression, filter or interlace method is unknown");
   // Our limits before libpng's own (1,000,000 px a side, refused with its own text).
-  check_size_claim(w, h, std::min(lim.max_side(), 1000000LL), "PNG header", path, lim);
+  lim.check(w, h, std::min(lim.max_side(), 1000000LL), path, "PNG header");
 }
 
 // A PNG file's chunk structure checked before libpng sees it: every chunk
@@ -318,7 +308,7 @@ void check_exr_structure(const std::string& path, const ImageLimits& lim) {
     if (w <= 0 || h <= 0)
       throw InvalidInputError("image '" + path + "' is empty (OpenEXR data window " + std::to_string(w) + "x" +
                               std::to_string(h) + ")");
-    check_size_claim(w, h, lim.max_side(), "OpenEXR data window", path, lim);
+    lim.check(w, h, lim.max_side(), path, "OpenEXR data window");
     chunks += exr_chunks(part, what);
     if (!multipart) break;
   }
@@ -401,7 +391,7 @@ void check_gif_screen(const std::string& path, const ImageLimits& lim) {
   const long long w = b[6] | (b[7] << 8), h = b[8] | (b[9] << 8);
   if (w == 0 || h == 0)
     throw IOError(what + "the GIF logical screen is " + std::to_string(w) + "x" + std::to_string(h));
-  check_size_claim(w, h, lim.max_side(), "GIF logical screen", path, lim);
+  lim.check(w, h, lim.max_side(), path, "GIF logical screen");
   if (w * h * 4 > 0x7FFFFFFFLL)
     throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) +
                             " (GIF logical screen): OpenImageIO reads at most 2^29 GIF pixels");

@@ -43,11 +43,9 @@ void check_spec(const OIIO::ImageSpec& spec, const std::string& path, const Imag
     throw InvalidInputError("image '" + path + "' has " + std::to_string(spec.nchannels) + " channels (at most " +
                             std::to_string(ImageLimits::kMaxChannels) + " are read)");
   const long long w = spec.width, h = spec.height;
-  if (w > lim.max_side() || h > lim.max_side() || w * h > lim.max_pixels)
-    throw InvalidInputError("image '" + path + "' is " + dims + " (" + std::to_string(w * h * spec.nchannels * 4 / (1 << 20)) +
-                            " MiB decoded); the limit is " + std::to_string(lim.max_side()) + " px a side and " +
-                            std::to_string(lim.max_pixels) + " pixels (" + std::to_string(lim.max_bytes() >> 20) +
-                            " MiB decoded): pass --max-image-pixels to raise it");
+  lim.check(w, h, lim.max_side(), path,
+            std::to_string(spec.nchannels) + " channels, " + std::to_string(w * h * spec.nchannels * 4 / (1 << 20)) +
+                " MiB decoded");
 }
 
 Image read_current(OIIO::ImageInput& in, const std::string& path) {

@@ -24,6 +24,11 @@ struct ImageLimits {
   long long max_bytes() const { return max_pixels * 16; }
   /// Most channels.
   static constexpr int kMaxChannels = 16;
+  /// Throws InvalidInputError naming these limits and --max-image-pixels when
+  /// a w x h image of `path` is over them. `side`: the longest side allowed
+  /// (max_side() or less); `what`: where the size comes from ("PNG header",
+  /// "3 channels, 12 MiB decoded"), said beside it.
+  void check(long long w, long long h, long long side, const std::string& path, const std::string& what) const;
 };
 
 /// The process-wide limits every read_image* call checks (the CLI sets them

@@ -8,6 +8,10 @@
 
 #include "geometry/image_io.h"
 
+#include <string>
+
+#include "geometry/errors.h"
+
 namespace surftex {
 namespace {
 ImageLimits g_limits;
@@ -16,6 +20,15 @@ ImageLimits g_limits;
 long long ImageLimits::max_side() const {
   const auto s = static_cast<long long>(std::ceil(std::sqrt(static_cast<double>(std::max(0LL, max_pixels)))));
   return std::max(16384LL, s);
+}
+
+void ImageLimits::check(long long w, long long h, long long side, const std::string& path,
+                        const std::string& what) const {
+  if (w > side || h > side || w * h > max_pixels)
+    throw InvalidInputError("image '" + path + "' is " + std::to_string(w) + "x" + std::to_string(h) + " (" + what +
+                            "); the limit is " + std::to_string(side) + " px a side and " + std::to_string(max_pixels) +
+                            " pixels (" + std::to_string(max_bytes() >> 20) +
+                            " MiB decoded): pass --max-image-pixels to raise it");
 }
 
 void set_image_limits(const ImageLimits& limits) { g_limits = limits; }

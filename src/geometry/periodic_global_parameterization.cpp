@@ -360,11 +360,11 @@ PgpCurlCorrectionOptions curl_options(const PgpOptions& o) {
 void face_gradients_into(const Mesh& mesh, const PgpOptions& o, const std::vector<FaceFrame>& frames,
                          const std::vector<char>* mask, std::vector<FaceGrad>& g,
                          PgpCurlCorrector* corrector = nullptr) {
-  auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
+  auto dir = find(mesh, o.direction_map);
   if (!dir.second)
-    throw InvalidInputError("periodic_global_parameterization: face map '" + o.direction_map +
+    throw InvalidInputError("periodic_global_parameterization: face map '" + std::string(o.direction_map.name) +
                             "' absent (interpolate a direction field first)");
-  auto scale = mesh.property_map<VertexIndex, double>(o.scale_map);
+  auto scale = find(mesh, o.scale_map);
   g.resize(mesh.num_faces());
   // Check the scale first (serially: the first bad vertex is reported).
   if (scale.second)
@@ -929,8 +929,8 @@ void PeriodicGlobalParameterization::Impl::write_corners(const std::vector<std::
   // difference is nearest to the edge's alpha_ij, which both faces of the edge
   // share: two faces whose three edge differences close (no zero of z inside)
   // then agree on their common edge exactly.
-  auto stm = mesh.add_property_map<HalfedgeIndex, STM>(opt.stm_map, STM{0, 0, 0}).first;
-  auto mat = mesh.property_map<VertexIndex, double>(opt.material_map);
+  auto stm = get_or_add(mesh, opt.stm_map, STM{0, 0, 0});
+  auto mat = find(mesh, opt.material_map);
   const std::vector<std::uint32_t>& faces = topology().faces;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t q = r.begin(); q != r.end(); ++q) {

@@ -109,6 +109,7 @@
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
+#include "geometry/property_names.h"
 
 namespace surftex {
 
@@ -180,10 +181,10 @@ struct PgpOptions {
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
-  std::string direction_map = "f:dir";
-  std::string scale_map = "v:scale";
-  std::string material_map = "v:material";
-  std::string stm_map = "h:stm";
+  PropertyName<FaceIndex, Vector3> direction_map = kFaceDirection;
+  PropertyName<VertexIndex, double> scale_map = kVertexScale;
+  PropertyName<VertexIndex, double> material_map = kVertexMaterial;
+  PropertyName<HalfedgeIndex, STM> stm_map = kCornerSTM;
 };
 
 struct PgpResult {

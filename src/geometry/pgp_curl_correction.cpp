@@ -14,6 +14,7 @@
 
 #include "geometry/direction_field_singularities.h"
 #include "geometry/errors.h"
+#include "geometry/properties.h"
 #include "geometry/mesh_util.h"
 
 namespace surftex {
@@ -127,9 +128,9 @@ PgpCurlCorrector::~PgpCurlCorrector() = default;
 PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
   Impl& im = *impl_;
   const PgpCurlCorrectionOptions& o = im.opt;
-  auto dir = mesh.property_map<FaceIndex, Vector3>(o.direction_map);
+  auto dir = find(mesh, o.direction_map);
   if (!dir.second)
-    throw InvalidInputError("pgp_curl_correction: face map '" + o.direction_map +
+    throw InvalidInputError("pgp_curl_correction: face map '" + std::string(o.direction_map.name) +
                             "' absent (interpolate a direction field first)");
   require_triangle_mesh(mesh, "pgp_curl_correction");
   const std::size_t nv = mesh.num_vertices(), nf = mesh.num_faces();
@@ -144,7 +145,7 @@ PgpCurlCorrection PgpCurlCorrector::compute(const Mesh& mesh) {
   fo.direction_map = o.direction_map;
   const std::vector<int> index = direction_field_indices(mesh, fo);
   // log S per vertex (absent map: S = 1); checked by the PGP, checked again here.
-  auto scale = mesh.property_map<VertexIndex, double>(o.scale_map);
+  auto scale = find(mesh, o.scale_map);
   std::vector<double> log_s(nv, 0.0);
   if (scale.second)
     for (VertexIndex v : mesh.vertices()) {

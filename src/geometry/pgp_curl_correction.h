@@ -83,8 +83,8 @@ struct PgpCurlCorrectionOptions {
   double stiffness = 1.0;
   /// The factor exp(phi) is clamped to [1/max_factor, max_factor] (>= 1).
   double max_factor = 2.0;
-  std::string direction_map = "f:dir";
-  std::string scale_map = "v:scale";  ///< S per vertex (absent: 1)
+  PropertyName<FaceIndex, Vector3> direction_map = kFaceDirection;
+  PropertyName<VertexIndex, double> scale_map = kVertexScale;  ///< S per vertex (absent: 1)
 };
 
 struct PgpCurlCorrection {

@@ -161,9 +161,9 @@ PgpSingularities detect_pgp_singularities(const Mesh& mesh, const PgpSingularity
                             std::to_string(opt.distortion_threshold));
   if (!(opt.mismatch_tolerance >= 0))
     throw InvalidInputError("detect_pgp_singularities: mismatch_tolerance must be >= 0");
-  auto found = mesh.property_map<HalfedgeIndex, STM>(opt.pgp.stm_map);
+  auto found = find(mesh, opt.pgp.stm_map);
   if (!found.second)
-    throw InvalidInputError("detect_pgp_singularities: corner map '" + opt.pgp.stm_map + "' absent");
+    throw InvalidInputError("detect_pgp_singularities: corner map '" + std::string(opt.pgp.stm_map.name) + "' absent");
   const StmMap& stm = found.first;
   const PgpTarget target = pgp_target(mesh, opt.pgp);
 

@@ -11,13 +11,14 @@
 
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
+#include "geometry/properties.h"
 #include "geometry/mesh_util.h"
 
 namespace surftex {
 
 ScalarFieldOptions material_field_options() {
   ScalarFieldOptions o;
-  o.value_map = "v:material";
+  o.value_map = kVertexMaterial;
   o.min_value = 0;
   o.max_value = 1;
   o.default_value = 0;
@@ -28,7 +29,7 @@ ScalarFieldOptions scale_field_options(double epsilon, double default_scale) {
   if (!(epsilon > 0))
     throw InvalidInputError("scale_field_options: epsilon must be > 0, got " + std::to_string(epsilon));
   ScalarFieldOptions o;
-  o.value_map = "v:scale";
+  o.value_map = kVertexScale;
   o.min_value = epsilon;
   o.default_value = std::max(default_scale, epsilon);
   return o;
@@ -42,7 +43,7 @@ ScalarFieldResult interpolate_scalar_field(Mesh& mesh, const std::vector<ScalarC
   const std::size_t nv = mesh.num_vertices();
   if (opt.area && opt.area->vertex_free.size() != nv)
     throw InvalidInputError("interpolate_scalar_field: effect area does not match the mesh");
-  auto val = mesh.add_property_map<VertexIndex, double>(opt.value_map, opt.default_value).first;
+  auto val = get_or_add(mesh, opt.value_map, opt.default_value);
   auto is_free = [&](VertexIndex v) { return !opt.area || opt.area->vertex_free[v.idx()]; };
 
   std::vector<char> locked(nv, 0);
@@ -54,11 +55,11 @@ ScalarFieldResult interpolate_scalar_field(Mesh& mesh, const std::vector<ScalarC
     }
   for (const ScalarConstraint& c : constraints) {
     if (c.vertex >= nv || mesh.is_removed(VertexIndex(c.vertex)))
-      throw InvalidInputError("interpolate_scalar_field(" + opt.value_map + "): constraint vertex " +
+      throw InvalidInputError("interpolate_scalar_field(" + std::string(opt.value_map.name) + "): constraint vertex " +
                               std::to_string(c.vertex) + " out of range (" + std::to_string(nv) +
                               " vertices)");
     if (!std::isfinite(c.value))
-      throw InvalidInputError("interpolate_scalar_field(" + opt.value_map +
+      throw InvalidInputError("interpolate_scalar_field(" + std::string(opt.value_map.name) +
                               "): non-finite value at vertex " + std::to_string(c.vertex));
     if (!is_free(VertexIndex(c.vertex))) continue;
     locked[c.vertex] = 1;
@@ -127,10 +128,10 @@ ScalarFieldResult interpolate_scalar_field(Mesh& mesh, const std::vector<ScalarC
     A.setFromTriplets(trip.begin(), trip.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
     if (solver.info() != Eigen::Success)
-      throw SolverError("interpolate_scalar_field(" + opt.value_map + "): factorisation failed");
+      throw SolverError("interpolate_scalar_field(" + std::string(opt.value_map.name) + "): factorisation failed");
     const Eigen::VectorXd sol = solver.solve(rhs);
     if (solver.info() != Eigen::Success)
-      throw SolverError("interpolate_scalar_field(" + opt.value_map + "): solve failed");
+      throw SolverError("interpolate_scalar_field(" + std::string(opt.value_map.name) + "): solve failed");
     for (VertexIndex v : mesh.vertices())
       if (var[v.idx()] >= 0) x[v.idx()] = sol[var[v.idx()]];
   }

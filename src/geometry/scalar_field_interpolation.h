@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
+#include "geometry/property_names.h"
 
 namespace surftex {
 
@@ -34,7 +35,7 @@ struct ScalarConstraint {
 };
 
 struct ScalarFieldOptions {
-  std::string value_map = "v:material";  ///< kVertexMaterial or kVertexScale ("v:scale")
+  PropertyName<VertexIndex, double> value_map = kVertexMaterial;  ///< or kVertexScale
   double min_value = -std::numeric_limits<double>::infinity();
   double max_value = std::numeric_limits<double>::infinity();
   double default_value = 0;

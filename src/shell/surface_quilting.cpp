@@ -15,6 +15,7 @@
 #include "geometry/disc_chart.h"
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
 #include "shell/element_clearance.h"
@@ -538,7 +539,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
   const double diag = norm3(sub3(hi, lo));
   if (!(diag > 0)) throw InvalidInputError("quilt_surface: the base mesh has a zero-size bounding box");
-  S_ = opt.relative_size * diag / std::max(swatch.length(), swatch.width());  // mesh units per swatch unit
+  S_ = surface_quilt_scale(mesh, swatch, opt.relative_size);
   c_ = opt.cell_size > 0 ? opt.cell_size : std::max(swatch.length(), swatch.width()) / 10.0;
   swatch_cells(swatch, c_, "quilt_surface", sx_, sy_);
   r_full_ = opt.subpatch_radius > 0 ? opt.subpatch_radius : std::max(1, std::min(sx_, sy_) / 4);
@@ -552,14 +553,13 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   if (l > 0) up_ = {opt.up[0] / l, opt.up[1] / l, opt.up[2] / l};
   if (opt.field == SurfaceQuiltOptions::Field::kUp && opt.smooth_field) {
     // The smooth guidance field: a 4-symmetric direction per base face interpolated from the projected up.
-    Mesh fm = mesh;  // (interpolate_direction_field writes a property map)
     DirectionFieldOptions fo;
     fo.symmetry = 4;
     fo.smoothing = opt.field_smoothing;
-    interpolate_direction_field(fm, constraints_from_constant_vector(fm, up_, opt.field_min_projection), fo);
-    auto dm = fm.property_map<FaceIndex, Vector3>(fo.direction_map).first;
+    std::vector<Vector3> dirs(mesh.num_faces(), Vector3(0, 0, 0));
+    interpolate_direction_field(mesh, constraints_from_constant_vector(mesh, up_, opt.field_min_projection), dirs, fo);
     field_dir_.resize(static_cast<std::size_t>(nf_));
-    for (FaceIndex f : fm.faces()) field_dir_[f.idx()] = {dm[f].x(), dm[f].y(), dm[f].z()};
+    for (FaceIndex f : mesh.faces()) field_dir_[f.idx()] = {dirs[f.idx()].x(), dirs[f.idx()].y(), dirs[f.idx()].z()};
   }
   // Area-weighted vertex normals of the base, for the lifted positions (finish).
   vertex_normal_.assign(b_.pts.size(), P3{0, 0, 0});
@@ -1592,6 +1592,25 @@ SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
 }
 
 }  // namespace
+
+double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relative_size) {
+  P3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (VertexIndex v : base.vertices()) {
+    const Point3& p = base.point(v);
+    const P3 q{p.x(), p.y(), p.z()};
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+  }
+  const double diag = base.is_empty() ? 0.0 : norm3(sub3(hi, lo));
+  return relative_size * diag / std::max(swatch.length(), swatch.width());
+}
+
+double surface_quilt_placements(const Mesh& base, const Swatch& swatch, double relative_size) {
+  double area = 0;
+  for (FaceIndex f : base.faces()) area += face_area(base, f);
+  const double S = surface_quilt_scale(base, swatch, relative_size);
+  const double swatch_area = swatch.length() * swatch.width() * S * S;
+  return swatch_area > 0 ? area / swatch_area : 0.0;
+}
 
 SurfaceQuiltResult quilt_surface(const Mesh& mesh, const Swatch& swatch, SurfaceQuilt& out, const SurfaceQuiltOptions& opt) {
   SurfaceQuilter q(mesh, swatch, opt);

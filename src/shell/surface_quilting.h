@@ -284,6 +284,15 @@ struct SurfaceQuiltResult {
   double seconds = 0, seconds_patch = 0, seconds_step = 0, seconds_turn = 0, seconds_finish = 0;
 };
 
+/// Mesh units per swatch unit (3.1): the swatch's longer side becomes
+/// relative_size times the diagonal of the base's bounding box (0 for a base
+/// of zero size).
+double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relative_size);
+
+/// Swatch copies needed to cover `base` at that scale: the base's area over the
+/// scaled swatch's xy area (0 when the swatch has no area).
+double surface_quilt_placements(const Mesh& base, const Swatch& swatch, double relative_size);
+
 /// Quilts `swatch` over `base`; writes `out`. See the header comment.
 SurfaceQuiltResult quilt_surface(const Mesh& base, const Swatch& swatch, SurfaceQuilt& out,
                                  const SurfaceQuiltOptions& opt = {});

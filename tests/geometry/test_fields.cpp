@@ -178,6 +178,29 @@ TEST(DirectionField, OneConstraintOnAGridGivesAConstantField) {
   }
 }
 
+// The map-free form (what the surface quilter uses on its const base mesh)
+// gives the map form's directions bit for bit and leaves the mesh untouched.
+TEST(DirectionField, TheMapFreeFormMatchesTheMapFormAndAddsNoMap) {
+  Mesh m = skinny_grid();
+  const std::vector<DirectionConstraint> c{{0, {1, 0, 0}}, {100, {0.3, 1, 0}}};
+  DirectionFieldOptions o;
+  o.smoothing = 2;
+  const Mesh& cm = m;
+  std::vector<Vector3> dirs(m.num_faces(), Vector3(0, 0, 0));
+  const auto r1 = interpolate_direction_field(cm, c, dirs, o);
+  EXPECT_FALSE(find(m, kFaceDirection).second);
+  const auto r2 = interpolate_direction_field(m, c, o);
+  EXPECT_EQ(r1.solved_faces, r2.solved_faces);
+  auto dir = find(m, kFaceDirection).first;
+  for (FaceIndex f : m.faces()) {
+    EXPECT_EQ(dirs[f.idx()].x(), dir[f].x());
+    EXPECT_EQ(dirs[f.idx()].y(), dir[f].y());
+    EXPECT_EQ(dirs[f.idx()].z(), dir[f].z());
+  }
+  std::vector<Vector3> short_list(3, Vector3(0, 0, 0));
+  EXPECT_THROW(interpolate_direction_field(cm, c, short_list, o), InvalidInputError);
+}
+
 TEST(DirectionField, LocksConstraintsAndNeverNan) {
   Mesh m = skinny_grid();
   std::vector<DirectionConstraint> c{{0, {1, 0, 0}}, {100, {0.3, 1, 0}}};

@@ -786,4 +786,21 @@ TEST(SurfaceQuilting, FieldOptionsAreChecked) {
 }
 
 }  // namespace
+// The scale of 3.1 in one place (the CLI's size check uses it too): the
+// swatch's longer side is relative_size times the base's bounding-box diagonal,
+// and the placements are the base's area over the scaled swatch's.
+TEST(SurfaceQuilting, ScaleAndPlacementsFollowTheBoundingBoxDiagonal) {
+  Mesh base;
+  make_grid(base, 4, 4, 3.0, 4.0);  // diagonal 5, area 12
+  const Swatch sw = weave_4x4(6, 6);
+  const double big = std::max(sw.length(), sw.width());
+  EXPECT_NEAR(surface_quilt_scale(base, sw, 0.2), 0.2 * 5.0 / big, 1e-12);
+  const double S = 0.2 * 5.0 / big;
+  EXPECT_NEAR(surface_quilt_placements(base, sw, 0.2), 12.0 / (sw.length() * sw.width() * S * S), 1e-9);
+  // Doubling the relative size quarters the placements; the quilt uses the same scale.
+  EXPECT_NEAR(surface_quilt_placements(base, sw, 0.4) * 4, surface_quilt_placements(base, sw, 0.2), 1e-9);
+  Mesh empty;
+  EXPECT_EQ(surface_quilt_placements(empty, sw, 0.2), 0.0);
+}
+
 }  // namespace surftex
