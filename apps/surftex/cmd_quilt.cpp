@@ -26,6 +26,7 @@
 #include "shell/element_colors.h"
 #include "shell/embed_surface_quilt.h"
 #include "shell/mesh_quilting.h"
+#include "shell/quilt_json.h"
 #include "shell/surface_quilting.h"
 #include "shell/swatch_generators.h"
 #include "surftex/demo_steps.h"
@@ -97,30 +98,6 @@ std::string lower_ext(const std::string& path) {
   std::string e = path.substr(dot);
   for (char& ch : e) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return e;
-}
-
-// The merge statistics of a quilt (planar or on a surface) into its report:
-// one writer for both branches, so that both reports carry the same keys.
-void write_stitch_stats(nlohmann::json& rep, const QuiltStepStats& st) {
-  rep["stitched"] = st.stitched;
-  rep["stitch_refused"] = st.stitch_refused;
-  rep["coincident"] = st.coincident;
-  rep["coincident_cut_added"] = st.coincident_cut_added;
-  rep["stitched_trimmed"] = st.stitched_trimmed;
-  rep["related"] = st.related;
-  rep["stitch_refused_loops"] = st.refused_loops;
-  rep["stitch_refused_border"] = st.refused_border;
-  rep["stitch_refused_geometry"] = st.refused_geometry;
-  rep["stitch_refused_infeasible"] = st.refused_infeasible;
-  rep["stitch_refused_reasons"] = st.refused_reasons;
-  rep["outputs_replaced"] = st.out_replaced;
-  rep["inputs_added"] = st.in_added;
-  rep["inputs_dropped"] = st.in_dropped;
-  rep["inputs_kept_cut"] = st.in_cut_added;
-  rep["crossing_hits"] = st.crossing_hits;  // new elements that would have passed through placed ones
-  rep["crossing_dropped"] = st.crossing_dropped;
-  rep["crossing_trimmed"] = st.crossing_trimmed;
-  rep["crossing_pushed"] = st.crossing_pushed;
 }
 
 // Mean and largest element length of a planar quilt: each element's larger
@@ -243,22 +220,13 @@ void quilt_on_plane(const QuiltArgs& a, Mesh& sm, double w, double h, Mesh& out,
   if (out.number_of_faces() == 0)
     throw InvalidInputError("quilt: no element was placed on the " + a.plane + " plane");
   color_by_element(out, a.common.seed);
+  rep.update(to_json(r));
   rep["plane"] = {w, h};
   rep["swatch_faces"] = s.mesh.tris.size();
   rep["swatch_elements"] = s.elements.size();
-  rep["elements"] = r.elements;
-  rep["faces"] = r.faces;
-  rep["vertices"] = r.vertices;
-  rep["steps"] = r.steps;
   const auto [len_mean, len_max] = element_lengths(out, std::max(s.length(), s.width()));
   rep["element_length_mean"] = len_mean;
   rep["element_length_max"] = len_max;
-  write_stitch_stats(rep, r.stats);
-  rep["seconds"] = {{"quilt", r.seconds},
-                    {"match", r.stats.seconds_match},
-                    {"correspond", r.stats.seconds_correspond},
-                    {"deform", r.stats.seconds_deform},
-                    {"merge", r.stats.seconds_merge}};
 }
 
 // Refuses a surface quilt whose output could not be held: the placements
@@ -282,72 +250,6 @@ void set_surface_quilt_options(const QuiltArgs& a, SurfaceQuiltOptions& o) {
   o.smooth_field = a.smooth_field;
   o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
-}
-
-// The figures of a surface quilt (section 3.1) and of its embedding through
-// the shell map (3.2) into the report.
-void report_surface_quilt(const SurfaceQuiltResult& r, const EmbedSurfaceQuiltResult& er,
-                          nlohmann::json& rep) {
-  rep["elements"] = r.elements;
-  rep["steps"] = r.steps;
-  rep["patches_shrunk"] = r.patches_shrunk;
-  rep["patches_transported"] = r.patches_transported;
-  rep["patches_aligned"] = r.patches_aligned;
-  rep["overlap_jump_deg"] = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
-  rep["patches_turned"] = r.patches_turned;
-  rep["elements_past_border"] = r.elements_past_border;
-  rep["elements_stretched"] = r.elements_stretched;
-  rep["edge_stretch_max"] = r.edge_stretch_max;
-  rep["crossings_resolved"] = r.crossings_resolved;
-  rep["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
-  rep["fragments_removed"] = r.fragments_removed;
-  rep["faces_refilled"] = r.faces_refilled;
-  rep["bare_fraction"] = r.bare_fraction;
-  write_stitch_stats(rep, r.stats);
-  rep["charts"] = er.atlas.num_charts;
-  rep["tets"] = er.tets;
-  rep["shell_height"] = er.shell_height;
-  rep["clamped_vertices"] = er.clamped_vertices;
-  rep["stretch_before"] = er.stretch.stretch_before;
-  rep["stretch_after"] = er.stretch.stretch_after;
-  rep["outside_vertices"] = er.embed.outside;
-  rep["elements_not_expressible"] = r.elements_not_expressible;
-  rep["elements_not_expressed"] = r.elements_not_expressed;
-  rep["elements_partial"] = r.elements_partial;
-  rep["seams_broken"] = r.seams_broken;
-  rep["z_fitted_elements"] = r.z_fitted_elements;
-  rep["outside_below"] = er.outside_below;
-  rep["outside_above"] = er.outside_above;
-  rep["outside_uv"] = er.outside_uv;
-  rep["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
-  if (er.outside_shell_measured) {
-    // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
-    rep["outside_shell"] = er.outside_shell.outside;
-    rep["outside_shell_below"] = er.outside_shell.below;
-    rep["outside_shell_above"] = er.outside_shell.above;
-    rep["outside_shell_side"] = er.outside_shell.side;
-    rep["outside_shell_max_distance"] = er.outside_shell.max_distance;
-  }
-  if (er.embed.checked) {
-    rep["self_intersections"] = er.embed.self_intersecting_pairs;
-    rep["self_intersections_within_elements"] = er.self_intersections_within;
-    rep["self_intersections_between_elements"] = er.self_intersections_between;
-  } else {
-    rep["self_intersections"] = nullptr;
-  }
-  rep["seconds"] = {{"quilt", r.seconds},
-                    {"patches", r.seconds_patch},
-                    {"match", r.stats.seconds_match},
-                    {"correspond", r.stats.seconds_correspond},
-                    {"deform", r.stats.seconds_deform},
-                    {"merge", r.stats.seconds_merge},
-                    {"resolve", r.stats.seconds_resolve},
-                    {"finish", r.seconds_finish},
-                    {"atlas", er.seconds_atlas},
-                    {"shell", er.seconds_shell},
-                    {"stretch", er.seconds_stretch},
-                    {"shell_map", er.seconds_map},
-                    {"embed", er.seconds_embed}};
 }
 
 // Surface mesh quilting (section 3.1) of the swatch over the base mesh,
@@ -381,7 +283,7 @@ void quilt_on_mesh(const QuiltArgs& a, Mesh& sm, Mesh& out, Mesh& scene, nlohman
   eo.progress = o.progress;
   const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
   color_by_element(out, a.common.seed);
-  report_surface_quilt(r, er, rep);
+  rep.update(to_json(r, er));
   rep["mesh"] = a.base;
   rep["base_faces"] = base.number_of_faces();
   rep["swatch_faces"] = s.mesh.tris.size();
