@@ -18,7 +18,7 @@
 // has no scale option (its texel follows from the patch size and
 // --patch-res): its defaults are used and the texels across it got are
 // printed. material-map needs a material tile: one per texture is made first
-// (texture/material_tile.h, one key, one layer, side = the exemplar's shorter
+// (texture/material_space/material_tile.h, one key, one layer, side = the exemplar's shorter
 // side up to 256), its time is printed apart.
 //
 // Usage: bench_fidelity [WORK_DIR] [METHODS] [SURFACES] [TEXTURES] [THREADS]
@@ -45,7 +45,7 @@
 #include <vector>
 
 #include "geometry/image_io.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 
 using namespace surftex;
 namespace fs = std::filesystem;

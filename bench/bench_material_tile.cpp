@@ -31,7 +31,7 @@
 #include "geometry/image_io.h"
 #include "geometry/timer.h"
 #include "texture/image_ops.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 #include "texture/wrap_seam_ratio.h"
 
 using namespace surftex;

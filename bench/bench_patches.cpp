@@ -36,9 +36,9 @@
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
-#include "texture/patch_atlas.h"
-#include "texture/patch_seam_ratio.h"
-#include "texture/patch_synthesis.h"
+#include "texture/patches/patch_atlas.h"
+#include "texture/patches/patch_seam_ratio.h"
+#include "texture/patches/patch_synthesis.h"
 
 using namespace surftex;
 namespace fs = std::filesystem;

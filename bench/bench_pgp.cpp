@@ -5,7 +5,7 @@
 // Best of 3 runs (wall "seconds", and "cpu_seconds" of all threads of that
 // run); one JSON line per mesh and step.
 // The first two lines per mesh ("driver_map", "driver_update") time the
-// pipeline through texture/material_mapping.h at the CLI's defaults; the
+// pipeline through texture/material_space/material_mapping.h at the CLI's defaults; the
 // step lines after them use the paper table's settings (see driver_figures).
 // Usage: bench_pgp [--no-sweep] [--no-swap [--one-system]] [mesh ...]   (default: shared data fandisk,
 // dragon_25k, armadillo_52k; --no-sweep skips the singular fraction against
@@ -227,14 +227,14 @@
 #include "geometry/mesh_util.h"
 #include "geometry/effect_area.h"
 #include "geometry/mesh.h"
-#include "geometry/periodic_global_parameterization.h"
-#include "geometry/pgp_curl_correction.h"
-#include "geometry/pgp_singularities.h"
+#include "texture/material_space/periodic_global_parameterization.h"
+#include "texture/material_space/pgp_curl_correction.h"
+#include "texture/material_space/pgp_singularities.h"
 #include "geometry/principal_curvatures.h"
 #include "geometry/read_mesh.h"
 #include "geometry/scalar_field_interpolation.h"
 #include "geometry/timer.h"
-#include "texture/material_mapping.h"
+#include "texture/material_space/material_mapping.h"
 
 using namespace surftex;
 

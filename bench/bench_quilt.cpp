@@ -60,8 +60,8 @@
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
-#include "shell/embed_surface_quilt.h"
-#include "shell/surface_quilting.h"
+#include "shell/quilting/embed_surface_quilt.h"
+#include "shell/quilting/surface_quilting.h"
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
 

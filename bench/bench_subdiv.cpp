@@ -57,11 +57,11 @@
 #include "geometry/polygon_util.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
-#include "geometry/sqrt2_subdivide.h"
+#include "texture/subdivision/sqrt2_subdivide.h"
 #include "geometry/timer.h"
-#include "geometry/turk_orientation_field.h"
-#include "texture/k_region_matching.h"
-#include "texture/subdivision_synthesis.h"
+#include "texture/subdivision/turk_orientation_field.h"
+#include "texture/subdivision/k_region_matching.h"
+#include "texture/subdivision/subdivision_synthesis.h"
 
 using namespace surftex;
 

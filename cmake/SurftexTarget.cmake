@@ -15,8 +15,12 @@ endfunction()
 # header/source pair, so adding an algorithm needs no CMake edit.
 # EXCLUDE names sources of the folder that are built elsewhere.
 function(surftex_add_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE;SUBDIRS" ${ARGN})
   file(GLOB _srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
+  foreach(_d ${ARG_SUBDIRS})  # one method's files (e.g. texture/patches/)
+    file(GLOB _sub CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/${_d}/*.cpp")
+    list(APPEND _srcs ${_sub})
+  endforeach()
   foreach(_x ${ARG_EXCLUDE})
     list(REMOVE_ITEM _srcs "${CMAKE_CURRENT_SOURCE_DIR}/${_x}")
   endforeach()

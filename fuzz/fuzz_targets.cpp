@@ -10,12 +10,12 @@
 #include "geometry/errors.h"
 #include "geometry/image.h"
 #include "geometry/image_io.h"
-#include "geometry/material_constraints.h"
+#include "texture/material_space/material_constraints.h"
 #include "geometry/mesh.h"
 #include "geometry/mesh_parsers.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/read_mesh.h"
-#include "texture/material_tile_io.h"
+#include "texture/material_space/material_tile_io.h"
 
 namespace fs = std::filesystem;
 

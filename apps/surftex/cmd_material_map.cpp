@@ -17,12 +17,12 @@
 #include "geometry/effect_area.h"
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
-#include "geometry/material_constraints.h"
+#include "texture/material_space/material_constraints.h"
 #include "geometry/mesh.h"
 #include "geometry/mesh_util.h"
 #include "geometry/output_file.h"
-#include "geometry/periodic_global_parameterization.h"
-#include "geometry/pgp_singularities.h"
+#include "texture/material_space/periodic_global_parameterization.h"
+#include "texture/material_space/pgp_singularities.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/principal_curvatures.h"
 #include "geometry/properties.h"
@@ -35,13 +35,13 @@
 #include "geometry/write_mesh.h"
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
-#include "texture/material_tile.h"
-#include "texture/material_tile_io.h"
+#include "texture/material_space/material_tile.h"
+#include "texture/material_space/material_tile_io.h"
 #include "texture/procedural_texture.h"
-#include "texture/bake_material_space.h"
-#include "texture/material_mapping.h"
+#include "texture/material_space/bake_material_space.h"
+#include "texture/material_space/material_mapping.h"
 #include "texture/pbr_maps.h"
-#include "texture/render_material_space.h"
+#include "texture/material_space/render_material_space.h"
 #include "texture/surface_fidelity.h"
 
 namespace surftex::cli {
@@ -303,7 +303,7 @@ SubcommandRegistrar reg{
            ->check(CLI::ExistingDirectory);
        app.add_option("--constraints", a->constraints,
                       "Constraints JSON (strokes, scale and material at points, effect_radius; see "
-                      "geometry/material_constraints.h). Default: none (field from --field, constant scale, m = 0)");
+                      "texture/material_space/material_constraints.h). Default: none (field from --field, constant scale, m = 0)");
        app.add_option("--update", a->update,
                       "New constraints JSON applied to the state given by --state: only the effect area "
                       "(effect_radius around them) is re-solved; the rest stays bit for bit");

@@ -9,7 +9,7 @@
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "surftex/command.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 
 namespace surftex::cli {
 namespace {

@@ -25,11 +25,11 @@
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
 #include "texture/image_ops.h"
-#include "texture/patch_atlas.h"
-#include "texture/patch_exemplar_maps.h"
+#include "texture/patches/patch_atlas.h"
+#include "texture/patches/patch_exemplar_maps.h"
 #include "texture/pbr_maps.h"
-#include "texture/patch_seam_ratio.h"
-#include "texture/patch_synthesis.h"
+#include "texture/patches/patch_seam_ratio.h"
+#include "texture/patches/patch_synthesis.h"
 #include "texture/procedural_texture.h"
 #include "texture/surface_fidelity.h"
 
@@ -114,7 +114,7 @@ struct ExemplarMaps {
 // (mesh.png, power of two, mip gutters) comes with a height map
 // (mesh_height.png, 16-bit) and a tangent-space normal map (mesh_normal.png):
 // exemplar maps resampled through the same synthesis coordinates when given
-// (texture/patch_exemplar_maps.h), else height = luminance and the normal
+// (texture/patches/patch_exemplar_maps.h), else height = luminance and the normal
 // from the height (`bump` = tilt per unit height slope, height per exemplar
 // texel: one atlas texel is one exemplar texel); roughness -> mesh_roughness.png
 // and the GLB's metallicRoughnessTexture.

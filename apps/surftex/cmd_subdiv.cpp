@@ -30,8 +30,8 @@
 #include "texture/displace_by_vertex_color.h"
 #include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
-#include "texture/subdivision_exemplar_maps.h"
-#include "texture/subdivision_synthesis.h"
+#include "texture/subdivision/subdivision_exemplar_maps.h"
+#include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/surface_fidelity.h"
 #include "texture/tangent_space_bake.h"
 
@@ -334,7 +334,7 @@ ExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
 }
 
 // The maps' values at the final vertices, where the colour was read
-// (texture/subdivision_exemplar_maps.h); `filled` counts vertices without a lookup.
+// (texture/subdivision/subdivision_exemplar_maps.h); `filled` counts vertices without a lookup.
 VertexMaps vertex_maps(const Mesh& mesh, const SubdivisionSynthesisResult& r, const ExemplarMaps& maps, int w, int h,
                        std::size_t& filled) {
   VertexMaps vm;

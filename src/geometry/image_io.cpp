@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
+
+#include <unistd.h>
 
 #include "geometry/errors.h"
 #include "geometry/file_extension.h"
@@ -16,6 +19,60 @@
 namespace surftex {
 
 namespace {
+
+// What a decoder prints on stderr itself while pixels are decoded (libpng
+// writes "libpng error: ..." before OpenImageIO reports the failure): held in
+// a temporary file, then folded into our error (a refusal stays one `error:`
+// line) or, after a successful decode, passed on to stderr unchanged.
+class StderrCapture {
+ public:
+  StderrCapture() {
+    std::fflush(stderr);
+    file_ = std::tmpfile();
+    if (file_) saved_ = dup(2);
+    if (saved_ >= 0 && dup2(fileno(file_), 2) < 0) {
+      close(saved_);
+      saved_ = -1;
+    }
+  }
+  StderrCapture(const StderrCapture&) = delete;
+  StderrCapture& operator=(const StderrCapture&) = delete;
+  ~StderrCapture() {
+    restore();
+    if (file_) std::fclose(file_);
+  }
+  /// Restores stderr and returns what was written meanwhile (at most 4 kB).
+  std::string release() {
+    restore();
+    std::string text;
+    if (!file_) return text;
+    std::rewind(file_);
+    char buf[4096];
+    text.assign(buf, std::fread(buf, 1, sizeof buf, file_));
+    return text;
+  }
+
+ private:
+  void restore() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    dup2(saved_, 2);
+    close(saved_);
+    saved_ = -1;
+  }
+  std::FILE* file_ = nullptr;
+  int saved_ = -1;
+};
+
+// OpenImageIO's reason `why` with the first line a decoder printed itself
+// added (when it says something new), for a one-line refusal.
+std::string with_printed(std::string why, std::string printed) {
+  printed.resize(std::min(printed.find('\n'), printed.size()));
+  const auto colon = printed.rfind(": ");  // "libpng error: X" says X, which OpenImageIO may say too
+  const std::string said = colon == std::string::npos ? printed : printed.substr(colon + 2);
+  if (!said.empty() && why.find(said) == std::string::npos) why += (why.empty() ? "" : "; ") + printed;
+  return why;
+}
 
 // Takes every pending OpenImageIO message (the reader's and the global
 // ones): OIIO prints those left unretrieved when the reader is destroyed, and
@@ -52,9 +109,13 @@ Image read_current(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec& spec = in.spec();
   check_spec(spec, path, image_limits());
   Image img(spec.width, spec.height, spec.nchannels);
-  if (!in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
-                     img.data.data())) {
-    std::string why = take_errors(&in);
+  StderrCapture decoder_text;
+  const bool decoded =
+      in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img.data.data());
+  const std::string printed = decoder_text.release();
+  if (decoded && !printed.empty()) std::fputs(printed.c_str(), stderr);
+  if (!decoded) {
+    const std::string why = with_printed(take_errors(&in), printed);
     in.close();
     (void)take_errors(&in);
     throw IOError("cannot decode image '" + path + "' (truncated or corrupt): " + why);
@@ -77,8 +138,12 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const Imag
   check_image_container(path, format, lim);
   auto in = OIIO::ImageInput::create(format);
   OIIO::ImageSpec spec;
-  if (!in || !in->open(path, spec)) {
-    const std::string why = take_errors(in.get());
+  StderrCapture decoder_text;
+  const bool opened = in && in->open(path, spec);
+  const std::string printed = decoder_text.release();
+  if (opened && !printed.empty()) std::fputs(printed.c_str(), stderr);
+  if (!opened) {
+    const std::string why = with_printed(take_errors(in.get()), printed);
     throw IOError("cannot read image '" + path + "' as " + format + (why.empty() ? "" : ": " + why));
   }
   (void)take_errors(in.get());  // warnings of a header that opened

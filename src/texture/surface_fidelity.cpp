@@ -21,7 +21,7 @@
 #include "geometry/vec3.h"
 #include "texture/graphcut_synthesis.h"
 #include "texture/image_ops.h"
-#include "texture/material_tile_io.h"
+#include "texture/material_space/material_tile_io.h"
 
 namespace surftex {
 namespace {

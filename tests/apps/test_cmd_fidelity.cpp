@@ -13,7 +13,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/write_mesh.h"
 #include "test_support.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 
 using namespace surftex;
 namespace fs = std::filesystem;

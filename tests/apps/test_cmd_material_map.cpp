@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "geometry/effect_area.h"
-#include "geometry/material_constraints.h"
+#include "texture/material_space/material_constraints.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/read_mesh.h"
@@ -17,7 +17,7 @@
 #include "apps/asset_checks.h"
 #include "geometry/image_io.h"
 #include "test_support.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 
 using namespace surftex;
 

@@ -18,7 +18,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "shell/embed_outside_shell.h"
-#include "shell/embed_surface_quilt.h"
+#include "shell/quilting/embed_surface_quilt.h"
 #include "shell/shell_map.h"
 #include "shell/shell_space.h"
 #include "shell/shell_stretch.h"

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The quilt report's figures come from the results' to_json (shell/quilt_json.h).
+// The quilt report's figures come from the results' to_json (shell/quilting/quilt_json.h).
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
-#include "shell/quilt_json.h"
+#include "shell/quilting/quilt_json.h"
 
 namespace surftex {
 namespace {

@@ -19,11 +19,11 @@
 #include "geometry/read_mesh.h"
 #include "geometry/render_mesh.h"
 #include "test_support.h"
-#include "texture/bake_material_space.h"
-#include "texture/material_mapping.h"
+#include "texture/material_space/bake_material_space.h"
+#include "texture/material_space/material_mapping.h"
 #include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
-#include "texture/render_material_space.h"
+#include "texture/material_space/render_material_space.h"
 
 namespace surftex {
 namespace {

@@ -13,8 +13,8 @@
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "test_support.h"
-#include "texture/constrained_tile_synthesis.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/constrained_tile_synthesis.h"
+#include "texture/material_space/material_tile.h"
 #include "texture/procedural_texture.h"
 #include "texture/wrap_seam_ratio.h"
 

@@ -10,8 +10,8 @@
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "test_support.h"
-#include "texture/material_tile.h"
-#include "texture/material_tile_io.h"
+#include "texture/material_space/material_tile.h"
+#include "texture/material_space/material_tile_io.h"
 
 namespace surftex {
 namespace {

@@ -14,9 +14,9 @@
 #include "geometry/mesh_util.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "texture/patch_atlas.h"
-#include "texture/patch_seam_ratio.h"
-#include "texture/patch_synthesis.h"
+#include "texture/patches/patch_atlas.h"
+#include "texture/patches/patch_seam_ratio.h"
+#include "texture/patches/patch_synthesis.h"
 #include "texture/procedural_texture.h"
 
 namespace surftex {

@@ -8,14 +8,14 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
-#include "geometry/periodic_global_parameterization.h"
-#include "geometry/pgp_singularities.h"
+#include "texture/material_space/periodic_global_parameterization.h"
+#include "texture/material_space/pgp_singularities.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "geometry/rasterizer.h"
 #include "geometry/render_mesh.h"
-#include "texture/material_tile_io.h"
-#include "texture/render_material_space.h"
+#include "texture/material_space/material_tile_io.h"
+#include "texture/material_space/render_material_space.h"
 
 namespace surftex {
 namespace {

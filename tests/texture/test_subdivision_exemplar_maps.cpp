@@ -14,8 +14,8 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "texture/procedural_texture.h"
-#include "texture/subdivision_exemplar_maps.h"
-#include "texture/subdivision_synthesis.h"
+#include "texture/subdivision/subdivision_exemplar_maps.h"
+#include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/tangent_space_bake.h"
 
 using namespace surftex;

@@ -14,12 +14,12 @@
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "geometry/turk_orientation_field.h"
+#include "texture/subdivision/turk_orientation_field.h"
 #include "texture/displace_by_vertex_color.h"
-#include "texture/graph_cut_transfer.h"
-#include "texture/k_region_matching.h"
+#include "texture/subdivision/graph_cut_transfer.h"
+#include "texture/subdivision/k_region_matching.h"
 #include "texture/procedural_texture.h"
-#include "texture/subdivision_synthesis.h"
+#include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/wrap_seam_ratio.h"
 
 using namespace surftex;

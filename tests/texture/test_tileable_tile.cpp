@@ -13,7 +13,7 @@
 #include "test_support.h"
 #include "texture/graphcut_synthesis.h"
 #include "texture/image_ops.h"
-#include "texture/material_tile.h"
+#include "texture/material_space/material_tile.h"
 #include "texture/tileable_tile.h"
 #include "texture/wrap_seam_ratio.h"
 

@@ -1,0 +1,313 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/quilting/embed_surface_quilt.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/self_intersections.h"
+#include "shell/element_clearance.h"
+#include "geometry/timer.h"
+#include "shell/element_mesh.h"
+#include "shell/shell_map.h"
+#include "shell/shell_space.h"
+
+namespace surftex {
+
+namespace {
+// EmbedSurfaceQuiltOptions::resolve_crossings: the face pairs of the embedded
+// mesh that intersect (exact); of two elements the later yields its faces,
+// an element crossing itself both; a compact element with such faces is
+// removed, another has them (and one ring) cut out and its pieces capped
+// (trim_and_cap). `out` is rebuilt.
+void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact,
+                                std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+  std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
+  for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
+  auto element_of = [&](std::uint32_t f) {
+    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
+  };
+  std::vector<std::vector<char>> bad(els.size());
+  auto mark = [&](std::size_t e, std::uint32_t f) {
+    if (bad[e].empty()) bad[e].assign(els[e].tris.size(), 0);
+    bad[e][f - first[e]] = 1;
+  };
+  for (const FacePair& p : pairs) {
+    const std::size_t a = element_of(p[0]), b = element_of(p[1]);
+    if (a == b) {
+      mark(a, p[0]);
+      mark(a, p[1]);
+    } else {
+      mark(std::max(a, b), a > b ? p[0] : p[1]);
+    }
+  }
+  std::vector<ElementMesh> kept;
+  std::vector<char> kept_compact;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const bool c = e < compact.size() && compact[e];
+    if (bad[e].empty()) {
+      kept.push_back(std::move(els[e]));
+      kept_compact.push_back(c);
+      continue;
+    }
+    ++res.crossing_elements;
+    if (c) continue;
+    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
+      kept.push_back(std::move(piece));
+      kept_compact.push_back(0);
+    }
+  }
+  els.swap(kept);
+  compact.swap(kept_compact);
+  mesh_from_elements(els, out);
+}
+
+/// The shell space of Zhou et al. 2006 s.3.1 over the charted base mesh, of
+/// absolute height h; its counts into `res`.
+ShellSpace build_quilt_shell(const Mesh& atlas_mesh, double h, EmbedSurfaceQuiltResult& res) {
+  ShellSpaceOptions so;
+  so.height = h;
+  so.relative_height = false;
+  ShellSpace shell = build_shell_space(atlas_mesh, so);
+  res.tets = shell.tets.size();
+  res.clamped_vertices = shell.clamped_vertices;
+  res.shell_height = shell.height;
+  return shell;
+}
+
+/// The atlas's corner UVs per base face (as surface_quilt_to_texture), after
+/// checking that every quilt vertex lies on a base face and that the shell
+/// has three tets per face. Throws InvalidInputError otherwise.
+std::vector<std::array<UV, 3>> face_corner_uvs(const Mesh& atlas_mesh, const SurfaceQuilt& quilt,
+                                               const ShellSpace& shell) {
+  auto [uv, has_uv] = atlas_mesh.property_map<HalfedgeIndex, UV>(kCornerUV.name);
+  if (!has_uv) throw InvalidInputError("embed_surface_quilt: the atlas wrote no kCornerUV");
+  const std::size_t nf = atlas_mesh.number_of_faces();
+  std::vector<std::array<UV, 3>> face_uv(nf);
+  for (FaceIndex f : atlas_mesh.faces()) {
+    int k = 0;
+    for (HalfedgeIndex hh : atlas_mesh.halfedges_around_face(atlas_mesh.halfedge(f)))
+      if (k < 3) face_uv[f.idx()][static_cast<std::size_t>(k++)] = uv[hh];
+  }
+  for (const SurfaceQuiltVertex& v : quilt.vertices)
+    if (v.face < 0 || static_cast<std::size_t>(v.face) >= nf)
+      throw InvalidInputError("embed_surface_quilt: quilt vertex on face " + std::to_string(v.face) + " (base has " +
+                              std::to_string(nf) + " faces)");
+  // Tets 3f .. 3f+2 are the prism of base face f (build_shell_space order).
+  if (shell.tets.size() != 3 * nf) throw InvalidInputError("embed_surface_quilt: unexpected shell layout");
+  return face_uv;
+}
+
+/// Where the quilt's vertices went: world positions, and per vertex whether
+/// it fell outside the texture space or had its location clamped (by how much).
+struct QuiltVertexMapping {
+  std::vector<Vec3> pos;
+  std::vector<char> outside, clamped;
+  std::vector<double> most_negative;
+};
+
+/// The vertex lies on its face: quilt_surface settles locations up to a
+/// small negative tolerance, and on a chart-border edge such a (u, v) would
+/// fall into the atlas gap beside the chart. Clamps the barycentrics `b` onto
+/// the face; returns whether it had to (and the most negative one before).
+bool clamp_onto_face(std::array<double, 3>& b, double& most_negative) {
+  if (!(std::min({b[0], b[1], b[2]}) < 0)) return false;
+  most_negative = std::min({b[0], b[1], b[2]});
+  for (double& x : b) x = std::max(0.0, x);
+  const double sum = b[0] + b[1] + b[2];
+  if (sum > 0)
+    for (double& x : b) x /= sum;
+  else
+    b = {1.0 / 3, 1.0 / 3, 1.0 / 3};
+  return true;
+}
+
+/// Outside the chart's texture space (w beyond [0,1] after deformation; with
+/// w in [0, 1] only if the chart's tets stopped tiling it): the affine map of
+/// the vertex's own prism tet (base face `face`) with the largest smallest
+/// barycentric coordinate, extrapolated. Local by construction: a global
+/// nearest-tet search can pick a tet of another chart (long spikes).
+Vec3 extrapolate_from_prism(const ShellSpace& shell, const Vec3& uvw, int face) {
+  const Vec3 x{uvw[0], uvw[1], uvw[2] * shell.w_scale};
+  double best = -1e300;
+  std::array<double, 4> bb{1, 0, 0, 0};
+  int bt = 3 * face;
+  for (int k = 0; k < 3; ++k) {
+    const Tet& tt = shell.tets[static_cast<std::size_t>(3 * face + k)];
+    const Vec3 p0 = shell.texture_metric(tt[0]), p1 = shell.texture_metric(tt[1]), p2 = shell.texture_metric(tt[2]),
+               p3 = shell.texture_metric(tt[3]);
+    const double vol = tet_signed_volume(p0, p1, p2, p3);
+    if (!(vol > 0)) continue;
+    const std::array<double, 4> w{tet_signed_volume(x, p1, p2, p3) / vol, tet_signed_volume(p0, x, p2, p3) / vol,
+                                  tet_signed_volume(p0, p1, x, p3) / vol, tet_signed_volume(p0, p1, p2, x) / vol};
+    const double m = std::min({w[0], w[1], w[2], w[3]});
+    if (m > best) best = m, bb = w, bt = 3 * face + k;
+  }
+  const Tet& tt = shell.tets[static_cast<std::size_t>(bt)];
+  Vec3 q{0, 0, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < 3; ++d) q[static_cast<std::size_t>(d)] += bb[static_cast<std::size_t>(k)] * shell.shell_points[static_cast<std::size_t>(tt[static_cast<std::size_t>(k)])][static_cast<std::size_t>(d)];
+  return q;
+}
+
+/// Zhou et al. 2006 s.3.2: every quilt vertex through the shell map, from
+/// its texture coordinates (u, v from the face's corner UVs, w from its
+/// height), in parallel (each vertex on its own).
+QuiltVertexMapping map_quilt_vertices(const SurfaceQuilt& quilt, const ShellSpace& shell, const ShellMap& map,
+                                      const std::vector<std::array<UV, 3>>& face_uv) {
+  const std::size_t nv = quilt.vertices.size();
+  const double dz = quilt.z_max - quilt.z_min;
+  QuiltVertexMapping vm;
+  vm.pos.resize(nv);
+  vm.outside.assign(nv, 0);
+  vm.clamped.assign(nv, 0);
+  vm.most_negative.assign(nv, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv), [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
+      const SurfaceQuiltVertex& v = quilt.vertices[i];
+      const auto& c = face_uv[static_cast<std::size_t>(v.face)];
+      std::array<double, 3> b{1 - v.b1 - v.b2, v.b1, v.b2};
+      if (clamp_onto_face(b, vm.most_negative[i])) vm.clamped[i] = 1;
+      const Vec3 uvw{b[0] * c[0][0] + b[1] * c[1][0] + b[2] * c[2][0], b[0] * c[0][1] + b[1] * c[1][1] + b[2] * c[2][1],
+                     (v.z - quilt.z_min) / dz};
+      // Section 3.2 maps a point through the tet that contains it; where the
+      // stretch minimisation moved the offset vertices that tet may belong to
+      // a neighbouring prism of the same chart: walk there from the own prism.
+      const ShellMap::Location loc = map.locate_texture_from(uvw, 3 * v.face);
+      if (loc.inside) {
+        vm.pos[i] = map.shell_point(loc);
+        continue;
+      }
+      vm.outside[i] = 1;
+      vm.pos[i] = extrapolate_from_prism(shell, uvw, v.face);
+    }
+  });
+  return vm;
+}
+
+/// The quilt's elements as meshes of the mapped positions (each element's
+/// vertices numbered in order of first use).
+std::vector<ElementMesh> quilt_elements(const SurfaceQuilt& quilt, const std::vector<Vec3>& pos) {
+  std::vector<ElementMesh> els(static_cast<std::size_t>(quilt.elements));
+  std::vector<int> local(quilt.vertices.size(), -1);
+  for (std::size_t f = 0; f < quilt.tris.size(); ++f) {
+    ElementMesh& m = els[static_cast<std::size_t>(quilt.tri_element[f])];
+    Tri tri;
+    for (int k = 0; k < 3; ++k) {
+      const int v = quilt.tris[f][static_cast<std::size_t>(k)];
+      if (local[static_cast<std::size_t>(v)] < 0) {
+        local[static_cast<std::size_t>(v)] = static_cast<int>(m.points.size());
+        m.points.push_back(pos[static_cast<std::size_t>(v)]);
+      }
+      tri[static_cast<std::size_t>(k)] = local[static_cast<std::size_t>(v)];
+    }
+    m.tris.push_back(tri);
+  }
+  return els;
+}
+
+/// Counts the clamped locations and the vertices mapped outside the texture
+/// space (below, above, or beside it in u, v).
+void count_mapping(const SurfaceQuilt& quilt, const QuiltVertexMapping& vm, EmbedSurfaceQuiltResult& res) {
+  const std::size_t nv = quilt.vertices.size();
+  const double dz = quilt.z_max - quilt.z_min;
+  res.embed.vertices = nv;
+  for (std::size_t i = 0; i < nv; ++i)
+    if (vm.clamped[i]) ++res.locations_clamped, res.most_negative_barycentric = std::min(res.most_negative_barycentric, vm.most_negative[i]);
+  for (std::size_t i = 0; i < nv; ++i) {
+    if (!vm.outside[i]) continue;
+    ++res.embed.outside;
+    const double w = (quilt.vertices[i].z - quilt.z_min) / dz;
+    if (w < 0)
+      ++res.outside_below;
+    else if (w > 1)
+      ++res.outside_above;
+    else
+      ++res.outside_uv;
+  }
+}
+
+/// Resolution rounds when asked (a cut piece's cap may meet another element),
+/// each reusing the exact check that the count reports; then the
+/// self-intersecting face pairs counted, within and between elements.
+void resolve_and_count_crossings(const SurfaceQuilt& quilt, const EmbedSurfaceQuiltOptions& opt,
+                                 std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+  std::vector<FacePair> pairs;
+  bool checked = false;
+  if (opt.resolve_crossings) {
+    std::vector<char> compact = quilt.element_compact;
+    for (int round = 0; round < 3; ++round) {
+      pairs = self_intersecting_faces(out);
+      checked = true;
+      if (pairs.empty()) break;
+      resolve_embedded_crossings(pairs, compact, els, out, res);
+      checked = false;
+    }
+  }
+  if (opt.check_self_intersections) {
+    if (!checked) pairs = self_intersecting_faces(out);
+    auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+    for (const FacePair& fp : pairs) {
+      if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])
+        ++res.self_intersections_within;
+      else
+        ++res.self_intersections_between;
+    }
+    res.embed.self_intersecting_pairs = pairs.size();
+    res.embed.checked = true;
+  }
+}
+}  // namespace
+
+/// Zhou et al. 2006 s.3: the base mesh charted, its shell space built and
+/// its shell map's stretch minimised; the quilt's vertices mapped through
+/// it, its elements assembled, their crossings resolved and counted.
+EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt& quilt, Mesh& out,
+                                            const EmbedSurfaceQuiltOptions& opt) {
+  if (!(opt.shell_height > 0) || !std::isfinite(opt.shell_height))
+    throw InvalidInputError("embed_surface_quilt: shell_height must be > 0 (" + std::to_string(opt.shell_height) + ")");
+  const double h = opt.shell_height * (quilt.z_max - quilt.z_min) * quilt.scale;
+  if (!(h > 0)) throw InvalidInputError("embed_surface_quilt: the quilt has zero height or scale");
+  EmbedSurfaceQuiltResult res;
+  Timer t;
+  Mesh atlas_mesh = base;
+  report_progress(opt.progress, "atlas", 0.0);
+  res.atlas = compute_base_mesh_atlas(atlas_mesh, opt.atlas);
+  res.seconds_atlas = t.seconds();
+  t.reset();
+  report_progress(opt.progress, "shell", 0.0);
+  ShellSpace shell = build_quilt_shell(atlas_mesh, h, res);
+  res.seconds_shell = t.seconds();
+  t.reset();
+  report_progress(opt.progress, "stretch", 0.0);
+  res.stretch = shell_map_minimize_stretch(shell, opt.stretch);
+  res.seconds_stretch = t.seconds();
+  t.reset();
+  report_progress(opt.progress, "embed", 0.0);
+  const ShellMap map(shell);
+  res.seconds_map = t.seconds();
+  t.reset();
+  const std::vector<std::array<UV, 3>> face_uv = face_corner_uvs(atlas_mesh, quilt, shell);
+  const QuiltVertexMapping vm = map_quilt_vertices(quilt, shell, map, face_uv);
+  // Elements as meshes (kFaceElement = element id).
+  std::vector<ElementMesh> els = quilt_elements(quilt, vm.pos);
+  mesh_from_elements(els, out);
+  if (opt.measure_outside_shell) {
+    res.outside_shell = measure_outside_shell(vm.pos, shell, map, opt.outside_shell);
+    res.outside_shell_measured = true;
+  }
+  count_mapping(quilt, vm, res);
+  resolve_and_count_crossings(quilt, opt, els, out, res);
+  res.seconds_embed = t.seconds();
+  report_progress(opt.progress, "embed", 1.0);
+  return res;
+}
+
+}  // namespace surftex

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/quilting/quilt_json.h"
+
+#include <nlohmann/json.hpp>
+
+namespace surftex {
+
+nlohmann::json to_json(const QuiltStepStats& st) {
+  return {{"stitched", st.stitched},
+          {"stitch_refused", st.stitch_refused},
+          {"coincident", st.coincident},
+          {"coincident_cut_added", st.coincident_cut_added},
+          {"stitched_trimmed", st.stitched_trimmed},
+          {"related", st.related},
+          {"stitch_refused_loops", st.refused_loops},
+          {"stitch_refused_border", st.refused_border},
+          {"stitch_refused_geometry", st.refused_geometry},
+          {"stitch_refused_infeasible", st.refused_infeasible},
+          {"stitch_refused_reasons", st.refused_reasons},
+          {"outputs_replaced", st.out_replaced},
+          {"inputs_added", st.in_added},
+          {"inputs_dropped", st.in_dropped},
+          {"inputs_kept_cut", st.in_cut_added},
+          {"crossing_hits", st.crossing_hits},  // new elements that would have passed through placed ones
+          {"crossing_dropped", st.crossing_dropped},
+          {"crossing_trimmed", st.crossing_trimmed},
+          {"crossing_pushed", st.crossing_pushed}};
+}
+
+nlohmann::json to_json(const QuiltResult& r) {
+  nlohmann::json j = to_json(r.stats);
+  j["elements"] = r.elements;
+  j["faces"] = r.faces;
+  j["vertices"] = r.vertices;
+  j["steps"] = r.steps;
+  j["seconds"] = {{"quilt", r.seconds},
+                  {"match", r.stats.seconds_match},
+                  {"correspond", r.stats.seconds_correspond},
+                  {"deform", r.stats.seconds_deform},
+                  {"merge", r.stats.seconds_merge}};
+  return j;
+}
+
+namespace {
+
+// Placement and element quality of the surface quilt (3.1).
+void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
+  j["elements"] = r.elements;
+  j["steps"] = r.steps;
+  j["patches_shrunk"] = r.patches_shrunk;
+  j["patches_transported"] = r.patches_transported;
+  j["patches_aligned"] = r.patches_aligned;
+  j["overlap_jump_deg"] = r.overlap_area > 0 ? r.overlap_turn_sum / r.overlap_area : 0.0;
+  j["patches_turned"] = r.patches_turned;
+  j["elements_past_border"] = r.elements_past_border;
+  j["elements_stretched"] = r.elements_stretched;
+  j["edge_stretch_max"] = r.edge_stretch_max;
+  j["crossings_resolved"] = r.crossings_resolved;
+  j["fragments_removed"] = r.fragments_removed;
+  j["faces_refilled"] = r.faces_refilled;
+  j["bare_fraction"] = r.bare_fraction;
+  j["elements_not_expressible"] = r.elements_not_expressible;
+  j["elements_not_expressed"] = r.elements_not_expressed;
+  j["elements_partial"] = r.elements_partial;
+  j["seams_broken"] = r.seams_broken;
+  j["z_fitted_elements"] = r.z_fitted_elements;
+}
+
+// The embedding through the shell map (3.2): the shell, its stretch and what
+// ended outside it.
+void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
+  j["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
+  j["charts"] = er.atlas.num_charts;
+  j["tets"] = er.tets;
+  j["shell_height"] = er.shell_height;
+  j["clamped_vertices"] = er.clamped_vertices;
+  j["stretch_before"] = er.stretch.stretch_before;
+  j["stretch_after"] = er.stretch.stretch_after;
+  j["outside_vertices"] = er.embed.outside;
+  j["outside_below"] = er.outside_below;
+  j["outside_above"] = er.outside_above;
+  j["outside_uv"] = er.outside_uv;
+  j["locations_clamped"] = er.locations_clamped;  // quilt vertices clamped onto their base face
+  if (er.outside_shell_measured) {
+    // Vertices outside the union of the shell's 3D tets (distance > 1e-6 shell heights).
+    j["outside_shell"] = er.outside_shell.outside;
+    j["outside_shell_below"] = er.outside_shell.below;
+    j["outside_shell_above"] = er.outside_shell.above;
+    j["outside_shell_side"] = er.outside_shell.side;
+    j["outside_shell_max_distance"] = er.outside_shell.max_distance;
+  }
+  if (er.embed.checked) {
+    j["self_intersections"] = er.embed.self_intersecting_pairs;
+    j["self_intersections_within_elements"] = er.self_intersections_within;
+    j["self_intersections_between_elements"] = er.self_intersections_between;
+  } else {
+    j["self_intersections"] = nullptr;
+  }
+}
+
+}  // namespace
+
+nlohmann::json to_json(const SurfaceQuiltResult& r, const EmbedSurfaceQuiltResult& er) {
+  nlohmann::json j = to_json(r.stats);
+  add_placement(r, j);
+  add_embedding(er, j);
+  j["seconds"] = {{"quilt", r.seconds},
+                  {"patches", r.seconds_patch},
+                  {"match", r.stats.seconds_match},
+                  {"correspond", r.stats.seconds_correspond},
+                  {"deform", r.stats.seconds_deform},
+                  {"merge", r.stats.seconds_merge},
+                  {"resolve", r.stats.seconds_resolve},
+                  {"finish", r.seconds_finish},
+                  {"atlas", er.seconds_atlas},
+                  {"shell", er.seconds_shell},
+                  {"stretch", er.seconds_stretch},
+                  {"shell_map", er.seconds_map},
+                  {"embed", er.seconds_embed}};
+  return j;
+}
+
+}  // namespace surftex

@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Bakes a material-space mapping (Ray et al. 2009, sections 2-3) into a
+// standard UV atlas, so that any viewer shows what surftex's own
+// singularity-fixed render shows: every atlas texel covered by a face holds
+// the (s,t,m) lookup of the 3D tile at that point, with section 3's fix (a
+// point of a singular face is looked up three times, in the 1-ring charts of
+// the face's three vertices, and the three colours are blended by its
+// barycentrics) and the material blend of the tile (linear between the two
+// layers nearest to m, texture/material_space/material_tile_io.h).
+//
+// Steps: multi-chart atlas of the mesh (geometry/base_mesh_atlas.h, charts
+// spaced for the mip gutter), texel rasterisation of every face in uv space
+// (geometry/uv_raster.h, one texel band around each chart), the lookups, and
+// the gutter: every chart dilated by 2^K texels for the K mip levels down to
+// `min_mip_size`, background filled by the dilation (geometry/atlas_gutter.h).
+// The tile's map layers go through the very same lookups (Ray et al.: "this
+// can be also applied to additional attributes, such as normal maps"), for
+// the PBR set (texture/pbr_maps.h): height (the tile's height layers, else
+// its luminance), roughness, and the normal. A tile normal is tangent-space
+// in the tile's frame (+x = +s, +y = up in the tile image = -t); per lookup
+// it becomes the object-space normal x S + y U + z N, with N the
+// interpolated vertex normal (kVertexNormal, else area-weighted as the mesh
+// writers compute it), S the surface direction of increasing s (dP/ds of the
+// lookup's chart on the face) made orthogonal to N and U that of decreasing t
+// made orthogonal to N and S; a singular face's three lookups are blended by
+// the barycentrics and renormalised, as the colour.
+//
+// Reads the singularities' charts (computed on this mesh), writes kCornerUV
+// (atlas uv) and kFacePatch (chart id). Throws InvalidInputError (size not in
+// 64..8192, min_mip_size < 1, singularities of another mesh, non-triangle
+// face), plus what the atlas throws.
+
+#include <vector>
+
+#include "geometry/image.h"
+#include "geometry/mesh_fwd.h"
+#include "texture/material_space/pgp_singularities.h"
+#include "texture/material_space/material_tile_io.h"
+
+namespace surftex {
+
+struct MaterialBakeOptions {
+  int size = 2048;          ///< atlas width = height, texels, 64..8192 (default 2048)
+  int min_mip_size = 64;    ///< smallest mip level kept free of bleeding, >= 1 (default 64)
+  bool fix_singularities = true;  ///< section 3's three lookups (false = plain lookups)
+};
+
+struct MaterialBakeResult {
+  Image color;               ///< size x size x 3, linear RGB
+  Image height;              ///< size x size x 1, [0,1]: the tile's height layers, else its luminance
+  bool height_from_tile = false;  ///< height from the tile's height layers
+  Image roughness;           ///< size x size x 1, [0,1], from the tile's roughness layers (else empty)
+  /// size x size x 3, the unit object-space normal (not encoded) on the
+  /// rasterised texels (raster triangle >= 0), 0 elsewhere (not dilated),
+  /// from the tile's normal layers (else empty).
+  Image object_normal;
+  std::vector<int> chart;    ///< per texel before dilation: chart id, -1 = gutter/background
+  std::vector<int> owner;    ///< per texel after dilation: the chart it belongs to
+  int charts = 0;
+  int gutter = 0;            ///< texels: 2^K, or less for many small charts (geometry/gutter_atlas.h)
+  int protected_mip_size = 0;  ///< smallest mip side kept free of bleeding
+  double margin = 0;         ///< atlas chart spacing used (fraction of the side)
+  std::size_t gutter_violations = 0;  ///< texels within `gutter` of a chart not owned by it (0 wanted)
+  double coverage = 0;       ///< fraction of texels covered by charts
+  double texels_per_length = 0;  ///< atlas texels per mesh unit
+  double seconds_atlas = 0, seconds_lookup = 0, seconds_gutter = 0;
+};
+
+MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile,
+                                       const MaterialBakeOptions& options = {});
+
+/// The tangent-space normal map (3 channels, (n + 1) / 2) a glTF viewer needs
+/// to show `bake.object_normal` on the GLB that write_mesh writes of the baked
+/// `mesh` (its kCornerUV, kFacePatch, normals): per texel n_ts = (n.T, n.B,
+/// n.N) in the frame texture/tangent_space_bake.h rebuilds from the file's
+/// NORMAL and TANGENT, normalised; gutters filled by dilating the charts'
+/// values. Throws InvalidInputError if the bake has no object normals.
+Image material_space_tangent_normals(const Mesh& mesh, const MaterialBakeResult& bake);
+
+/// The colour of the mapping at barycentrics `bary` of `face` (what the
+/// fixed render shows): one lookup, or three blended on a singular face.
+Vec3f material_space_color(const PgpSingularities& sing, const MaterialTile& tile, std::uint32_t face,
+                           const std::array<double, 3>& bary, bool fix_singularities = true);
+
+}  // namespace surftex

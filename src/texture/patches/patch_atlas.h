@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Texture atlas of patch images and per-corner UVs into it (Gorla et al. 2003,
+// 3.2 / 4.1: the paper stores one texture per patch and names an atlas "as in
+// lapped textures" as the alternative; we pack one atlas so that the result
+// opens as a standard textured OBJ/glTF).
+//
+// Every patch's chart (the bounding box of its Inside and Boundary pixels in
+// its res x res raster, flatten_patch.h) is shelf-packed, tallest first, with
+// 2 g + 1 texels between charts and g from the border, g = the mip gutter of
+// geometry/atlas_gutter.h for the atlas side (2^K texels for the K halvings
+// down to `min_mip_size`). The atlas is square, by default the smallest power
+// of two whose gutter lets every chart fit; when even `max_size` cannot (the
+// gutter grows with the side), it is `max_size` with the largest
+// power-of-two gutter that fits (`gutter` and `protected_mip_size` say which
+// levels stay clean). One atlas texel is one patch texel (no resampling).
+// Inside and Boundary pixels (Boundary pixels hold the neighbour's texture,
+// patch_synthesis.h step 7) are the charts; every other texel is filled by
+// dilating them (geometry/atlas_gutter.h: each patch's gutter from its own
+// colours, no background). UV of a corner: its flat (u, v) -> patch pixel ->
+// atlas pixel -> (x / W, 1 - y / H) (v up, as write_mesh and the rasterizer
+// expect).
+//
+// Writes kCornerUV (h:uv) for every face corner. Throws InvalidInputError if
+// images and patches disagree in number or size, or options are out of range.
+
+#include <array>
+#include <vector>
+
+#include "texture/patches/flatten_patch.h"
+#include "geometry/image.h"
+#include "geometry/mesh_fwd.h"
+
+namespace surftex {
+
+struct PatchAtlasOptions {
+  int min_mip_size = 64;     ///< smallest mip level kept free of bleeding, >= 1 (default 64)
+  bool power_of_two = true;  ///< square power-of-two side (default); false = just the grid
+  int max_size = 4096;       ///< largest side, 64..16384 (default 4096: 192 MiB of float RGB)
+};
+
+struct PatchAtlas {
+  Image image;
+  int gutter = 0;              ///< texels of gutter around every chart
+  int protected_mip_size = 0;  ///< smallest mip side whose texels stay inside one patch's gutter
+  std::vector<std::array<int, 2>> offset;  ///< per patch: atlas pixel of its raster's pixel (0, 0)
+  std::vector<int> chart;      ///< per texel: patch of an Inside/Boundary pixel, -1 = other
+  std::vector<int> owner;      ///< per texel after dilation
+};
+
+PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::vector<Image>& images,
+                            const PatchAtlasOptions& options = {});
+
+}  // namespace surftex

@@ -1,0 +1,283 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// Texture synthesis on surfaces by graph matching over a sqrt(2)-subdivision
+// hierarchy (Bangay & Morkel 2006, sections 3 and 4): the whole pipeline.
+//
+// 1. Scale (3.3.2), chosen from the inputs (choose_subdivision_scale): the
+//    texture size is given as exemplar widths across the object (`repeats`,
+//    the default: 3 across the longest bounding-box side), as exemplar texels
+//    per mean edge of the input (`texels_per_edge`) or as the paper's r_scale
+//    (texels per object unit; with normalize_units, default, one object unit
+//    is the longest bounding-box side, so r_scale means "texels across the
+//    object" whatever the file's units). The number of uniform levels is the
+//    fewest whose vertex spacing (sqrt(area / faces) of the final quads) is
+//    at most one texel; if that needs more than max_vertices vertices, the
+//    deepest level within the budget is used and the exemplar is reduced so
+//    that one synthesis texel is that level's vertex spacing (same repeats,
+//    coarser texels).
+// 2. Adaptive sqrt(2)-subdivision of the base mesh (3.2.2), default f = 1.5.
+// 3. Orientation field (Turk diffusion from key vertices) and sweep field on
+//    the base mesh (3.1.1); after every subdivision step both are carried to
+//    the new vertices and re-diffused (coarse to fine).
+// 4. Levels: the base mesh, then `levels` uniform sqrt(2) steps (3.2.1).
+//    Old vertices keep their colours; face points start with the average of
+//    their face's colours ("missing entries filled by interpolation", 4).
+// 5. Order (3.1.2): on the base level vertices are visited in increasing sweep
+//    value; on every later level in a random order (std::mt19937_64 from
+//    `seed`). On the base level the first pass skips vertices whose region has
+//    no coloured vertex yet; the very first vertex gets a random texel; after
+//    the first pass, fill passes visit the skipped vertices until all are
+//    coloured (section 4's two-pass process); then passes 2..P refine.
+// 6. Per vertex P (3.3): k from region_k at P's mean edge length and P's
+//    stack level m (the region spans region_texels texels OF LEVEL m, i.e.
+//    n 2^m level-0 texels, about n x n vertices at every mesh level: see
+//    level_relative_region; the graph cut's r is that span), its
+//    k-region with local (u,v), samples = the coloured region vertices other
+//    than P, each at its anti-aliasing level (or, without anti-aliasing, the
+//    level max(0, levels - level index): coarse mesh <-> coarse stack image),
+//    exhaustive match (match_region), then transfer: graph cut over the whole
+//    region (graph_cut_transfer, r = 2^m n texels) or P alone. With
+//    skip_patched, vertices that received colour from a cut earlier in the
+//    same pass are not matched again in that pass (the speed-up of section 4).
+// Colours are read from the stack level of each vertex (3.3.4); each colour
+// remembers that level and is compared against it when it serves as a sample
+// (old vertices carry coarse, blurred colours into the next mesh level).
+// Wrap (issue 18 item 2): the exemplar is treated as periodic only when it
+// tiles (wrap_seam_ratio at most wrap_threshold, or wrap = Periodic); else,
+// at every stack level whose regions fit in half the exemplar (the fine
+// levels, which decide the final texels), matches take only candidates whose
+// whole region lies inside it and the transfer pins the vertices that fall
+// outside, so its wrap seams are never copied; coarser, blurred levels wrap. Repetition: every vertex remembers the level-0 exemplar texel its
+// colour came from; a match adds to d(Q) a penalty for exemplar areas that
+// nearby vertices (within about one exemplar width, outside the region being
+// matched) already show more often than the average area (see
+// repetition_penalty).
+//
+// Writes kVertexColor (linear RGB), kVertexDirection, kVertexSweep on the
+// final (finest) mesh, which replaces `mesh`. Throws InvalidInputError (bad
+// options, empty mesh or exemplar), TopologyError (from the subdivision).
+
+#include <cstddef>
+#include <cstdint>
+#include <array>
+#include <random>
+#include <vector>
+
+#include "geometry/image.h"
+#include "geometry/mesh_fwd.h"
+#include "geometry/progress.h"
+#include "texture/subdivision/turk_orientation_field.h"
+#include "texture/subdivision/k_region_matching.h"
+
+namespace surftex {
+
+enum class ExemplarWrap {
+  Auto,      ///< periodic when wrap_seam_ratio(exemplar) <= wrap_threshold
+  Periodic,  ///< always wrap (the exemplar is a seamless tile)
+  Bounded    ///< never wrap
+};
+
+struct SubdivisionSynthesisOptions {
+  /// Scale, the first of these that is set (step 1): r_scale > 0 = texels per
+  /// object unit; texels_per_edge > 0 = exemplar texels per mean edge of the
+  /// input mesh; else `repeats` exemplar widths across the longest
+  /// bounding-box side (> 0, default 3).
+  double r_scale = 0;
+  bool normalize_units = true;  ///< object unit = longest bounding-box side
+  double texels_per_edge = 0;
+  double repeats = 3;
+  /// Uniform sqrt(2) steps after the base level, 0..12; -1 (default) = chosen
+  /// (step 1: vertex spacing <= one texel within max_vertices).
+  int levels = -1;
+  /// Most vertices of the finest level when levels are chosen, >= 1000.
+  /// Default 150000 (about 20 s at defaults on 2 cores).
+  std::size_t max_vertices = 150000;
+  double adaptive_factor = 1.5; ///< f of 3.2.2 (the paper's choice); 0 = no adaptive subdivision
+  int adaptive_steps = 4;       ///< adaptive steps when adaptive_factor > 0, 0..32
+  int passes = 1;               ///< passes per level, 1..16 (2: brick_small_96 flat square 1.77 vs 1.81, 1.8x the time)
+  ExemplarWrap wrap = ExemplarWrap::Auto;
+  /// Auto wrap: the exemplar counts as periodic when its wrap-seam ratio
+  /// (texture/wrap_seam_ratio.h: jump across its wrap / jump inside) is at
+  /// most this, > 0. Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
+  double wrap_threshold = 1.3;
+  /// lambda of the repetition term added to a candidate's SSD:
+  /// lambda * sigma^2 * (samples) * max(0, R - 1), sigma^2 the exemplar's
+  /// summed channel variance, R the count of nearby vertices (within the 27
+  /// cells of one exemplar width around the centre, the region's own
+  /// vertices left out) whose source lies in the candidate's exemplar bin
+  /// (16 x 16 bins) over the mean count per bin. >= 0; 0 = off. Default 0.3.
+  /// n: neighbourhood edge length in texels, > 0. 3 is the paper's Table-1 (timing)
+  /// setting; it is too small for structured exemplars at the fine stack levels,
+  /// where SSD favours the most uniform exemplar areas (dark seams of a brick
+  /// wall grow into blobs). 9 keeps brick structure on brick_small_96.
+  double region_texels = 9;
+  bool pyramid = false;         ///< Gaussian pyramid (a = 2) instead of the stack (a = 1)
+  bool antialias = true;        ///< per-vertex stack level (3.3.4)
+  bool averaging = true;        ///< oversampling groups (3.3.3)
+  bool graph_cut = true;        ///< graph-cut transfer (3.4), else P alone
+  bool skip_patched = true;     ///< do not re-match vertices patched in the same pass
+  /// Count region_texels in texels of the centre's stack level m, i.e. the
+  /// region spans n 2^m level-0 texels (a = 2 in section 3.3.2's formula, as
+  /// for a pyramid), so every level matches about n x n vertices. Default on.
+  /// Off = the paper's a = 1 for a stack: a region of n level-0 texels at
+  /// every level, which at coarse levels (edges longer than n texels) is only
+  /// the 1-ring; its samples are blurred together by the level's stack
+  /// filter, the match then merely continues the colour around it, and the
+  /// structure laid down is far coarser than the exemplar's (on a deep
+  /// hierarchy: cells several times too large, or one uniform colour) which
+  /// the fine levels, whose regions are smaller than those features, cannot
+  /// break. Stack levels still give every sample its own anti-aliased level.
+  bool level_relative_region = true;
+  double repetition_penalty = 0.3;
+  /// Mesh levels from the base on that use the exhaustive search
+  /// (Algorithm 1), 0..13; every later level uses the coherence search
+  /// (section 2.3: search "restricted to regions around points previously
+  /// matched", Ashikhmin 2001, Ying et al. 2001): the candidates are the
+  /// centres that the region's coloured vertices' sources imply (source minus
+  /// offset) and the centre's own source, scored with the same distance and
+  /// penalty; the exhaustive search runs where none is usable. Default 1 (the
+  /// base level lays out the pattern exhaustively; the levels below refine
+  /// it): on brick_small_96, flat square at 256 texels, fidelity ratio 1.71
+  /// and 14 s CPU against 1.81 and 60 s exhaustive everywhere
+  /// (docs/decisions/204). 13 = exhaustive everywhere.
+  int exhaustive_levels = 1;
+  double sigma = 1.0;           ///< sigma of equation (1), > 0
+  int max_k = 24;               ///< cap on k, 1..64
+  LocalCoordinates coordinates = LocalCoordinates::kUnfolding;
+  /// Orientation keys; empty = vertex 0 with the world x axis (projected).
+  std::vector<OrientationKey> keys;
+  std::uint64_t seed = 1;
+  ProgressCallback progress;
+};
+
+struct SynthesisPassStats {
+  std::size_t matched = 0;   ///< vertices matched (Algorithm 1 runs)
+  std::size_t patched = 0;   ///< extra vertices coloured by cuts
+  std::size_t skipped = 0;   ///< no coloured neighbour yet (left for a fill pass)
+  std::size_t seeded = 0;    ///< random texel (nothing coloured at all)
+  double mean_k = 0;
+  double mean_region = 0;    ///< vertices per region
+  double mean_groups = 0;    ///< compared groups per match (after averaging)
+  std::size_t candidates = 0;  ///< exemplar texels scored over all matches (branch and bound)
+  std::size_t recomputed = 0;  ///< speculative jobs redone at commit (their region changed)
+  /// Thread time summed over vertices (so it can exceed the wall time).
+  double seconds_match = 0, seconds_transfer = 0, seconds_region = 0;
+  double seconds_setup = 0;    ///< frames, region graph (wall)
+};
+
+struct SynthesisLevelStats {
+  int level = 0;
+  std::size_t vertices = 0, faces = 0;
+  int passes = 0;       ///< passes run, fill passes included
+  int fill_passes = 0;
+  std::vector<SynthesisPassStats> pass_stats;
+  double seconds_subdivide = 0, seconds_fields = 0, seconds_synthesis = 0;
+};
+
+/// Where a vertex's colour was read: stack (or pyramid) level and position in
+/// that level's texels, read bilinearly as the level wraps or clamps
+/// (texel_bilinear; integer positions for single-texel reads). Level -1 =
+/// not read from the exemplar (a face point's averaged colour).
+struct ExemplarLookup {
+  int level = -1;
+  double x = 0, y = 0;
+};
+
+/// The scale and depth chosen from the inputs (step 1), reported by the CLI.
+struct SubdivisionScale {
+  const char* scale_from = "repeats";  ///< "rscale", "texels_per_edge" or "repeats"
+  double repeats = 0;          ///< exemplar widths across the longest bounding-box side
+  double texels_per_edge = 0;  ///< exemplar texels per mean edge of the input mesh
+  double r_scale = 0;          ///< exemplar texels per object unit
+  double texel_size = 0;       ///< mesh units per synthesis texel
+  double exemplar_scale = 1;   ///< synthesis texels per exemplar pixel (< 1: reduced for max_vertices)
+  int exemplar_width = 0, exemplar_height = 0;  ///< the exemplar as synthesised
+  int levels = 0;              ///< uniform sqrt(2) steps
+  bool levels_chosen = false;  ///< chosen (levels = -1) rather than given
+  bool budget_limited = false; ///< the vertex budget, not the texel size, set the depth
+  double spacing_texels = 0;   ///< predicted final vertex spacing, synthesis texels
+  std::size_t predicted_vertices = 0;
+};
+
+struct SubdivisionSynthesisResult {
+  std::vector<SynthesisLevelStats> levels;
+  std::vector<double> adaptive_area_std_percent;  ///< before + after each adaptive step
+  double object_unit = 1;  ///< mesh units per object unit
+  int stack_levels = 0;
+  SubdivisionScale scale;
+  double wrap_seam_ratio = 0;  ///< of the exemplar as synthesised
+  bool periodic = true;        ///< treated as periodic (wrapped)
+  int bounded_levels = 0;      ///< stack levels matched without wrapping (ExemplarLevels)
+  Image exemplar;              ///< the exemplar as synthesised (RGB, reduced if exemplar_scale < 1)
+  /// Per final vertex: the exemplar texel (level 0 of `exemplar`) its colour
+  /// was read from, {-1, -1} if none (a face point never matched or patched).
+  std::vector<std::array<int, 2>> source;
+  /// Per final vertex: the exact lookup its colour came from, so that other
+  /// maps of the exemplar can be read the same way (subdivision_exemplar_maps.h).
+  std::vector<ExemplarLookup> lookup;
+  bool pyramid = false;  ///< the exemplar levels were a pyramid (options.pyramid)
+  double seconds_total = 0;
+};
+
+/// Step 1 alone: the scale and depth synthesize_on_subdivision would use on
+/// `mesh` (after adaptive subdivision) for an exemplar of w x h pixels.
+/// `input_mean_edge` is the mean edge of the mesh as given (texels_per_edge).
+/// Throws InvalidInputError (options out of range, no extent).
+SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double input_mean_edge,
+                                          const SubdivisionSynthesisOptions& opt);
+
+SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& exemplar,
+                                                     const SubdivisionSynthesisOptions& opt = {});
+
+/// An image of the input exemplar's size resampled as the exemplar was for
+/// the synthesis (SubdivisionScale: reduced when exemplar_scale < 1: halved
+/// with the binomial blur while more than twice the target, then bilinear),
+/// any channel count, float. Throws InvalidInputError if `img` is empty.
+Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale);
+
+/// The per-level geometry a pass reads: vertex frames and the region graph.
+/// Built once per mesh level and shared by all its passes (they do not move
+/// vertices), instead of once per pass.
+struct PassGeometry {
+  SurfaceFrames frames;
+  RegionGraph graph;
+  int mesh_level = 0;  ///< mesh level in the hierarchy (0 = base): chooses the search (exhaustive_levels)
+};
+PassGeometry make_pass_geometry(const Mesh& mesh);
+
+/// One synthesis pass over `order` on a mesh that already has
+/// kVertexDirection (for the benchmark and tests): `colored` flags which
+/// vertices have a colour in kVertexColor (updated). `hierarchy_level` is the
+/// stack level used without anti-aliasing. `r_scale` here is texels per MESH
+/// unit. Returns the pass statistics.
+///
+/// The pass is the sequential one (each vertex matched against the colours
+/// left by the vertices before it in `order`), computed speculatively in
+/// parallel: chunks of consecutive vertices are matched with TBB against the
+/// colours at the chunk's start and committed in order; a vertex whose region
+/// was written by an earlier commit of its chunk is recomputed. Results do
+/// not depend on the thread count.
+SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const std::vector<std::size_t>& order,
+                                  std::vector<char>& colored, double r_scale, int hierarchy_level,
+                                  const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
+/// The same with a prebuilt index of `ex` (reused across passes).
+/// `color_level` (optional, one entry per vertex, updated): the stack level
+/// each vertex's current colour was read from. A sample is compared against
+/// that level, not the vertex's current anti-aliasing level: colours carried
+/// from a coarser mesh level are blurred, and comparing them against sharper
+/// texels makes SSD prefer the exemplar's extreme (dark) texels, which then
+/// grow into blobs. Null = every colour belongs to its vertex's current level.
+/// `source` (optional, one entry per vertex, updated): the level-0 exemplar
+/// texel each colour came from ({-1,-1} = none); the repetition penalty and
+/// the result's source record need it (no penalty without it). `geometry`
+/// (optional): make_pass_geometry(mesh), reused; null = built here.
+/// `lookup` (optional, one entry per vertex, updated): where each colour was read.
+SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
+                                  const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
+                                  int hierarchy_level, const SubdivisionSynthesisOptions& opt,
+                                  std::mt19937_64& rng, std::vector<int>* color_level = nullptr,
+                                  std::vector<std::array<int, 2>>* source = nullptr,
+                                  const PassGeometry* geometry = nullptr,
+                                  std::vector<ExemplarLookup>* lookup = nullptr);
+
+}  // namespace surftex
