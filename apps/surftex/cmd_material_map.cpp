@@ -65,80 +65,11 @@ struct Args {
 
 // ---- pipeline --------------------------------------------------------------
 
-struct Outputs {
-  Image plain, fixed, normal;
-};
-
-Outputs render_all(const Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int size,
-                   const std::vector<float>& view, double bump) {
-  RenderMesh rm = make_render_mesh(mesh);
-  const Camera cam = fit_camera(bounding_box(rm), view[0], view[1]);
-  RenderOptions ro;
-  ro.width = ro.height = size;
-  ro.color_source = RenderOptions::ColorSource::Callback;
-  Outputs o;
-  MaterialRenderOptions mo;
-  mo.lookup = MaterialRenderOptions::Lookup::Plain;
-  ro.callback = material_space_fragment(rm, sing, tile, mo);
-  o.plain = render(rm, cam, ro).color;
-  mo.lookup = MaterialRenderOptions::Lookup::Blended;
-  ro.callback = material_space_fragment(rm, sing, tile, mo);
-  o.fixed = render(rm, cam, ro).color;
-  mo.output = MaterialRenderOptions::Output::NormalMap;
-  mo.bump_strength = bump;
-  mo.light_world = light_direction_world(cam, ro.light_direction);
-  ro.callback = material_space_fragment(rm, sing, tile, mo);
-  ro.shade = false;
-  o.normal = render(rm, cam, ro).color;
-  return o;
-}
-
-// The PBR set of the baked atlas, every map through the colour's lookups:
-// height (the tile's height layers, else its luminance), roughness (the
-// tile's roughness layers, as glTF metallicRoughness) and the tangent-space
-// normal map (from the tile's normal layers, else from the height's slopes;
-// `bump` is the tilt per unit of height per period, as in the render).
-struct BakedAsset {
-  MaterialBakeResult bake;
-  Image normal, metallic_roughness;
-  std::string normal_source;
-};
-
-BakedAsset bake_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int atlas_size,
-                      double bump, double period) {
-  BakedAsset a;
-  MaterialBakeOptions bo;
-  bo.size = atlas_size;
-  a.bake = bake_material_space(mesh, sing, tile, bo);
-  if (!a.bake.roughness.empty()) a.metallic_roughness = metallic_roughness_from_roughness(a.bake.roughness);
-  if (!a.bake.object_normal.empty()) {  // the tile's normals, in the GLB's tangent frames
-    a.normal = material_space_tangent_normals(mesh, a.bake);
-    a.normal_source = "exemplar_normal";
-    return a;
-  }
-  a.normal = normal_map_from_height(a.bake.height, a.bake.chart, bump * period * a.bake.texels_per_length);
-  a.normal_source = "height";
-  return a;
-}
-
-nlohmann::json bake_report(const BakedAsset& a) {
-  const MaterialBakeResult& b = a.bake;
-  return {{"size", b.color.width},          {"charts", b.charts},
-          {"gutter", b.gutter},             {"gutter_violations", b.gutter_violations},
-          {"protected_mip_size", b.protected_mip_size},
-          {"margin", b.margin},             {"coverage", b.coverage},
-          {"texels_per_length", b.texels_per_length},
-          {"normal_source", a.normal_source},
-          {"height_source", b.height_from_tile ? "exemplar_height" : "luminance"},
-          {"roughness", !b.roughness.empty()},
-          {"seconds", {{"atlas", b.seconds_atlas}, {"lookup", b.seconds_lookup}, {"gutter", b.seconds_gutter}}}};
-}
-
 // OBJ (+MTL, base colour, normal and 16-bit height maps), GLB (base colour
 // and normal texture, the material m as a vertex attribute) with the atlas
 // uv; PLY with m as a vertex scalar.
 // Returns every file written (write_mesh's lists: the OBJ's .mtl and maps too).
-std::vector<std::string> write_meshes(Mesh& mesh, const BakedAsset& a, const std::string& obj, const std::string& glb,
+std::vector<std::string> write_meshes(Mesh& mesh, const MaterialAsset& a, const std::string& obj, const std::string& glb,
                                       const std::string& ply, bool force) {
   auto mat = find(mesh, kVertexMaterial).first;
   auto scalar = mesh.add_property_map<VertexIndex, double>("material", 0.0).first;
@@ -259,12 +190,12 @@ int run(const Args& a) {
   ensure_directory(a.out);
   // Renders first: the bake replaces the corner uv by the atlas's.
   t.reset();
-  const Outputs img = render_all(mesh, sing, tile, a.render_size, a.view, a.bump);
+  const MaterialViews img = render_material_views(mesh, sing, tile, a.render_size, a.view[0], a.view[1], a.bump);
   sec["render"] = t.seconds();
   t.reset();
-  const BakedAsset baked = bake_asset(mesh, sing, tile, a.atlas_size, a.bump, mapping.result().default_scale);
+  const MaterialAsset baked = bake_material_asset(mesh, sing, tile, a.atlas_size, a.bump, mapping.result().default_scale);
   sec["bake"] = t.seconds();
-  rep["atlas"] = bake_report(baked);
+  rep["atlas"] = to_json(baked);
   t.reset();
   write_meshes(mesh, baked, a.out + "/mesh.obj", a.out + "/mesh.glb", a.out + "/mesh.ply", a.common.force);
   sec["write_meshes"] = t.seconds();
@@ -398,8 +329,8 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   mapping.map(c);
   const PgpSingularities& sing = mapping.result().singularities;
   z_up_to_y_up(mesh);  // the torus was built around z: lying flat in glTF viewers
-  const Outputs img = render_all(mesh, sing, tile, 384, {20.f, 45.f}, 0.03);
-  const BakedAsset baked = bake_asset(mesh, sing, tile, 512, 0.03, mapping.result().default_scale);
+  const MaterialViews img = render_material_views(mesh, sing, tile, 384, 20.f, 45.f, 0.03);
+  const MaterialAsset baked = bake_material_asset(mesh, sing, tile, 512, 0.03, mapping.result().default_scale);
   ctx.wrote(write_meshes(mesh, baked, ctx.path("material_map.obj"), ctx.path("material_map.glb"),
                          ctx.path("material_map.ply"), true));
   write_image(ctx.path("material_map_plain.png"), img.plain);
@@ -408,7 +339,7 @@ nlohmann::json demo_material_map(DemoContext& ctx) {
   return {{"faces", mesh.number_of_faces()},
           {"tile_layers", tile.layers.size()},
           {"singular_fraction", sing.singular_fraction},
-          {"atlas", bake_report(baked)},
+          {"atlas", to_json(baked)},
           {"outputs",
            {"material_tile/tile.json", "material_map.obj", "material_map.mtl", "material_map.png", "material_map_normal.png",
             "material_map_height.png", "material_map.glb", "material_map.ply", "material_map_plain.png",

@@ -210,41 +210,6 @@ nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const Pbr
   return j;
 }
 
-nlohmann::json synthesis_report(const SubdivisionSynthesisResult& r, const SubdivisionSynthesisOptions& o) {
-  nlohmann::json j;
-  const SubdivisionScale& sc = r.scale;
-  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"texels_per_edge", sc.texels_per_edge},
-                {"r_scale", sc.r_scale}, {"texel_size", sc.texel_size}, {"exemplar_scale", sc.exemplar_scale},
-                {"exemplar_size", {sc.exemplar_width, sc.exemplar_height}}, {"levels", sc.levels},
-                {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},
-                {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
-                {"predicted_vertices", sc.predicted_vertices}};
-  j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
-               {"bounded_levels", r.bounded_levels}};
-  j["repetition_penalty"] = o.repetition_penalty;
-  j["exhaustive_levels"] = o.exhaustive_levels;
-  j["r_scale"] = sc.r_scale;
-  j["object_unit"] = r.object_unit;
-  j["stack_levels"] = r.stack_levels;
-  j["pyramid"] = o.pyramid;
-  j["passes_per_level"] = o.passes;
-  j["adaptive_factor"] = o.adaptive_factor;
-  j["adaptive_area_std_percent"] = r.adaptive_area_std_percent;
-  j["seconds_synthesis_total"] = r.seconds_total;
-  for (const auto& l : r.levels) {
-    nlohmann::json lj{{"level", l.level}, {"vertices", l.vertices}, {"faces", l.faces}, {"passes", l.passes},
-                      {"fill_passes", l.fill_passes}, {"seconds_subdivide", l.seconds_subdivide},
-                      {"seconds_fields", l.seconds_fields}, {"seconds_synthesis", l.seconds_synthesis}};
-    for (const auto& p : l.pass_stats)
-      lj["pass_stats"].push_back({{"matched", p.matched}, {"patched", p.patched}, {"skipped", p.skipped},
-                                  {"mean_k", p.mean_k}, {"mean_region", p.mean_region}, {"mean_groups", p.mean_groups},
-                                  {"seconds_region", p.seconds_region}, {"seconds_match", p.seconds_match},
-                                  {"seconds_transfer", p.seconds_transfer}});
-    j["levels"].push_back(lj);
-  }
-  return j;
-}
-
 // --texel-size: "Nx" = N exemplar widths across the longest bounding-box
 // side, "N/edge" = N exemplar texels per mean edge of the input mesh.
 void parse_texel_size(const std::string& spec, SubdivisionSynthesisOptions& o) {
@@ -418,7 +383,7 @@ int run_subdiv(const SubdivArgs& a) {
   std::size_t no_lookup = 0;  // frames of the surface as written (after --displace)
   const VertexMaps vmaps = vertex_maps(mesh, r, maps, ex.width, ex.height, no_lookup);
   ensure_directory(a.outdir);
-  nlohmann::json rep = synthesis_report(r, o);
+  nlohmann::json rep = to_json(r, o);
   rep["fidelity"] = fidelity;
   if (a.displace != 0) rep["displace_offset_range"] = {disp.min_offset, disp.max_offset};
   rep["mesh"] = a.mesh;
@@ -573,7 +538,7 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  const auto r = demo_run(mesh, ex, ctx.seed, ctx.progress);
                                  const std::string dir = ctx.path("subdiv");
                                  ensure_directory(dir);
-                                 nlohmann::json j = synthesis_report(r, {});
+                                 nlohmann::json j = to_json(r, {});
                                  PbrSettings pbr;
                                  pbr.atlas_size = 512;
                                  pbr.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale

@@ -135,7 +135,7 @@ struct GraphcutOptions {
   /// at the same sources) exceeds straight_seam_ratio. Eq.-1 cuts can leave
   /// two large patches meeting along a straight overlap edge, a seam the eye
   /// follows, and the refinement above never raises the eq.-1 cost, so it
-  /// keeps them (measured, bench/bench_graphcut.cpp session 5). An attempt
+  /// keeps them (measured with bench/bench_graphcut.cpp). An attempt
   /// takes the worst such line with a stretch not tried yet, the stretch
   /// (half the repair patch) with the largest excess jump (jump minus the
   /// exemplar's jump), and pastes a repair patch (a quarter of the output

@@ -41,8 +41,8 @@
 // both tiles above then measure 0.09 and 0.26. That figure is the minimum
 // over the lines of the torus, biased low by construction; TileResult keeps
 // the ratio at the synthesis cut beside it (1.60 and 1.74 for these two
-// with the error-region refinement of session 4).
-// Is the synthesis cut a special line? No (session 5, 128-px tiles of the 28
+// with the error-region refinement).
+// Is the synthesis cut a special line? No (128-px tiles of the 28
 // non-constant shared textures, seeds 1-6, line_jump_profile): line 0's jump
 // ranks at percentile 0.48 +- 0.02 among the 128 lines of its orientation
 // (uniform: 0.5; columns 0.480, rows 0.480), its mean ratio to the mean line

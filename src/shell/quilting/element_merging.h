@@ -78,7 +78,7 @@ struct MergeOptions {
   double match_distance = 0;
   /// Weight of B's guide links, in units of the largest n-link weight; >= 0.
   double guide_factor = 100;
-  /// Guide links by vertices (our addition, issue #8 session 6): a triangle
+  /// Guide links by vertices (our addition): a triangle
   /// of B is pulled to SINK if its centroid's closest face of A or the
   /// closest face of any of its vertices (within match_distance) was kept,
   /// so that B's kept part starts just past A's cut (a gap of at most one
@@ -86,7 +86,7 @@ struct MergeOptions {
   /// it. With the centroid alone the two kept ends overlapped by about a
   /// hundredth of a thread spacing on the planar weave: tubes of slightly
   /// different radius running through each other, 56% of the refusals
-  /// ("self-intersecting stitch"). false = the centroid only (the state before).
+  /// ("self-intersecting stitch"). false = the centroid only.
   bool guide_by_vertices = true;
   /// Round-trip tolerance of "face g of B has a corresponding vertex in A"
   /// (see the header), in mean edge lengths of B; > 0. Was 0.5: with rows of
@@ -96,7 +96,7 @@ struct MergeOptions {
   double round_trip_edges = 0.25;
   /// The SINK rule's "adjacent face with no corresponding vertex in A" only
   /// for uncovered faces whose connected uncovered region of B reaches B's
-  /// own outside region (our reading of section 2.7, issue #8 session 6):
+  /// own outside region (our reading of section 2.7):
   /// B continues past A there. The start of B lying along A (its end cap
   /// beside A's middle) is uncovered too, but A continues there; deleting A
   /// at B's start as well as at its own end put A's cut at the far side of
@@ -104,7 +104,7 @@ struct MergeOptions {
   bool uncovered_must_escape = true;
   /// Apply the SINK rule of section 2.7 also to A's vertices that poke past
   /// the overlap region into the other side (not A's own outside, not off
-  /// the grid), not only to those in the overlap (issue #8 session 6).
+  /// the grid), not only to those in the overlap.
   /// Elements are kept whole, so an old thread can end a little past the
   /// processed cells; its end then had no infinite SINK link, the cut kept
   /// all of A and the merge was refused ("cuts opened 0 and 1 loops",
@@ -121,7 +121,7 @@ struct MergeOptions {
   /// facing loops a fraction of a row apart are pulled onto one another and
   /// the strip between them collapses into slivers that cross each other
   /// (the paper's mesh merging [Yu et al. 2004] fuses the two boundaries
-  /// instead of bridging them). false = full averages (the state before).
+  /// instead of bridging them). false = full averages.
   bool average_across_axis_only = true;
   /// Geometric test of every zipped loop pair (section 2.7 stitches two
   /// elements whose cut paths are "close to each other"; the paper has no

@@ -50,12 +50,12 @@ struct QuiltStepOptions {
   /// so that the new patch is covered up to the overlap, where the old
   /// elements stay (the two abut there instead of being stitched). Issue #8: on the 5K-face bunny 1,364 of 2,316
   /// placed threads were dropped whole, leaving bare strips. false = drop the
-  /// whole input element (the state before).
+  /// whole input element.
   bool keep_cut_refused_inputs = true;
   /// Geometric checks of each stitch (MergeOptions::max_loop_offset and the
   /// next three, at their defaults): zip only loop pairs that face each other
-  /// and refuse stitches that cross themselves. false = off (the state before
-  /// issue #8's fix, for comparisons).
+  /// and refuse stitches that cross themselves. false = off (for
+  /// comparisons).
   bool check_stitch_geometry = true;
   /// Options of every merge (section 2.7); its mu is replaced by `mu` above,
   /// and check_stitch_geometry = false turns its geometric checks off.
@@ -129,13 +129,12 @@ struct QuiltStepStats {
   /// chain-mail ring placed again); the output element is kept whole and the
   /// input one dropped, i.e. the element is completed from one side (section
   /// 2.7 keeps one side whole where an element lies in the overlap). Not
-  /// counted in stitch_refused (until issue #8's session 4 they were, as
-  /// "loops": planar 3x3 chain mail, 38 of 43 refusals).
+  /// counted in stitch_refused.
   std::size_t coincident = 0;
   /// Of those, the inputs whose end beyond the overlap, away from the output
   /// element, was kept closed at the overlap instead of dropped with the rest
   /// (MergeResult::capped_b of a coincident merge, with
-  /// keep_cut_refused_inputs; issue #8 session 5: once a patch's threads lie
+  /// keep_cut_refused_inputs: once a patch's threads lie
   /// on the old ones, a thread continuing an old one past the overlap is a
   /// coincident merge, and dropping it whole left bare strips).
   std::size_t coincident_cut_added = 0;

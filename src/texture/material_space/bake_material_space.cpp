@@ -3,6 +3,7 @@
 #include "texture/material_space/bake_material_space.h"
 #include "geometry/vec3.h"
 
+#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include "geometry/polygon_util.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
+#include "texture/pbr_maps.h"
 #include "texture/tangent_space_bake.h"
 
 namespace surftex {
@@ -232,6 +234,37 @@ Image material_space_tangent_normals(const Mesh& mesh, const MaterialBakeResult&
   std::vector<int> label = bake.chart;
   dilate_charts(out, label);
   return out;
+}
+
+
+MaterialAsset bake_material_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int atlas_size,
+                                  double bump, double period) {
+  MaterialAsset a;
+  MaterialBakeOptions bo;
+  bo.size = atlas_size;
+  a.bake = bake_material_space(mesh, sing, tile, bo);
+  if (!a.bake.roughness.empty()) a.metallic_roughness = metallic_roughness_from_roughness(a.bake.roughness);
+  if (!a.bake.object_normal.empty()) {  // the tile's normals, in the GLB's tangent frames
+    a.normal = material_space_tangent_normals(mesh, a.bake);
+    a.normal_source = "exemplar_normal";
+    return a;
+  }
+  a.normal = normal_map_from_height(a.bake.height, a.bake.chart, bump * period * a.bake.texels_per_length);
+  a.normal_source = "height";
+  return a;
+}
+
+nlohmann::json to_json(const MaterialAsset& a) {
+  const MaterialBakeResult& b = a.bake;
+  return {{"size", b.color.width},          {"charts", b.charts},
+          {"gutter", b.gutter},             {"gutter_violations", b.gutter_violations},
+          {"protected_mip_size", b.protected_mip_size},
+          {"margin", b.margin},             {"coverage", b.coverage},
+          {"texels_per_length", b.texels_per_length},
+          {"normal_source", a.normal_source},
+          {"height_source", b.height_from_tile ? "exemplar_height" : "luminance"},
+          {"roughness", !b.roughness.empty()},
+          {"seconds", {{"atlas", b.seconds_atlas}, {"lookup", b.seconds_lookup}, {"gutter", b.seconds_gutter}}}};
 }
 
 }  // namespace surftex

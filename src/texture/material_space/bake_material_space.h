@@ -31,7 +31,10 @@
 // 64..8192, min_mip_size < 1, singularities of another mesh, non-triangle
 // face), plus what the atlas throws.
 
+#include <string>
 #include <vector>
+
+#include <nlohmann/json_fwd.hpp>
 
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
@@ -77,6 +80,24 @@ MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing,
 /// NORMAL and TANGENT, normalised; gutters filled by dilating the charts'
 /// values. Throws InvalidInputError if the bake has no object normals.
 Image material_space_tangent_normals(const Mesh& mesh, const MaterialBakeResult& bake);
+
+/// The PBR set of the baked atlas that material-map writes, every map through
+/// the colour's lookups: height (the tile's height layers, else its
+/// luminance), roughness (the tile's roughness layers, as glTF
+/// metallicRoughness) and the tangent-space normal map (from the tile's normal
+/// layers, else from the height's slopes; `bump` is the tilt per unit of
+/// height per period `period`, as in the render).
+struct MaterialAsset {
+  MaterialBakeResult bake;
+  Image normal, metallic_roughness;
+  std::string normal_source;  ///< "exemplar_normal" or "height"
+};
+MaterialAsset bake_material_asset(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile, int atlas_size,
+                                  double bump, double period);
+
+/// The atlas figures of the report: size, charts, gutter, coverage, texel
+/// density, map sources and "seconds" {atlas, lookup, gutter}.
+nlohmann::json to_json(const MaterialAsset& asset);
 
 /// The colour of the mapping at barycentrics `bary` of `face` (what the
 /// fixed render shows): one lookup, or three blended on a singular face.

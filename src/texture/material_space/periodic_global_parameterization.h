@@ -125,59 +125,26 @@ struct PgpOptions {
   int update_iterations = 4;
   /// Weight mu of the unit-modulus pull, relative to the mean diagonal of
   /// F_PGP over the mean vertex area (> 0). Smaller lets vortices (PGP
-  /// singularities) be smaller but |z| sag; 0.01 measured best on spheres
-  /// and real meshes (0.05: +1-6% singular faces, 0.2: +15-25%).
+  /// singularities) be smaller but |z| sag (docs/decisions/304-pgp-options.md).
   double stiffness = 0.01;
   /// Curl correction of the target gradients before the solve (Ray et al.
-  /// 2006; texture/material_space/pgp_curl_correction.h): g = d/S is scaled per vertex by
-  /// the factor exp(phi) that brings it closest to curl-free, directions
-  /// kept. Measured: singular faces (section 3, curvature field, 8 mean
-  /// edges per period) fandisk 9.6% -> 6.8%, dragon_25k 58.4% -> 54.3%,
-  /// armadillo_52k 29.6% -> 24.0% (bench_pgp --curl-only), for about +8% of
-  /// the initialisation's CPU time. Off by default (the project's choice,
-  /// session 4): the period is then locally rescaled against the user's
-  /// scale S (armadillo: factors 0.5..2, visible on the renders), and a
-  /// local update must refresh the gradients of every face (the factor is
-  /// global): armadillo's PGP update 0.08 -> 0.15 s CPU, past the 0.1 s
-  /// budget of an interactive edit. Ray et al. 2009 section 2.3 uses the
-  /// target d/S as given.
+  /// 2006; material_space/pgp_curl_correction.h): g = d/S scaled per vertex
+  /// towards curl-free, directions kept. Off by default: Ray et al. 2009
+  /// section 2.3 uses d/S as given, and the correction rescales the user's
+  /// period locally and makes a local update refresh every face (decision 304).
   bool curl_correction = false;
   /// Swap s and t across the quarter-turn cuts of the combed N-field (Ray et
   /// al. 2006's coupling; the default). false = the paper's simplified PGP
-  /// (Ray et al. 2009 section 2.3: "singularities can be handled at rendering
-  /// time and there is no swapping of texture coordinates"): every corner's
-  /// and edge's turns are taken as 0, s couples only with s and t only with t
-  /// (each vertex's (s,t) is that of every face around it, the edges' alphas
-  /// read in their reference face's frame by both faces), so the system is
-  /// two independent real systems, numbered s first then t, each in the same
-  /// nested-dissection order: about a quarter of the factorisation's flops,
-  /// half of each triangular solve. The faces along the field's cuts then
-  /// become singular (distorted faces), which section 3's blending hides.
-  /// Measured (bench_pgp --no-swap, load ~3): armadillo_52k first init
-  /// 0.65-0.70 -> 0.57-0.58 s, factor flops 1.83e9 -> 5.7e8 (one real
-  /// system; see separate_halves for the complex halves: 0.44 s CPU);
-  /// singular faces fandisk 9.6% -> 22.9%, armadillo 29.6% -> 33.1%.
+  /// (Ray et al. 2009 section 2.3: "no swapping of texture coordinates"):
+  /// s couples only with s and t only with t, two independent systems of a
+  /// quarter of the factorisation's flops; the faces along the field's cuts
+  /// become singular, which section 3's blending hides (decision 304).
   bool swap_coordinates = true;
-  /// With swap_coordinates false only: factor and relax the s and t systems
-  /// (each relaxation step normalises s pairs and t pairs separately, so the
-  /// two chains of steps are independent) one after the other, each as the
-  /// complex Hermitian n x n system of z_s (z_t) that its real 2n x 2n form
-  /// stands for (the 2x2 blocks are scaled rotations: multiplication by
-  /// c + i s), instead of one real block-diagonal 4n system: about half the
-  /// real flops of the factorisation and half the factor's bytes read per
-  /// solve. Same bytes on any thread count; equal to the one-system result
-  /// up to rounding (fandisk init + update: 7e-14). false (one real system)
-  /// is kept for comparison (tests, bench_pgp --one-system). The two halves
-  /// run side by side on two tasks where the BLAS allows concurrent calls
-  /// (see the BLAS note above), in turn otherwise. The coupled form (the default) has no complex form:
-  /// its quarter and half turns conjugate z (antilinear maps).
-  /// Measured 2026-11-22, armadillo_52k, shared 2-core machine at load 8-10
-  /// (wall figures for the lead to re-measure), one real system -> two
-  /// complex halves, CPU seconds: init (analysis reused) 0.38-0.41 ->
-  /// 0.23-0.24, first call 0.64 -> 0.40-0.43, local update 0.059-0.069 ->
-  /// 0.034-0.042; singular fractions unchanged (bench_pgp header). Quiet,
-  /// halves side by side (pthread OpenBLAS): first call 0.39 s wall, local
-  /// update 0.068 s (orientation + scale + PGP).
+  /// With swap_coordinates false only: solve the s and t systems each as the
+  /// complex Hermitian n x n system of z_s (z_t) its real 2n x 2n form stands
+  /// for (half the real flops; equal to the one-system result up to rounding,
+  /// same bytes on any thread count), side by side where the BLAS allows
+  /// concurrent calls. false (one real system) is kept for comparison.
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)

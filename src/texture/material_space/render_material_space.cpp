@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "geometry/render_mesh.h"
 #include "geometry/errors.h"
 
 namespace surftex {
@@ -122,6 +123,31 @@ FragmentCallback material_space_fragment(const RenderMesh& mesh, const PgpSingul
     const float s = ambient + (1 - ambient) * lambert;
     return {albedo[0] * s, albedo[1] * s, albedo[2] * s};
   };
+}
+
+
+MaterialViews render_material_views(const Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile,
+                                    int size, float azimuth_deg, float elevation_deg, double bump) {
+  RenderMesh rm = make_render_mesh(mesh);
+  const Camera cam = fit_camera(bounding_box(rm), azimuth_deg, elevation_deg);
+  RenderOptions ro;
+  ro.width = ro.height = size;
+  ro.color_source = RenderOptions::ColorSource::Callback;
+  MaterialViews o;
+  MaterialRenderOptions mo;
+  mo.lookup = MaterialRenderOptions::Lookup::Plain;
+  ro.callback = material_space_fragment(rm, sing, tile, mo);
+  o.plain = render(rm, cam, ro).color;
+  mo.lookup = MaterialRenderOptions::Lookup::Blended;
+  ro.callback = material_space_fragment(rm, sing, tile, mo);
+  o.fixed = render(rm, cam, ro).color;
+  mo.output = MaterialRenderOptions::Output::NormalMap;
+  mo.bump_strength = bump;
+  mo.light_world = light_direction_world(cam, ro.light_direction);
+  ro.callback = material_space_fragment(rm, sing, tile, mo);
+  ro.shade = false;
+  o.normal = render(rm, cam, ro).color;
+  return o;
 }
 
 }  // namespace surftex

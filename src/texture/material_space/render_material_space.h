@@ -51,4 +51,14 @@ FragmentCallback material_space_fragment(const RenderMesh& mesh, const PgpSingul
 /// towards the viewer) expressed in world coordinates for `camera`.
 Vec3f light_direction_world(const Camera& camera, const Vec3f& light_camera);
 
+/// The three views `material-map` renders (size x size, camera fitted at the
+/// azimuth and elevation): plain lookups (the singularities show), blended
+/// lookups (section 3's fix), and the blended normal map lit (`bump` as
+/// MaterialRenderOptions::bump_strength).
+struct MaterialViews {
+  Image plain, fixed, normal;
+};
+MaterialViews render_material_views(const Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile,
+                                    int size, float azimuth_deg, float elevation_deg, double bump);
+
 }  // namespace surftex

@@ -9,6 +9,8 @@
 
 #include <unordered_map>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -939,6 +941,41 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
   report_progress(opt.progress, "synthesis", 1.0);
   res.seconds_total = total.seconds();
   return res;
+}
+
+nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSynthesisOptions& o) {
+  nlohmann::json j;
+  const SubdivisionScale& sc = r.scale;
+  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"texels_per_edge", sc.texels_per_edge},
+                {"r_scale", sc.r_scale}, {"texel_size", sc.texel_size}, {"exemplar_scale", sc.exemplar_scale},
+                {"exemplar_size", {sc.exemplar_width, sc.exemplar_height}}, {"levels", sc.levels},
+                {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},
+                {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
+                {"predicted_vertices", sc.predicted_vertices}};
+  j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
+               {"bounded_levels", r.bounded_levels}};
+  j["repetition_penalty"] = o.repetition_penalty;
+  j["exhaustive_levels"] = o.exhaustive_levels;
+  j["r_scale"] = sc.r_scale;
+  j["object_unit"] = r.object_unit;
+  j["stack_levels"] = r.stack_levels;
+  j["pyramid"] = o.pyramid;
+  j["passes_per_level"] = o.passes;
+  j["adaptive_factor"] = o.adaptive_factor;
+  j["adaptive_area_std_percent"] = r.adaptive_area_std_percent;
+  j["seconds_synthesis_total"] = r.seconds_total;
+  for (const auto& l : r.levels) {
+    nlohmann::json lj{{"level", l.level}, {"vertices", l.vertices}, {"faces", l.faces}, {"passes", l.passes},
+                      {"fill_passes", l.fill_passes}, {"seconds_subdivide", l.seconds_subdivide},
+                      {"seconds_fields", l.seconds_fields}, {"seconds_synthesis", l.seconds_synthesis}};
+    for (const auto& p : l.pass_stats)
+      lj["pass_stats"].push_back({{"matched", p.matched}, {"patched", p.patched}, {"skipped", p.skipped},
+                                  {"mean_k", p.mean_k}, {"mean_region", p.mean_region}, {"mean_groups", p.mean_groups},
+                                  {"seconds_region", p.seconds_region}, {"seconds_match", p.seconds_match},
+                                  {"seconds_transfer", p.seconds_transfer}});
+    j["levels"].push_back(lj);
+  }
+  return j;
 }
 
 }  // namespace surftex

@@ -63,6 +63,8 @@
 #include <random>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
 #include "geometry/progress.h"
@@ -228,6 +230,11 @@ SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double
 
 SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& exemplar,
                                                      const SubdivisionSynthesisOptions& opt = {});
+
+/// The report's figures of a run with options `opt`: the chosen scale and
+/// levels, the wrap decision, the hierarchy and, per level, its passes
+/// (matched, patched, skipped regions and timings).
+nlohmann::json to_json(const SubdivisionSynthesisResult& result, const SubdivisionSynthesisOptions& opt);
 
 /// An image of the input exemplar's size resampled as the exemplar was for
 /// the synthesis (SubdivisionScale: reduced when exemplar_scale < 1: halved
