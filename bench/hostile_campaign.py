@@ -20,6 +20,8 @@ Every run is classified:
                  number spelling) whose result differs from the seed's
   partial_output something left in OUT after a failure, a missing or extra
                  output after a success, or a staging folder / temporary left
+  broken_install the binary could not load its image IO module (a rebuilt
+                 module beside an older binary): the run measured nothing
 Usage: bench/hostile_campaign.py --binary build/bin/surftex [--server build/bench/hostile_fork_server]
        [--family meshes|images|json|all] [--count N] [--seed S] [--out results.jsonl]
 Prints one JSON line per family with the counts (and writes every run to --out);
@@ -99,6 +101,8 @@ def classify(status, err, seconds, rss_delta, out_dir, expected):
         return "hang"
     if status < 0 or status not in (0, 2) or "Sanitizer" in err or "terminate called" in err or "runtime error" in err:
         return "crash"
+    if "cannot load the image IO module" in err:
+        return "broken_install"  # the binary and its image IO module do not match: the campaign measures nothing
     if any(".surftex-" in x for x in left):
         return "partial_output"
     if status == 2:
@@ -418,9 +422,27 @@ def sphere(work):
     return p
 
 
+JSON_COMPARED = ("mesh.ply", "mesh.png")  # the mapping (m per vertex) and the baked atlas
+
+
+def json_reference(args, work, mesh, tile_case, seed):
+    """The compared outputs of material-map on the unmutated seed (None where the run failed)."""
+    ref = os.path.join(work, "ref")
+    shutil.rmtree(ref, ignore_errors=True)
+    inp = os.path.join(work, "ref.json")
+    tile = make_tile(work, seed) if tile_case else make_tile(work)
+    open(inp, "wb").write(CONSTRAINT_SEEDS[1] if tile_case else seed)
+    subprocess.call(["nice", args.binary, "material-map", mesh, "--tile", tile, "--constraints", inp, "-o",
+                     os.path.join(ref, "m"), "--render-size", "16", "--atlas-size", "128", "-q"],
+                    stderr=subprocess.DEVNULL)
+    files = [os.path.join(ref, "m", f) for f in JSON_COMPARED]
+    return [open(f, "rb").read() if os.path.exists(f) else None for f in files]
+
+
 def campaign_json(args, rnd, work, log):
     mesh = sphere(work)
     counts = {}
+    reference = {}
     for i in range(args.count):
         tile_case = i % 4 == 3
         seed = TILE_SEED if tile_case else CONSTRAINT_SEEDS[i % len(CONSTRAINT_SEEDS)]
@@ -449,6 +471,14 @@ def campaign_json(args, rnd, work, log):
         if status == 2 and "json" in err and re.search(r"\.json: line \d+: field ", err) is None and "layer file" not in err \
                 and "cannot open" not in err and "MiB" not in err:
             outcome = "unnamed_error"
+        if kind.startswith("neutral"):
+            # Blanks around commas change nothing: the mesh and atlas must be the seed's, byte for byte.
+            key = "tile" if tile_case else i % len(CONSTRAINT_SEEDS)
+            if key not in reference:
+                reference[key] = json_reference(args, work, mesh, tile_case, seed)
+            got = [open(os.path.join(out, "m", f), "rb").read() if status == 0 else None for f in JSON_COMPARED]
+            if got != reference[key]:
+                outcome = "silent_misread" if status == 0 else outcome + "_on_neutral"
         counts[outcome] = counts.get(outcome, 0) + 1
         log.write(json.dumps({"family": "json", "file": "tile.json" if tile_case else "constraints", "mutation": kind,
                               "outcome": outcome, "status": status, "seconds": round(sec, 3), "max_rss_mb": round(rss / 2**20),
@@ -457,7 +487,7 @@ def campaign_json(args, rnd, work, log):
 
 
 OUTCOMES = ["clean_error", "success", "crash", "hang", "silent_misread", "partial_output", "over_limits",
-            "unclean_error", "unnamed_error"]
+            "unclean_error", "unnamed_error", "broken_install"]
 
 
 def summarize(paths):
