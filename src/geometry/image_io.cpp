@@ -156,7 +156,11 @@ OIIO::ImageSpec spec_for(const Image& img, const std::string& path, bool eight_b
   OIIO::TypeDesc fmt = (eight_bit || !float_ok) ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
   if (ext == ".exr" && fmt == OIIO::TypeDesc::UINT8) fmt = OIIO::TypeDesc::HALF;
   if (sixteen_bit && ext != ".exr") fmt = OIIO::TypeDesc::UINT16;
-  return OIIO::ImageSpec(img.width, img.height, img.channels, fmt);
+  OIIO::ImageSpec spec(img.width, img.height, img.channels, fmt);
+  // The TIFF writer stamps the current time into its DateTime tag unless one
+  // is given: a fixed one keeps the same input and seed giving the same bytes.
+  if (ext == ".tif" || ext == ".tiff") spec.attribute("DateTime", "2000:01:01 00:00:00");
+  return spec;
 }
 
 void check_writable(const Image& img, const std::string& path) {
