@@ -90,14 +90,7 @@ struct GraphcutOptions {
   int overlap = 0;
   /// Refinement passes after the output is filled (each tries as many error
   /// regions as the fill pass placed patches, see the file comment). Range >= 0.
-  /// Measured (256 output, seed 1, repetition_penalty 0, seam cost after
-  /// fill -> after one pass):
-  /// tree_bark_512 69.5 -> 53.2, ink_a_400 142.0 -> 127.0, brick_small_96
-  /// 709.8 -> 688.7; an earlier variant (the whole patch window matched,
-  /// a 3x3 core at the worst pixel forced, kept only if not worse) gave
-  /// 69.5, 141.3, 709.1. Excluding the translations already at the worst
-  /// seam from the draw was tried and gave higher seam costs (wood_512
-  /// 128-px tile 21.8 -> 32.5), not kept.
+  /// (Figures: docs/decisions/502-graphcut-bench-history.md.)
   int refinement_passes = 1;
   /// Side of the error region of the refinement in pixels (Kwatra et al.
   /// 2003 section 4), 0 = automatic: max(3, overlap/4), at most the patch.
@@ -115,13 +108,8 @@ struct GraphcutOptions {
   /// optimisation (Kaspar et al. 2015, "Self tuning texture optimization")
   /// applied to patch offsets: an output that shows the same exemplar region
   /// twice shows less of the rest (lower completeness, Simakov et al. 2008).
-  /// Measured (256 output, seed 1, one value for all 29 shared textures):
-  /// ink_a_400's output repeated a third of itself (distinct exemplar pixels
-  /// 65% of the output) with 0, 89% with 0.3, and its bidirectional
-  /// dissimilarity fell from 0.00343 to 0.00287; 0.1 left 72%. With the
-  /// error-region refinement, the outputs no worse than G'MIC's median went
-  /// from 23 to 26 of 29 (bench/bench_graphcut.cpp). Cost per placement:
-  /// one pass over the output and one over the exemplar. Range >= 0.
+  /// Cost per placement: one pass over the output and one over the
+  /// exemplar (figures behind 0.3: decision 502). Range >= 0.
   double repetition_penalty = 0.3;
   /// Divide the matching cost by the gradient term (Kwatra eq. 5).
   bool gradient_normalized = false;
@@ -134,25 +122,13 @@ struct GraphcutOptions {
   /// source_matched_line_profile: a line's jump over the exemplar's own jump
   /// at the same sources) exceeds straight_seam_ratio. Eq.-1 cuts can leave
   /// two large patches meeting along a straight overlap edge, a seam the eye
-  /// follows, and the refinement above never raises the eq.-1 cost, so it
-  /// keeps them (measured with bench/bench_graphcut.cpp). An attempt
-  /// takes the worst such line with a stretch not tried yet, the stretch
-  /// (half the repair patch) with the largest excess jump (jump minus the
-  /// exemplar's jump), and pastes a repair patch (a quarter of the output
-  /// side, at least 16 px, at most the patch size) centred on it: a
-  /// lens-shaped band straddling the line there must take the new patch (so
-  /// the line's pairs there become exemplar neighbours), the rest is cut
-  /// freely with the gradient-normalised cost of eq. 5 (new seams along
-  /// texture edges). The offsets tried are the 8 best sub-patch matches of
-  /// the footprint (band left out) not within max(2, repair patch/8) px of a
-  /// translation already in the footprint (continuing one side only moves
-  /// the straight seam). Of those that lower the penalty (summed squared excess of the
-  /// lines above straight_seam_ratio), do not raise the worst line, keep the
-  /// total eq.-1 seam cost within (1 + straight_seam_cost_tolerance) times
-  /// its value before this stage and do not make the output's own wrap lines
-  /// rougher (wrap_seam_ratio above max(its value before, straight_seam_ratio)),
-  /// the one removing the most penalty per unit of eq.-1 cost added is kept.
-  /// Cost: one FFT match and up to 8 small cuts per attempt.
+  /// follows, and the refinement above never raises the eq.-1 cost. Each
+  /// attempt pastes a repair patch centred on the worst stretch of the worst
+  /// line, forced across the line, cut freely elsewhere, and is kept only if
+  /// it lowers the lines' excess without raising the worst line, the seam
+  /// cost (straight_seam_cost_tolerance) or the output's own wrap lines
+  /// (the steps in detail: decision 502). Cost: one FFT match and up to 8
+  /// small cuts per attempt.
   /// Range >= 0; 0 = off.
   int straight_seam_steps = 0;
   /// Source-matched line ratio above which a line is repaired. Range > 1.
