@@ -489,6 +489,25 @@ void fan_triangulate_left(Mesh& mesh, OriginVisitor& vis, SoupRepairCounts& c) {
   }
 }
 
+/// PMP::triangulate_faces on a copy, then a fan for the faces it left. CGAL
+/// 5.5's triangulate_faces can leave a broken halfedge structure (prev/next
+/// mismatch) when it fails on a face (fuzz_off found an OFF file whose
+/// polygons then sent every face circulator round forever): then the
+/// original is fan-triangulated instead, every face from its first corner.
+void triangulate_or_fan(Mesh& mesh, OriginVisitor& vis, SoupRepairCounts& c) {
+  Mesh trial = mesh;
+  const bool done = PMP::triangulate_faces(trial, CGAL::parameters::visitor(vis));
+  if (done || CGAL::is_valid_polygon_mesh(trial)) {
+    mesh = std::move(trial);
+    if (!done) fan_triangulate_left(mesh, vis, c);
+    return;
+  }
+  vis.origin->assign(vis.origin->size(), SIZE_MAX);
+  *vis.current = 0;
+  *vis.split = 0;
+  fan_triangulate_left(mesh, vis, c);
+}
+
 /// Triangulates the non-triangular faces (PMP::triangulate_faces, then a fan
 /// for those it leaves), each triangle keeping its face's material and
 /// corner UVs.
@@ -511,8 +530,9 @@ void triangulate_keeping_attributes(Mesh& mesh, bool has_materials, SoupRepairCo
         list.emplace_back(mesh.target(h), uvm.first[h]);
     }
   OriginVisitor vis{&origin, &current, &split};
-  if (!PMP::triangulate_faces(mesh, CGAL::parameters::visitor(vis))) fan_triangulate_left(mesh, vis, c);
+  triangulate_or_fan(mesh, vis, c);
   c.faces_triangulated = split;
+  uvm = find(mesh, kCornerUV);  // the mesh may be the triangulated copy
   if (has_materials) {
     auto mat = find(mesh, kFaceMaterial).first;
     for (FaceIndex f : mesh.faces()) {
