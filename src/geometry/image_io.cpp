@@ -64,6 +64,18 @@ class StderrCapture {
   int saved_ = -1;
 };
 
+// Runs a decoder step with stderr captured: after a success what it printed
+// is passed on unchanged; after a failure it is left in `printed` for the
+// refusal (with_printed).
+template <class Step>
+bool quietly(std::string& printed, Step step) {
+  StderrCapture capture;
+  const bool ok = step();
+  printed = capture.release();
+  if (ok && !printed.empty()) std::fputs(printed.c_str(), stderr);
+  return ok;
+}
+
 // OpenImageIO's reason `why` with the first line a decoder printed itself
 // added (when it says something new), for a one-line refusal.
 std::string with_printed(std::string why, std::string printed) {
@@ -109,11 +121,10 @@ Image read_current(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec& spec = in.spec();
   check_spec(spec, path, image_limits());
   Image img(spec.width, spec.height, spec.nchannels);
-  StderrCapture decoder_text;
-  const bool decoded =
-      in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img.data.data());
-  const std::string printed = decoder_text.release();
-  if (decoded && !printed.empty()) std::fputs(printed.c_str(), stderr);
+  std::string printed;
+  const bool decoded = quietly(printed, [&] {
+    return in.read_image(in.current_subimage(), 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img.data.data());
+  });
   if (!decoded) {
     const std::string why = with_printed(take_errors(&in), printed);
     in.close();
@@ -138,10 +149,8 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, const Imag
   check_image_container(path, format, lim);
   auto in = OIIO::ImageInput::create(format);
   OIIO::ImageSpec spec;
-  StderrCapture decoder_text;
-  const bool opened = in && in->open(path, spec);
-  const std::string printed = decoder_text.release();
-  if (opened && !printed.empty()) std::fputs(printed.c_str(), stderr);
+  std::string printed;
+  const bool opened = in && quietly(printed, [&] { return in->open(path, spec); });
   if (!opened) {
     const std::string why = with_printed(take_errors(in.get()), printed);
     throw IOError("cannot read image '" + path + "' as " + format + (why.empty() ? "" : ": " + why));

@@ -495,7 +495,9 @@ void fan_triangulate_left(Mesh& mesh, OriginVisitor& vis, SoupRepairCounts& c) {
 /// polygons then sent every face circulator round forever): then the
 /// original is fan-triangulated instead, every face from its first corner.
 void triangulate_or_fan(Mesh& mesh, OriginVisitor& vis, SoupRepairCounts& c) {
-  Mesh trial = mesh;
+  const auto faces = mesh.faces();
+  if (std::all_of(faces.begin(), faces.end(), [&](FaceIndex f) { return mesh.degree(f) == 3; })) return;
+  Mesh trial = mesh;  // only meshes with polygons pay for the copy
   const bool done = PMP::triangulate_faces(trial, CGAL::parameters::visitor(vis));
   if (done || CGAL::is_valid_polygon_mesh(trial)) {
     mesh = std::move(trial);

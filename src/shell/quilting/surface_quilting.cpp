@@ -534,12 +534,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     : mesh_(mesh), swatch_(swatch), opt_(opt), b_(make_base(mesh)), tree_(swatch.mesh), rng_(opt.seed), growth_(mesh) {
   check_options(opt);
   nf_ = static_cast<int>(b_.faces.size());
-  P3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (const P3& p : b_.pts)
-    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
-  const double diag = norm3(sub3(hi, lo));
-  if (!(diag > 0)) throw InvalidInputError("quilt_surface: the base mesh has a zero-size bounding box");
-  S_ = surface_quilt_scale(mesh, swatch, opt.relative_size);
+  S_ = surface_quilt_scale(mesh, swatch, opt.relative_size);  // relative_size > 0 (check_options)
+  if (!(S_ > 0)) throw InvalidInputError("quilt_surface: the base mesh has a zero-size bounding box");
   c_ = opt.cell_size > 0 ? opt.cell_size : std::max(swatch.length(), swatch.width()) / 10.0;
   swatch_cells(swatch, c_, "quilt_surface", sx_, sy_);
   r_full_ = opt.subpatch_radius > 0 ? opt.subpatch_radius : std::max(1, std::min(sx_, sy_) / 4);
