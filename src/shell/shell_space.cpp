@@ -185,36 +185,114 @@ std::size_t mark_inverted_prisms(const ShellSpace& s, const std::vector<std::arr
   return nbad;
 }
 
-/// Offset with local clamping: every top vertex at its base vertex moved
-/// along the vertex normal by the vertex's height; the heights of the
-/// vertices of inverted prisms shrink by shrink_factor per round until none
-/// is left. Throws SolverError after max_shrink_steps rounds.
-void offset_with_clamping(const Mesh& base, const std::vector<Vector3>& normal,
+/// Top vertices at their base vertex moved along its offset direction by its
+/// height.
+void place_top_layer(const std::vector<Vector3>& normal, ShellSpace& s) {
+  for (std::size_t i = 0; i < s.shell_points.size(); i += 2) {
+    const int v = s.base_vertex[i];
+    const Vector3& n = normal[static_cast<std::size_t>(v)];
+    const double hv = s.vertex_height[static_cast<std::size_t>(v)];
+    const Vec3& p = s.shell_points[i];
+    s.shell_points[i + 1] = {p[0] + hv * n.x(), p[1] + hv * n.y(), p[2] + hv * n.z()};
+  }
+}
+
+/// Local clamping: the heights of the vertices of inverted prisms shrink by
+/// shrink_factor per round, at most max_shrink_steps rounds. Returns the
+/// prisms still inverted (their vertices set in `bad`).
+std::size_t shrink_inverted_prisms(const std::vector<Vector3>& normal, const std::vector<std::array<int, 3>>& face_bottom,
+                                   const ShellSpaceOptions& opt, ShellSpace& s, std::vector<std::uint8_t>& shrunk,
+                                   std::vector<std::uint8_t>& bad) {
+  for (int round = 0;; ++round) {
+    place_top_layer(normal, s);
+    const std::size_t nbad = mark_inverted_prisms(s, face_bottom, bad);
+    s.shrink_rounds = round;
+    if (nbad == 0 || round >= opt.max_shrink_steps) return nbad;
+    for (std::size_t v = 0; v < bad.size(); ++v)
+      if (bad[v]) s.vertex_height[v] *= opt.shrink_factor, shrunk[v] = 1;
+  }
+}
+
+/// Base positions as the shell's bottom layer holds them, per base vertex.
+std::vector<Vec3> bottom_positions(const Mesh& base, const ShellSpace& s) {
+  std::vector<Vec3> pos(base.num_vertices(), Vec3{0, 0, 0});
+  for (std::size_t i = 0; i < s.shell_points.size(); i += 2) pos[static_cast<std::size_t>(s.base_vertex[i])] = s.shell_points[i];
+  return pos;
+}
+
+/// Unfolds the base where no offset direction can make a prism positive: a
+/// face turned over against all its neighbours (a fold, e.g. a tiny flipped
+/// triangle in a scanned mesh) inverts its prism at any height. The vertices
+/// in `bad` move to the mean of their neighbours (Jacobi, `passes` times), in
+/// the shell's bottom layer only; the offset directions of every vertex next
+/// to a moved one are recomputed (area-weighted face normals) and the moved
+/// vertices get the full height back. Returns the vertices moved.
+std::size_t unfold_base_layer(const Mesh& base, const std::vector<std::uint8_t>& bad, int passes, ShellSpace& s,
+                              std::vector<Vector3>& normal) {
+  std::vector<Vec3> pos = bottom_positions(base, s);
+  std::size_t moved = 0;
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<Vec3> next = pos;
+    for (VertexIndex v : base.vertices()) {
+      if (!bad[v.idx()] || base.is_isolated(v)) continue;
+      Vec3 sum{0, 0, 0};
+      double n = 0;
+      for (VertexIndex w : base.vertices_around_target(base.halfedge(v))) {
+        for (int k = 0; k < 3; ++k) sum[k] += pos[w.idx()][k];
+        n += 1;
+      }
+      for (int k = 0; k < 3; ++k) next[v.idx()][k] = sum[k] / n;
+    }
+    pos.swap(next);
+  }
+  for (std::size_t i = 0; i < s.shell_points.size(); i += 2) s.shell_points[i] = pos[static_cast<std::size_t>(s.base_vertex[i])];
+  std::vector<std::uint8_t> touched(base.num_vertices(), 0);
+  for (VertexIndex v : base.vertices()) {
+    if (!bad[v.idx()]) continue;
+    ++moved;
+    s.vertex_height[v.idx()] = s.height;
+    touched[v.idx()] = 1;
+    for (VertexIndex w : base.vertices_around_target(base.halfedge(v))) touched[w.idx()] = 1;
+  }
+  for (VertexIndex v : base.vertices()) {
+    if (!touched[v.idx()] || base.is_isolated(v)) continue;
+    Vector3 sum(0, 0, 0);
+    for (FaceIndex f : base.faces_around_target(base.halfedge(v))) {
+      if (f == Mesh::null_face()) continue;
+      std::array<Vec3, 3> p;
+      int k = 0;
+      for (VertexIndex w : base.vertices_around_face(base.halfedge(f))) p[static_cast<std::size_t>(k++)] = pos[w.idx()];
+      const Vector3 a(p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]);
+      const Vector3 b(p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]);
+      sum = sum + CGAL::cross_product(a, b);
+    }
+    const double l = std::sqrt(sum.squared_length());
+    if (l > 0) normal[v.idx()] = sum / l;
+  }
+  return moved;
+}
+
+/// Offset with local clamping (see the header); where shrinking cannot help,
+/// the base layer is unfolded locally (unfold_base_layer, up to 4 times, the
+/// moved set grown by what is still inverted) and the shrinking resumed.
+/// Throws SolverError when prisms stay inverted.
+void offset_with_clamping(const Mesh& base, std::vector<Vector3>& normal,
                           const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
                           ShellSpace& s) {
   s.vertex_height.assign(base.num_vertices(), s.height);
   std::vector<std::uint8_t> shrunk(base.num_vertices(), 0);
-  std::vector<std::uint8_t> bad(base.num_vertices(), 0);
-  for (int round = 0;; ++round) {
-    for (std::size_t i = 0; i < s.shell_points.size(); i += 2) {
-      const int v = s.base_vertex[i];
-      const Vector3& n = normal[static_cast<std::size_t>(v)];
-      const double hv = s.vertex_height[static_cast<std::size_t>(v)];
-      const Vec3& p = s.shell_points[i];
-      s.shell_points[i + 1] = {p[0] + hv * n.x(), p[1] + hv * n.y(), p[2] + hv * n.z()};
-    }
-    const std::size_t nbad = mark_inverted_prisms(s, face_bottom, bad);
-    if (nbad == 0) {
-      s.shrink_rounds = round;
-      break;
-    }
-    if (round >= opt.max_shrink_steps)
-      throw SolverError("shell space: " + std::to_string(nbad) + " prisms still inverted after " +
-                        std::to_string(round) + " shrink rounds (height " + vstr(s.height) +
-                        "; a uv triangle flipped by the atlas, or the surface is too curved for this height)");
-    for (std::size_t v = 0; v < bad.size(); ++v)
-      if (bad[v]) s.vertex_height[v] *= opt.shrink_factor, shrunk[v] = 1;
+  std::vector<std::uint8_t> bad(base.num_vertices(), 0), unfold(base.num_vertices(), 0);
+  std::size_t nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
+  for (int attempt = 0; nbad > 0 && attempt < 4; ++attempt) {
+    for (std::size_t v = 0; v < bad.size(); ++v) unfold[v] |= bad[v];
+    s.unfolded_vertices = unfold_base_layer(base, unfold, 4 << attempt, s, normal);
+    nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
   }
+  if (nbad > 0)
+    throw SolverError("shell space: " + std::to_string(nbad) + " prisms still inverted after " +
+                      std::to_string(s.shrink_rounds) + " shrink rounds and unfolding " +
+                      std::to_string(s.unfolded_vertices) + " base vertices (height " + vstr(s.height) +
+                      "; a uv triangle flipped by the atlas, or the surface is too curved for this height)");
   for (auto x : shrunk) s.clamped_vertices += x;
 }
 }  // namespace

@@ -44,6 +44,9 @@
 // oriented in 3D (CGAL::orientation, exact) or whose top triangle turns over
 // against its base triangle has the heights of its three vertices multiplied
 // by shrink_factor, until no prism is bad (at most max_shrink_steps rounds).
+// Where shrinking cannot help (a face turned over against its neighbours
+// inverts its prism at any height), the shell's bottom layer is unfolded
+// there: those vertices move to their neighbours' mean and shrinking resumes.
 // This keeps the offset surface locally embedded (no flipped face, no inverted
 // tet); it does not test global self-intersection of the offset surface
 // (thin shells, h << feature size, are the caller's responsibility).
@@ -99,6 +102,7 @@ struct ShellSpace {
   std::vector<double> vertex_height; ///< per base vertex, after clamping (mesh units)
   std::size_t clamped_vertices = 0;  ///< base vertices whose height was shrunk
   int shrink_rounds = 0;             ///< rounds of clamping used
+  std::size_t unfolded_vertices = 0; ///< base vertices moved in the bottom layer to undo a fold (0 on most meshes)
 
   /// Texture-space point in metric units: (u, v, w * w_scale).
   Vec3 texture_metric(int i) const {

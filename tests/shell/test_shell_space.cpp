@@ -175,6 +175,42 @@ TEST(ShellSpace, HeightIsClampedInsideACylinderWhereTheOffsetWouldFlip) {
   EXPECT_EQ(build_shell_space(m, opt).clamped_vertices, 0u);
 }
 
+// A fold (faces turned over against their neighbours, as in cow.off) inverts
+// its prisms at every height, so shrinking alone cannot help: the bottom
+// layer is unfolded there, the rest of the base kept exactly.
+TEST(ShellSpace, FoldedFacesAreUnfoldedInTheBottomLayerInsteadOfFailing) {
+  Mesh m;
+  make_grid(m, 8, 8, 1.0, 1.0);
+  set_planar_uv(m, 0.9, 0.05);  // the atlas of the unfolded grid: every uv triangle positive
+  VertexIndex centre;
+  double best = 1e9;
+  for (VertexIndex v : m.vertices()) {
+    const double d = std::hypot(m.point(v).x() - 0.5, m.point(v).y() - 0.5);
+    if (d < best) best = d, centre = v;
+  }
+  const Point3 c = m.point(centre);
+  m.point(centre) = Point3(c.x() + 0.2, c.y() + 0.05, c.z());  // past its right neighbour, in the plane: a fold
+  ShellSpaceOptions opt;
+  opt.height = 0.05;
+  opt.relative_height = false;
+  ShellSpace s = build_shell_space(m, opt);
+  EXPECT_GT(s.unfolded_vertices, 0u);
+  EXPECT_LT(s.unfolded_vertices, 12u);
+  auto [ns, nt] = count_not_positive(s);
+  EXPECT_EQ(ns, 0u);
+  EXPECT_EQ(nt, 0u);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < s.shell_points.size(); i += 2) {
+    const Point3& p = m.point(VertexIndex(static_cast<std::uint32_t>(s.base_vertex[i])));
+    moved += s.shell_points[i] != Vec3{p.x(), p.y(), p.z()};
+  }
+  EXPECT_GT(moved, 0u);
+  EXPECT_LE(moved, s.unfolded_vertices);
+  // Without a fold nothing moves.
+  m.point(centre) = c;
+  EXPECT_EQ(build_shell_space(m, opt).unfolded_vertices, 0u);
+}
+
 TEST(ShellSpace, RefusesMissingAtlasAndBadOptions) {
   Mesh m;
   make_grid(m, 2, 2);

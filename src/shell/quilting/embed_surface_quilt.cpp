@@ -78,6 +78,7 @@ ShellSpace build_quilt_shell(const Mesh& atlas_mesh, double h, EmbedSurfaceQuilt
   ShellSpace shell = build_shell_space(atlas_mesh, so);
   res.tets = shell.tets.size();
   res.clamped_vertices = shell.clamped_vertices;
+  res.unfolded_vertices = shell.unfolded_vertices;
   res.shell_height = shell.height;
   return shell;
 }

@@ -80,6 +80,7 @@ struct EmbedSurfaceQuiltResult {
   BaseMeshAtlasResult atlas;
   MinimizeStretchResult stretch;  ///< stretch_before / stretch_after (normalised eq. 9)
   std::size_t tets = 0, clamped_vertices = 0;
+  std::size_t unfolded_vertices = 0;  ///< base vertices moved to undo a fold (shell_space.h)
   double shell_height = 0;        ///< nominal absolute shell height (mesh units)
   EmbedInShellResult embed;       ///< outside vertices, self-intersecting pairs (all)
   /// The outside vertices by cause: w below 0 / above 1 (the quilt's height

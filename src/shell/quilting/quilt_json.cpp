@@ -74,6 +74,7 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["tets"] = er.tets;
   j["shell_height"] = er.shell_height;
   j["clamped_vertices"] = er.clamped_vertices;
+  if (er.unfolded_vertices > 0) j["unfolded_vertices"] = er.unfolded_vertices;  // only when a fold was undone
   j["stretch_before"] = er.stretch.stretch_before;
   j["stretch_after"] = er.stretch.stretch_after;
   j["outside_vertices"] = er.embed.outside;
