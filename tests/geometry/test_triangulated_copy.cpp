@@ -51,6 +51,26 @@ TEST(TriangulatedCopy, AvoidsAnExistingDiagonal) {
   for (VertexIndex v : t.vertices()) EXPECT_EQ(tc.first[v], col[VertexIndex(from[v.idx()])]);
 }
 
+// Two quads glued along both edges of the valence-2 vertex 1, both with the
+// shorter diagonal 0-2: the second must not reuse the first one's fan
+// diagonal (a-c in four triangles), and takes 1-4.
+TEST(TriangulatedCopy, AvoidsADiagonalOfAnEarlierFan) {
+  Mesh m;
+  std::vector<VertexIndex> v;
+  for (const auto& p : {Point3(0, 0, 0), Point3(1, 0.2, 0), Point3(2, 0, 0), Point3(1, -3, 0), Point3(1, 3, 0)})
+    v.push_back(m.add_vertex(p));
+  ASSERT_NE(m.add_face(v[0], v[1], v[2], v[3]), Mesh::null_face());
+  ASSERT_NE(m.add_face(v[2], v[1], v[0], v[4]), Mesh::null_face());
+  Mesh t;
+  const std::vector<std::uint32_t> from = triangulated_copy(m, t);
+  EXPECT_TRUE(t.is_valid(false));
+  EXPECT_TRUE(all_triangles(t));
+  EXPECT_EQ(t.number_of_faces(), 4u);
+  EXPECT_EQ(from.size(), 5u);
+  EXPECT_TRUE(has_edge(t, 0, 2));
+  EXPECT_TRUE(has_edge(t, 1, 4));
+}
+
 // A lone quad is split along its shorter diagonal.
 TEST(TriangulatedCopy, QuadSplitsAlongTheShorterDiagonal) {
   for (const double stretch : {0.5, 2.0}) {
