@@ -17,12 +17,13 @@
 // (default all, no file output, all cores). out_dir receives
 // CASE_atlas.png and CASE_render.png. texels_per_second is texels over the
 // synthesis wall time; pipeline_cpu_seconds is the process CPU time (all
-// threads) of the pipeline call, which is load-independent.
+// threads) of the synthesis (texture/patches/patch_texture.h step 1), which is
+// load-independent; with_atlas_and_seam is the wall time of the driver call
+// (synthesis, atlas, seam figure).
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
-#include <ctime>
 #include <stdexcept>
 #include <unistd.h>
 #include <memory>
@@ -36,9 +37,7 @@
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
-#include "texture/patches/patch_atlas.h"
-#include "texture/patches/patch_seam_ratio.h"
-#include "texture/patches/patch_synthesis.h"
+#include "texture/patches/patch_texture.h"
 
 using namespace surftex;
 namespace fs = std::filesystem;
@@ -71,14 +70,16 @@ void run_case(const std::string& name, const std::string& mesh_file, const std::
               const std::string& out) {
   Mesh mesh = cgal_mesh(mesh_file);
   const Image ex = rgb(read_image(std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/" + texture));
-  PatchSynthesisOptions po;  // the CLI's defaults
+  PatchTextureOptions to;  // the CLI's synthesis defaults; no PBR maps, no fidelity (not measured here)
+  to.pbr_maps = false;
+  to.fidelity = false;
+  const PatchSynthesisOptions& po = to.synthesis;
   Timer total;
-  const std::clock_t c0 = std::clock();
-  PatchSynthesisResult r = synthesize_patches(mesh, {ex}, po);
-  const double pipeline_cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-  PatchAtlas at = pack_patch_atlas(mesh, r.flat, r.images);
-  const SeamRatioResult s = patch_seam_ratio(mesh, r.flat, at.image);
+  const PatchTextureResult t = synthesize_patch_texture(mesh, {ex}, {}, to);
   const double all = total.seconds();
+  const PatchSynthesisResult& r = t.synthesis;
+  const PatchAtlas& at = t.atlas;
+  const SeamRatioResult& s = t.seam;
   if (!out.empty()) {
     fs::create_directories(out);
     write_image(out + "/" + name + "_atlas.png", at.image);
@@ -107,7 +108,7 @@ void run_case(const std::string& name, const std::string& mesh_file, const std::
   j["seconds"] = {{"partition", r.seconds_partition}, {"field", r.seconds_field},
                   {"flatten", r.seconds_flatten},     {"synthesis", r.seconds_synthesis},
                   {"pipeline", r.seconds_total},      {"with_atlas_and_seam", all}};
-  j["pipeline_cpu_seconds"] = pipeline_cpu;
+  j["pipeline_cpu_seconds"] = t.cpu_seconds_synthesis;
   j["threads"] = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   j["synthesis_share"] = r.seconds_synthesis / r.seconds_total;
   j["seam_ratio"] = s.ratio;

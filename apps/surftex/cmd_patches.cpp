@@ -25,13 +25,8 @@
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
 #include "texture/image_ops.h"
-#include "texture/patches/patch_atlas.h"
-#include "texture/patches/patch_exemplar_maps.h"
-#include "texture/pbr_maps.h"
-#include "texture/patches/patch_seam_ratio.h"
-#include "texture/patches/patch_synthesis.h"
+#include "texture/patches/patch_texture.h"
 #include "texture/procedural_texture.h"
-#include "texture/surface_fidelity.h"
 
 namespace fs = std::filesystem;
 
@@ -104,96 +99,35 @@ MultiTexture parse_multi(const std::string& m) {
   throw InvalidInputError("--multi '" + m + "' is not none|illumination|curvature|height");
 }
 
-// Maps given beside the colour exemplar (--exemplar-normal, --exemplar-height,
-// --exemplar-roughness), each empty when not given.
-struct ExemplarMaps {
-  Image normal, height, roughness;
-};
-
-// The pipeline and every output into `dir`; returns the report. The atlas
-// (mesh.png, power of two, mip gutters) comes with a height map
-// (mesh_height.png, 16-bit) and a tangent-space normal map (mesh_normal.png):
-// exemplar maps resampled through the same synthesis coordinates when given
-// (texture/patches/patch_exemplar_maps.h), else height = luminance and the normal
-// from the height (`bump` = tilt per unit height slope, height per exemplar
-// texel: one atlas texel is one exemplar texel); roughness -> mesh_roughness.png
-// and the GLB's metallicRoughnessTexture.
-nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars,
-                            const PatchSynthesisOptions& po, const std::string& dir,
-                            std::uint64_t seed, double bump, const ExemplarMaps& maps = {}) {
-  Timer total;
-  PatchSynthesisResult r = synthesize_patches(mesh, exemplars, po);
+// The driver (texture/patches/patch_texture.h) and every output into `dir`;
+// returns the report. The atlas (mesh.png, power of two, mip gutters) comes
+// with a height map (mesh_height.png, 16-bit) and a tangent-space normal map
+// (mesh_normal.png), with --exemplar-roughness mesh_roughness.png and the
+// GLB's metallicRoughnessTexture; render.png shows the atlas.
+nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars, const PatchTextureOptions& o,
+                            const std::string& dir, const PatchExemplarMaps& maps = {}) {
+  const PatchTextureResult r = synthesize_patch_texture(mesh, exemplars, maps, o);
   Timer tout;
-  const std::array<int, 2> ex_size{exemplars[0].width, exemplars[0].height};
-  auto map_atlas = [&](const Image& m, bool normal) {
-    return pack_patch_atlas(mesh, r.flat, resample_patch_map(r, m, ex_size, po.el, normal)).image;
-  };
-  Image height, normal, mr;
-  if (!maps.height.empty()) {
-    height = map_atlas(maps.height, false);
-    if (height.channels != 1) height = height_from_luminance(height);
-  }
-  if (!maps.normal.empty()) normal = map_atlas(maps.normal, true);
-  if (!maps.roughness.empty()) mr = metallic_roughness_from_roughness(height_from_luminance(map_atlas(maps.roughness, false)));
-  PatchAtlas atlas = pack_patch_atlas(mesh, r.flat, r.images);
-  if (height.empty()) height = height_from_luminance(atlas.image);
-  if (normal.empty()) normal = normal_map_from_height(height, atlas.chart, bump);
-  const double s_atlas = tout.seconds();
-  Timer tseam;
-  SeamRatioOptions so;
-  so.seed = seed;
-  const SeamRatioResult seam = patch_seam_ratio(mesh, r.flat, atlas.image, so);
-  const double s_seam = tseam.seconds();
-  tout.reset();
   ensure_directory(dir);
   WriteMeshOptions wo;
-  wo.texture = &atlas.image;
-  wo.normal_texture = &normal;
-  wo.height_texture = &height;
-  wo.metallic_roughness_texture = &mr;
+  wo.texture = &r.atlas.image;
+  wo.normal_texture = &r.normal;
+  wo.height_texture = &r.height;
+  wo.metallic_roughness_texture = &r.metallic_roughness;
   wo.texture_repeat = false;
   wo.write_colors = false;
   write_mesh((fs::path(dir) / "mesh.obj").string(), mesh, wo);
   wo.height_texture = nullptr;
   write_mesh((fs::path(dir) / "mesh.glb").string(), mesh, wo);
   ViewOptions view;
-  view.texture = &atlas.image;
+  view.texture = &r.atlas.image;
   write_image((fs::path(dir) / "render.png").string(), render_view(mesh, view));
   const double s_write = tout.seconds();
-  nlohmann::json j;
-  j["patches"] = r.flat.patches.size();
-  j["greedy_patches"] = r.partition.greedy_patches;
-  j["split_patches"] = r.split_patches;
-  j["merged_patches"] = r.partition.merged_patches;
-  j["reassigned_faces"] = r.partition.reassigned_faces;
-  j["max_normal_deviation_deg"] = r.partition.max_deviation_deg;
-  j["patch_resolution"] = po.flatten.resolution;
-  j["texel_size"] = r.flat.texel;
-  j["dropped_boundary_triangles"] = r.flat.dropped_boundary;
-  j["texels_synthesized"] = r.texels;
-  j["texels_seeded"] = r.seeded;
-  j["known_boundary_pixels"] = r.known_boundary;
-  j["texels_per_second"] = r.texels / std::max(r.seconds_synthesis, 1e-9);
-  j["seconds"] = {{"partition", r.seconds_partition}, {"field", r.seconds_field},
-                  {"flatten", r.seconds_flatten},     {"synthesis", r.seconds_synthesis},
-                  {"atlas", s_atlas},                 {"seam_metric", s_seam},
-                  {"write", s_write},                 {"total", total.seconds()}};
-  j["synthesis_share"] = r.seconds_synthesis / std::max(r.seconds_total, 1e-9);
-  j["seam"] = {{"ratio", seam.ratio},
-               {"mean_jump_across", seam.mean_across},
-               {"mean_jump_within", seam.mean_within},
-               {"pairs_across", seam.pairs_across},
-               {"pairs_within", seam.pairs_within},
-               {"step_texels", so.step_texels}};
-  j["atlas"] = {{"width", atlas.image.width}, {"height", atlas.image.height}, {"gutter", atlas.gutter},
-                {"protected_mip_size", atlas.protected_mip_size}, {"bump", bump},
-                {"normal_source", maps.normal.empty() ? "height" : "exemplar_normal"},
-                {"height_source", maps.height.empty() ? "luminance" : "exemplar_height"},
-                {"roughness", !maps.roughness.empty()}};
-  j["fidelity"] = atlas_fidelity_report(mesh, exemplars[0], atlas.image, r.flat.texel,  // issue 18 item 3
-                                        po.field != PatchField::None, seed);
+  nlohmann::json j = to_json(r);
+  j["seconds"]["write"] = s_write;
+  j["seconds"]["total"] = r.seconds_total + s_write;
   j["outputs"] = {"mesh.obj", "mesh.mtl", "mesh.png", "mesh_normal.png", "mesh_height.png", "mesh.glb", "render.png"};
-  if (!maps.roughness.empty()) j["outputs"].push_back("mesh_roughness.png");
+  if (!r.metallic_roughness.empty()) j["outputs"].push_back("mesh_roughness.png");
   return j;
 }
 
@@ -215,7 +149,9 @@ int run(const PatchArgs& a) {
         throw InvalidInputError(std::string(what) + " with --exemplar2: exemplar maps follow the first exemplar "
                                 "only; multi-texturing with maps is not supported");
     }
-  PatchSynthesisOptions po;
+  PatchTextureOptions to;
+  to.bump = a.bump;
+  PatchSynthesisOptions& po = to.synthesis;
   po.field = parse_field(a.field);
   po.multi = parse_multi(a.multi);
   if (po.multi != MultiTexture::None && a.exemplar2.empty())
@@ -229,7 +165,7 @@ int run(const PatchArgs& a) {
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common);
   const Image colour = read_image(a.exemplar);
   // Exemplar maps: the colour exemplar's size, resized with it.
-  ExemplarMaps maps;
+  PatchExemplarMaps maps;
   auto read_map = [&](const std::string& path, const char* what) -> Image {
     Image m = read_exemplar_map(path, what, a.exemplar, colour);
     return m.empty() ? m : as_rgb(m, a.exemplar_size);
@@ -254,7 +190,7 @@ int run(const PatchArgs& a) {
   check_budget(estimate_patches(mesh.number_of_faces(), ex[0].width, ex[0].height, static_cast<int>(ex.size()),
                                 a.patch_res, a.max_faces, a.window, a.rotations),
                a.common);
-  nlohmann::json rep = run_pipeline(mesh, ex, po, a.outdir, a.common.seed, a.bump, maps);
+  nlohmann::json rep = run_pipeline(mesh, ex, to, a.outdir, maps);
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
@@ -364,7 +300,8 @@ DemoStepRegistrar demo{{30, "patches",
                           z_up_to_y_up(mesh);  // lying flat in glTF viewers
                           const Image ex = make_stripes(48, 8, 0);
                           write_image(ctx.path("patches_exemplar.png"), ex);
-                          PatchSynthesisOptions po;
+                          PatchTextureOptions to;  // bump 2
+                          PatchSynthesisOptions& po = to.synthesis;
                           po.field = PatchField::Kmax;
                           po.flatten.resolution = 48;
                           po.flatten.margin = 3;
@@ -372,8 +309,7 @@ DemoStepRegistrar demo{{30, "patches",
                           po.el.window = 9;
                           po.el.rotations = 32;
                           po.seed = ctx.seed;
-                          nlohmann::json j =
-                              run_pipeline(mesh, {ex}, po, ctx.path("patches"), ctx.seed, 2.0);
+                          nlohmann::json j = run_pipeline(mesh, {ex}, to, ctx.path("patches"));
                           write_file_atomic(ctx.path("patches/report.json"), j.dump(2) + "\n", true);
                           for (auto& name : j["outputs"]) name = "patches/" + name.get<std::string>();  // under the demo folder
                           return j;

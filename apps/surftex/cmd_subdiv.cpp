@@ -7,18 +7,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <type_traits>
-#include <unordered_set>
 #include <utility>
 #include <vector>
 
-#include "geometry/bake_vertex_colors.h"
-#include "geometry/gutter_atlas.h"
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/output_file.h"
-#include "geometry/polygon_util.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
@@ -28,76 +23,14 @@
 #include "surftex/command.h"
 #include "surftex/demo_steps.h"
 #include "texture/displace_by_vertex_color.h"
-#include "texture/pbr_maps.h"
 #include "texture/procedural_texture.h"
-#include "texture/subdivision/subdivision_exemplar_maps.h"
+#include "texture/subdivision/subdivision_asset.h"
 #include "texture/subdivision/subdivision_synthesis.h"
-#include "texture/surface_fidelity.h"
-#include "texture/tangent_space_bake.h"
 
 namespace fs = std::filesystem;
 
 namespace surftex::cli {
 namespace {
-
-// Fan triangulation keeping vertex indices and colours (quads split along the
-// shorter diagonal), for the atlas (compute_base_mesh_atlas wants triangles).
-// A fan diagonal that already exists as an edge (of the mesh, or of another
-// face's fan) would make the result non-manifold; that happens on messy
-// input, e.g. around valence-2 vertices. The other fan starts are tried, and
-// if every start has such a diagonal, the face's fan is built on copies of
-// its vertices (same positions and colours): a separate small component that
-// the atlas charts on its own. `from` (optional) receives the source vertex
-// of every vertex of the copy.
-Mesh triangulated_copy(const Mesh& m, std::vector<VertexIndex>* from_out = nullptr) {
-  auto key = [](VertexIndex a, VertexIndex b) {
-    const std::uint64_t x = std::min(a.idx(), b.idx()), y = std::max(a.idx(), b.idx());
-    return (x << 32) | y;
-  };
-  std::unordered_set<std::uint64_t> edges;
-  for (EdgeIndex e : m.edges()) edges.insert(key(m.vertex(e, 0), m.vertex(e, 1)));
-  Mesh t;
-  std::vector<VertexIndex> from;  // source vertex of every vertex of t
-  std::vector<VertexIndex> to(m.num_vertices(), Mesh::null_vertex());
-  for (VertexIndex v : m.vertices()) {
-    to[v.idx()] = t.add_vertex(m.point(v));
-    from.push_back(v);
-  }
-  for (FaceIndex f : m.faces()) {
-    std::vector<VertexIndex> vs;
-    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) vs.push_back(v);
-    if (vs.size() == 4 && (m.point(vs[0]) - m.point(vs[2])).squared_length() >
-                              (m.point(vs[1]) - m.point(vs[3])).squared_length())
-      std::rotate(vs.begin(), vs.begin() + 1, vs.end());
-    bool fits = false;
-    for (std::size_t start = 0; start < vs.size() && !fits; ++start) {
-      fits = true;
-      for (std::size_t i = 2; i + 1 < vs.size() && fits; ++i) fits = !edges.count(key(vs[0], vs[i]));
-      if (!fits) std::rotate(vs.begin(), vs.begin() + 1, vs.end());
-    }
-    std::vector<VertexIndex> tv;
-    if (fits) {
-      for (std::size_t i = 2; i + 1 < vs.size(); ++i) edges.insert(key(vs[0], vs[i]));
-      for (VertexIndex v : vs) tv.push_back(to[v.idx()]);
-    } else {
-      for (VertexIndex v : vs) {
-        tv.push_back(t.add_vertex(m.point(v)));
-        from.push_back(v);
-      }
-    }
-    for (std::size_t i = 1; i + 1 < tv.size(); ++i)
-      if (t.add_face(tv[0], tv[i], tv[i + 1]) == Mesh::null_face())
-        throw TopologyError("subdiv: could not triangulate face " + std::to_string(f.idx()) +
-                            " for the atlas");
-  }
-  auto src = find(m, kVertexColor);
-  if (src.second) {
-    auto dst = get_or_add(t, kVertexColor);
-    for (VertexIndex v : t.vertices()) dst[v] = src.first[from[v.idx()]];
-  }
-  if (from_out) *from_out = std::move(from);
-  return t;
-}
 
 struct Outputs {
   std::string ply, glb, obj, render;
@@ -118,86 +51,35 @@ std::vector<std::string> output_files(const std::string& dir) {
   return f;
 }
 
-struct PbrSettings {
-  int atlas_size = 1024;
-  double bump = 2;              ///< tilt per unit height slope, height per exemplar texel
-  double texels_per_length = 0; ///< exemplar texels per mesh unit
-  double texel_size = 0;        ///< synthesis texel in mesh units: > 0 measures the atlas seams (issue 18 item 3)
-};
-
-// Per-vertex values read from the exemplar maps (--exemplar-height,
-// --exemplar-roughness: one per vertex; --exemplar-normal: object-space unit
-// normals), by vertex index of the synthesised mesh; empty = not given.
-struct VertexMaps {
-  std::vector<float> height, roughness;
-  std::vector<std::array<float, 3>> normal;
-};
-
-// The vertex colours baked into a gutter atlas of a triangulated copy, with
-// height (luminance) and normal maps: surface_atlas.obj (+MTL, maps) and
-// surface.glb (atlas as base colour, normal map, vertex colours kept as
-// _COLOR beside the texture that holds them: COLOR_0 would multiply it);
-// surface.ply keeps the polygons with COLOR_0-style vertex colours. With
-// exemplar maps: height and roughness baked from their vertex values like the
-// colour (roughness -> surface_atlas_roughness.png, the GLB's
-// metallicRoughnessTexture), the normal map from the object-space vertex
-// normals in the GLB's tangent frames (texture/tangent_space_bake.h), else
-// from the height.
-nlohmann::json write_outputs(Mesh& mesh, const Outputs& o, bool force, const PbrSettings& pbr,
-                             const VertexMaps& maps = {}) {
+// Writes the synthesised `mesh` and its baked asset: surface.ply keeps the
+// polygons with COLOR_0-style vertex colours; surface_atlas.obj (+MTL, maps)
+// and surface.glb hold the asset's triangle copy (the atlas as base colour,
+// normal map, vertex colours kept as _COLOR beside the texture that holds
+// them: COLOR_0 would multiply it; roughness as the GLB's
+// metallicRoughnessTexture); render.png shows the vertex colours. Returns
+// the report's "export" block with "files" (every path written).
+nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, const Outputs& o, bool force) {
   nlohmann::json j;
   Timer t;
   WriteMeshOptions wo;
   wo.overwrite = force;
   wo.write_uvs = false;
   std::vector<std::string> files = write_mesh(o.ply, mesh, wo);
-  j["seconds_write_mesh"] = t.seconds();
-  t.reset();
-  std::vector<VertexIndex> from;
-  Mesh tri = triangulated_copy(mesh, &from);
-  const GutterAtlas ga = compute_gutter_atlas(tri, pbr.atlas_size);
-  BakeOptions bo;
-  bo.size = pbr.atlas_size;
-  const BakeResult baked = bake_vertex_colors(tri, bo);
-  auto on_copy = [&](const auto& per_vertex) {  // values of `mesh` -> vertices of `tri`
-    std::vector<typename std::decay_t<decltype(per_vertex)>::value_type> t(tri.num_vertices());
-    for (VertexIndex v : tri.vertices()) t[v.idx()] = per_vertex[from[v.idx()].idx()];
-    return t;
-  };
-  const Image height = maps.height.empty() ? height_from_luminance(baked.image)
-                                           : bake_vertex_values(tri, on_copy(maps.height), 1, bo).image;
-  const double atlas_per_exemplar = ga.atlas.uv_per_length * pbr.atlas_size / pbr.texels_per_length;
-  const Image normal = maps.normal.empty()
-                           ? normal_map_from_height(height, baked.chart, pbr.bump * atlas_per_exemplar)
-                           : tangent_space_normal_map(tri, on_copy(maps.normal), pbr.atlas_size);
-  Image mr;
-  if (!maps.roughness.empty())
-    mr = metallic_roughness_from_roughness(bake_vertex_values(tri, on_copy(maps.roughness), 1, bo).image);
   WriteMeshOptions ao;
   ao.overwrite = force;
   ao.write_colors = false;
-  ao.texture = &baked.image;
-  ao.normal_texture = &normal;
-  ao.height_texture = &height;
-  ao.metallic_roughness_texture = &mr;
+  ao.texture = &asset.color.image;
+  ao.normal_texture = &asset.normal;
+  ao.height_texture = &asset.height;
+  ao.metallic_roughness_texture = &asset.metallic_roughness;
   ao.texture_repeat = false;
-  for (const std::string& f : write_mesh(o.obj, tri, ao)) files.push_back(f);
+  for (const std::string& f : write_mesh(o.obj, *asset.mesh, ao)) files.push_back(f);
   ao.height_texture = nullptr;
   ao.write_colors = true;
   ao.color_attribute = "_COLOR";
-  for (const std::string& f : write_mesh(o.glb, tri, ao)) files.push_back(f);
-  const double N2 = double(pbr.atlas_size) * pbr.atlas_size;
-  j["atlas"] = {{"charts", ga.atlas.num_charts}, {"size", pbr.atlas_size}, {"coverage", double(baked.covered) / N2},
-                {"gutter", ga.gutter}, {"gutter_violations", ga.violations}, {"margin", ga.margin},
-                {"protected_mip_size", ga.protected_mip_size},
-                {"mean_area_distortion", ga.atlas.mean_area_distortion}, {"flipped_faces", ga.atlas.flipped_faces},
-                {"bump", pbr.bump}, {"atlas_texels_per_exemplar_texel", atlas_per_exemplar},
-                {"normal_source", maps.normal.empty() ? "height" : "exemplar_normal"},
-                {"height_source", maps.height.empty() ? "luminance" : "exemplar_height"},
-                {"roughness", !maps.roughness.empty()}, {"seconds", {{"bake", t.seconds()}}}};
-  if (pbr.texel_size > 0)  // colour jumps across the baked atlas's chart seams (issue 18 item 3)
-    j["atlas"]["seam"] = to_json(surface_seam_ratio(tri, atlas_color_source(tri, baked.image),
-                                                    seam_edges_from_corner_uv(tri), pbr.texel_size));
+  for (const std::string& f : write_mesh(o.glb, *asset.mesh, ao)) files.push_back(f);
+  j["seconds_write_mesh"] = t.seconds();
+  j["atlas"] = to_json(asset);
   t.reset();
   ViewOptions view;
   view.colors = ViewOptions::Colors::VertexColors;
@@ -251,21 +133,6 @@ void print_scale(const SubdivisionSynthesisResult& r) {
                r.periodic ? "wrapped as periodic" : "not wrapped", r.wrap_seam_ratio);
 }
 
-// Issue 18 item 3: the vertex colours resampled in charts at the synthesis
-// texel, against the exemplar as synthesised.
-nlohmann::json subdiv_fidelity(const Mesh& mesh, const SubdivisionSynthesisResult& r, std::uint64_t seed) {
-  SurfaceFidelityOptions fo;
-  fo.texel_size = r.scale.texel_size;
-  fo.periodic_exemplar = r.periodic;
-  fo.seed = seed;
-  fo.source = vertex_source_coordinates(r.source);
-  try {
-    return to_json(surface_fidelity(mesh, r.exemplar, vertex_color_source(mesh), frames_from_vertex_directions(mesh), fo));
-  } catch (const InvalidInputError& e) {  // e.g. no chart fits a tiny or very thin mesh
-    return {{"error", e.what()}};
-  }
-}
-
 struct SubdivArgs {
   std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
   std::string exemplar_normal, exemplar_height, exemplar_roughness;
@@ -280,15 +147,11 @@ struct SubdivArgs {
 // Exemplar maps (--exemplar-normal, --exemplar-height, --exemplar-roughness):
 // each the colour exemplar's size, a normal map RGB. Read before the
 // synthesis, so a bad map stops the run before any output.
-struct ExemplarMaps {
-  Image normal, height, roughness;
-};
-
-ExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
+SubdivisionExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
   auto read_map = [&](const std::string& path, const char* what) -> Image {
     return read_exemplar_map(path, what, a.exemplar, colour);
   };
-  ExemplarMaps maps;
+  SubdivisionExemplarMaps maps;
   maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");
   if (!maps.normal.empty() && maps.normal.channels < 3)
     throw InvalidInputError("--exemplar-normal '" + a.exemplar_normal + "' has " +
@@ -296,30 +159,6 @@ ExemplarMaps read_exemplar_maps(const SubdivArgs& a, const Image& colour) {
   maps.height = read_map(a.exemplar_height, "--exemplar-height");
   maps.roughness = read_map(a.exemplar_roughness, "--exemplar-roughness");
   return maps;
-}
-
-// The maps' values at the final vertices, where the colour was read
-// (texture/subdivision/subdivision_exemplar_maps.h); `filled` counts vertices without a lookup.
-VertexMaps vertex_maps(const Mesh& mesh, const SubdivisionSynthesisResult& r, const ExemplarMaps& maps, int w, int h,
-                       std::size_t& filled) {
-  VertexMaps vm;
-  filled = 0;
-  if (!maps.height.empty()) {
-    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.height, w, h);
-    vm.height = vertex_luminance(v);
-    filled = v.filled;
-  }
-  if (!maps.roughness.empty()) {
-    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.roughness, w, h);
-    vm.roughness = vertex_luminance(v);
-    filled = v.filled;
-  }
-  if (!maps.normal.empty()) {
-    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.normal, w, h);
-    vm.normal = object_normals_from_map(mesh, v);
-    filled = v.filled;
-  }
-  return vm;
 }
 
 int run_subdiv(const SubdivArgs& a) {
@@ -344,7 +183,7 @@ int run_subdiv(const SubdivArgs& a) {
   // sqrt(2)-subdivision takes any polygons: they are kept when they need no repair.
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common, true);
   const Image ex = read_image(a.exemplar);
-  const ExemplarMaps maps = read_exemplar_maps(a, ex);
+  const SubdivisionExemplarMaps maps = read_exemplar_maps(a, ex);
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;
@@ -377,11 +216,17 @@ int run_subdiv(const SubdivArgs& a) {
   check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, est_levels, a.atlas), a.common);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
   if (!a.common.quiet) print_scale(r);
-  const nlohmann::json fidelity = subdiv_fidelity(mesh, r, a.common.seed);
+  const nlohmann::json fidelity = subdivision_fidelity_report(mesh, r, a.common.seed);
   DisplaceResult disp;
   if (a.displace != 0) disp = displace_by_vertex_color(mesh, a.displace * r.object_unit);
-  std::size_t no_lookup = 0;  // frames of the surface as written (after --displace)
-  const VertexMaps vmaps = vertex_maps(mesh, r, maps, ex.width, ex.height, no_lookup);
+  // frames of the surface as written (after --displace)
+  const SubdivisionVertexMaps vmaps = exemplar_maps_at_vertices(mesh, r, maps, ex.width, ex.height);
+  SubdivisionAssetOptions ao;
+  ao.atlas_size = a.atlas;
+  ao.bump = a.bump;
+  ao.texels_per_length = r.scale.r_scale / r.object_unit;
+  ao.texel_size = r.scale.texel_size;
+  const SubdivisionAsset asset = bake_subdivision_asset(mesh, vmaps, ao);
   ensure_directory(a.outdir);
   nlohmann::json rep = to_json(r, o);
   rep["fidelity"] = fidelity;
@@ -392,13 +237,8 @@ int run_subdiv(const SubdivArgs& a) {
   rep["displace"] = a.displace;
   if (!a.exemplar_normal.empty() || !a.exemplar_height.empty() || !a.exemplar_roughness.empty())
     rep["exemplar_maps"] = {{"normal", a.exemplar_normal}, {"height", a.exemplar_height},
-                            {"roughness", a.exemplar_roughness}, {"vertices_without_lookup", no_lookup}};
-  PbrSettings pbr;
-  pbr.atlas_size = a.atlas;
-  pbr.bump = a.bump;
-  pbr.texels_per_length = r.scale.r_scale / r.object_unit;
-  pbr.texel_size = r.scale.texel_size;
-  nlohmann::json written = write_outputs(mesh, out, a.common.force, pbr, vmaps);
+                            {"roughness", a.exemplar_roughness}, {"vertices_without_lookup", vmaps.filled}};
+  nlohmann::json written = write_outputs(mesh, asset, out, a.common.force);
   const RunFiles files{inputs, written["files"].get<std::vector<std::string>>()};
   rep["seconds"] = {{"read", seconds_read},
                     {"synthesis", r.seconds_total},
@@ -539,10 +379,11 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  const std::string dir = ctx.path("subdiv");
                                  ensure_directory(dir);
                                  nlohmann::json j = to_json(r, {});
-                                 PbrSettings pbr;
-                                 pbr.atlas_size = 512;
-                                 pbr.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
-                                 nlohmann::json written = write_outputs(mesh, output_paths(dir), true, pbr);
+                                 SubdivisionAssetOptions ao;
+                                 ao.atlas_size = 512;
+                                 ao.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
+                                 const SubdivisionAsset asset = bake_subdivision_asset(mesh, {}, ao);
+                                 nlohmann::json written = write_outputs(mesh, asset, output_paths(dir), true);
                                  // Report keys as the CLI's (issue 16 item 7): names under the demo folder.
                                  for (const auto& f : written["files"])
                                    j["outputs"].push_back(fs::relative(f.get<std::string>(), ctx.dir).string());

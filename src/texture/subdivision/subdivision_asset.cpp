@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "texture/subdivision/subdivision_asset.h"
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/timer.h"
+#include "geometry/triangulated_copy.h"
+#include "texture/pbr_maps.h"
+#include "texture/subdivision/subdivision_exemplar_maps.h"
+#include "texture/tangent_space_bake.h"
+
+namespace surftex {
+
+SubdivisionAsset::SubdivisionAsset() = default;
+SubdivisionAsset::~SubdivisionAsset() = default;
+SubdivisionAsset::SubdivisionAsset(SubdivisionAsset&&) noexcept = default;
+SubdivisionAsset& SubdivisionAsset::operator=(SubdivisionAsset&&) noexcept = default;
+
+SubdivisionVertexMaps exemplar_maps_at_vertices(const Mesh& mesh, const SubdivisionSynthesisResult& r,
+                                                const SubdivisionExemplarMaps& maps, int w, int h) {
+  SubdivisionVertexMaps vm;
+  if (!maps.height.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.height, w, h);
+    vm.height = vertex_luminance(v);
+    vm.filled = v.filled;
+  }
+  if (!maps.roughness.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.roughness, w, h);
+    vm.roughness = vertex_luminance(v);
+    vm.filled = v.filled;
+  }
+  if (!maps.normal.empty()) {
+    const VertexMapValues v = read_map_at_vertices(mesh, r, maps.normal, w, h);
+    vm.normal = object_normals_from_map(mesh, v);
+    vm.filled = v.filled;
+  }
+  return vm;
+}
+
+nlohmann::json subdivision_fidelity_report(const Mesh& mesh, const SubdivisionSynthesisResult& r,
+                                           std::uint64_t seed) {
+  SurfaceFidelityOptions fo;
+  fo.texel_size = r.scale.texel_size;
+  fo.periodic_exemplar = r.periodic;
+  fo.seed = seed;
+  fo.source = vertex_source_coordinates(r.source);
+  try {
+    return to_json(surface_fidelity(mesh, r.exemplar, vertex_color_source(mesh), frames_from_vertex_directions(mesh), fo));
+  } catch (const InvalidInputError& e) {  // e.g. no chart fits a tiny or very thin mesh
+    return {{"error", e.what()}};
+  }
+}
+
+namespace {
+
+// Values of the synthesised mesh -> vertices of the triangle copy.
+template <class T>
+std::vector<T> on_copy(const std::vector<T>& per_vertex, const std::vector<std::uint32_t>& from) {
+  std::vector<T> t(from.size());
+  for (std::size_t v = 0; v < from.size(); ++v) t[v] = per_vertex[from[v]];
+  return t;
+}
+
+// The PBR maps of the baked atlas (file comment).
+void bake_maps(SubdivisionAsset& a, const SubdivisionVertexMaps& maps, const std::vector<std::uint32_t>& from) {
+  const Mesh& tri = *a.mesh;
+  const SubdivisionAssetOptions& o = a.options;
+  BakeOptions bo;
+  bo.size = o.atlas_size;
+  a.height_from_exemplar = !maps.height.empty();
+  a.normal_from_exemplar = !maps.normal.empty();
+  a.height = maps.height.empty() ? height_from_luminance(a.color.image)
+                                 : bake_vertex_values(tri, on_copy(maps.height, from), 1, bo).image;
+  a.atlas_texels_per_exemplar_texel = a.atlas.atlas.uv_per_length * o.atlas_size / o.texels_per_length;
+  a.normal = maps.normal.empty()
+                 ? normal_map_from_height(a.height, a.color.chart, o.bump * a.atlas_texels_per_exemplar_texel)
+                 : tangent_space_normal_map(tri, on_copy(maps.normal, from), o.atlas_size);
+  if (!maps.roughness.empty())
+    a.metallic_roughness =
+        metallic_roughness_from_roughness(bake_vertex_values(tri, on_copy(maps.roughness, from), 1, bo).image);
+}
+
+}  // namespace
+
+SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVertexMaps& maps,
+                                        const SubdivisionAssetOptions& options) {
+  if (!(options.texels_per_length > 0))
+    throw InvalidInputError("bake_subdivision_asset: texels_per_length " + std::to_string(options.texels_per_length) +
+                            " must be > 0");
+  Timer t;
+  SubdivisionAsset a;
+  a.options = options;
+  a.mesh = std::make_unique<Mesh>();
+  const std::vector<std::uint32_t> from = triangulated_copy(mesh, *a.mesh);
+  Mesh& tri = *a.mesh;
+  a.atlas = compute_gutter_atlas(tri, options.atlas_size);
+  BakeOptions bo;
+  bo.size = options.atlas_size;
+  a.color = bake_vertex_colors(tri, bo);
+  bake_maps(a, maps, from);
+  if (options.texel_size > 0) {
+    a.seam = surface_seam_ratio(tri, atlas_color_source(tri, a.color.image), seam_edges_from_corner_uv(tri),
+                                options.texel_size);
+    a.seam_measured = true;
+  }
+  a.seconds = t.seconds();
+  return a;
+}
+
+nlohmann::json to_json(const SubdivisionAsset& a) {
+  const int size = a.options.atlas_size;
+  const double N2 = double(size) * size;
+  const GutterAtlas& ga = a.atlas;
+  nlohmann::json j = {{"charts", ga.atlas.num_charts},
+                      {"size", size},
+                      {"coverage", double(a.color.covered) / N2},
+                      {"gutter", ga.gutter},
+                      {"gutter_violations", ga.violations},
+                      {"margin", ga.margin},
+                      {"protected_mip_size", ga.protected_mip_size},
+                      {"mean_area_distortion", ga.atlas.mean_area_distortion},
+                      {"flipped_faces", ga.atlas.flipped_faces},
+                      {"bump", a.options.bump},
+                      {"atlas_texels_per_exemplar_texel", a.atlas_texels_per_exemplar_texel},
+                      {"normal_source", a.normal_from_exemplar ? "exemplar_normal" : "height"},
+                      {"height_source", a.height_from_exemplar ? "exemplar_height" : "luminance"},
+                      {"roughness", !a.metallic_roughness.empty()},
+                      {"seconds", {{"bake", a.seconds}}}};
+  if (a.seam_measured) j["seam"] = to_json(a.seam);
+  return j;
+}
+
+}  // namespace surftex

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The exported asset of a subdivision synthesis: the vertex colours baked on
+// a triangle copy with its atlas, the maps' sources, the report's keys.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "texture/subdivision/subdivision_asset.h"
+
+namespace surftex {
+namespace {
+
+// A unit cube of six quads, each vertex coloured by its position.
+Mesh coloured_quad_cube() {
+  Mesh m;
+  std::vector<VertexIndex> v;
+  for (int i = 0; i < 8; ++i) v.push_back(m.add_vertex(Point3(i & 1, (i >> 1) & 1, (i >> 2) & 1)));
+  const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : q) EXPECT_NE(m.add_face(v[f[0]], v[f[1]], v[f[2]], v[f[3]]), Mesh::null_face());
+  auto col = get_or_add(m, kVertexColor);
+  for (VertexIndex x : m.vertices())
+    col[x] = Color3f{float(m.point(x).x()), float(m.point(x).y()), float(m.point(x).z())};
+  return m;
+}
+
+TEST(SubdivisionAsset, BakesTheColoursOnATriangleCopy) {
+  const Mesh m = coloured_quad_cube();
+  SubdivisionAssetOptions o;
+  o.atlas_size = 64;
+  o.texels_per_length = 32;
+  const SubdivisionAsset a = bake_subdivision_asset(m, {}, o);
+  ASSERT_TRUE(a.mesh);
+  const Mesh& t = *a.mesh;
+  EXPECT_TRUE(t.is_valid(false));
+  EXPECT_EQ(t.number_of_faces(), 12u);
+  EXPECT_EQ(t.number_of_vertices(), 8u);
+  auto tc = find(t, kVertexColor);
+  ASSERT_TRUE(tc.second);
+  auto mc = find(m, kVertexColor).first;
+  for (VertexIndex v : t.vertices()) EXPECT_EQ(tc.first[v], mc[v]);
+  EXPECT_TRUE(find(t, kCornerUV).second) << "the atlas's uvs are on the copy";
+  EXPECT_EQ(a.color.image.width, 64);
+  EXPECT_EQ(a.height.width, 64);
+  EXPECT_EQ(a.normal.width, 64);
+  EXPECT_EQ(a.height.channels, 1);
+  EXPECT_TRUE(a.metallic_roughness.empty());
+  EXPECT_GT(a.color.covered, 64u * 64u / 4);
+  EXPECT_FALSE(a.seam_measured);
+  // The atlas texel density against the exemplar's: atlas texels per mesh
+  // unit over exemplar texels per mesh unit.
+  EXPECT_NEAR(a.atlas_texels_per_exemplar_texel, a.atlas.atlas.uv_per_length * 64 / 32.0, 1e-12);
+}
+
+TEST(SubdivisionAsset, MapsFromVertexValues) {
+  const Mesh m = coloured_quad_cube();
+  SubdivisionVertexMaps maps;
+  maps.height.assign(8, 0.25f);
+  maps.roughness.assign(8, 0.75f);
+  SubdivisionAssetOptions o;
+  o.atlas_size = 64;
+  o.texel_size = 0.05;
+  const SubdivisionAsset a = bake_subdivision_asset(m, maps, o);
+  EXPECT_TRUE(a.height_from_exemplar);
+  EXPECT_FALSE(a.normal_from_exemplar);
+  ASSERT_FALSE(a.metallic_roughness.empty());
+  // The height is the baked vertex value wherever a chart covers the texel.
+  int covered = 0;
+  for (int i = 0; i < 64 * 64; ++i)
+    if (a.color.chart[i] >= 0) {
+      ++covered;
+      EXPECT_NEAR(a.height.data[i], 0.25f, 1e-5f);
+    }
+  EXPECT_GT(covered, 0);
+  EXPECT_TRUE(a.seam_measured);
+  const nlohmann::json j = to_json(a);
+  EXPECT_EQ(j["height_source"], "exemplar_height");
+  EXPECT_EQ(j["normal_source"], "height");
+  EXPECT_EQ(j["roughness"], true);
+  EXPECT_TRUE(j.contains("seam"));
+}
+
+// The keys the subdiv report's "export.atlas" block carries.
+TEST(SubdivisionAsset, JsonHasTheReportKeys) {
+  const Mesh m = coloured_quad_cube();
+  SubdivisionAssetOptions o;
+  o.atlas_size = 64;
+  o.bump = 3;
+  const nlohmann::json j = to_json(bake_subdivision_asset(m, {}, o));
+  for (const char* k : {"charts", "size", "coverage", "gutter", "gutter_violations", "margin", "protected_mip_size",
+                        "mean_area_distortion", "flipped_faces", "bump", "atlas_texels_per_exemplar_texel",
+                        "normal_source", "height_source", "roughness", "seconds"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_FALSE(j.contains("seam")) << "no texel size, no seam figure";
+  EXPECT_EQ(j["size"], 64);
+  EXPECT_EQ(j["bump"], 3.0);
+  EXPECT_EQ(j["height_source"], "luminance");
+  EXPECT_EQ(j["roughness"], false);
+  EXPECT_TRUE(j["seconds"].contains("bake"));
+  EXPECT_GT(j["coverage"].get<double>(), 0.0);
+}
+
+}  // namespace
+}  // namespace surftex
