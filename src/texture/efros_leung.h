@@ -5,18 +5,13 @@
 // per-pixel orientation (3.3.2, pre-rotated exemplars) and per-pixel choice of
 // exemplar (multi-texturing, section 5).
 //
-// Pass 1: an unweighted small window over the known neighbours, on every
-// candidate (ElSearch::Exhaustive, the paper) or on a short list (Approximate,
-// default); the `preselect` best kept. Pass 2: the full Gaussian-weighted
-// window (Efros & Leung 1999). The pixel is copied from a random candidate
-// among the best max(pick_min, ceil(pick_fraction * preselect)) (Gorla: "10
-// or 10%"), minus those worse than (1 + error_tolerance) x the best (Efros &
-// Leung's epsilon; our addition). Fill pixels are synthesised, Known pixels
-// read only, Outside pixels untouched. Fill order: onion peel or a direction
-// sweep (Gorla 4); a pixel with no known neighbour is seeded with a random
-// 3x3 patch. Even windows reach one pixel further up/left. Seeded mt19937_64
-// in fill order; same bytes for any thread count. Details and the exhaustive
-// pass's vectorised ranking: docs/decisions/505-efros-leung-details.md.
+// Pass 1: a small unweighted window on every candidate (Exhaustive, the
+// paper) or a short list (Approximate, default), `preselect` kept; pass 2:
+// the full Gaussian-weighted window; the pixel copied from a random one of
+// the best max(pick_min, pick_fraction * preselect) within (1 +
+// error_tolerance) of the best (our addition). Fill order: onion peel or
+// direction sweep; isolated pixels seeded. Same bytes for any thread count.
+// In full: docs/decisions/505-efros-leung-details.md.
 //
 // Throws InvalidInputError naming the option or input on any invalid value.
 
@@ -55,9 +50,8 @@ enum class FillOrder {
 struct ElOptions {
   /// Full (second-pass) neighbourhood diameter, pixels, 3..51. Default 11.
   int window = 11;
-  /// First-pass unweighted neighbourhood diameter, 3..window; 0 = automatic:
-  /// max(3, round(window * 5 / 12)), i.e. Gorla's Figure 5 ratio (5x5 for
-  /// 12x12), inside the paper's "1/3 to 1/2 of the full diameter".
+  /// First-pass window, 3..window; 0 = max(3, round(window * 5 / 12)) (Gorla's
+  /// Figure 5 ratio).
   int first_pass_window = 0;
   /// Pass-1 candidates kept for pass 2, >= 0; 0 = the exemplar's width (Gorla:
   /// "one scanline"), clamped to the candidate count.
@@ -81,9 +75,8 @@ struct ElOptions {
   /// Number of pre-rotated orientations when an angle field is given
   /// (Gorla 3.3.2), 1..128. Default 64.
   int rotations = 64;
-  /// The exemplars tile seamlessly: neighbourhoods wrap around their edges,
-  /// so every exemplar pixel is a candidate (else only positions whose whole
-  /// window lies inside the exemplar).
+  /// The exemplars tile: windows wrap, every pixel is a candidate (else only
+  /// windows inside).
   bool periodic_exemplar = false;
   /// Pass-1 candidate search (see ElSearch). Default Approximate.
   ElSearch search = ElSearch::Approximate;
@@ -98,9 +91,7 @@ struct ElOptions {
   /// Approximate search: the kd-tree holds every ann_stride-th row and column,
   /// each hit standing for its block, 1..4. Default 2 (a quarter of the index cost).
   int ann_stride = 2;
-  /// Reference mode: Efros-Leung's original single exhaustive pass with the
-  /// full Gaussian-weighted window (no preselection). Slow; for tests and
-  /// comparisons.
+  /// Reference mode: Efros-Leung's single exhaustive Gaussian pass. Slow.
   bool single_pass = false;
   /// Split each pixel's search over TBB threads (same result); off when
   /// syntheses already run in parallel. Default on.
@@ -119,9 +110,8 @@ struct ElPreparedExemplars;
 
 /// Everything a synthesis run reads besides the options.
 struct ElInput {
-  /// One or more exemplars (multi-texturing, Gorla 5), same channel count,
-  /// each at least `window` pixels on each side unless periodic. Must be
-  /// empty when `prepared` is given (the prepared exemplars are used).
+  /// One or more exemplars (Gorla 5), same channels, each >= `window` per side
+  /// unless periodic; empty when `prepared` is given.
   std::vector<Image> exemplars;
   /// Alternative to `exemplars`: prepared once for many runs (el_prepare_exemplars
   /// with the run's window, search and rotation options, else InvalidInputError).
@@ -131,9 +121,8 @@ struct ElInput {
   Image target;
   /// Per-pixel state, row-major, width*height; empty = every pixel Fill.
   std::vector<PixelState> state;
-  /// Optional per-pixel orientation (radians, convention of
-  /// rotated_exemplars.h: the exemplar's +x axis is drawn along
-  /// (cos a, -sin a)); a 1-channel image of the target's size. Empty = none.
+  /// Optional per-pixel orientation (radians, rotated_exemplars.h convention),
+  /// 1 channel, the target's size. Empty = none.
   Image angle;
   /// Alternative to `angle`: a function of the pixel (x, y). Used when
   /// `angle` is empty and this is set.
@@ -157,9 +146,7 @@ struct ElResult {
   int window = 0;              ///< effective full window
   int first_pass_window = 0;   ///< effective first-pass window
   int rotations_used = 0;      ///< distinct (exemplar, orientation) pairs searched
-  /// Candidates ranked by pass 1, summed over the pixels: the exemplar's
-  /// candidate count per pixel for the exhaustive search, the short list's
-  /// length for the approximate one.
+  /// Candidates ranked by pass 1, summed over the pixels.
   std::size_t pass1_candidates = 0;
   double seconds = 0.0;
 };
