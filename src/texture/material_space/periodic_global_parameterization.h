@@ -6,22 +6,13 @@
 // S^T = mean vertex scale), defined up to integers, so a periodic tile maps
 // seamlessly wherever the field allows it.
 //
-// Per vertex two unit complex numbers z_s = exp(2 pi i s), z_t = exp(2 pi i t)
-// in the vertex's frame; a quarter turn across a cut of the combed 4-field
-// maps z_s -> z_t, z_t -> conj(z_s) (as Ray et al. 2006), so the system is
-// real-linear, 4 reals per vertex. Equation (3) per edge, alpha_ij = e_ij .
-// (g^T + g^T') / 2 in periods, solved in the least-squares sense: F_PGP =
-// sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2, sparse SPD with 4x4 blocks
-// (METIS order, CHOLMOD supernodal Cholesky; analysis reused while the free
-// set is unchanged; connectivity work beside field work on a second thread).
-// The BLAS is pinned to one thread (same bytes on any machine); where it does
-// not allow concurrent calls, BLAS-reaching calls take turns behind one lock.
-// Initialisation: alphas integrated along a spanning tree, then
-// `init_iterations` Ginzburg-Landau steps (weight `stiffness`); one locked
-// vertex per component. Local update: vertices outside the free set keep z.
-// Corners (equation 4): s_j = Arg(z_j)/2pi + round(s_i + alpha_ij - Arg(z_j)/2pi),
-// so two faces agree exactly on their shared edge; m = the vertex material.
-// (Signs differ from the paper's, which are not self-consistent.) The
+// Per vertex z_s = exp(2 pi i s), z_t = exp(2 pi i t); a quarter turn across
+// a cut maps z_s -> z_t, z_t -> conj(z_s) (Ray et al. 2006): 4 reals per
+// vertex. Equation (3) per edge solved in the least-squares sense (sparse SPD,
+// METIS + CHOLMOD, analysis reused; BLAS pinned to one thread and locked when
+// not concurrent-safe). Start: spanning-tree integration + `init_iterations`
+// Ginzburg-Landau steps; corners by equation (4), consistent across edges.
+// In full, with why the paper's start was replaced: docs/decisions/305.
 // derivation, the BLAS notes and why the paper's initialisation was replaced:
 // docs/decisions/305-pgp-solver.md.
 //
