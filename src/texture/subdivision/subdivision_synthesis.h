@@ -207,7 +207,7 @@ SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const st
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
 /// The same with a prebuilt index of `ex` (reused across passes).
-/// The same with a prebuilt index. Optional, one entry per vertex, updated:
+/// Optional, one entry per vertex, updated:
 /// `color_level` (stack level each colour was read from; samples compare at
 /// it), `source` (level-0 texel, {-1,-1} none; needed by the repetition
 /// penalty), `lookup`; `geometry`: make_pass_geometry(mesh), null = built here.
