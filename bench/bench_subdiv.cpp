@@ -14,19 +14,7 @@
 // 1, so k and the groups per match are comparable); the bounding-box-based
 // 1/e is reported too (247 for this mesh).
 //
-// Measured (s3-subdiv), 66,680 vertices, 2 threads, machine shared (load
-// 7-8 on 2 cores, so wall >> CPU; the lead re-measures quietly). CPU seconds
-// per pass, all threads (matching only / with graph cut): r_scale 30: 7.2 /
-// 14.1 (k 9.5, 360 region vertices, 32 groups per match); r_scale 100: 3.9 /
-// 4.6 (k 2.8, 14 groups); r_scale 200: 2.4 / 2.7 (k 1.4, 6.6 groups). Before
-// (f533745, same load, process CPU of a one-pass run): r_scale 30 about 13.7 /
-// 32.6 CPU seconds. Quiet wall figures before: 6.9 / 15.3, 3.9 / 4.3,
-// 2.0 / 2.1 s.
-// Graph-cut transfer folded (forced nodes into the terminals, reused
-// GraphCut storage, one exp per node), same machine, load 9-10: r_scale 30
-// matching only / with graph cut 8.0 / 13.2 CPU s (before, same session,
-// load 10.5-12: 8.5 / 17.1); colour_hash unchanged (3b2885b33712e1a7 with
-// the cut, c5f52d01582f2f68 without, 2 threads).
+// Measured times (shared machine, loads 7-12): docs/decisions/204-subdiv-speed-and-search.md.
 //
 // Usage: bench_subdiv [MESH] [TEXTURE] [THREADS] [R_SCALES] [CUT]: R_SCALES a
 // comma-separated list (default 30,100,200), CUT one of both (default), cut,

@@ -10,6 +10,7 @@
 #include "geometry/image_io.h"
 #include "surftex/command.h"
 #include "texture/material_space/material_tile.h"
+#include "texture/material_space/material_tile_json.h"
 
 namespace surftex::cli {
 namespace {
@@ -103,15 +104,11 @@ int run(const Args& a) {
   info.roughness_sources = a.roughnesses;
   write_material_tile(a.out, r, info, a.common.force);
 
-  nlohmann::json rep;
+  nlohmann::json rep = to_json(r);
   rep["output"] = a.out;
   rep["sources"] = info.sources;
   rep["size"] = a.size;
-  rep["layers"] = r.layers.size();
   rep["layers_per_pair"] = a.layers;
-  rep["sign_changes"] = r.sign_changes;
-  rep["mask_agreement"] = r.mask_agreement;
-  rep["seconds"] = {{"keys", r.seconds_keys}, {"morph", r.seconds_morph}, {"synthesis", r.seconds_synthesis}};
   RunFiles files{a.inputs, files_in_folder(a.out)};
   for (const std::string& m : a.masks)
     if (m != "-") files.inputs.push_back(m);

@@ -17,6 +17,7 @@
 #include "texture/graphcut_synthesis.h"
 #include "texture/histogram_distance.h"
 #include "texture/image_ops.h"
+#include "texture/synthesis_json.h"
 
 namespace surftex::cli {
 namespace {
@@ -121,29 +122,19 @@ int run(const SynthArgs& a) {
   bo.exemplar_stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(ex_patches / 16384.0))));
   const BidirectionalResult bs = bidirectional_similarity(r.image, exemplar, bo);
   const double chi = histogram_chi_square(r.image, exemplar);
-  nlohmann::json rep;
+  nlohmann::json rep = a.method == "el2pass" ? to_json(r) : nlohmann::json::object();
   rep["method"] = a.method;
   rep["exemplar"] = a.exemplar;
   rep["output"] = a.output;
   rep["width"] = w;
   rep["height"] = h;
   if (a.method == "el2pass") {
-    rep["window"] = r.window;
-    rep["first_pass_window"] = r.first_pass_window;
     rep["preselect"] = a.preselect > 0 ? a.preselect : exemplar.width;
-    rep["orientations_searched"] = r.rotations_used;
-    rep["seeded_pixels"] = r.seeded;
     rep["search"] = a.search;
   }
   rep["seconds"] = {{"synthesis", seconds}};
   rep["texels_per_second"] = (w * static_cast<double>(h)) / std::max(seconds, 1e-9);
-  rep["bidirectional_similarity"] = {{"patch", bo.patch},
-                                     {"stride", bo.stride},
-                                     {"exemplar_stride", bo.exemplar_stride},
-                                     {"approximate_max_candidates", bo.max_candidates},
-                                     {"coherence", bs.coherence},
-                                     {"completeness", bs.completeness},
-                                     {"total", bs.total}};
+  rep["bidirectional_similarity"] = to_json(bs, bo);
   rep["histogram_chi_square"] = chi;
   rep["seconds"]["metrics"] = mt.seconds();
   write_report(a.common, "synth", rep, {inputs, {a.output}});

@@ -57,29 +57,19 @@ ProgressCallback terminal_progress(bool quiet);
 /// Throws InvalidInputError if `input` does not exist or is not a regular file.
 void require_input_file(const std::string& input, const std::string& what);
 
-/// Throws if `output` names the same file as any of `inputs` (never overwrite
-/// what the user gave), exists while !force, or (folder_must_exist) its folder
-/// does not exist: checked before any work, so that no output is written when
-/// a later one cannot be. Subcommands writing into an output folder they
-/// create pass folder_must_exist = false.
+/// Throws if `output` is one of `inputs`, exists while !force, or (when
+/// folder_must_exist) its folder does not exist: before any work.
 void check_output(const std::string& output, const std::vector<std::string>& inputs, bool force,
                   bool folder_must_exist = true);
 
-/// Removes what runs killed earlier (SIGKILL, crash) left in the folders the
-/// arguments name or sit in: their staging folders and temporaries (undoing
-/// a half-finished move of outputs; geometry/output_file.h
-/// sweep_stale_outputs). Called before the arguments are checked, so that a
-/// re-run is not refused because of a dead run's partial outputs.
+/// Removes what killed runs left in the folders the arguments name
+/// (sweep_stale_outputs), before the arguments are checked.
 void sweep_stale_outputs_of_arguments(const CLI::App& sub);
 
-/// Checks every subcommand's parsed arguments before it runs (main.cpp):
-/// --max-image-pixels and --max-memory are applied (set_image_limits,
-/// set_memory_budget); an empty string given to a numeric option is refused;
-/// a floating-point option given a NaN or an infinity is refused naming the
-/// option (CLI11's range checks let NaN through); the --report path must not
-/// name a file given as another argument (an input or another output), must
-/// not replace an existing file without --force, and its folder must exist.
-/// Throws InvalidInputError / IOError.
+/// Checks every subcommand's parsed arguments (main.cpp): applies the image
+/// and memory limits, refuses empty numeric strings, NaN and infinities, and a
+/// --report path that is another argument, exists without --force or lacks its
+/// folder. Throws InvalidInputError / IOError.
 void check_parsed_arguments(const CLI::App& sub);
 
 /// Reads and repairs a method's input mesh (geometry/load_input_mesh.h): a

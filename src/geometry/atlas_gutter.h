@@ -1,20 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Gutters of a texture atlas for mip-mapped lookups (issue 16 item 3): a
-// viewer samples level k of the mip chain, whose texel averages 2^k x 2^k
-// base texels; a chart whose neighbourhood holds other charts' texels or an
-// empty background bleeds them into its seams at that level. So every chart
-// keeps a gutter of at least 2^K texels, K = the number of halvings from the
-// atlas side down to `min_mip_size` (64 px by default: 2048 -> 32 texels,
-// 1024 -> 16), filled with the chart's own colours, and the packing keeps
-// charts apart by twice that.
-//
-// dilate_charts fills every empty texel (no background is left, so no black):
-// rings of growing Chebyshev distance around the charts, breadth first; a
-// texel of ring r takes the label that most of its ring-(r-1) 8-neighbours
-// carry (ties: the lower label) and the mean of those neighbours' values.
-// Charts spaced 2g+1 texels apart therefore own every texel within g of them.
-// No CGAL here.
+// Gutters of a texture atlas for mip-mapped lookups (issue 16 item 3): every
+// chart keeps 2^K texels of its own colours, K the halvings from the atlas
+// side to `min_mip_size`, and charts stay twice that apart (decision 302).
+// dilate_charts fills every empty texel ring by ring (Chebyshev), each taking
+// the majority label of its inner 8-neighbours (ties: lower) and their mean,
+// so charts 2g+1 apart own every texel within g. No CGAL here.
 
 #include <vector>
 

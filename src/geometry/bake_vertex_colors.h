@@ -3,18 +3,10 @@
 // Bakes per-vertex colours into a texture atlas image, so a vertex-coloured
 // result also exists as an image (Bangay & Morkel 2006, section 3.5: "the
 // surface colouring can be converted into a conventional texture map").
-// Every triangle is rasterised in uv space (kCornerUV, v up; geometry/
-// uv_raster.h: texel centres inside, plus a one-texel band at the nearest
-// point), each texel the barycentric blend of the three vertex colours; then
-// every empty texel is filled by dilating the charts (geometry/atlas_gutter.h:
-// no background, each chart's gutter from its own colours). Charts are
-// kFacePatch when present (geometry/gutter_atlas.h spaces them for mip
-// gutters), else one chart.
-//
-// bake_vertex_values does the same for any per-vertex values (height,
-// roughness: "every channel" of a synthesis); rasterize_atlas gives the
-// texels, their triangle and barycentrics, for bakers that blend other
-// per-corner data (texture/tangent_space_bake.h).
+// Triangles rasterised in uv (uv_raster.h), each texel the barycentric blend,
+// empty texels filled by dilating the charts (atlas_gutter.h; kFacePatch, else
+// one chart). bake_vertex_values: the same for any per-vertex values;
+// rasterize_atlas: the texels with their triangle and barycentrics.
 //
 // Reads kCornerUV, kVertexColor, kFacePatch (optional). Throws
 // InvalidInputError (non-triangle face, missing map, size outside 1..16384).

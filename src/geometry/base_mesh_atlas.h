@@ -5,39 +5,16 @@
 // low-distortion multi-chart atlas of the bunny). The paper does not say how
 // the atlas is made; this is a careful, simple choice:
 //
-// 1. Segmentation (geometry/disc_chart.h): greedy region growing. Seeds are taken in face-index order
-//    (the first face not yet in a chart); a chart grows breadth-first over
-//    edges and accepts a face when (a) its normal is within
-//    `max_normal_angle_deg` of the seed face's normal, (b) the chart has fewer
-//    than `max_chart_faces` faces, and (c) the chart stays a topological disc:
-//    the face shares exactly one edge with the chart and its opposite vertex is
-//    not yet in the chart, or it shares two edges (fills a notch). Sharing all
-//    three edges (closing the chart into a sphere) is refused. After growing,
-//    every chart is verified to be a disc (Euler characteristic V-E+F = 1 and
-//    exactly one border loop); a chart that fails throws TopologyError (this
-//    is an internal invariant and does not happen on manifold input).
-// 2. Flattening (geometry/disc_chart.h): each chart is copied into its own Surface_mesh and flattened
-//    with CGAL's LSCM (Surface_mesh_parameterization::LSCM_parameterizer_3,
-//    two pinned vertices chosen by CGAL). A chart whose flattening comes out
-//    with negative total signed area is mirrored. The chart is then scaled so
-//    that its uv area equals its 3D area (so every chart has the same
-//    uv-per-length scale before packing) and rotated to its minimal-area
-//    bounding box among 16 angles. LSCM can fold a chart over itself (its
-//    border crosses itself); such a chart is regrown into discs of at most half its faces, each flattened
-//    the same way, until every flattening is an embedding.
-// 2b. Merging (`merge_charts`; Sander et al. 2001, "Texture mapping progressive
-//    meshes", section 4.1: greedy merging of adjacent charts into discs): the
-//    chart of smallest 3D area first is merged into the neighbour sharing the
-//    longest border with it for which (a) the union has at most
-//    `max_chart_faces` faces and is a disc, (b) its LSCM flattening is an
-//    embedding, (c) its area distortion is at most max(`max_merge_distortion`,
-//    the parts' area-weighted one), and (d) its bounding box with the packing
-//    gap (`margin` of the estimated side) around it is smaller than the two
-//    parts' together. Many small charts otherwise spend the atlas on gaps.
-// 3. Packing: shelf packing of the chart bounding boxes (tallest first) into a
-//    square-ish strip, a gap of `margin` (as a fraction of the final atlas
-//    side) around every chart, then one uniform scale into [0,1]^2. All
-//    charts share one scale: uv_per_length in the result.
+// 1. Segmentation (disc_chart.h): greedy region growing from the first free
+//    face, within max_normal_angle_deg and max_chart_faces, keeping discs
+//    (verified; TopologyError otherwise).
+// 2. Flattening: CGAL LSCM per chart, mirrored if negative, scaled to its 3D
+//    area, rotated to its smallest bounding box; folded charts regrown smaller.
+// 2b. Merging (merge_charts; Sander et al. 2001, 4.1): smallest charts merged
+//    into neighbours while the union is a disc, embeds, stays within
+//    max_merge_distortion and packs smaller.
+// 3. Packing: shelf packing with `margin` gaps, one uniform scale into [0,1]^2.
+// In full: docs/decisions/104-shell-space.md.
 //
 // Works on closed (genus 0, genus g) and open manifold triangle meshes.
 // Writes: kCornerUV (halfedge h: uv of the corner of face(h) at target(h)),

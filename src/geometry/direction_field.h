@@ -6,30 +6,13 @@
 // direction d_s per face; d_t is d_s rotated by +90 degrees in the face
 // (d_t = n x d_s) and is not stored.
 //
-// Method (the paper interpolates *orientations*, "letting singularities emerge
-// from the geometry" [HZ00, RLL06, LRL06]; it gives no formulas, so we use the
-// standard representation-vector formulation, a careful equivalent):
-//   - each face f has a frame (e1 along its first edge, e2 = n x e1); a
-//     direction at angle theta is represented by u_f = exp(i N theta), which
-//     is the same for the N directions of an N-symmetric cross (N = 4 for
-//     tiles, 2 for line fields, 1 for vectors);
-//   - across an interior edge shared by f and g, the Levi-Civita connection
-//     maps angles by theta_g = theta_f - a_f + a_g (a_x = the edge's angle in
-//     frame x), so r_fg = exp(i N (a_g - a_f));
-//   - minimise sum_e w_e |u_g - r_fg u_f|^2, w_e = 3 |e|^2 / (A_f + A_g)
-//     (the ratio dual-edge / primal-edge, capped at 1e3 so slivers stay sane),
-//     with constrained faces (and faces outside the effect area) locked: a
-//     sparse Hermitian positive definite complex system (one unknown per free
-//     face) solved once with Eigen's SimplicialLDLT (info() checked); with an
-//     effect area only the free faces and their neighbours are visited;
-//   - d_s = frame direction of arg(u_f)/N; the N representatives are then
-//     "combed" by growing a dual spanning tree from the locked faces,
-//     smoothest edges first (Prim), each face taking the representative
-//     closest to its parent's transported direction: quarter-turn mismatches
-//     remain only on cut paths joining singular vertices, where the field
-//     turns fastest.
-// A connected component with no constrained face gets d_s = e1 of each face
-// (and is counted in `unconstrained_faces`).
+// Method (the paper gives no formulas; the standard representation-vector
+// formulation): u_f = exp(i N theta) per face frame, the Levi-Civita
+// connection across edges, minimise sum_e w_e |u_g - r_fg u_f|^2 (w_e =
+// 3|e|^2 / (A_f + A_g), capped) with constrained and outside faces locked
+// (Hermitian SPD, SimplicialLDLT); then the N representatives combed along a
+// dual spanning tree. A component without constraints gets d_s = e1 (counted).
+// In full: docs/decisions/308-direction-field.md.
 //
 // Reads/writes the face map `direction_map` (Vector3, default kFaceDirection
 // "f:dir", created if absent). With an effect area, faces outside it keep their
@@ -63,13 +46,8 @@ struct DirectionFieldOptions {
   /// Free faces; nullptr = the whole mesh. Faces outside are locked to the
   /// current content of direction_map.
   const EffectArea* area = nullptr;
-  /// >= 0. 0: constraints are exact (locked). > 0: after the interpolation,
-  /// one implicit smoothing step over the area's faces with the constraints
-  /// made soft, min E(u) + sum_f (D_f / smoothing) |u_f - u0_f|^2 (u0 the
-  /// interpolated field, D_f the face's diagonal of E): roughly a diffusion
-  /// over sqrt(smoothing) face rings. For noisy constraints (principal
-  /// directions), whose disagreements between nearby locked faces otherwise
-  /// become field singularities.
+  /// >= 0. 0: constraints exact. > 0: one implicit smoothing step with soft
+  /// constraints (about sqrt(smoothing) face rings), for noisy constraints.
   double smoothing = 0;
 };
 

@@ -7,20 +7,11 @@
 // surface_quilting.h, section 3.1: "growing the region using breadth-first
 // traversal", "flattened ... using LSCM").
 //
-// Growth: a queue of the faces across the edges of every accepted face (in
-// halfedges_around_face order); a face is accepted when accept(f) holds, the
-// chart has fewer than max_faces faces and the chart stays a disc: the face
-// shares exactly one edge with the chart and its opposite vertex is not yet
-// in the chart, or it shares two edges (fills a notch). Sharing three edges
-// (closing the chart into a sphere) is refused.
-// Flattening: the chart copied into its own Surface_mesh, checked to be a
-// disc (one border loop, Euler characteristic 1), flattened by CGAL's
-// LSCM_parameterizer_3 (two vertices pinned by CGAL), mirrored if its signed
-// uv area is negative and scaled so that its uv area equals its 3D area.
-// Validity: the flattening is an embedding (no flips, no overlap) exactly when
-// every face has positive uv area and the border loop is simple (the winding
-// number of the border then counts the faces over every uv point: 0 or 1);
-// both are counted with exact orientation predicates.
+// Growth: breadth-first across edges; a face is accepted when accept(f)
+// holds, the chart is below max_faces and stays a disc (one shared edge and a
+// new opposite vertex, or two shared edges). Flattening: a disc check, CGAL
+// LSCM, mirrored if negative, scaled to the 3D area. Valid (an embedding)
+// when every uv face is positive and the border loop simple (exact tests).
 #include <array>
 #include <cstddef>
 #include <functional>

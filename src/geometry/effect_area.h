@@ -9,16 +9,10 @@
 // current value, so a local edit leaves the rest of the mesh bit for bit
 // unchanged ("all variables m, S, s, t associated to the boundary are fixed").
 //
-// Definitions (indices are Surface_mesh indices, `.idx()`):
-//   - a vertex is reached when its Dijkstra distance <= radius (seeds have 0);
-//   - a face is in the area (free: its direction may change) when its three
-//     vertices are reached (and the face budget is not exhausted);
-//   - a vertex is free (its S, m, s, t may change) when all its incident faces
-//     are in the area; reached vertices with a face outside form the locked
-//     boundary. A vertex on a mesh border whose faces are all in the area is free.
-// The paper leaves open whether distance is measured on faces or vertices and
-// what a "budget" is: we measure edge-path distance between vertices (a
-// careful, cheap approximation of geodesic distance) and count whole faces.
+// Reached: Dijkstra edge-path distance <= radius; a face is in the area when
+// its three vertices are reached (within the face budget); a vertex is free
+// when all its faces are in it, else locked boundary. (Our reading: the paper
+// leaves the distance and the budget open.)
 
 #include <cstddef>
 #include <cstdint>

@@ -10,17 +10,10 @@
 // read the partition with is_source_side(). Nodes are 0..num_nodes-1; the
 // source and sink terminals are implicit.
 //
-// Capacities are non-negative doubles. An infinite capacity is written as
-// GraphCut::kInfinity (or std::numeric_limits<double>::infinity(), which is
-// mapped to kInfinity): such an edge is never cut while a finite cut exists.
-// Finite capacities should sum to far less than kInfinity (1e18) so that
-// residuals keep their precision; anything >= kInfinity counts as infinite.
-//
-// solve() folds every node with an infinite link to exactly one terminal
-// (e.g. the pinned target and the kept border of a texture cut) into that
-// terminal before running BK, so BK sees only the free nodes; a graph with
-// no source link or no sink link left is answered without BK (max flow 0).
-// Neither changes the flow or the partition (graph_cut.cpp gives the proof).
+// Capacities are non-negative doubles; kInfinity (or +inf) is never cut while
+// a finite cut exists, and finite sums should stay far below it. solve()
+// folds nodes with one infinite terminal link into that terminal before BK
+// (same flow and partition; proof in graph_cut.cpp).
 
 #include <cstddef>
 #include <vector>

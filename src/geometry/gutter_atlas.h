@@ -1,22 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// A multi-chart uv atlas of a triangle mesh ready for baking at a given
-// texel size with mip-safe gutters (issue 16 item 3): the charts of
-// geometry/base_mesh_atlas.h (segmentation, LSCM, rotation, merged while a
-// merge saves atlas area at the full gutter's gap, its step 2b; grown in its
-// default 50-degree normal cone and, when those cannot keep the full gutter,
-// also in an 85-degree one: the packing with the higher texel density per
-// mesh length, divided by the square root of the mean area distortion, is
-// kept) repacked in texels: shelf packing of their boxes (tallest first) with 2 g + 3 texels
-// between boxes and from the border (g = the gutter of geometry/
-// atlas_gutter.h, plus the raster's one-texel band on each side), at the
-// largest common scale that fits (bisection). When the full gutter leaves
-// less than a quarter of the texel density of a one-texel gutter (very many
-// small charts), the largest power-of-two gutter that keeps a quarter is
-// used instead and `protected_mip_size` says down to which mip level the
-// atlas stays clean. Then every face is rasterised
-// in uv space (geometry/uv_raster.h) and the gutters are verified on the
-// texels (`violations`, 0 by construction).
+// A multi-chart uv atlas for baking at a texel size with mip-safe gutters
+// (issue 16 item 3): base_mesh_atlas.h's charts (50-degree cone, or 85 when
+// that packs denser per distortion) shelf-packed in texels 2 g + 3 apart at
+// the largest common scale (bisection); when the full gutter costs more than
+// 3/4 of the density, the largest power-of-two gutter keeping a quarter
+// (`protected_mip_size`). Faces rasterised in uv (uv_raster.h) and gutters
+// verified (`violations`, 0 by construction). In full: decision 302.
 //
 // Writes kCornerUV and kFacePatch. Throws what compute_base_mesh_atlas and
 // rasterize_uv_triangles throw, and InvalidInputError when the charts cannot

@@ -1,16 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Internal: the entry points of the image IO module. OpenImageIO and the ~260
-// shared libraries it pulls in (codecs, OpenCV, GDAL, ...) cost about 0.4 s
-// of symbol relocation at process start, so they are not linked into the
-// executables: image_io.cpp is built as a loadable module
-// (libsurftex_image_io.so, image_io_module/) that image_io_loader.cpp opens
-// on the first image read or write. The module resolves the rest of surftex
-// (output_file.h, ...) against the executable, which exports its surftex::
-// symbols (cmake/surftex_exports.list), so there is one copy of that code
-// and its state. Adding a function to image_io.h means adding it here, in
+// Internal: the entry points of the image IO module. OpenImageIO and its
+// shared libraries are costly to relocate at start (docs/decisions/503), so
+// image_io.cpp is a loadable module (libsurftex_image_io.so) opened on first
+// use, resolving the rest of surftex against the executable's exports
+// (cmake/surftex_exports.list). A new image_io.h function goes here, in
 // image_io_module/image_io_table.cpp and in image_io_loader.cpp.
-// docs/decisions/503-lazy-image-io.md has the measurements.
 
 #include <string>
 #include <vector>

@@ -3,17 +3,10 @@
 // Reading user JSON files (constraints, tile.json) so that no input can
 // crash or stall the reader and every refusal reads
 // "FILE: line L: field F: what" (issue 21 item 1):
-// - the file size is bounded before it is read (Limits::max_bytes);
-// - the nesting depth is bounded while parsing, by a SAX handler that stops
-//   at the first level past Limits::max_depth, before any recursion (the DOM
-//   is built by the handler; nothing recursive ever sees a deep value);
-// - numbers that overflow a double and malformed text are refused with the
-//   line, the column and the field being read, in our own words (no
-//   JSON-library text reaches the user);
-// - values are described in messages by describe(), bounded in length and
-//   never recursive.
-// Objects of the parsed DOM carry the line of the object, of each key and
-// of each element of an array-valued key in hidden fields (is_meta_key()).
+// the size is bounded before reading, the depth while parsing (SAX, no
+// recursion), overflowing numbers and malformed text refused in our words
+// with line, column and field; describe() bounds value texts. Parsed objects
+// carry their lines in hidden fields (is_meta_key()).
 
 #include <cstddef>
 #include <nlohmann/json.hpp>

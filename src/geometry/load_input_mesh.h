@@ -3,21 +3,11 @@
 // Loading a user's mesh for a texturing method (docs/DESIGN.md data flow step 1:
 // "load -> validate -> repair (or refuse with a precise error)").
 //
-// Every method subcommand (patches, material-map, subdiv, quilt) reads its
-// base mesh through this: the file is read and its polygon soup repaired
-// (read_mesh.h), then the mesh is repaired as by `surftex repair` with its
-// defaults (repair_mesh.h: stitching, zero-area faces, needles and caps,
-// non-manifold vertices, isolated vertices, outward orientation; no hole
-// filling, no component removal, no self-intersection count). A mesh the
-// repair cannot make valid (for instance one whose faces all have zero area)
-// is refused with the repair's reason instead of failing deep inside a
-// method with a solver or parameterization error.
-//
-// keep_polygons (sqrt(2)-subdivision takes polygons): a mesh with
-// non-triangle faces is kept as it is when none of its faces is degenerate
-// (every face has three corners that are not collinear, exact predicate) and
-// none of its vertices is isolated; otherwise it is triangulated and repaired
-// like a triangle mesh.
+// Every method reads its base mesh through this: read and soup-repaired
+// (read_mesh.h), then repaired as `surftex repair` does by default
+// (repair_mesh.h); a mesh the repair cannot make valid is refused with its
+// reason. keep_polygons (sqrt(2)-subdivision): polygons kept when no face is
+// degenerate and no vertex isolated, else triangulated and repaired.
 
 #include <string>
 

@@ -3,23 +3,12 @@
 // Safe output (brief: "no half-written output, nothing the user gave is
 // overwritten silently"; issue 21 item 3: "a run's outputs as one unit").
 //
-// Every writer goes through AtomicOutputFile (one file), AtomicOutputFolder
-// (a folder replaced whole) or ensure_directory (a folder created). Alone,
-// each writes a temporary beside its destination and renames it into place
-// when complete. While an OutputStaging is active (the CLI keeps one for the
-// whole run, apps/main.cpp), nothing reaches its destination during the run:
-// every file and folder is written into one staging folder per destination
-// folder, `.surftex-stage-PID-START` beside the target, and
-// OutputStaging::commit() moves them all into place only when the whole run
-// succeeded (replaced files are kept aside until the last move, and put back
-// if any move fails or a signal arrives meanwhile). On an error or a
-// cancellation the staging folders are removed and nothing is left. A
-// journal in each staging folder lets a later run undo a run killed by
-// SIGKILL, even in the middle of its moves (sweep_stale_outputs).
-//
-// Temporary names are short (`.surftex-tmp-PID-START-N.ext`, the
-// destination's name kept only inside the staging folder), so any legal
-// file name works as an output.
+// Every writer goes through AtomicOutputFile, AtomicOutputFolder or
+// ensure_directory: a temporary beside the destination, renamed when complete.
+// While an OutputStaging is active (the CLI's whole run) everything is staged
+// in `.surftex-stage-PID-START` folders and moved into place by commit() only
+// when the run succeeded (undone on failure or signal; a journal lets a later
+// run undo a SIGKILLed one). In full: docs/decisions/601-run-output-staging.md.
 
 #include <string>
 #include <vector>
@@ -95,13 +84,9 @@ void rename_output(const std::string& from, const std::string& to);
 /// Drops an output written earlier in this run (nothing happens if absent).
 void discard_output(const std::string& path);
 
-/// Removes, in folder `dir`, the staging folders and temporaries left by
-/// surftex runs that no longer exist (killed by SIGKILL, a crash or a power
-/// cut): a run killed while moving its outputs into place is undone first
-/// (what it had moved is removed, what it had replaced is put back), from
-/// the journal in its staging folder. Another live run's files are never
-/// touched (the process id and start time in the name are checked). Returns
-/// the number of entries removed. Never throws.
+/// Removes, in `dir`, the staging folders and temporaries of surftex runs that
+/// no longer exist (undoing a run killed mid-commit from its journal); a live
+/// run's files are never touched. Returns the entries removed. Never throws.
 std::size_t sweep_stale_outputs(const std::string& dir);
 
 /// The run-level staging (one per process at a time; the CLI's main keeps it

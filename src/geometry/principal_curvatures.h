@@ -11,15 +11,10 @@
 // outward (area-weighted) vertex normal, so a sphere of radius r has
 // kmax = kmin = +1/r and a saddle has kmax > 0 > kmin.
 //
-// Robustness:
-//   - the k-ring grows (up to max_rings) until it holds >= min_points points,
-//   - at umbilic or flat vertices (|kmax - kmin| <= umbilic_tolerance *
-//     max(|kmax|,|kmin|, 1/bbox_diagonal)) the directions of the fit are noise: they are replaced by
-//     `reference` projected on the tangent plane (or another axis if
-//     `reference` is nearly normal), and dmin = n x dmax,
-//   - a fit that fails (too few points, non-finite result) gives k = 0 and
-//     the projected reference; never NaN (also on slivers and duplicates).
-// Directions are unit, tangent to the vertex normal, and dmin = n x dmax.
+// Robustness: the k-ring grows (max_rings) to min_points points; at umbilic
+// or flat vertices (umbilic_tolerance) and on failed fits the directions are
+// `reference` projected (k = 0 on failure), never NaN. Directions are unit,
+// tangent, dmin = n x dmax.
 //
 // Writes kVertexKmax, kVertexKmin (1/length units), kVertexDmax, kVertexDmin
 // (created if absent). Throws InvalidInputError for non-triangle faces or

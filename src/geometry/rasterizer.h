@@ -3,20 +3,11 @@
 // A small software rasterizer for previews and validation renders (docs/DESIGN.md:
 // "a software rasterizer renders results to images, no GPU needed").
 //
-// Pipeline: vertices -> camera frame -> homogeneous clip coordinates; triangles
-// crossing the near plane (or far outside the image) are clipped in clip space
-// (Sutherland-Hodgman), then snapped to 1/256-sample fixed point and scanned
-// with exact integer edge functions and a top-left fill rule, so triangles
-// sharing an edge cover every sample on it exactly once (no cracks, no double
-// hits). A z-buffer keeps the nearest fragment per sample (a visibility buffer:
-// triangle + barycentrics); visible samples are then shaded once each
-// (constant / vertex colour / bilinear texture / caller callback, times
-// two-sided Lambert + ambient) and N x N samples are box-averaged per pixel.
-// Attributes use perspective-correct barycentrics.
-//
-// The image is cut into tiles rendered in parallel (TBB); each tile owns its
-// pixels and draws its triangles in index order, so the output is the same
-// bytes whatever the thread count.
+// Clip-space clipping, 1/256-sample fixed point, exact integer edge functions
+// with a top-left rule (shared edges covered exactly once), a visibility
+// z-buffer shaded once per sample, N x N supersampling; perspective-correct
+// attributes. Tiles rendered in parallel: same bytes for any thread count.
+// In full: docs/decisions/607-rasterizer.md.
 //
 // This header and its .cpp use no CGAL: image code may include it freely.
 // Build a RenderMesh from a surftex::Mesh with geometry/render_mesh.h.
@@ -71,14 +62,10 @@ struct Camera {
   float near_plane = 0.01f;
 };
 
-/// A camera on the sphere around `box`: azimuth rotates about the world +Y
-/// axis (0 = looking from +Z towards -Z, 90 = from +X), elevation lifts the eye
-/// towards +Y (-90..90 degrees). The camera looks at the box centre from the
-/// nearest distance (perspective, 35 degree vertical field of view) or with the
-/// smallest view height (orthographic) that keeps all eight box corners inside
-/// the image with a 5% margin; the near plane lies in front of the box.
-/// `aspect` = width / height.
-/// Throws InvalidInputError on non-finite angles or aspect <= 0.
+/// A camera on the sphere around `box`: azimuth about world +Y (0 = from +Z),
+/// elevation towards +Y (-90..90 deg); the nearest view (perspective, 35 deg
+/// vertical) keeping the box inside with a 5% margin. Throws InvalidInputError
+/// on non-finite angles or aspect <= 0.
 Camera fit_camera(const BBox3f& box, float azimuth_deg, float elevation_deg,
                   Camera::Projection projection = Camera::Projection::Perspective,
                   float aspect = 1.f);
@@ -119,9 +106,7 @@ struct RenderResult {
   Image color;     ///< width x height x 3, linear RGB
   Image depth;     ///< width x height x 1: nearest view depth (world units along the view direction), +inf where empty
   Image coverage;  ///< width x height x 1: fraction of the pixel's samples covered, in [0,1]
-  /// Samples that passed the edge test, summed over all triangles before the
-  /// depth test (a closed frame-filling surface without overlap gives exactly
-  /// width * height * supersample^2: a check for cracks and double hits).
+  /// Samples that passed the edge test before the depth test (a crack check).
   std::size_t fragments = 0;
   std::size_t triangles_drawn = 0;    ///< screen triangles after clipping and culling
   std::size_t triangles_clipped = 0;  ///< input triangles that needed clipping

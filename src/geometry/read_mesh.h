@@ -50,25 +50,14 @@ struct PolygonSoup {
   std::vector<std::string> warnings;
 };
 
-/// Reads any supported format (chosen by the extension .off/.obj/.ply/.stl/
-/// .glb/.gltf, case-insensitive; by content for any other extension, a GLB by
-/// its "glTF" magic). OBJ: `mtllib` files are read from the OBJ's folder
-/// (newmtl, Kd, map_Kd: materials, texture files resolved against the .mtl's
-/// folder, not decoded here); a missing .mtl or an undefined material is a
-/// warning, not an error. glTF: see read_gltf.cpp (triangles of the default
-/// scene with node transforms; POSITION, indices, TEXCOORD_n of the
-/// base-colour texture, COLOR_0, materials; embedded or external textures). Formats: OFF with
-/// the ST/C/N prefixes (COFF colours as 0-255 integers or 0-1 floats), OBJ
-/// (v, vt, f with v/vt/vn forms and negative relative indices, polygons;
-/// `v x y z r g b` colours), PLY ascii / binary little / big endian (x,y,z of
-/// any numeric type, optional red/green/blue, face list vertex_indices or
-/// vertex_index; other elements and properties skipped), STL ascii and binary
-/// (binary when the size is exactly 84 + 50n; welded on exactly equal
-/// positions). Every count in a header is checked against the file size
-/// before anything is allocated. Throws IOError (missing, empty, unreadable,
-/// truncated, malformed, unknown format: the message names file and line or
-/// element) or InvalidInputError (NaN/inf coordinates, out-of-range or
-/// negative indices, no faces).
+/// Reads any supported format (by extension, case-insensitive; else by
+/// content, a GLB by its magic). OBJ reads its `mtllib` files (a missing one is
+/// a warning); glTF: the default scene's triangles with node transforms
+/// (read_gltf.cpp). Every header count is checked against the file size before
+/// allocating. The accepted variants of each format:
+/// docs/decisions/404-mesh-readers.md. Throws IOError (missing, unreadable,
+/// truncated, malformed, unknown; names file and line or element) or
+/// InvalidInputError (NaN/inf, bad indices, no faces).
 PolygonSoup read_polygon_soup(const std::string& path);
 
 struct SoupToMeshOptions {
@@ -97,22 +86,13 @@ struct SoupRepairCounts {
   std::size_t uv_corners_dropped = 0;  ///< corners whose UV could not be mapped (or had none)
 };
 
-/// Repairs and orients a soup and builds the mesh (which is cleared first).
-/// Steps: the steps of CGAL PMP repair_polygon_soup (merge duplicate points,
-/// simplify polygons, split pinched polygons, remove polygons with < 3
-/// vertices, remove duplicate polygons, remove isolated points) run one by one
-/// so that each is counted; orient_polygon_soup (may duplicate points at
-/// non-manifold spots); polygon_soup_to_polygon_mesh; PMP triangulate_faces
-/// when opt.triangulate.
-/// Properties written: kVertexColor (if soup.colors is non-empty; colours are
-/// mapped through the repair by exact position), kCornerUV (if any polygon has
-/// UVs; mapped per corner by position, corners without a UV get (0,0) and are
-/// counted in uv_corners_dropped; diagonals added by triangulation get the UV
-/// of their corner in the original polygon).
-/// Throws InvalidInputError if an index is out of range, TopologyError
-/// (naming soup.source) if no face is left or the result is not a mesh.
-/// A polygon that triangulate_faces cannot split is fan-triangulated and
-/// counted (faces_fan_triangulated) rather than failing the whole file.
+/// Repairs and orients a soup and builds the mesh (cleared first): CGAL PMP
+/// repair_polygon_soup's steps one by one (each counted), orient_polygon_soup,
+/// polygon_soup_to_polygon_mesh, triangulate_faces when opt.triangulate
+/// (fan-triangulating, and counting, what it cannot split). Writes kVertexColor
+/// and kCornerUV when the soup has them (mapped by position; corners without a
+/// UV get (0,0), counted). Throws InvalidInputError (index out of range),
+/// TopologyError (no face left, not a mesh; names soup.source).
 void soup_to_mesh(PolygonSoup soup, Mesh& mesh, const SoupToMeshOptions& opt = {},
                   SoupRepairCounts* counts = nullptr);
 

@@ -3,29 +3,15 @@
 // Repair of degenerate input meshes (docs/DESIGN.md data flow step 1: "load ->
 // validate -> repair (or refuse with a precise error)"), built from CGAL 5.5
 // Polygon Mesh Processing steps:
-//   0. triangulate non-triangle faces (PMP::triangulate_faces; faces it
-//      cannot triangulate are deleted and counted);
-//   1. repeated until nothing changes (at most RepairOptions::max_rounds):
-//      stitch coincident borders (PMP::stitch_borders), remove zero-area faces
-//      (PMP::remove_degenerate_faces; collinearity is an exact predicate),
-//      collapse needles / flip caps (PMP::is_needle_triangle_face /
-//      is_cap_triangle_face + Euler::collapse_edge / flip_edge, only when the
-//      change flips no neighbouring face), delete degenerate faces that are
-//      left, split non-manifold vertices (PMP::duplicate_non_manifold_vertices),
-//      remove isolated vertices;
-//   2. optionally fill holes up to max_hole_edges (PMP::triangulate_hole),
-//      then step 1 again on the filled mesh;
-//   3. orient every closed component outward (signed volume > 0);
-//   4. optionally keep the largest component (PMP::keep_largest_connected_components);
-//   5. report self-intersecting face pairs (exact predicates; not removed);
-//   6. validate: CGAL::is_valid_polygon_mesh, all triangles, no degenerate
-//      face (exact collinearity), no non-manifold vertex, every closed
-//      component outward, something left. If any check fails, `valid` is
-//      false and `refusal` says which check and how many elements.
-// Every step runs under a guard: an exception (CGAL::Failure_exception or any
-// std::exception) inside a step is recorded in RepairDone::step_errors and
-// the step is skipped; the final validation decides. repair_mesh itself does
-// not throw for bad geometry; it throws InvalidInputError for bad options.
+// Steps: 0. triangulate (faces it cannot: deleted, counted); 1. until stable
+// (max_rounds): stitch borders, remove zero-area faces, collapse needles /
+// flip caps, split non-manifold vertices, remove isolated vertices; 2. fill
+// holes (optional) and step 1 again; 3. orient closed components outward;
+// 4. keep the largest component (optional); 5. count self-intersections;
+// 6. validate (valid = false and `refusal` naming the failed check). A step
+// that throws is recorded in step_errors and skipped; repair_mesh throws only
+// InvalidInputError for bad options. Each step's PMP call:
+// docs/decisions/603-hostile-input-limits.md.
 // Properties: none read; vertex/face properties of removed elements are
 // dropped (Surface_mesh garbage is collected), new elements get defaults.
 

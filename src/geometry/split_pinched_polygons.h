@@ -2,10 +2,8 @@
 #pragma once
 // Splitting polygons that visit a vertex more than once ("pinched") into
 // simple cycles, in time linear in the number of corners (issue 21 item 5).
-// CGAL 5.5's split_pinched_polygons_in_polygon_soup splits one repeat at a
-// time and copies the rest of the polygon each time: quadratic, so one face
-// of 800K corners cycling over 4 vertices took `info` 105 s. This runs
-// before it (soup_to_mesh), leaving it nothing to do.
+// CGAL 5.5's split_pinched_polygons_in_polygon_soup is quadratic in the
+// corners (figure: docs/decisions/603); this runs before it (soup_to_mesh).
 //
 // Walks the corners keeping a stack of the current path; when a vertex
 // already on the stack comes again, the cycle from its earlier position to

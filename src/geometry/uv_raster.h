@@ -4,14 +4,10 @@
 // width x height texel grid, for baking anything defined on a surface into an
 // atlas (vertex colours, material-space lookups, PBR maps).
 //
-// Pass 1: a texel whose centre lies inside a triangle (barycentrics >= -1e-9;
-// the first triangle in index order wins on shared edges) takes that triangle
-// and the centre's barycentrics. Pass 2 (`band` > 0): an uncovered texel whose
-// centre lies within `band` texels of a triangle takes the nearest triangle
-// (ties: lower index) and the barycentrics of the nearest point on it (inside
-// or on the triangle), so a chart's edge texels hold the chart's own values
-// and bilinear lookups right at the chart border read no gutter texels.
-// Degenerate (zero-area) triangles cover nothing.
+// Pass 1: texel centres inside a triangle (first in index order on shared
+// edges) take it and their barycentrics. Pass 2 (`band` > 0): uncovered texels
+// within `band` take the nearest triangle and nearest point, so chart edges
+// hold the chart's own values. Zero-area triangles cover nothing.
 //
 // This header uses no CGAL. Throws InvalidInputError on sizes outside
 // 1..16384, band outside [0, 4] or a non-finite uv.

@@ -6,13 +6,9 @@
 // estimate is over the memory budget, naming the estimate and the option to
 // change (--max-memory), before any of the work is done.
 //
-// The estimates are upper-bound fits of measured peak resident memory and
-// CPU time at the CLI's defaults (docs/decisions/602-work-estimates.md has
-// the measurements, the fits and the commands): linear in the work's size
-// (faces, texels, exemplar pixels times search candidates), plus the
-// process's base. They are estimates, not guarantees; the refusal is meant
-// to catch the runs that would take many GB or many minutes, not to cut
-// close to the limit.
+// The estimates are upper-bound linear fits of measured peak memory and CPU
+// time at the CLI's defaults (docs/decisions/602-work-estimates.md): meant to
+// catch runs of many GB or minutes, not to cut close to the limit.
 
 #include <cstddef>
 #include <string>
@@ -26,10 +22,8 @@ struct WorkEstimate {
   /// The options that shrink the work most, named in a refusal
   /// ("--patch-res, --max-patch-faces").
   std::string shrink;
-  /// The exemplar and the longest side the method's search takes: its
-  /// candidates grow with the exemplar's width (Efros-Leung preselects one
-  /// per exemplar column), so a 8043-pixel-wide exemplar made a 64x64
-  /// synthesis take 76 s. 0 = no exemplar.
+  /// The exemplar and the longest side the method's search takes (candidates
+  /// grow with the exemplar's width). 0 = no exemplar.
   int exemplar_width = 0, exemplar_height = 0, max_exemplar_side = 0;
 };
 

@@ -1,17 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Interpenetration between quilted elements (issue 17). In Zhou et al. 2006
-// the elements "keep their integrity" and do not pass through each other:
-// where a new patch's element corresponds to an old one the two are merged
-// (sections 2.5-2.7); an element that corresponds to none is added as it is
-// (2.7, first rule), which on curved or re-covered ground can put it through
-// an old element. ElementCollider finds such hits exactly (CGAL's
-// triangle-triangle do_intersect over an AABB tree, Epick's filtered exact
-// predicates) and, optionally, vertices closer than a clearance to another
-// element (the swatch's own spacing; element-triangle distance through the
-// tree); trim_and_cap removes the triangles that hit, plus rings around them,
-// and closes every cut loop with a fan around its centroid, so that the
-// remaining pieces are closed elements again.
+// Interpenetration between quilted elements (issue 17; Zhou et al. 2006's
+// elements keep their integrity, but 2.7 adds uncorresponded elements as
+// they are). ElementCollider finds exact triangle-triangle hits (AABB tree,
+// filtered exact predicates) and vertices within a clearance; trim_and_cap
+// removes the hits plus rings and caps every cut loop with a fan.
 // Throws InvalidInputError for indices out of range.
 #include <cstddef>
 #include <memory>
@@ -29,13 +22,9 @@ class ElementCollider {
   ~ElementCollider();
   ElementCollider(ElementCollider&&) noexcept;
   ElementCollider& operator=(ElementCollider&&) noexcept;
-  /// Per triangle of `m`: 1 if it intersects a triangle of the collider whose
-  /// element is not `skip` (-1: none skipped), or, with clearance > 0, if one
-  /// of its corners lies within `clearance` of such a triangle; else 0.
-  /// (With a skipped element the distance test is not made: its own
-  /// triangles would be nearest.)
-  /// `dead` (indexed by element tag; tags past its end count as alive):
-  /// elements whose triangles are ignored.
+  /// Per triangle of `m`: 1 if it intersects a collider triangle of another
+  /// element than `skip` (-1: none), or (clearance > 0, no skip) a corner lies
+  /// within `clearance` of one; elements in `dead` are ignored.
   std::vector<char> hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead = nullptr) const;
   /// Smallest distance from any of `points` to a triangle of the collider, or `limit` if none is closer.
   double nearest_distance(const std::vector<P3>& points, double limit) const;
@@ -48,13 +37,10 @@ class ElementCollider {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The triangles of `m` without those marked in `drop`, and without `rings`
-/// rings of triangles around them (rings >= 0; a ring: the triangles sharing
-/// a vertex with a removed one), split into connected pieces; each piece
-/// whose border is a set of simple loops gets every loop closed by a fan
-/// around the loop's centroid (a new vertex) and is returned if it has at
-/// least min_faces triangles before capping and is closed and consistently
-/// oriented after it. `m` should be closed (else no piece is returned).
+/// `m` without the `drop` triangles and `rings` rings around them, split into
+/// pieces; each piece of simple border loops is capped by fans and returned
+/// if it had at least min_faces triangles and is closed and oriented. `m`
+/// should be closed.
 std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<char>& drop, int rings, std::size_t min_faces);
 
 /// An element is compact if the larger side of its xy bounding box is at

@@ -3,16 +3,10 @@
 // Final mesh embedding (Zhou et al. 2006, section 3.2): an output mesh whose
 // vertex coordinates are texture-space coordinates (u, v, w) (u, v in the base
 // mesh atlas, w in [0,1] the height in the shell) is mapped vertex by vertex
-// through the shell map into 3D. Faces stay straight triangles between mapped
-// vertices (the paper maps vertices; elements much smaller than the shell's
-// tets are needed for faces to follow the map closely).
-//
-// Then the result is checked for self-intersections with exact predicates
-// (count_self_intersections, CGAL PMP), reported as a count of face pairs.
-//
-// Vertices outside the texture space (in the gaps between charts, or w outside
-// [0,1]) are either refused (InvalidInputError) or placed by extrapolating the
-// barycentric map of the nearest tet (outside_policy); they are counted.
+// Faces stay straight between mapped vertices (elements must be small against
+// the tets); self-intersections counted exactly (PMP). Vertices outside the
+// texture space are refused or extrapolated from the nearest tet
+// (outside_policy), and counted.
 // Reads/writes: the mesh's vertex points only (overwritten in place).
 // Throws: InvalidInputError (outside vertex with kRefuse, non-triangle faces
 // when checking).

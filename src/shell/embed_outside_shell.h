@@ -5,19 +5,11 @@
 // between M_base and one offset of it"; a vertex placed outside that volume is
 // an embedding defect the paper's construction excludes).
 //
-// Definition (ours; the paper gives none): the geometric shell is the union of
-// the shell-space tetrahedra of a ShellSpace, i.e. the prisms between the base
-// surface (layer 0) and its clamped offset (layer 1). A point is outside when
-// its Euclidean distance to that union exceeds tolerance * shell.height. The
-// distance is computed only for points that ShellMap::locate_shell does not
-// find inside a tet, as the distance to the nearest boundary triangle of the
-// union: bottom triangles (base surface), top triangles (offset surface) and
-// lateral walls on mesh borders (walls between two charts coincide in 3D and
-// are inside the union: they are left out). The side of an outside point is
-// the layer of that nearest triangle: below (under the base surface), above
-// (over the offset surface) or side (beyond a mesh-border wall).
-// Because the distance is to the nearest shell triangle, a point is measured
-// against the shell where it is, not against the prism it was meant for.
+// Definition (ours): the geometric shell is the union of the shell-space
+// tets; a point is outside when farther than tolerance * shell.height from
+// it, measured (only for points locate_shell does not place) to the nearest
+// boundary triangle: bottom (below), top (above) or a mesh-border wall
+// (side); walls between charts are inside. In full: decision 104.
 //
 // Reads: shell.shell_points, tets, tet_face, chart, base_vertex, layer, height.
 // Throws: InvalidInputError (empty shell, tolerance < 0 or not finite).

@@ -4,27 +4,12 @@
 // piecewise-linear bijection between shell space and texture space defined by
 // barycentric coordinates in corresponding tetrahedra of a ShellSpace.
 //
-// A point is located in one space with a uniform grid over the tets' bounding
-// boxes (texture space gridded in metric units (u, v, w * w_scale), so the
-// thin texture slab gets a flat grid), its barycentric coordinates in the
-// containing tet are computed in double precision, and the same coordinates
-// applied to the corresponding tet of the other space. A point lies in a tet
-// when every barycentric coordinate is >= -tolerance; if several tets qualify
-// (shared faces, coincident chart borders in shell space), the one with the
-// largest smallest coordinate wins, ties to the lower tet index
-// (deterministic). Shell-space points on a chart border belong to two charts;
-// either image is a valid answer.
-//
-// locate_texture_from() finds a texture point by walking from a given tet
-// across tet faces (to the neighbour opposite the most negative barycentric
-// coordinate) instead of the global grid. Tets are adjacent only inside one
-// chart (shell vertices are per chart), so the walk never leaves the start
-// tet's chart: texture space is continuous across prism walls within a chart
-// (section 3.2: "a piecewise-linear, bijective mapping between shell space and
-// texture space", with the lateral boundaries of each shell patch fixed; a
-// shell patch is a chart here, our reading), while the grid search would take
-// any chart whose texture tets contain the point. A walk that reaches the chart's boundary or runs
-// max_walk_steps falls back to the grid search restricted to the chart.
+// Points are located with a uniform grid over the tets (texture space in
+// metric units), inside = every barycentric >= -tolerance, ties to the
+// largest smallest coordinate then the lower index (deterministic).
+// locate_texture_from() walks across tet faces instead, so it never leaves
+// the start tet's chart (our reading of 3.2's per-patch bijection), falling
+// back to the chart's grid. In full: docs/decisions/104-shell-space.md.
 //
 // The map copies what it needs from the ShellSpace at construction: rebuild it
 // after shell_map_minimize_stretch changes texture coordinates.

@@ -3,57 +3,19 @@
 // Shell space over a base mesh and its texture space (Zhou et al. 2006, section
 // 3.2 "Final Mesh Embedding"; the shell map of Porumbescu et al. 2005).
 //
-// The shell is the thin volume between the base mesh M_base (layer w = 0) and
-// its offset along the vertex normals (layer w = 1). It is built per chart of
-// the base mesh's texture atlas: every (chart, base vertex) pair gives one
-// bottom and one top shell vertex, so shell vertices on chart borders are
-// duplicated (their 3D positions coincide; their texture coordinates differ).
-// The prism over each triangle is split into 3 tetrahedra by a rule that
-// depends only on the base vertex indices, so neighbouring prisms agree on the
-// diagonal of their common lateral quad: with bottom a < b < c (by base vertex
-// index) and top A, B, C, the tets are (a,b,c,C), (a,b,B,C), (a,A,B,C), i.e.
-// every lateral quad is cut from the bottom of its smaller-index vertex to the
-// top of its larger one.
-//
-// Why prisms, not TetGen, for the shell map (a decision, issue #8 item 4):
-// section 3.2 meshes the shell with tetrahedra and maps by barycentric
-// coordinates (the shell map of Porumbescu et al. 2005, whose tets come from
-// splitting each prism). The map needs every tet corner to be a shell vertex
-// with known texture coordinates, and every tet positive in BOTH spaces.
-// The prism split guarantees both by construction. A TetGen mesh of a chart's
-// closed shell boundary (tetgen_adapter.h with shell_boundary_surface(); the
-// test TetGenAdapter.ShellGivenByItsBoundaryIsTetrahedralizedToTheSameVolume
-// checks it fills the same volume with positive tets) may add interior
-// Steiner points (no texture coordinates) and connects corners of distant
-// prisms, whose image in texture space can be inverted where the shell
-// curves; so the embedding uses the prism tets and TetGen serves shells
-// given only by their boundary.
-//
-// Texture space: a shell vertex of base vertex v in chart c has texture
-// coordinates (u, v, w) with (u, v) the atlas coordinate of v in c
-// (kCornerUV) and w = 0 (bottom) or 1 (top). For distances and volumes the w
-// axis is measured in uv units: w_metric = w * w_scale with w_scale = the
-// nominal shell height times the atlas' uv-per-length scale, so that a flat,
-// unclamped shell maps to texture space by a similarity (the paper does not
-// say how w is scaled against (u, v); this makes the stretch of section 3.2
-// scale-free and 1 for an undistorted shell).
-//
-// Height: h = height * (mean edge length) if relative_height, else height.
-// Local clamping (the paper leaves the offset unspecified): per base vertex the
-// height starts at h; every prism whose tetrahedra are not all positively
-// oriented in 3D (CGAL::orientation, exact) or whose top triangle turns over
-// against its base triangle has the heights of its three vertices multiplied
-// by shrink_factor, until no prism is bad (at most max_shrink_steps rounds).
-// Where shrinking cannot help (a face turned over against its neighbours
-// inverts its prism at any height), the shell's bottom layer is unfolded
-// there: those vertices move to their neighbours' mean and shrinking resumes.
-// This keeps the offset surface locally embedded (no flipped face, no inverted
-// tet); it does not test global self-intersection of the offset surface
-// (thin shells, h << feature size, are the caller's responsibility).
-//
-// Every tetrahedron is stored positively oriented in texture space; the
-// builder verifies with the exact predicate that it is positively oriented in
-// shell space too, and refuses (SolverError) otherwise.
+// The thin volume between the base (w = 0) and its offset along the vertex
+// normals (w = 1), built per atlas chart (shell vertices duplicated on chart
+// borders). Each prism is split into 3 tets by base vertex index, so
+// neighbours agree; prisms rather than TetGen because every tet corner needs
+// texture coordinates and every tet must be positive in both spaces (the
+// decision: docs/decisions/104-shell-space.md). Texture space (u, v, w): w is
+// measured as w * w_scale (uv units), so a flat shell maps by a similarity.
+// Height h (relative to the mean edge if relative_height); heights of bad
+// prisms (a non-positive tet or a turned-over top) shrink by shrink_factor
+// until none is left; where shrinking cannot help (a face turned over against
+// its neighbours), the bottom layer is unfolded there (the vertices move to
+// their neighbours' mean) and shrinking resumes. Tets are stored positive in
+// texture space and checked positive in shell space (SolverError otherwise).
 //
 // Reads: kCornerUV and kFacePatch (e.g. from compute_base_mesh_atlas); every
 // corner of one base vertex inside one chart must carry the same uv. Vertex

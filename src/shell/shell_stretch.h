@@ -9,20 +9,11 @@
 // space (metric units (u, v, w * w_scale), see shell_space.h) and in shell
 // space. Total (eq. 9): L2(M) = sqrt(sum_i L2_i^2 |T_s^i| / sum_j |T_s^j|).
 //
-// Two places where the paper cannot be taken literally, and what is done:
-// * Direction. The paper writes J for g: shell -> texture but weights by shell
-//   volumes and normalises by sqrt(sum|T_t| / sum|T_s|) "such that 1.0 is a
-//   lower bound", which is Sander et al.'s construction for the map from the
-//   parameter domain to the surface. With J of g and these weights no lower
-//   bound holds (Hoelder's inequality bounds it from above). We therefore take
-//   J of f = g^-1: texture -> shell, as Sander et al. do (their f maps texture
-//   to surface); eq. 8 and 9 are otherwise unchanged.
-// * Exponent. In 3D the scale-free normalisation is (sum|T_t| / sum|T_s|)^(1/3)
-//   (the paper's square root is the 2D one carried over; with it a uniformly
-//   scaled texture would not give 1). With the cube root, Hoelder's inequality
-//   gives normalised L2 >= 1, with equality iff the map is a similarity of one
-//   scale everywhere.
-// The normalised value is the one reported and minimised.
+// Two departures from the letter of the paper (reasons: decision 104): J is
+// the Jacobian of texture -> shell (Sander et al.'s direction), and the
+// normalisation is (sum|T_t| / sum|T_s|)^(1/3), so that normalised L2 >= 1
+// with equality iff the map is a similarity. The normalised value is the one
+// reported and minimised.
 
 #include <cstddef>
 #include <cstdint>
@@ -80,23 +71,12 @@ struct MinimizeStretchResult {
 /// over the vertex's tets (equivalent to lowering the global value, since the
 /// texture volume of a chart is fixed by its boundary) and every texture tet
 /// of the vertex stays positively oriented (exact CGAL::orientation).
-/// Vertices are coloured greedily (index order) so that no two vertices of one
-/// colour share a tet; each colour is processed with tbb::parallel_for, each
-/// vertex drawing its direction from a generator seeded by (seed, sweep,
-/// vertex): the result does not depend on the number of threads.
-/// Modifies shell.texture_points (u, v of free layer-1 vertices).
-/// What the result keeps (the shell map stays a bijection per chart): the
-/// bottom layer, every w and the lateral vertices do not move (section 3.2),
-/// and every texture tet stays positive. The top triangles stay in the plane
-/// w = 1, positively oriented, with their chart-border edges fixed, so they
-/// still tile the chart's uv region; the chart's texture slab (uv region x
-/// [0, 1]) has the same boundary as before, and positive tets summing to its
-/// volume cover it exactly once. So every (u, v, w) with (u, v) in a base
-/// face's uv triangle and w in [0, 1] lies in a tet of the face's chart,
-/// though not always of its own prism (the prism walls lean): locate it in the
-/// chart (ShellMap::locate_texture_from), not in the prism. No move is
-/// rejected for leaning (our choice: the paper's line search has no such
-/// constraint, and the stretch gain is kept whole).
+/// Vertices are coloured so that no two of a colour share a tet, each colour
+/// run with tbb::parallel_for, directions seeded by (seed, sweep, vertex):
+/// independent of the thread count. Modifies shell.texture_points. The bottom
+/// layer, every w and the lateral vertices stay; every texture tet stays
+/// positive, so the chart's tets still tile its slab (locate points in the
+/// chart, not the prism: ShellMap::locate_texture_from).
 /// Throws InvalidInputError for bad options or an empty shell.
 MinimizeStretchResult shell_map_minimize_stretch(ShellSpace& shell, const MinimizeStretchOptions& opt = {});
 

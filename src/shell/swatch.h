@@ -43,18 +43,12 @@ struct Swatch {
   double height() const { return bbox_max[2] - bbox_min[2]; }  ///< h_in (z)
 };
 
-/// Builds a swatch from a triangle mesh: elements = connected components
-/// (numbered in order of their first face). Throws InvalidInputError if the
-/// mesh has no face, a non-triangle face, a non-finite coordinate, or a zero
-/// xy extent. A zero height (flat swatch, z extent 0) is accepted: planar
-/// quilting (section 2) works in xy; embedding on a surface (section 3.2)
-/// needs a shell of positive thickness and refuses it there
-/// (embed_surface_quilt).
+/// Builds a swatch: elements = connected components (by first face). Throws
+/// InvalidInputError for no face, a non-triangle, a non-finite coordinate or a
+/// zero xy extent; a flat swatch is accepted here (embedding refuses it).
 Swatch make_swatch(const Mesh& mesh);
-/// As above, with the thin axis `up` turned onto z first (kAuto: the axis of
-/// the smallest bounding-box extent, swatch_thin_axis); Swatch::up_axis says
-/// which it was. The turn is a cyclic permutation of the axes (x up: (y, z,
-/// x); y up: (z, x, y)), so orientation and handedness are kept.
+/// As above with the thin axis `up` turned onto z first (a cyclic permutation,
+/// handedness kept; kAuto: swatch_thin_axis); Swatch::up_axis records it.
 Swatch make_swatch(const Mesh& mesh, SwatchAxis up);
 /// The axis (0, 1, 2) of the smallest bounding-box extent of `mesh` (the
 /// paper's h_in, section 2.1); z unless another extent is smaller by more than
@@ -63,11 +57,9 @@ int swatch_thin_axis(const Mesh& mesh);
 /// Permutes the coordinates of every vertex cyclically so that `axis` (0, 1,
 /// 2) becomes z; axis 2 leaves the mesh unchanged.
 void orient_swatch_up(Mesh& mesh, int axis);
-/// The grid of section 2.3 over the swatch's xy rectangle for cells of side
-/// `cell` (swatch units): sx x sy cells. Throws InvalidInputError, with `who`
-/// leading, if either is below 3, naming the swatch's axes as the input had
-/// them (its thin axis, Swatch::up_axis, is the height), the cell size and
-/// the CLI's --cell and --swatch-up.
+/// The section 2.3 grid for cells of side `cell`: sx x sy. Throws
+/// InvalidInputError (led by `who`, naming the axes, cell and --cell /
+/// --swatch-up) if either is below 3.
 void swatch_cells(const Swatch& swatch, double cell, const std::string& who, int& sx, int& sy);
 /// The swatch's element spacing (swatch units): the median, over its
 /// elements, of the xy distance from an element's vertex centroid to the

@@ -6,19 +6,11 @@
 // shell space is meshed with tetrahedra; see shell_space.h for the prism path
 // and shell_boundary_surface() for a shell's boundary).
 //
-// The surface's vertices and triangles become a tetgenio PLC (one facet per
-// triangle); `tetrahedralize(switches, in, out)` is called with the switches
-// of the options ("pQY" by default: p = tetrahedralize a PLC, Q = quiet, Y =
-// keep the boundary as given, no Steiner points on it). TetGen reports failure
-// by throwing an int (1 out of memory, 2 internal error, 3 self-intersecting
-// input, 4 very small input feature, 5 close facets, 10 input error); any such
-// throw, or any other exception, becomes a SolverError naming the code. The
-// output is checked: at least one tet, 4 corners each, indices in range, every
-// tet non-degenerate. Tets are returned positively oriented (CGAL::orientation
-// exact predicate on Epick points; TetGen's own convention is the opposite
-// sign, so most tets are reordered: swap of the first two corners).
-// The surface is first checked for self-intersections (exact predicates):
-// TetGen 1.5 was seen to crash outright on such input, so it is refused.
+// The surface becomes a tetgenio PLC (one facet per triangle), tetrahedralized
+// with the options' switches ("pQY": no Steiner points on the boundary).
+// TetGen's thrown codes become SolverError; the output is checked (tets, 4
+// valid corners, non-degenerate) and returned positively oriented. A
+// self-intersecting surface is refused first (TetGen 1.5 crashes on it).
 // Throws: InvalidInputError (surface not closed, not triangles or
 //         self-intersecting; bad switches),
 //         SolverError (TetGen failed, or returned a degenerate/invalid mesh).

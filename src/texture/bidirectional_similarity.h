@@ -14,12 +14,9 @@
 // difference per value, in squared image units), so figures compare across
 // image and patch sizes.
 //
-// Nearest neighbours are exact (up to float rounding): patches are projected
-// on the leading principal components (Eigen) and a nanoflann kd-tree over the
-// projections runs a branch-and-bound search in which every point the tree
-// offers is re-ranked with the full distance; since the subspace distance is
-// a lower bound of the full one, a subtree or point whose bound reaches the
-// best full distance found so far cannot hold the nearest patch and is pruned.
+// Nearest neighbours are exact (up to rounding): a kd-tree over PCA
+// projections, every offered point re-ranked with the full distance and the
+// subspace distance (a lower bound) used to prune.
 //
 // Throws InvalidInputError on empty images, different channel counts,
 // patch outside 1..31 or larger than an image, stride < 1, or a mask of the
@@ -48,19 +45,14 @@ struct BidirectionalOptions {
   /// Dimensions kept by the PCA projection for the kd-tree (1..k*k*channels,
   /// clamped), default 16. Affects speed only, not the result.
   int pca_dims = 16;
-  /// 0 (default) = exact search as described above. > 0 = approximate: stop
-  /// after this many full-distance evaluations per query and take the best
-  /// seen (an upper bound of the true distance; figures can only be too
-  /// high). Bounds the time on exemplars whose patches PCA separates poorly
-  /// (large, regular ones such as stripes).
+  /// 0 (default) = exact. > 0 = approximate: at most this many full distances per
+  /// query, the best seen kept (figures can only be too high).
   int max_candidates = 0;
   /// Brute-force search instead of the kd-tree (reference; slow).
   bool brute_force = false;
-  /// Optional validity mask of the output (width*height, row-major; empty =
-  /// every pixel valid): only output patches whose k*k pixels are all valid
-  /// are compared, in both directions (an output made of several charts laid
-  /// side by side with invalid gaps, texture/surface_fidelity.h). At least
-  /// one valid patch is required.
+  /// Optional validity mask of the output (width*height; empty = all valid):
+  /// only patches of valid pixels compared, both ways (surface_fidelity.h's
+  /// charts). At least one valid patch is required.
   std::vector<char> output_valid{};
 };
 

@@ -5,60 +5,13 @@
 // per-pixel orientation (3.3.2, pre-rotated exemplars) and per-pixel choice of
 // exemplar (multi-texturing, section 5).
 //
-// Each pixel to fill is synthesised from the already known pixels around it:
-//  - pass 1: a small UNWEIGHTED square neighbourhood compared over the
-//    known neighbours only (SSD over all channels), on every candidate
-//    position of the (rotated) exemplar (ElSearch::Exhaustive, the paper) or
-//    on a short list of coherent and approximate-nearest candidates
-//    (ElSearch::Approximate, the default: its cost does not grow with the
-//    exemplar); the `preselect` best are kept (ties broken by candidate
-//    position, so the set is unique);
-//  - pass 2: the preselected candidates are scored with the full window,
-//    Gaussian-weighted (Efros & Leung 1999), weights renormalised over the
-//    known neighbours;
-//  - the pixel is copied from a random candidate among the best
-//    max(pick_min, ceil(pick_fraction * preselect)) of pass 2 (Gorla: "among
-//    the best 10 or 10% of matches, whichever is greater"). In addition, and
-//    unless error_tolerance < 0, candidates whose error exceeds
-//    (1 + error_tolerance) times the best are dropped (Efros & Leung's
-//    epsilon rule). Gorla does not mention this; we add it because a pure
-//    best-k pick copies visibly worse matches on regular textures, while the
-//    threshold keeps the randomness where matches are equally good.
-//
-// Pixel states: Fill pixels are synthesised; Known pixels are boundary
-// conditions, read as neighbours and never written (bit for bit); Outside
-// pixels are not part of the domain: never read, never written.
-//
-// Fill order: OnionPeel takes next the pixel with the most known 8-neighbours
-// (ties: lowest row-major index, so the order is deterministic); Direction
-// sweeps the pixels by increasing projection on a direction vector (Gorla 4:
-// "following the direction of the vector field"), ties by the perpendicular
-// coordinate. A pixel with no known neighbour in its whole window (an empty
-// target, or a Fill component that touches nothing known) is seeded instead:
-// a random 3x3 exemplar patch is pasted centred on it (Fill pixels only).
-// With no Known pixel at all, the first seed goes to the Fill pixel nearest
-// the centre of the Fill pixels' bounding box (Efros-Leung grow from a seed).
-//
-// Windows: a window of size N covers offsets -floor(N/2) .. N-1-floor(N/2)
-// around the pixel, so even sizes are supported as they are (Gorla's
-// Figure 5 uses 12x12 with a 5x5 first pass): an even window reaches one
-// pixel further up/left than down/right.
-//
-// Determinism: every random choice comes from std::mt19937_64(seed),
-// consumed in the (deterministic) fill order. The exhaustive candidate
-// search of one pixel is split over TBB tasks, each keeping its own best list; the lists
-// are merged under the total order (error, candidate position), so the result
-// is the same bytes for any thread count.
-//
-// Speed of the exhaustive pass 1: it computes every candidate's error
-// over channel planes, 8 consecutive candidates per vector register; the n
-// best are then found without sorting thousands of candidates: a threshold
-// guessed from every 8th error keeps about 2n of them (checked: if fewer
-// than n pass, all are ranked), ranked by (error, position). Pass 2 ranks
-// only the best max(pick_min, ...) it picks from. Exemplar preparation
-// (rotations, channel planes, candidate lists) can be done once for many
-// runs (el_prepare_exemplars), as the patch pipeline does for its hundreds
-// of patches.
+// Pass 1: a small unweighted window on every candidate (Exhaustive, the
+// paper) or a short list (Approximate, default), `preselect` kept; pass 2:
+// the full Gaussian-weighted window; the pixel copied from a random one of
+// the best max(pick_min, pick_fraction * preselect) within (1 +
+// error_tolerance) of the best (our addition). Fill order: onion peel or
+// direction sweep; isolated pixels seeded. Same bytes for any thread count.
+// In full: docs/decisions/505-efros-leung-details.md.
 //
 // Throws InvalidInputError naming the option or input on any invalid value.
 
@@ -80,14 +33,9 @@ enum class PixelState : std::uint8_t {
 
 /// How pass 1 finds its candidates.
 enum class ElSearch {
-  /// A short list whose size does not grow with the exemplar: the coherent
-  /// candidates (each known neighbour's source position shifted by its
-  /// offset, Ashikhmin 2001; same exemplar and orientation only) and the
-  /// `ann_candidates` nearest first-pass neighbourhoods by a kd-tree over
-  /// their PCA coefficients (texture/partial_neighbourhood_index.h: the
-  /// unknown part of the query estimated from the known part), per
-  /// (exemplar, orientation). Pass 1 ranks the short list exactly and keeps
-  /// the `preselect` best for pass 2 as in the exhaustive search.
+  /// A short list independent of the exemplar size: the coherent candidates
+  /// (Ashikhmin 2001) and the `ann_candidates` nearest by a kd-tree over PCA
+  /// coefficients (partial_neighbourhood_index.h), ranked exactly by pass 1.
   Approximate,
   /// Every candidate position (Gorla's pass 1 as published; cost grows with
   /// the exemplar area). The reference.
@@ -102,14 +50,11 @@ enum class FillOrder {
 struct ElOptions {
   /// Full (second-pass) neighbourhood diameter, pixels, 3..51. Default 11.
   int window = 11;
-  /// First-pass unweighted neighbourhood diameter, 3..window; 0 = automatic:
-  /// max(3, round(window * 5 / 12)), i.e. Gorla's Figure 5 ratio (5x5 for
-  /// 12x12), inside the paper's "1/3 to 1/2 of the full diameter".
+  /// First-pass window, 3..window; 0 = max(3, round(window * 5 / 12)) (Gorla's
+  /// Figure 5 ratio).
   int first_pass_window = 0;
-  /// Number n of pass-1 candidates kept for pass 2, >= 0; 0 = the width of
-  /// the exemplar searched (Gorla: "one scanline" suffices for easy
-  /// textures; hard ones need 4 to 8 times more). Clamped to the number of
-  /// candidate positions.
+  /// Pass-1 candidates kept for pass 2, >= 0; 0 = the exemplar's width (Gorla:
+  /// "one scanline"), clamped to the candidate count.
   int preselect = 0;
   /// Sigma of the pass-2 Gaussian weights, pixels, >= 0; 0 = window / 6.4
   /// (Efros & Leung 1999).
@@ -130,9 +75,8 @@ struct ElOptions {
   /// Number of pre-rotated orientations when an angle field is given
   /// (Gorla 3.3.2), 1..128. Default 64.
   int rotations = 64;
-  /// The exemplars tile seamlessly: neighbourhoods wrap around their edges,
-  /// so every exemplar pixel is a candidate (else only positions whose whole
-  /// window lies inside the exemplar).
+  /// The exemplars tile: windows wrap, every pixel is a candidate (else only
+  /// windows inside).
   bool periodic_exemplar = false;
   /// Pass-1 candidate search (see ElSearch). Default Approximate.
   ElSearch search = ElSearch::Approximate;
@@ -144,20 +88,13 @@ struct ElOptions {
   int ann_pca_dims = 4;
   /// Approximate search: (1 + eps)-approximate kd-tree distances, >= 0. Default 1.
   double ann_eps = 1.0;
-  /// Approximate search: the kd-tree holds the candidates on every
-  /// ann_stride-th row and column, each hit standing for its ann_stride^2
-  /// block (all of which pass 1 ranks), 1..4. Default 2: a quarter of the
-  /// points, so building the index of each of 64 rotations of a 512 px
-  /// exemplar costs a quarter as much.
+  /// Approximate search: the kd-tree holds every ann_stride-th row and column,
+  /// each hit standing for its block, 1..4. Default 2 (a quarter of the index cost).
   int ann_stride = 2;
-  /// Reference mode: Efros-Leung's original single exhaustive pass with the
-  /// full Gaussian-weighted window (no preselection). Slow; for tests and
-  /// comparisons.
+  /// Reference mode: Efros-Leung's single exhaustive Gaussian pass. Slow.
   bool single_pass = false;
-  /// Split each pixel's candidate search over TBB threads when the search is
-  /// large enough (the result does not depend on it). Turn off when several
-  /// syntheses run in parallel already (one task per patch), where the
-  /// per-pixel fork/join would cost more than it gains. Default on.
+  /// Split each pixel's search over TBB threads (same result); off when
+  /// syntheses already run in parallel. Default on.
   bool parallel_pixel_search = true;
   /// Seed of every random choice.
   std::uint64_t seed = 1;
@@ -173,23 +110,19 @@ struct ElPreparedExemplars;
 
 /// Everything a synthesis run reads besides the options.
 struct ElInput {
-  /// One or more exemplars (multi-texturing, Gorla 5), same channel count,
-  /// each at least `window` pixels on each side unless periodic. Must be
-  /// empty when `prepared` is given (the prepared exemplars are used).
+  /// One or more exemplars (Gorla 5), same channels, each >= `window` per side
+  /// unless periodic; empty when `prepared` is given.
   std::vector<Image> exemplars;
-  /// Alternative to `exemplars`: exemplars prepared once for many runs
-  /// (el_prepare_exemplars with the same window, first-pass window,
-  /// rotations, periodic_exemplar, search, ann_pca_dims and ann_stride as
-  /// the run's options, else InvalidInputError).
+  /// Alternative to `exemplars`: prepared once for many runs (el_prepare_exemplars
+  /// with the run's window, search and rotation options, else InvalidInputError).
   std::shared_ptr<const ElPreparedExemplars> prepared;
   /// Output canvas: size and channels of the result (channels must match the
   /// exemplars); values at Known pixels are the boundary conditions.
   Image target;
   /// Per-pixel state, row-major, width*height; empty = every pixel Fill.
   std::vector<PixelState> state;
-  /// Optional per-pixel orientation (radians, convention of
-  /// rotated_exemplars.h: the exemplar's +x axis is drawn along
-  /// (cos a, -sin a)); a 1-channel image of the target's size. Empty = none.
+  /// Optional per-pixel orientation (radians, rotated_exemplars.h convention),
+  /// 1 channel, the target's size. Empty = none.
   Image angle;
   /// Alternative to `angle`: a function of the pixel (x, y). Used when
   /// `angle` is empty and this is set.
@@ -199,11 +132,8 @@ struct ElInput {
   std::vector<int> exemplar_index;
 };
 
-/// Where a synthesised pixel took its value: pixel (x, y) of exemplar
-/// `exemplar` rotated by orientation `rotation` (rotate_exemplar with the
-/// run's periodic_exemplar and a margin of window / 2); exemplar -1 = not
-/// synthesised (Known or Outside pixels). Other maps of the same exemplar
-/// resampled there follow the same synthesis.
+/// Where a synthesised pixel took its value: pixel (x, y) of `exemplar` rotated
+/// by `rotation` (rotate_exemplar, margin window / 2); exemplar -1 = not synthesised.
 struct ElSource {
   int exemplar = -1, rotation = 0, x = 0, y = 0;
 };
@@ -216,9 +146,7 @@ struct ElResult {
   int window = 0;              ///< effective full window
   int first_pass_window = 0;   ///< effective first-pass window
   int rotations_used = 0;      ///< distinct (exemplar, orientation) pairs searched
-  /// Candidates ranked by pass 1, summed over the pixels: the exemplar's
-  /// candidate count per pixel for the exhaustive search, the short list's
-  /// length for the approximate one.
+  /// Candidates ranked by pass 1, summed over the pixels.
   std::size_t pass1_candidates = 0;
   double seconds = 0.0;
 };
@@ -230,12 +158,9 @@ ElResult efros_leung_synthesize(const ElInput& input, const ElOptions& opt = {})
 Image efros_leung_synthesize(const Image& exemplar, int width, int height,
                              const ElOptions& opt = {});
 
-/// Validates `exemplars` (as efros_leung_synthesize does) and prepares them
-/// for runs with opt.window, first_pass_window, rotations,
-/// periodic_exemplar, search, ann_pca_dims and ann_stride (other options
-/// are not read).
-/// Rotations (and their search index) are built on first use, each once,
-/// concurrently for different rotations. Throws InvalidInputError.
+/// Validates and prepares `exemplars` for runs with opt's window, rotation and
+/// search options (others not read); rotations built lazily, each once,
+/// concurrently. Throws InvalidInputError.
 std::shared_ptr<const ElPreparedExemplars> el_prepare_exemplars(const std::vector<Image>& exemplars,
                                                                 const ElOptions& opt);
 

@@ -5,19 +5,12 @@
 // F_M of the last, produces M+1 masks F_0 .. F_M in which the source features
 // are pushed into the target features (they may split and merge), with the
 // paper's four ingredients:
-//  - material-space oversampling: N >> M advection steps of length
-//    dt = max_s(-phi_N(s)) / N, so that even the source texels farthest from
-//    every target feature travel far enough in N steps;
-//  - advection of phi outside F_M along grad phi_N, each texel displaced to
-//    s + grad phi_N(s) dt and splatted conservatively onto the texel grid with
-//    the overlap ratio of two unit texels (bilinear weights);
-//  - interior dilation of the advected source features inside F_M;
-//  - sweeping towards phi_N, so the last field is exactly the target;
-//  - speed-adaptive subsampling H(m): the M+1 stored steps are chosen so the
-//    number of texels changing sign between consecutive masks is as constant
-//    as possible.
-// Everything is on the torus (the masks describe periodic tiles). See
-// mask_morph.cpp for the choices made where the paper is vague.
+// The paper's ingredients: material-space oversampling (N >> M steps),
+// advection of phi outside F_M along grad phi_N (conservative bilinear
+// splats), interior dilation, sweeping towards phi_N (the last field is the
+// target), and speed-adaptive subsampling H(m) (even sign changes per layer).
+// On the torus. The choices where the paper is vague: mask_morph.cpp and
+// docs/decisions/303.
 
 #include <cstdint>
 #include <vector>
@@ -28,15 +21,11 @@
 namespace surftex {
 
 struct MaskMorphOptions {
-  /// N, the number of advection steps (material-space oversampling). 0 (default)
-  /// = automatic: max(16 M, ceil(2 D)) with D the largest distance (pixels)
-  /// from a texel to the target features, so a step moves a texel at most
-  /// half a texel. Otherwise must be >= M.
+  /// N, the advection steps; 0 (default) = max(16 M, ceil(2 D)), D the largest
+  /// distance to the target features (at most half a texel per step); else >= M.
   int steps = 0;
-  /// Which field's magnitude drives the sweeping front (see mask_morph.cpp).
-  /// Target (default): |phi_N|, the reading that matches the paper's stated
-  /// purpose (fill unreached target features from their centres, settle the
-  /// sign at the sources of the advection field). Source: |phi_0| as printed.
+  /// Field whose magnitude drives the sweep: Target (default, |phi_N|, the
+  /// paper's stated purpose) or Source (|phi_0|, as printed).
   enum class SweepReference { Target, Source };
   SweepReference sweep_reference = SweepReference::Target;
   /// Rounds of coordinate descent refining H(m) after the arc-length start.

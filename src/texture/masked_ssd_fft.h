@@ -8,11 +8,8 @@
 //          = corr(mb*|B|^2, mt) - 2 sum_c corr(mb*B_c, mt*T_c) + corr(mb, mt*|T|^2)
 //
 // where corr(f, g)(u) = sum_i f(u+i) g(i) is one product in frequency space.
-// The spectra of the big image are computed once (MaskedSsdMatcher keeps
-// them), so each query costs (channels + 2) forward FFTs and one or two
-// inverse FFTs. Used by graph-cut texture synthesis for entire-patch matching
-// (big = output canvas, template = exemplar) and sub-patch matching (big =
-// exemplar, template = an output window).
+// MaskedSsdMatcher keeps the big image's spectra: a query costs (channels + 2)
+// forward and one or two inverse FFTs (entire- and sub-patch matching).
 //
 // Masks are per-pixel weights (normally 0/1); an empty mask means all ones.
 // Units: whatever the images hold (floats), squared and summed over channels.

@@ -3,21 +3,11 @@
 // Approximate nearest neighbourhoods for partially known queries: the
 // candidate short list of efros_leung.h's approximate first pass (Gorla 3.3).
 //
-// Index: the f x f neighbourhood (all channels) of every given candidate
-// position of an image (channel planes), reduced by PCA to `pca_dims`
-// coefficients (texture/pca_kdtree.h, fitted on up to 16384 evenly spaced
-// candidates) and put in a kd-tree.
-//
-// Query: a neighbourhood of which only some pixels are known (the rest of
-// an Efros-Leung window is not synthesised yet). Its coefficients are
-// estimated from the known entries as the posterior mean of probabilistic
-// PCA (Tipping & Bishop 1999): c = (B_K^T B_K + s2 L^-1)^-1 B_K^T (x_K - mu_K),
-// with B_K the basis rows of the known entries, L the kept eigenvalues and s2
-// the mean of the discarded ones (the residual variance per entry). With
-// every entry known and s2 small this is the plain projection. The k nearest
-// candidates of c ((1+eps)-approximate) are returned; the caller ranks them
-// exactly. Cost per query: O(known pixels * pca_dims^2 + pca_dims^3 + tree
-// search), independent of the number of candidates but for the tree's depth.
+// Index: every candidate's f x f neighbourhood reduced by PCA (pca_kdtree.h)
+// in a kd-tree. Query: coefficients of a partly known neighbourhood as the
+// probabilistic-PCA posterior mean (Tipping & Bishop 1999) from its known
+// entries; the k (1+eps)-approximate nearest returned, ranked exactly by the
+// caller. Cost independent of the candidate count. In full: decision 501.
 
 #include <cstddef>
 #include <cstdint>
@@ -30,15 +20,11 @@ namespace surftex {
 
 class PartialNeighbourhoodIndex {
  public:
-  /// `planes`: `channels` planes of plane_size floats, row pitch `pitch`;
-  /// `ids`: candidate centres (buffer offsets y * pitch + x) whose whole f x f
-  /// window (offsets -f/2 .. f-1-f/2) lies in the buffer; f = `window` >= 1;
-  /// pca_dims in 1..f*f*channels (clamped). Throws InvalidInputError on
-  /// empty ids or bad sizes, SolverError if the PCA fails.
-  /// `stride` >= 1: only the candidates at buffer positions whose x and y
-  /// are multiples of it go in the kd-tree (stride^2 times fewer points); a
-  /// query then returns, for each hit, the candidates of its stride x stride
-  /// block.
+  /// `planes`: `channels` planes (row pitch `pitch`); `ids`: candidate centres
+  /// whose f x f window lies inside; pca_dims clamped to 1..f*f*channels;
+  /// `stride` >= 1: only positions on multiples of it are indexed, each hit
+  /// standing for its block. Throws InvalidInputError (empty ids, bad sizes),
+  /// SolverError (PCA).
   PartialNeighbourhoodIndex(const float* planes, std::size_t plane_size, int pitch, int channels,
                             const std::vector<int>& ids, int window, int pca_dims, int stride = 1);
   ~PartialNeighbourhoodIndex();

@@ -3,17 +3,10 @@
 // The PBR texture set of an atlas (issue 16 item 2): height and tangent-space
 // normal maps beside the base colour, the same for every image-texture method.
 //
-// Height: the luminance of the base colour (Rec. 709 weights), or an exemplar
-// height map resampled where the colour came from (the caller's synthesis
-// coordinates). Normal: from the height's slopes in the atlas, by central
-// differences between texels of the same chart (one-sided at a chart's
-// edge, flat where a texel has no same-chart neighbour on either side):
-//   n = normalize(-k dh/du, -k dh/dv, 1),  k = strength_per_texel,
-// in the tangent frame of the atlas uv (x along +u, y along +v: "+Y up", the
-// OpenGL / glTF convention), stored as (n + 1) / 2. The GLB carries a
-// TANGENT attribute in that frame (geometry/vertex_tangents.h), so viewers do
-// not have to generate one (the glTF validator warns when they must).
-// No CGAL here.
+// Height: the base colour's luminance (Rec. 709) or a resampled exemplar
+// height. Normal: n = normalize(-k dh/du, -k dh/dv, 1) from central
+// differences within a chart, in the atlas uv frame (+Y up, glTF), stored
+// (n + 1) / 2; the GLB carries a matching TANGENT. No CGAL here.
 
 #include <vector>
 

@@ -8,13 +8,9 @@
 // kd-tree ... ANN") and the bidirectional similarity (its exact
 // branch-and-bound search).
 //
-// PcaFit accumulates sample vectors (sums in double) and returns a PcaBasis:
-// the mean and the leading eigenvectors of the sample covariance, in
-// decreasing eigenvalue order, each signed so that its largest-magnitude
-// entry is positive (a deterministic basis). KdIndex<T> is a kd-tree over n
-// points of `dims` coordinates (float or double, leaf size 16) answering
-// k-nearest queries ((1+eps)-approximate) and visitor searches (the visitor
-// sets the pruning bound and sees every point within it).
+// PcaFit accumulates vectors (double sums) into a PcaBasis (mean, leading
+// eigenvectors, each signed deterministically); KdIndex<T>: a kd-tree (leaf
+// 16) for (1+eps)-approximate k-nearest queries and bounded visitor searches.
 
 #include <cstddef>
 #include <cstdint>

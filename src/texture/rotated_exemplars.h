@@ -11,19 +11,10 @@
 // Orientation k of K is the angle 2*pi*k/K; directions are not folded to
 // [0, pi) because a direction field may distinguish a from a + pi.
 //
-// Cropping (the paper leaves it open):
-// - non-periodic exemplar: each rotation is stored in the bounding box of the
-//   rotated exemplar (same size parity as the source so that the centres
-//   coincide), with a validity mask that is 1 where the bilinear footprint is
-//   fully inside the source. Synthesis only uses neighbourhoods that are
-//   entirely valid, so the usable region shrinks with the window near the
-//   rotated corners.
-// - periodic exemplar (tiles seamlessly): samples wrap toroidally, so every
-//   pixel is valid; the rotation is stored as a (W + 2m) x (H + 2m) block
-//   around the centre, with m the margin asked for (synthesis passes half
-//   its window), so that all W x H positions of one period can be
-//   neighbourhood centres.
-// Rotation 0 is an exact copy of the exemplar (no resampling).
+// Cropping (left open by the paper): a non-periodic rotation is stored in its
+// bounding box with a validity mask (bilinear footprint inside the source); a
+// periodic one as a (W + 2m) x (H + 2m) wrapped block. Rotation 0 is an exact
+// copy. In full: docs/decisions/505.
 
 #include <vector>
 

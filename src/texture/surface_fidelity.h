@@ -4,48 +4,19 @@
 // exemplar, measured on the surface, one figure for every image-texture
 // method (patches, subdiv, material-map; issue 18 item 3).
 //
-// 1. Local charts: square windows of chart_texels x chart_texels texels at
-//    the synthesis texel size h (mesh units per exemplar texel), centred on
-//    seeded random surface points (area-weighted, at least one chart side
-//    apart in 3D). A chart holds the triangles edge-connected to its seed
-//    whose normal is within max_normal_angle_deg of the seed's and whose
-//    projection meets the window; they are projected orthogonally onto the
-//    seed's tangent plane, in the seed face's texture frame: pixel +x along
-//    the exemplar's +x on the surface, pixel +y (rows down) along the
-//    exemplar's +y (TextureFrames). A pixel is valid when its centre lies in
-//    exactly one chart triangle (a fold, two triangles strictly overlapping,
-//    makes it invalid; so do pixels off the surface). Polygons are fanned.
-// 2. Resampling: every valid pixel gets the surface colour at its centre
-//    (SurfaceColorFn: vertex colours, an atlas through corner UVs, a
-//    material-space tile, ...), i.e. what a renderer shows there.
-// 3. Similarity: the charts are laid side by side (one invalid row/column
-//    between them) and texture/bidirectional_similarity compares every valid
-//    patch x patch window (none straddles two charts) with the exemplar:
-//    fidelity.bds = coherence + completeness. The reference: graph-cut 2D
-//    synthesis (texture/graphcut_synthesis, default options, same seed) of the
-//    same exemplar, resampled like a texture painted on the charts (each
-//    chart reads it bilinearly at a seeded sub-texel offset, as a surface
-//    texture is read at pixel centres that are not its texel centres) and
-//    masked the same way, so both figures compare the same number and layout
-//    of equally resampled patches: bds_2d; ratio = bds / bds_2d (1 = as close
-//    to the exemplar as 2D synthesis).
-// 4. Seams: surface_seam_ratio resamples charts the same way (its own seeded
-//    placement, any tangent frame) and compares the colour jumps of
-//    horizontal and vertical neighbour pixels whose faces lie on two sides of
-//    a chart/patch boundary (`seam_edges`: faces in different islands of
-//    unflagged edges, or adjacent across a flagged edge; each pixel's colour
-//    read through its own face, as a renderer does) with those of the other
-//    neighbour pixels: ratio = (sum of across jumps) / (sum over the across
-//    pairs of the mean within jump of the same direction), so an anisotropic
-//    texture does not bias it: about 1 when boundaries are invisible.
-// 5. Verbatim copies (issue 18 item 2), when the method knows where each
-//    point's colour came from: along every chart row, neighbouring pixels
-//    whose sources differ by one exemplar texel along +x (within half a
-//    texel) continue a straight run; columns likewise along +y. The share of
-//    valid pixels on a run longer than half the exemplar's width (rows) or
-//    height (columns) is long_run_fraction: about 1 for the exemplar pasted
-//    whole (a verbatim tiling), 0 for a texture made of pieces smaller than
-//    half the exemplar.
+// 1. Charts: chart_texels-square windows at texel size h, centred on seeded
+//    area-weighted surface points; the edge-connected faces within the normal
+//    cone, projected on the seed's plane in its texture frame; a pixel is
+//    valid when its centre lies in exactly one chart triangle.
+// 2. Resampling: each valid pixel takes the surface colour at its centre.
+// 3. Similarity: the charts side by side, bidirectional similarity with the
+//    exemplar (bds); the reference bds_2d is graph-cut 2D synthesis resampled
+//    and masked the same way; ratio = bds / bds_2d (1 = as good as 2D).
+// 4. Seams: colour jumps across chart/patch boundaries over the mean jump
+//    within, same direction (about 1 when boundaries are invisible).
+// 5. Verbatim copies: the share of valid pixels on straight runs of
+//    consecutive exemplar texels longer than half the exemplar.
+// Every rule in full: docs/decisions/201-surface-fidelity.md.
 //
 // Deterministic: every random choice from `seed`; the same inputs give the
 // same figures for any thread count. Throws InvalidInputError (empty mesh or
@@ -97,10 +68,8 @@ SurfaceColorFn atlas_color_source(const Mesh& mesh, const Image& atlas);
 SurfaceColorFn vertex_source_coordinates(const std::vector<std::array<int, 2>>& per_vertex);
 
 struct MaterialTile;
-/// A material-space tile (Ray et al. 2009) looked up plainly at the face's
-/// own corner (s,t,m) (`corners`, per face, corner k = target(halfedge(f)),
-/// then next, next-next: PgpSingularities::corners), what a viewer of the
-/// exported (s,t) UVs shows. Triangle faces only. Keeps copies.
+/// A material-space tile (Ray et al. 2009) looked up at each face's corner
+/// (s,t,m) (`corners`: PgpSingularities::corners order). Triangles only.
 SurfaceColorFn material_tile_source(const std::vector<std::array<std::array<double, 3>, 3>>& corners,
                                     const MaterialTile& tile);
 
@@ -110,9 +79,8 @@ SurfaceColorFn material_tile_source(const std::vector<std::array<std::array<doub
 struct TextureFrames {
   std::vector<std::array<double, 3>> x_axis, y_axis;
 };
-/// From kVertexDirection (subdivision synthesis): x = the face's mean vertex
-/// direction, y = x cross n (k_region_matching's offsets: dv along n x u is
-/// drawn upwards in the exemplar). Throws InvalidInputError if absent.
+/// From kVertexDirection (subdivision synthesis): x = mean vertex direction,
+/// y = x cross n. Throws InvalidInputError if absent.
 TextureFrames frames_from_vertex_directions(const Mesh& mesh);
 /// From kFaceDirection (patch synthesis: the exemplar's +x drawn along the
 /// field, y = x cross n). Throws InvalidInputError if absent.
@@ -159,9 +127,7 @@ SurfaceSeamRatio surface_seam_ratio(const Mesh& mesh, const SurfaceColorFn& colo
 struct SurfaceFidelityOptions {
   /// Synthesis texel size: mesh units per exemplar texel, > 0 (required).
   double texel_size = 0;
-  /// Chart side in texels, 16..1024. Default 64. When no chart of this side
-  /// fits (an object a few dozen texels across), it is halved down to 16;
-  /// the result's chart_texels is the side used.
+  /// Chart side in texels, 16..1024, halved down to 16 when none fits. Default 64.
   int chart_texels = 64;
   /// Most charts, 1..256. Default 24 (about 100K texels at the default side).
   int max_charts = 24;
@@ -174,9 +140,7 @@ struct SurfaceFidelityOptions {
   int patch = 7;
   int stride = 2;
   bool periodic_exemplar = false;
-  /// Nearest-neighbour search: full distances evaluated per query at most
-  /// (BidirectionalOptions::max_candidates; 0 = exact). Default 64: the same
-  /// bound for the surface and the reference, a few seconds per report.
+  /// Full distances per nearest-neighbour query (0 = exact). Default 64.
   int max_candidates = 64;
   /// Every exemplar_stride-th exemplar patch queries the charts for
   /// completeness (BidirectionalOptions::exemplar_stride), >= 0; 0 (default)
@@ -184,10 +148,8 @@ struct SurfaceFidelityOptions {
   int exemplar_stride = 0;
   /// Compute the graph-cut 2D reference (bds_2d, ratio). Default on.
   bool reference_2d = true;
-  /// Optional: the exemplar texel each surface point was copied from, as
-  /// (x, y, known) with known > 0.5 when the point has a source (interpolated
-  /// over the fan triangle like a colour). When set, long_run_fraction is
-  /// measured (step 5 of the file comment).
+  /// Optional: the exemplar texel of each point as (x, y, known > 0.5); when
+  /// set, long_run_fraction is measured (step 5).
   SurfaceColorFn source;
   std::uint64_t seed = 1;
 };
@@ -196,9 +158,7 @@ struct SurfaceFidelityResult {
   double bds = 0;      ///< coherence + completeness of the surface charts
   double bds_2d = 0;   ///< the same for graph-cut 2D synthesis under the same mask (0 if not computed)
   double ratio = 0;    ///< bds / bds_2d (0 if not computed)
-  /// Share of valid texels on a straight run of consecutive exemplar texels
-  /// longer than half the exemplar's width (rows) or height (columns); -1 if
-  /// no source was given.
+  /// Share of valid texels on a verbatim run (step 5); -1 without a source.
   double long_run_fraction = -1;
   BidirectionalResult surface, reference;
   int charts = 0;                 ///< charts kept
@@ -216,26 +176,18 @@ struct SurfaceFidelityResult {
 SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, const SurfaceColorFn& color,
                                        const TextureFrames& frames, const SurfaceFidelityOptions& options);
 
-/// The report block of a textured mesh, for the CLI: to_json of
-/// surface_fidelity plus "seam" (surface_seam_ratio over `seam_edges`, when
-/// non-empty). A surface on which no chart fits (tiny or thin meshes at a
-/// coarse texel) gives {"error": reason} instead of throwing.
+/// The CLI's report block: to_json(surface_fidelity) plus "seam" (when
+/// seam_edges is non-empty); {"error": reason} when no chart fits.
 nlohmann::json fidelity_report(const Mesh& mesh, const Image& exemplar, const SurfaceColorFn& color,
                                const TextureFrames& frames, const std::vector<char>& seam_edges,
                                const SurfaceFidelityOptions& options);
 
-/// fidelity_report of a mesh textured by an atlas (kCornerUV, u right, v up)
-/// whose texel is `texel_size` mesh units, with the exemplar's +x along
-/// kFaceDirection (`face_directions`, patch synthesis) or along the atlas's
-/// own u axis; seams across kFacePatch boundaries if present, else across
-/// UV discontinuities. The `patches` report.
+/// fidelity_report of an atlas-textured mesh (kCornerUV; +x along
+/// kFaceDirection or the atlas's u; seams at kFacePatch or UV cuts). `patches`.
 nlohmann::json atlas_fidelity_report(const Mesh& mesh, const Image& exemplar, const Image& atlas, double texel_size,
                                      bool face_directions, std::uint64_t seed);
-/// fidelity_report of a material-space mapping: the tile looked up at the
-/// faces' corner (s,t,m) (`corners` as in material_tile_source), the frames
-/// and texel size from (s,t) times the tile size, the exemplar the tile
-/// layer at the surface's mean material (periodic), seams where the corner
-/// (s,t) of two faces differ. The `material-map` report.
+/// fidelity_report of a material-space mapping (tile at the corner (s,t,m),
+/// exemplar = the layer at the mean material). The `material-map` report.
 nlohmann::json material_map_fidelity_report(const Mesh& mesh,
                                             const std::vector<std::array<std::array<double, 3>, 3>>& corners,
                                             const MaterialTile& tile, std::uint64_t seed);

@@ -3,20 +3,11 @@
 // Element correspondences between the output elements and the placed input
 // elements (Zhou et al. 2006, section 2.5).
 //
-// 1. For every output vertex in the overlap region, its "nearest" input face
-//    f_in^i and the closest point h_in^i on it. Equation 2 takes the face
-//    minimising D (eq. 1) = (1 + lambda Dist)(1 + |n_v - n_f|); we take the face
-//    of smallest Dist (AABB tree closest point) and report D for it: since
-//    D >= 1 + lambda Dist, this face is the true minimiser whenever the normal
-//    term does not dominate, and it is what an AABB query can give (a careful
-//    approximation the paper's octree also implies).
-// 2. Pruning (paper: "normals opposite", "distance much larger than the local
-//    edge length average of the input mesh"): a pair is dropped if
-//    n_v . n_f < 0, or if Dist > prune_factor * (mean edge length of f_in).
-// 3. Relation: C_out is related to C_in if a surviving pair links them.
-// 4. Projection check: the triangles of both elements are projected onto the
-//    xy plane; if no two projected triangles intersect (exact CGAL predicate),
-//    the relation and its pairs are removed.
+// 1. Per output vertex in the overlap, the input face of smallest Dist (AABB
+//    closest point; D of eq. 1 reported for it, the minimiser unless the normal
+//    term dominates). 2. Pruned for opposite normals or Dist > prune_factor
+//    local edges. 3. Surviving pairs relate elements. 4. Relations whose xy
+//    projections do not intersect (exact) are removed. Detail: decision 103.
 #include <functional>
 #include <utility>
 #include <vector>

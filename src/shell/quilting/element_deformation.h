@@ -9,12 +9,9 @@
 // on up to three vertices (eq. 6: a point of a face; eq. 5: one vertex, weight
 // 1) and its target c_k. The original Laplacian coordinates are kept (not
 // rotated), as the paper does for small deformations.
-// Locked vertices (hard constraints) keep their positions exactly; the paper
-// has none, we use them to keep the part of an output element outside the
-// overlap region fixed (a careful-implementer choice: otherwise the whole
-// element would drift with the seam, the null space of L being translation).
-// The normal equations are factored once (Eigen SimplicialLDLT) and solved for
-// x, y and z.
+// Locked vertices keep their positions exactly (ours: the part of an output
+// element outside the overlap stays, else the element drifts with the seam).
+// One SimplicialLDLT factorisation, solved for x, y and z.
 // Throws InvalidInputError (vertex index out of range, mu <= 0), SolverError
 // (factorisation failure, e.g. no constraint and no locked vertex touches a
 // component: that component's translation is undetermined).

@@ -11,26 +11,11 @@
 // and pairs between two elements, and the count of embedded vertices outside
 // the geometric shell (embed_outside_shell.h).
 //
-// Mapping a vertex (section 3.2: a texture point goes through the tet that
-// contains it, by barycentric coordinates): its (u, v) is its face's
-// barycentric combination of the face's atlas corners, w = (z - z_min) /
-// (z_max - z_min). Our choices:
-// * The barycentric coordinates are clamped onto the face first (negatives to
-//   0, renormalised): quilt_surface accepts locations down to -1e-9, and on a
-//   chart-border edge such a (u, v) lies in the atlas gap next to the chart,
-//   in no tet (on the 6.6K-face bunny_6k quilt, 1,907 vertices; they were
-//   extrapolated to within 1.3e-10 mesh units of where the clamped point maps).
-// * The containing tet is found by walking from the vertex's own prism
-//   (ShellMap::locate_texture_from), so it is always a tet of the face's own
-//   chart: after the stretch minimisation moved offset-surface (u, v), it may
-//   be a tet of a neighbouring prism. Every point of a chart's texture slab
-//   (its uv region x [0, 1]) lies in some tet of the chart: the minimisation
-//   keeps every texture tet positive and the lateral boundary fixed
-//   (shell_stretch.h), so the chart's tets still tile the slab.
-// * A vertex found in no tet (w outside [0, 1]) is extrapolated by the affine
-//   map of the tet of its own prism with the largest smallest barycentric
-//   coordinate, not by the nearest tet anywhere (which can be in another
-//   chart: long spikes); it is counted in outside_below / above / uv.
+// A vertex maps through the tet containing its (u, v, w) (3.2); our choices:
+// its barycentrics are clamped onto its face first; the tet is found by
+// walking from its own prism within its chart; one in no tet is extrapolated
+// by its own prism's best tet and counted (outside_below / above / uv). Why,
+// with the figures: docs/decisions/104-shell-space.md.
 // Reads: the base mesh's points (a copy gets the atlas; `base` is unchanged).
 // Writes: `out` (cleared first): the embedded quilt, kFaceElement.
 // Throws: InvalidInputError (bad options), and what the stages throw
@@ -50,10 +35,8 @@ namespace surftex {
 struct EmbedSurfaceQuiltOptions {
   /// Shell thickness in units of the scaled swatch height (z_max - z_min) * scale; > 0.
   double shell_height = 1.0;
-  /// The base mesh atlas; its normal cone defaults to 30 degrees here (not
-  /// the atlas' 50): the bottom of the shell keeps the atlas' distortion, which
-  /// the stretch minimisation cannot remove (on the 5K-face bunny the mean area
-  /// distortion drops from 1.12 to 1.01, about 100 -> 280 charts).
+  /// The base mesh atlas; its normal cone defaults to 30 degrees here (the
+  /// atlas' own is 50): the shell keeps the atlas' distortion (decision 104).
   BaseMeshAtlasOptions atlas = [] {
     BaseMeshAtlasOptions a;
     a.max_normal_angle_deg = 30.0;
@@ -62,13 +45,9 @@ struct EmbedSurfaceQuiltOptions {
   MinimizeStretchOptions stretch;
   /// Run the exact self-intersection count on the embedded mesh.
   bool check_self_intersections = true;
-  /// Issue 17 item 1, the last stage: the faces of the embedded mesh that
-  /// still intersect (exact; the shell map bends elements a little otherwise
-  /// than quilt_surface's lifted check assumed) are resolved before the
-  /// count: of two elements the later yields; a compact element
-  /// (SurfaceQuilt::element_compact) with such faces is removed, another has
-  /// them and one ring cut out and its pieces capped. The count then reports
-  /// what is left. Default true.
+  /// Issue 17 item 1: faces still intersecting after the embedding are resolved
+  /// before the count (the later element yields: compact ones removed, others
+  /// cut and capped). Default true.
   bool resolve_crossings = true;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
@@ -83,11 +62,8 @@ struct EmbedSurfaceQuiltResult {
   std::size_t unfolded_vertices = 0;  ///< base vertices moved to undo a fold (shell_space.h)
   double shell_height = 0;        ///< nominal absolute shell height (mesh units)
   EmbedInShellResult embed;       ///< outside vertices, self-intersecting pairs (all)
-  /// The outside vertices by cause: w below 0 / above 1 (the quilt's height
-  /// left the swatch's z range), or w in [0, 1] with no tet of the face's
-  /// chart containing (u, v, w) (0 unless the chart's tets do not tile its
-  /// slab: a broken invariant; before the clamping above, the vertices beside
-  /// chart-border edges).
+  /// Outside vertices by cause: w below 0 / above 1, or (u, v, w) in no tet of
+  /// its chart (0 unless an invariant broke).
   std::size_t outside_below = 0, outside_above = 0, outside_uv = 0;
   /// Quilt vertices whose barycentric coordinates in their base face were
   /// negative (quilt_surface settles locations up to -1e-9) and were clamped

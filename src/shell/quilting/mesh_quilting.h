@@ -5,15 +5,10 @@
 // by repeatedly placing the swatch M_in near the most constrained unprocessed
 // grid cell and stitching its elements to the existing ones.
 //
-// Seed finding (2.3): the output rectangle, extended by one swatch size on
-// every side (so that elements sticking out of the rectangle are tracked too),
-// is cut into square cells of side cell_size; the seed is the unprocessed cell
-// inside the rectangle with the most processed cells among its 8 neighbours
-// (ties: lowest row, then lowest column). P_out = the cells within
-// subpatch_radius (Chebyshev) of the seed that lie in the rectangle.
-// Steps 2.4-2.7: quilt_step.h. At the end, elements whose vertex centroid lies
-// outside the rectangle are dropped (elements are never clipped: each stays
-// whole) and kFaceElement is written = connected component id.
+// Seed (2.3): the unprocessed cell of the rectangle (extended one swatch on
+// each side) with the most processed 8-neighbours (ties: lowest row, column);
+// P_out: cells within subpatch_radius. Steps 2.4-2.7: quilt_step.h. Elements
+// whose centroid ends outside are dropped (never clipped); kFaceElement written.
 #include <cstdint>
 
 #include "geometry/mesh_fwd.h"

@@ -9,22 +9,11 @@
 // barycentrics) and the material blend of the tile (linear between the two
 // layers nearest to m, texture/material_space/material_tile_io.h).
 //
-// Steps: multi-chart atlas of the mesh (geometry/base_mesh_atlas.h, charts
-// spaced for the mip gutter), texel rasterisation of every face in uv space
-// (geometry/uv_raster.h, one texel band around each chart), the lookups, and
-// the gutter: every chart dilated by 2^K texels for the K mip levels down to
-// `min_mip_size`, background filled by the dilation (geometry/atlas_gutter.h).
-// The tile's map layers go through the very same lookups (Ray et al.: "this
-// can be also applied to additional attributes, such as normal maps"), for
-// the PBR set (texture/pbr_maps.h): height (the tile's height layers, else
-// its luminance), roughness, and the normal. A tile normal is tangent-space
-// in the tile's frame (+x = +s, +y = up in the tile image = -t); per lookup
-// it becomes the object-space normal x S + y U + z N, with N the
-// interpolated vertex normal (kVertexNormal, else area-weighted as the mesh
-// writers compute it), S the surface direction of increasing s (dP/ds of the
-// lookup's chart on the face) made orthogonal to N and U that of decreasing t
-// made orthogonal to N and S; a singular face's three lookups are blended by
-// the barycentrics and renormalised, as the colour.
+// Steps: atlas (base_mesh_atlas.h), texel rasterisation in uv (uv_raster.h),
+// the lookups, and a mip gutter (atlas_gutter.h). The tile's maps go through
+// the same lookups (height, roughness, normal); a tile normal becomes the
+// object-space x S + y U + z N (S, U: directions of increasing s and
+// decreasing t, orthogonalised). In full: docs/decisions/301.
 //
 // Reads the singularities' charts (computed on this mesh), writes kCornerUV
 // (atlas uv) and kFacePatch (chart id). Throws InvalidInputError (size not in
@@ -73,20 +62,15 @@ struct MaterialBakeResult {
 MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing, const MaterialTile& tile,
                                        const MaterialBakeOptions& options = {});
 
-/// The tangent-space normal map (3 channels, (n + 1) / 2) a glTF viewer needs
-/// to show `bake.object_normal` on the GLB that write_mesh writes of the baked
-/// `mesh` (its kCornerUV, kFacePatch, normals): per texel n_ts = (n.T, n.B,
-/// n.N) in the frame texture/tangent_space_bake.h rebuilds from the file's
-/// NORMAL and TANGENT, normalised; gutters filled by dilating the charts'
-/// values. Throws InvalidInputError if the bake has no object normals.
+/// The tangent-space normal map ((n + 1) / 2) a glTF viewer needs to show
+/// `bake.object_normal` on the GLB of the baked `mesh` (frame of
+/// tangent_space_bake.h); gutters dilated. Throws InvalidInputError without
+/// object normals.
 Image material_space_tangent_normals(const Mesh& mesh, const MaterialBakeResult& bake);
 
-/// The PBR set of the baked atlas that material-map writes, every map through
-/// the colour's lookups: height (the tile's height layers, else its
-/// luminance), roughness (the tile's roughness layers, as glTF
-/// metallicRoughness) and the tangent-space normal map (from the tile's normal
-/// layers, else from the height's slopes; `bump` is the tilt per unit of
-/// height per period `period`, as in the render).
+/// The PBR set of the baked atlas (height, roughness, tangent-space normal;
+/// normals from the height's slopes when the tile has none, tilt `bump` per
+/// unit of height per `period`).
 struct MaterialAsset {
   MaterialBakeResult bake;
   Image normal, metallic_roughness;

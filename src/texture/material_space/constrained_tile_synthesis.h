@@ -5,22 +5,12 @@
 // made of the pixels of one exemplar tile whose feature mask follows F_k,
 // keeping the exemplar's colour histogram.
 //
-// Each layer is an indirection map per resolution (exemplar pixel coordinates
-// per output texel), optimised coarse to fine on a Gaussian pyramid (a 5-tap
-// binomial, toroidal, factor 2 per level). Initialisation follows the paper:
-//  - layer 0: the identity (the exemplar itself; F_0 must be its mask);
-//  - layer k > 0, coarsest level: a copy of layer k-1's optimised coarsest map;
-//  - finer levels: the coarser map upsampled, I(2i+b) = 2 I(i) + b.
-// Optimisation: `coarse_passes` (20) passes at the coarsest level, `fine_passes`
-// (3) above; each pass visits the texels in a seeded random order and replaces
-// I(p) by the exemplar pixel whose neighbourhood vector is nearest, where the
-// vector is the 5x5 colour neighbourhood reduced by PCA (Eigen) to `pca_dims`
-// (5) coefficients, followed by the 3x3 feature mask scaled by `mask_weight` (2).
-// Nearest neighbours: a kd-tree (nanoflann) approximate search for `candidates`
-// neighbours, plus the current and the four coherent candidates (I(p+o) - o);
-// each candidate is penalised by how many output texels already use it, which
-// keeps the histogram. All neighbourhoods wrap (output and exemplar are tiles),
-// so every layer tiles.
+// Each layer is an indirection map per pyramid level, optimised coarse to fine:
+// layer 0 the identity, layer k starting from layer k-1's coarsest map, finer
+// levels upsampled; each pass replaces I(p) by the exemplar pixel of nearest
+// neighbourhood (5x5 colour PCA + 3x3 mask x mask_weight; kd-tree plus
+// coherent candidates, a reuse penalty keeping the histogram). Everything
+// wraps, so every layer tiles. In full: docs/decisions/303-pbr-maps.md.
 
 #include <cstdint>
 #include <vector>
@@ -39,10 +29,8 @@ struct IndirectionMap {
 };
 
 struct ConstrainedSynthesisOptions {
-  /// Pyramid levels (>= 1). Each level halves the sides, rounding up
-  /// (texture/gaussian_pyramid.h): 63x45 -> 32x23 -> 16x12. 0 (default) =
-  /// halve while the longer side exceeds 32 texels and the next level's
-  /// shorter side stays >= 8: 256 -> 4 levels (256, 128, 64, 32).
+  /// Pyramid levels (>= 1), each halving the sides (rounding up); 0 (default) =
+  /// halve while the longer side exceeds 32 and the shorter stays >= 8.
   int levels = 0;
   int coarse_passes = 20;  ///< passes at the coarsest level (>= 0)
   int fine_passes = 3;     ///< passes at every finer level (>= 0)
@@ -54,15 +42,10 @@ struct ConstrainedSynthesisOptions {
   /// exemplar pixel's 3x3 feature mask differs from the target's (the others
   /// compare the current and coherent candidates only). Default on.
   bool fine_ann_only_mismatched = true;
-  /// PCA coefficients of the 5x5 colour neighbourhood (1..25*channels).
-  /// Default 5, the paper's timing setting (section 4: "5x5 patch size for
-  /// colors (reduced to a 5 dimensions vector)"; section 1.2 mentions 8).
+  /// PCA coefficients of the 5x5 colour neighbourhood (1..25*channels). Default 5 (paper, section 4).
   int pca_dims = 5;
   double mask_weight = 2;  ///< scale of the 3x3 mask entries in the vector (>= 0)
-  /// PCA coefficients kept of the (weighted) 3x3 mask neighbourhood (0..9,
-  /// 0 = all 9 raw entries). Default 3, the paper's figure (section 4,
-  /// "3x3 patch size for feature (reduced to a 3 dimensions vector)"); it keeps
-  /// the kd-tree low-dimensional (8 instead of 14), which is what makes it fast.
+  /// PCA coefficients of the 3x3 mask neighbourhood (0..9, 0 = raw). Default 3 (paper, section 4).
   int mask_pca_dims = 3;
   /// Reuse penalty: a candidate used u times (by other texels) costs
   /// reuse_penalty * u * V more, V the mean squared norm of the centred
@@ -74,10 +57,8 @@ struct ConstrainedSynthesisOptions {
   /// seeded random coordinates and optimises it too (used to make several
   /// different tiles with the same mask).
   bool random_first_layer = false;
-  /// Candidates whose exemplar position lies closer than this (finest-level
-  /// texels, toroidal) to the output position are refused (>= 0, default 0 =
-  /// none). Used with random_first_layer to force a tile that is a real
-  /// rearrangement of the exemplar rather than the exemplar itself.
+  /// Candidates closer than this (finest texels, toroidal) to the output position
+  /// are refused (>= 0, default 0); with random_first_layer forces a rearrangement.
   double exclude_radius = 0;
   std::uint64_t seed = 1;
   ProgressCallback progress;

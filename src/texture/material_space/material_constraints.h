@@ -4,34 +4,17 @@
 // and 4: the brush that fixes the effect area, orientation strokes, scale and
 // material picks) read from a JSON file and resolved on a mesh.
 //
-// Format (every top-level field optional; unknown fields are errors):
-//   {
-//     "effect_radius": 0.25,        // > 0, mesh units (edge-path distance from the
-//                                   // constrained vertices, effect_area.h); absent = whole mesh
-//     "strokes": [
-//       {"faces": [12, 13, 40], "direction": [1, 0, 0]},   // faces by index, one 3D direction
-//       {"polyline": [[0, 0, 1], [0.1, 0, 1], [0.2, 0.05, 1]]}  // >= 2 points, mesh units
-//     ],
-//     "scale":    [{"point": [0, 0, 1], "value": 0.05}],  // texture period S, mesh units,
-//                                   // 1e-6..1e6 times half the mesh box's largest side
-//     "material": [{"point": [0, 1, 0], "value": 1.0}]    // m in [0, 1]
-//   }
-// Every point must lie within one box size of the mesh's bounding box. A
-// polyline is sampled along each segment (about one sample per mean edge
-// length, at least the segment midpoint, and at most two samples per mesh
-// face over all strokes together); each sample's nearest face (the
-// incident face, around the nearest vertex, whose centroid is nearest) gets
-// the segment's unit tangent as direction (projected on the face plane by the
-// direction field; a sample whose tangent is normal to its face is skipped, a
-// "faces" direction normal to one of its faces is refused). A face constrained twice keeps its first direction. Scale
-// and material points go to their nearest vertex (a later point on the same
-// vertex replaces the earlier one).
+// Format (every field optional; unknown fields are errors): "effect_radius"
+// (> 0, mesh units; absent = whole mesh), "strokes" (faces + direction, or a
+// polyline of >= 2 points), "scale" and "material" points with values (S in
+// mesh units, m in [0, 1]). Points lie within one box size of the mesh.
+// Polylines are sampled about once per mean edge, each sample constraining
+// its nearest face; scale and material points go to their nearest vertex.
+// The format in full with an example: docs/decisions/303-pbr-maps.md.
 //
-// Errors throw InvalidInputError "FILE: line L: field F: what" (e.g.
-// "c.json: line 7: field strokes[1].faces[2]: face 9000 out of range (5120
-// faces)"), also for malformed JSON, numbers beyond the double range and
-// nesting deeper than 32 (geometry/json_input.h). read_material_constraints
-// throws IOError if the file cannot be read or is larger than 16 MiB.
+// Errors throw InvalidInputError "FILE: line L: field F: what" (json_input.h
+// limits); read_material_constraints throws IOError if the file cannot be
+// read or exceeds 16 MiB.
 
 #include <cstdint>
 #include <limits>

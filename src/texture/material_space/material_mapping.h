@@ -3,16 +3,11 @@
 // The material-space mapping pipeline of Ray et al. 2009, section 2, as one
 // driver shared by `surftex material-map`, the demo and bench_pgp (same steps,
 // same defaults):
-//   map():    orientation field (strokes, else principal curvature directions
-//             smoothed, else world +Y projected; 2.2), scale and material by
-//             Laplacian interpolation (2.2), PGP initialisation (2.3), the
-//             singular zones for the three-lookup fix (3);
-//   update(): the same inside the effect area of new constraints only (2.1);
-//             everything outside stays bit for bit;
-//   save_state() / load_state(): the solver state (z_s, z_t, direction,
-//             scale, material, the PGP variant) as JSON, for a later update.
-// The orientation and scalar fields run beside the PGP's connectivity-only
-// preparation (TBB), with the same bytes as one after the other.
+// map(): orientation field (strokes, else smoothed principal directions, else
+// +Y; 2.2), scale and material (2.2), PGP (2.3), singular zones (3);
+// update(): the same inside the new constraints' effect area (2.1), the rest
+// bit for bit; save_state() / load_state(): the solver state as JSON. Fields
+// run beside the PGP's preparation (TBB), same bytes.
 //
 // Writes kFaceDirection, kVertexScale, kVertexMaterial, kCornerSTM (and the
 // curvature maps for the curvature field). Throws InvalidInputError (options

@@ -16,15 +16,9 @@
 // next. Same-mask mode (one key): M+1 different tiles of the one texture that
 // share its mask, to hide periodicity (Figure 14).
 //
-// Maps of the keys (normal, height, roughness; issue 16 item 2; the paper:
-// "this can be also applied to additional attributes, such as normal maps")
-// go through the same coordinates as the colour: the same square resample,
-// the texel each key-tile texel was copied from (graph-cut sources, or the
-// toroidal synthesis's indirection), each layer's indirection maps, and the
-// same blend; normals are renormalised after the resample and the blend.
-// A normal map is tangent-space in the image's frame: RGB = (n + 1) / 2, +x
-// right, +y up (the image's up, i.e. towards smaller t of the tile lookup),
-// as patches' exemplar normals.
+// Maps of the keys (normal, height, roughness; "additional attributes, such
+// as normal maps") follow the colour's coordinates and blend; normals are
+// tangent-space, RGB = (n + 1) / 2, +x right, +y up, renormalised.
 
 #include <cstdint>
 #include <string>
@@ -53,16 +47,10 @@ struct MaterialKey {
 struct MaterialTileOptions {
   int size = 256;    ///< layer side in texels (>= 16; levels halve it rounding up)
   int layers = 8;    ///< M: intervals per key pair (>= 1); a pair gives M+1 layers
-  /// Key tiles: the input is first reduced to its largest centred square and
-  /// resampled (bilinear) to size x size. If `keys_are_tileable` is false
-  /// (default) the square is then made tileable: without a painted mask by
-  /// graph-cut textures on the torus (texture/tileable_tile.h, the paper's
-  /// [KdE*03]; its border rolled onto the smoothest row and column, before
-  /// the key's automatic feature mask is computed from it, so tile and mask
-  /// share the cut and the later layers inherit it); with a painted mask by unconstrained toroidal synthesis from
-  /// itself (the constrained synthesis with mask weight 0 and a random start),
-  /// which carries the mask along its indirection. If true, the square is used
-  /// as is (it must already tile).
+  /// Key tiles: the input's largest centred square resampled to size x size,
+  /// then made tileable (graph-cut on the torus, tileable_tile.h, or with a
+  /// painted mask toroidal synthesis from itself); true = used as is (it must
+  /// already tile). Default false.
   bool keys_are_tileable = false;
   /// One key: same-mask mode (M+1 tiles sharing the key's mask). Ignored for
   /// two or more keys.
@@ -115,17 +103,11 @@ struct MaterialTileInfo {
   std::vector<std::string> normal_sources{}, height_sources{}, roughness_sources{};
 };
 
-/// Writes the 3D tile into folder `dir`: layer_000.png ... (one PNG per
-/// layer, 8-bit), mask_000.png ... (the constraint masks), layers.tif (all
-/// layers as the subimages of one multi-page TIFF), the map layers when the
-/// tile has them (normal_000.png 8-bit RGB, height_000.png 16-bit grey,
-/// roughness_000.png 8-bit grey) and tile.json (global: size, layer count, M,
-/// sources, masks, seed, files, "maps": the kinds present; per layer: index,
-/// m, file, mask file, one file per map kind under its name, sign-change count
-/// since the previous layer, mask agreement). Files are
-/// written into a staging folder beside `dir` which is then renamed onto it, so
-/// a failure leaves nothing half-written. Throws IOError if `dir` exists and
-/// !overwrite, or on any write failure.
+/// Writes the tile into folder `dir`: layer_NNN.png, mask_NNN.png, layers.tif,
+/// map layers when present, and tile.json (global fields and per-layer m,
+/// files, sign changes, mask agreement); staged and renamed, so a failure
+/// leaves nothing. Throws IOError if `dir` exists and !overwrite, or on any
+/// write failure.
 void write_material_tile(const std::string& dir, const MaterialTileResult& tile, const MaterialTileInfo& info,
                          bool overwrite = false);
 

@@ -4,15 +4,9 @@
 // write_material_tile (material_tile.h), and the trilinear (s,t,m) lookup a
 // renderer uses (Ray et al. 2009, section 3: "one 3D texture lookup").
 //
-// Folder format (see material_tile_write.cpp): tile.json with "format" =
-// "surftex material tile", "size", "channels", "layers" (count),
-// "layers_per_pair" (M), and "layer_list": per layer {index, m, file, mask,
-// ...}; the layers are read from their PNG files (layer_NNN.png), which are
-// authoritative (layers.tif is a convenience copy and is not read). Optional
-// map layers: "maps" lists the kinds present ("normal", "height",
-// "roughness"), and every layer entry then names its file of each kind under
-// the kind's name (normal_NNN.png: 3 channels, (n + 1) / 2, +x = +s, +y = up
-// in the image = -t; height_NNN.png, roughness_NNN.png: 1 channel).
+// Folder format: tile.json ("format", "size", "channels", "layers",
+// "layers_per_pair", "layer_list", optional "maps") and the layer PNGs it
+// names (authoritative; layers.tif is not read). In full: docs/decisions/303.
 //
 // Lookup convention: layer texel (x, y) is centred at s = (x + 0.5) / size,
 // t = (y + 0.5) / size (row y = 0 at the top of the image, t grows downwards
@@ -39,18 +33,11 @@ struct MaterialTile {
   int layers_per_pair = 0;  ///< M
 };
 
-/// Reads `dir`/tile.json and every layer file it lists. Every field and every
-/// layer file's header is checked before any pixel is decoded: "size" at
-/// most image_limits().max_side(), "channels" 1..16, "layers" 1..4096, a
-/// layer within the per-image decoded limit and the tile (maps included)
-/// within 4 times it, layer and map files plain names inside `dir`. Throws
-/// IOError (no tile.json, larger than 16 MiB, unreadable or missing layer
-/// file: names the file) and InvalidInputError "tile.json: line L: field F:
-/// what" (malformed JSON, wrong format tag, a missing, ill-typed or
-/// out-of-range field, an unknown or repeated map kind, a missing map file or
-/// one whose size or channel count differs from the tile's, a layer whose size
-/// or channel count differs from the declared size/channels, a layer count
-/// that differs from "layers").
+/// Reads `dir`/tile.json and every layer file it lists; every field and file
+/// header is checked against the image limits before decoding. Throws IOError
+/// (missing, too large or unreadable files; names the file) and
+/// InvalidInputError "tile.json: line L: field F: what" (malformed, missing or
+/// out-of-range fields, maps or layers of the wrong size or channels).
 MaterialTile read_material_tile(const std::string& dir);
 
 /// Checks a tile made in memory the same way (non-empty, square, equal sizes

@@ -6,91 +6,17 @@
 // S^T = mean vertex scale), defined up to integers, so a periodic tile maps
 // seamlessly wherever the field allows it.
 //
-// Per vertex i two unit complex numbers z_s = exp(2 pi i s_i), z_t =
-// exp(2 pi i t_i), expressed in the vertex's own frame: the representative of
-// its reference face (the first non-border face around halfedge(v)). Each
-// face corner knows the quarter turns m between its face's representative and
-// its vertex's (the edge matchings accumulated around the vertex), and one
-// turn maps (s,t) -> (t,-s), i.e. z_s -> z_t, z_t -> conj(z_s): across a cut
-// of the combed 4-field s on one side is t on the other, which independent
-// s and t unknowns cannot represent (Ray et al. 2006 couple them the same
-// way). The system is therefore real-linear, 4 reals per vertex. For each
-// edge (i,j) with faces T, T':
-//   alpha_ij = e_ij . (g^T + g^T') / 2            (in periods; the paper's
-//              2 pi e.g is the same in radians),
-// where g^T' is taken from the representative of T''s N-symmetric cross that
-// best matches T's after transport across the edge (the paper says "there is no
-// swapping of texture coordinates"; with a 4-field some swapping is
-// unavoidable near singularities, and matching per edge keeps the local
-// gradients consistent everywhere else). Equation (3) z_j = exp(2 pi i alpha_ij) z_i,
-// written in T's frame (alpha_ij is), becomes x_j = P_mj R P_-mi x_i in the
-// vertices' frames (x = (Re z_s, Im z_s, Re z_t, Im z_t), P_m the m turns, R
-// the two rotations by alpha), solved in the least squares sense,
-// F_PGP = sum (A_T + A_T') |x_j - P_mj R P_-mi x_i|^2: a sparse symmetric
-// positive definite real form with 4x4 blocks (lower triangle assembled in a
-// precomputed order; the free vertices ordered by METIS nested dissection of
-// the vertex graph, their 4 unknowns together; CHOLMOD supernodal Cholesky
-// keeping that order, ordering and symbolic analysis reused while the free
-// set and the cut parities are unchanged). The connectivity-only work runs
-// beside the field-dependent work on a second thread (the METIS order beside
-// the gradients, alphas, edge maps and the start; the symbolic analysis
-// beside the assembly; same bytes on any number of threads), and prepare()
-// lets a caller start the order while the direction field is computed.
-// CHOLMOD's dense kernels run on the BLAS libcholmod is linked with:
-// Debian's default netlib BLAS is single-threaded (and slow: the
-// factorisation dominates, about 1.8e9 flops at 52K triangles); an OpenBLAS
-// is pinned to one thread so that the bytes do not depend on the machine's
-// cores (its threaded build gives different
-// bytes per thread count), and, where OpenBLAS 0.3.21 does not know the CPU
-// and falls back to its generic SSE3 kernels, it is switched to its AVX-512
-// (or AVX2) kernels once per process (PgpResult::blas_core names the set).
-// Concurrent calls: Debian 12's serial OpenBLAS (libopenblas0-serial
-// 0.3.21) is not safe for them (built without USE_LOCKING: its work-buffer
-// table is claimed without a lock); its pthread build
-// (libopenblas0-pthread, which scripts/setup.sh installs) is, and pinned to
-// one thread it gives the serial build's bytes. Where the BLAS is not known
-// to allow concurrent calls, the BLAS-reaching CHOLMOD calls (numeric
-// factorisation, solves) of all solvers of the process take turns behind
-// one lock: the no-swap s and t halves then run one after the other instead
-// of side by side, and two solvers on two threads give the bytes each gives
-// alone either way (PgpResult::concurrent_blas).
-// The paper writes R with the opposite rotation sign and a 2 pi missing in
-// the rounding of (4); we use the self-consistent signs.
-//   - initialisation: the paper locks one vertex and minimises F. That
-//     minimiser decays away from the locked vertex (median |z| ~ 3e-3 on
-//     fandisk) and its phase stops following the field; F's smallest
-//     eigenvector (RLL06) localises where the field's curl is low, its tail
-//     not following the field either (81% distorted faces on a constant-scale
-//     torus). We start from the alphas integrated along a breadth-first
-//     spanning tree (exact on the tree, the holonomy piled where branches
-//     meet) and relax with `init_iterations` Ginzburg-Landau steps
-//       z <- argmin F(z) + mu sum_i M_i |z_i - u_i|^2,  u = z/|z| (previous),
-//     mu = `stiffness` x (mean diagonal of F / mean vertex area), one
-//     factorisation of F + mu M for all steps; the holonomy becomes a few
-//     small vortices (the PGP singularities). One reference vertex per
-//     component (`locked_vertex` for its component, the lowest index
-//     otherwise) is locked at s = t = 0, as the paper does (with s and t
-//     coupled a constant shift is no longer a symmetry to fix afterwards);
-//   - local update: vertices outside the effect area's free set keep their z
-//     (they enter the right-hand side); `update_iterations` relaxation steps
-//     from the previous solution. Gradients, alphas and energies are
-//     recomputed only next to the free faces (the mesh must not change
-//     between calls, nor the maps outside the area).
-// Corner coordinates (equation 4), in the face's own frame (each vertex's
-// (s,t) turned by its corner's matching, the alphas of edges whose reference
-// face is the neighbour turned by the edge's matching): in face T = (i,j,k)
-// (i = target of halfedge(T)), s_i = Arg(z_i)/2pi, s_j = Arg(z_j)/2pi + p_j with the integer
-// p_j = round(s_i + alpha_ij - Arg(z_j)/2pi), alpha_ij the edge's shared
-// expected increase (as the paper writes it; an earlier version used T's own
-// gradient, which let the two faces of an edge round differently and doubled
-// the mismatched edges), same for k along (i,k). Two adjacent faces around which
-// the jumps close agree exactly on their shared edge.
-// The material m of a corner is the vertex material.
+// Per vertex z_s = exp(2 pi i s), z_t = exp(2 pi i t); a quarter turn across
+// a cut maps z_s -> z_t, z_t -> conj(z_s) (Ray et al. 2006): 4 reals per
+// vertex. Equation (3) per edge solved in the least-squares sense (sparse SPD,
+// METIS + CHOLMOD, analysis reused; BLAS pinned to one thread and locked when
+// not concurrent-safe). Start: spanning-tree integration + `init_iterations`
+// Ginzburg-Landau steps; corners by equation (4), consistent across edges.
+// In full, with why the paper's start was replaced: docs/decisions/305.
+// derivation, the BLAS notes and why the paper's initialisation was replaced:
+// docs/decisions/305-pgp-solver.md.
 //
-// With options.curl_correction (off by default) the face gradients g are first
-// multiplied by the factor of pgp_curl_correction.h (Ray et al. 2006's curl
-// correction): every use of g above (alphas, corners, energies,
-// pgp_face_gradients, pgp_halfedge_alphas) sees the corrected target.
+// With options.curl_correction every use of g sees pgp_curl_correction.h's factor.
 //
 // Reads the face map direction_map (Vector3 d_s), the vertex maps scale_map
 // (S > 0) and material_map (m); writes the halfedge map stm_map (STM, the
@@ -98,7 +24,7 @@
 // After an update only corners of faces in the effect area are rewritten.
 // Throws InvalidInputError (missing direction map, non-positive scale, bad
 // options), SolverError (symbolic analysis/factorisation/solve failure).
-// PgpResult::breakdown gives the wall time of each step (bench_pgp prints it).
+// PgpResult::breakdown: the wall time of each step (bench_pgp prints it).
 
 #include <array>
 #include <complex>
@@ -127,24 +53,15 @@ struct PgpOptions {
   /// F_PGP over the mean vertex area (> 0). Smaller lets vortices (PGP
   /// singularities) be smaller but |z| sag (docs/decisions/304-pgp-options.md).
   double stiffness = 0.01;
-  /// Curl correction of the target gradients before the solve (Ray et al.
-  /// 2006; material_space/pgp_curl_correction.h): g = d/S scaled per vertex
-  /// towards curl-free, directions kept. Off by default: Ray et al. 2009
-  /// section 2.3 uses d/S as given, and the correction rescales the user's
-  /// period locally and makes a local update refresh every face (decision 304).
+  /// Curl correction of the target gradients (Ray et al. 2006;
+  /// pgp_curl_correction.h). Default off, as Ray et al. 2009, 2.3 (decision 304).
   bool curl_correction = false;
-  /// Swap s and t across the quarter-turn cuts of the combed N-field (Ray et
-  /// al. 2006's coupling; the default). false = the paper's simplified PGP
-  /// (Ray et al. 2009 section 2.3: "no swapping of texture coordinates"):
-  /// s couples only with s and t only with t, two independent systems of a
-  /// quarter of the factorisation's flops; the faces along the field's cuts
-  /// become singular, which section 3's blending hides (decision 304).
+  /// Swap s and t across the field's quarter-turn cuts (Ray et al. 2006;
+  /// default true). false = the paper's simplified PGP: two independent s and t
+  /// systems, a quarter of the flops, singular faces along the cuts (decision 304).
   bool swap_coordinates = true;
-  /// With swap_coordinates false only: solve the s and t systems each as the
-  /// complex Hermitian n x n system of z_s (z_t) its real 2n x 2n form stands
-  /// for (half the real flops; equal to the one-system result up to rounding,
-  /// same bytes on any thread count), side by side where the BLAS allows
-  /// concurrent calls. false (one real system) is kept for comparison.
+  /// swap_coordinates false only: solve each half as its complex n x n system
+  /// (half the flops, same result up to rounding). Default true.
   bool separate_halves = true;
   double curl_stiffness = 1.0;   ///< PgpCurlCorrectionOptions::stiffness (> 0)
   double curl_max_factor = 2.0;  ///< PgpCurlCorrectionOptions::max_factor (>= 1)
@@ -159,19 +76,12 @@ struct PgpResult {
   double energy_s = 0, energy_t = 0;  ///< F_PGP at the solution (in area units)
   double seconds = 0;
   bool reused_analysis = false;  ///< symbolic factorisation reused from the previous solve
-  /// OpenBLAS kernel set behind CHOLMOD's dense kernels ("" for another
-  /// BLAS; see the BLAS note above).
+  /// OpenBLAS kernel set behind CHOLMOD ("" for another BLAS).
   std::string blas_core;
-  /// The BLAS allows concurrent calls (OpenBLAS's pthread build), so two
-  /// solvers on two threads, and the no-swap s and t halves, run side by
-  /// side instead of taking turns (same bytes either way).
+  /// The BLAS allows concurrent calls (halves and solvers run side by side).
   bool concurrent_blas = false;
-  /// Wall-time breakdown of `seconds` (each step's own wall time, seconds).
-  /// Three pairs of steps run side by side (tbb::parallel_invoke), so the
-  /// sum exceeds `seconds` on several threads: `ordering` beside `field`
-  /// (gradients, alphas, matchings and, when every edge map is read, the
-  /// edge maps) + `start`; `pattern` beside a local update's edge maps
-  /// (counted in `field`); `analysis` beside `assembly`.
+  /// Wall seconds per step; pairs run side by side, so the sum can exceed
+  /// `seconds` (ordering beside field + start, analysis beside assembly).
   struct Breakdown {
     double topology = 0;     ///< connectivity, areas, frames (first call only)
     double field = 0;        ///< face gradients, halfedge alphas, matchings, edge maps
@@ -219,17 +129,11 @@ class PeriodicGlobalParameterization {
   PeriodicGlobalParameterization(const PeriodicGlobalParameterization&) = delete;
   PeriodicGlobalParameterization& operator=(const PeriodicGlobalParameterization&) = delete;
 
-  /// Optional, ahead of initialize(): the work of the initialisation that
-  /// depends on the connectivity only (topology, fill-reducing order of the
-  /// free vertices, ~0.1 s at 52K triangles), for a caller to run while it
-  /// computes the direction field (e.g. with tbb::parallel_invoke). It reads
-  /// the mesh's connectivity and points and no property map, and adds none;
-  /// the mesh must not change afterwards (else initialize() redoes it).
-  /// initialize() gives the same bytes with or without it.
+  /// Optional, ahead of initialize(): the connectivity-only work (topology,
+  /// fill-reducing order), for a caller to overlap with the direction field.
+  /// Reads connectivity and points only; same bytes with or without it.
   void prepare();
-  /// The same ahead of update(area): the order of the area's free vertices,
-  /// for a caller to compute while it interpolates the orientation and scale
-  /// in the area (update() then reuses it; same bytes).
+  /// The same ahead of update(area) (the area's free-vertex order).
   void prepare(const EffectArea& area);
   /// Global solve (one locked vertex per component); writes every corner.
   PgpResult initialize();

@@ -3,49 +3,14 @@
 // Singular zones of a periodic global parameterization and their fix at
 // rendering time (Ray et al. 2009, section 3, after jump maps [ZG04]).
 //
-// Detection. A vertex's 1-ring is singular if it contains
-//   - a distorted triangle: |grad s - g_s|^2 > threshold |g_s|^2 or the same
-//     for t (grad s from T's corner values, g from the direction field and
-//     scale). The paper writes an absolute 0.5 on |grad s - g_s|^2, which has
-//     units 1/length^2; we make it relative to |g|^2 (same value 0.5), which is
-//     what a scale-independent test must mean;
-//   - or a mismatched edge: s_j^T - s_i^T != s_j^T' - s_i^T' (or t), beyond
-//     `mismatch_tolerance` periods.
-// "An edge (i,j)" of the neighbourhood of i is read as a spoke from i (the
-// rim edges of the ring do not affect i's chart): the fix below is continuous
-// across every edge as soon as each regular endpoint's spokes match, so a
-// mismatched edge makes its two endpoints singular, not the whole 2-ring (an
-// earlier version also counted rim edges, which roughly doubled the singular
-// faces). A face is singular when one of its vertices is.
-//
-// What singular_fraction counts: the faces with at least one singular
-// vertex, i.e. the triangles that get three texture lookups, which is what
-// the paper's figure refers to: "Each triangle T=(i,j,k) now has three sets
-// of texture coordinates (obtained from the neighborhoods of each vertex
-// i,j,k). Then, we use them to perform three texture lookups" (section 3) and
-// "we only need one 3D texture lookup for non-singular regions and three 3D
-// texture lookups around singularities (5 to 10 percent of the triangles)"
-// (section 4, Rendering). It is not the fraction of distorted triangles (the
-// first criterion alone), which is about a third of it (armadillo_52k, 8 mean
-// edges per period: 9.4% distorted, 29.6% three-lookup faces without the
-// curl correction; 7.7% and 24.0% with it). Our reading counts no more than
-// the literal one: spokes only (the literal "contains an edge" would add the
-// rim edges), and the threshold relative to |g|^2 (the literal absolute 0.5
-// is stricter whenever the period S is shorter than 1 mesh unit, as |g| = 1/S).
-// The paper does not state the period of its examples (in mesh units or
-// edges), so its 5-10% cannot be matched at "its" scale; the fraction grows
-// with the period (a vortex core is about one period wide): see bench_pgp.
-// The distortion test compares with the target the PGP followed
-// (PgpSingularityOptions::pgp; with the curl correction, the corrected g).
-//
-// Fix. Each singular vertex i gets its own 1-ring chart: s'_{i,i} = s_i^T (T =
-// the face of halfedge(i)), s'_{i,j} = s'_{i,i} + alpha_ij (alpha of eq. 3, in
-// periods), t likewise; a regular vertex's chart in face T is T's own corners.
-// A point of face T = (a,b,c) with barycentrics (b_a,b_b,b_c) is looked up
-// three times, once in each corner's chart, and the three results are blended
-// with the barycentrics: colour = sum_k b_k lookup(sum_l b_l chart_k[l]).
-// Corners and barycentrics are ordered as the face's halfedges: corner 0 =
-// target(halfedge(f)), 1 = target(next), 2 = target(next(next)).
+// Detection: a vertex is singular if its 1-ring holds a distorted triangle
+// (|grad s - g_s|^2 > threshold |g_s|^2, or t; the paper's absolute 0.5 made
+// relative) or a mismatched spoke edge (beyond mismatch_tolerance periods). A
+// face is singular when one of its vertices is; singular_fraction counts
+// those (the three-lookup faces of section 4). Fix: each singular vertex gets
+// its own 1-ring chart; a point of face T is looked up in each corner's chart
+// and blended by its barycentrics. Corner order: target(halfedge(f)), next,
+// next-next. Our readings and figures: docs/decisions/304-pgp-options.md.
 //
 // Reads the STM corner map and the maps of PgpOptions (direction, scale).
 // Throws InvalidInputError if a map is absent or options are out of range.

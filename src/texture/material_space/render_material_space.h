@@ -8,22 +8,13 @@
 // blended by the barycentrics; texture/material_space/pgp_singularities.h), and a
 // normal-map variant of both.
 //
-// Normal map (the choice we make, the paper only says "normal maps"): the
-// tile's luminance is a height field h(s,t,m) in [0,1]; its slopes dh/ds,
-// dh/dt (central differences one texel apart, in height per period) tilt the
-// interpolated shading normal n along the unit texture-space directions of the
-// chart in the triangle (u_s = grad s / |grad s|, u_t likewise):
-//   n' = normalize(n - bump_strength (dh/ds u_s + dh/dt u_t)).
-// With the fix the three perturbed normals are blended by the barycentrics.
-// The fragment is then lit by a two-sided Lambert term, so render it with
-// RenderOptions::shade = false (the callback does the shading).
-//
-// The callback keeps references to `mesh`, `sing` and `tile`: they must
-// outlive it. The RenderMesh must come from make_render_mesh of the triangle
-// mesh the singularities were computed on (its triangle_face maps triangles
-// to faces and its corner k is the PGP corner k: target(halfedge(f)), next,
-// next-next). Throws InvalidInputError if triangle_face is absent or names a
-// face the singularities do not know, or options are out of range.
+// Normal map (our choice): the tile's luminance as height, its slopes tilting
+// the shading normal along the chart's unit s and t directions,
+// n' = normalize(n - bump_strength (dh/ds u_s + dh/dt u_t)), blended with the
+// fix; lit two-sided by the callback (render with shade = false). The
+// callback references `mesh`, `sing`, `tile` (must outlive it); the
+// RenderMesh must come from make_render_mesh of the same triangle mesh.
+// Throws InvalidInputError (triangle_face absent or unknown, bad options).
 
 #include "texture/material_space/pgp_singularities.h"
 #include "geometry/rasterizer.h"

@@ -3,39 +3,14 @@
 // Flattening of near-planar patches into fixed-resolution rasters with
 // boundary conditions (Gorla, Interrante & Sapiro 2003, section 3.2).
 //
-// For each patch (kFacePatch, e.g. from partition_near_planar):
-//  - the plane: the paper projects "onto their common reference plane", the
-//    plane of the seed triangle (Figure 4: "the normal of the grey-shaded
-//    triangle defines the plane"); we follow it: origin = seed centroid,
-//    e1 = the seed's first edge, e2 = n x e1, coordinates (u, v) in world units;
-//  - patch triangles are projected orthogonally onto that plane;
-//  - neighbouring triangles of other patches are ROTATED about their shared
-//    edge into the plane (the paper: rotation, not projection, to minimise
-//    distortion). The shared edge is already in the plane as the projection
-//    of the patch's edge; the third vertex is placed from its 3D position
-//    relative to the edge (distance along it, distance from it), scaled by
-//    the projected/3D length ratio of the edge, on the side away from the
-//    patch triangle. Ring 1 = triangles sharing an edge with the patch;
-//    ring r+1 = triangles outside the patch sharing an edge with a ring-r
-//    triangle, unfolded about that edge (a careful extension: ring 1 alone
-//    leaves gaps at patch corners); rings up to boundary_rings;
-//  - the paper checks that rotated neighbours do not overlap: a boundary
-//    triangle that overlaps (interiors intersect, exact orientation
-//    predicates on the 2D coordinates) a patch triangle or an earlier
-//    boundary triangle is dropped (it then gives no boundary condition);
-//  - a patch whose own projection overlaps itself (possible for a patch that
-//    curls, even within the normal cone) is split by split_overlapping_patches:
-//    the later-reached triangle of each overlapping pair (breadth-first from
-//    the seed) leaves the patch, and the triangles that left form new patches
-//    (their own seed = lowest face index) by the same connected growth.
-//
-// Raster: every patch gets a res x res image with a common texel size for all
-// patches (so the texture has the same scale everywhere, as the paper's
-// equal-size patches intend): texel = (largest patch extent over all patches)
-// / (res - 2 * margin), the patch centred. A pixel is Inside if its centre
-// lies in a patch triangle, Boundary if in a (kept) boundary triangle, else
-// Outside; Inside and Boundary pixels store the 3D face and barycentrics of
-// their centre (for Boundary: in that neighbour's face).
+// Per patch (kFacePatch): the seed triangle's plane (Figure 4); patch
+// triangles projected onto it; neighbouring triangles ROTATED about their
+// shared edge into it (the paper), ring by ring up to boundary_rings (ours:
+// ring 1 alone leaves gaps); boundary triangles overlapping (exact test) are
+// dropped; a patch overlapping itself is split (split_overlapping_patches).
+// Raster: res x res per patch at one texel size for all, pixels Inside,
+// Boundary or Outside, each with its face and barycentrics. In full:
+// docs/decisions/505-efros-leung-details.md.
 //
 // Reads kFacePatch. split_overlapping_patches writes kFacePatch. Throws
 // InvalidInputError (missing kFacePatch, a face without patch, bad options,
@@ -103,11 +78,9 @@ std::vector<std::array<int, 2>> patch_overlaps(const FlatPatch& patch);
 /// `seed_face` is the patch's reference triangle.
 FlatPatch flatten_patch_geometry(const Mesh& mesh, int patch, int seed_face, int boundary_rings);
 
-/// Splits patches whose projection overlaps itself (see above): new patches
-/// grow from their lowest face index over connected leaving triangles within
-/// max_angle_deg of that seed's normal. `seed_faces` (per patch id) is
-/// updated with the seeds of new patches. Returns the number of patches split.
-/// Writes kFacePatch.
+/// Splits patches whose projection overlaps itself: new patches grow from their
+/// lowest face over the leaving triangles (within max_angle_deg); updates
+/// `seed_faces`; returns the number split. Writes kFacePatch.
 int split_overlapping_patches(Mesh& mesh, std::vector<int>& seed_faces, double max_angle_deg,
                               int max_rounds = 8);
 

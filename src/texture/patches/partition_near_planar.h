@@ -3,30 +3,13 @@
 // Partition of a triangle mesh into connected, nearly planar patches of
 // similar size (Gorla, Interrante & Sapiro 2003, section 3.1).
 //
-// Greedy stage (the paper's pseudo code): while a triangle is unassigned, the
-// unassigned triangle T with the lowest index (the paper: "an arbitrary"
-// one; the lowest index keeps runs deterministic) seeds a new patch G, which
-// grows breadth-first over edge-connected unassigned triangles C with
-//   - angle(normal(C), normal(T)) <= max_angle_deg, and
-//   - distance from the centroid of C to the farthest vertex of T < max_distance,
-//   - and (our addition, so that a fixed-resolution raster per patch holds a
-//     similar number of texels) at most max_faces triangles per patch.
-// The seed T defines the reference plane of the patch (the paper's green
-// triangles; section 3.2 projects onto it).
-//
-// Refinement ("two simple experimental rules iteratively applied until no
-// significant improvement"): we repeat, until nothing changes or
-// max_iterations passes,
-//   1. merge: a patch with fewer than small_faces triangles is dissolved into
-//      the edge-adjacent patch that can take all of its triangles within the
-//      distance, angle and size limits (best mean alignment wins);
-//   2. reassign: a non-seed triangle T of P1 moves to an edge-adjacent patch P2
-//      when it is strictly better aligned with P2's reference normal than with
-//      P1's and fits P2's distance and size limits;
-//   3. (our addition) a patch that became disconnected keeps the component
-//      holding its seed; the other components are regrown by the greedy stage.
-// Every triangle therefore always stays within max_angle_deg of its patch's
-// reference normal, and every patch is edge-connected.
+// Greedy stage (the paper's pseudo code): the lowest unassigned triangle
+// seeds a patch grown breadth-first within max_angle_deg of its normal,
+// max_distance of its farthest vertex and (ours) max_faces; the seed defines
+// the reference plane. Refinement until stable (max_iterations): merge small
+// patches, reassign better-aligned triangles, regrow disconnected parts
+// (ours). Every triangle stays within max_angle_deg; every patch is
+// edge-connected. In full: docs/decisions/505-efros-leung-details.md.
 //
 // Writes kFacePatch (f:patch, int, 0..patches-1; created if absent). Patch
 // ids are renumbered in order of their seed face index. Throws

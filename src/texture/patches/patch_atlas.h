@@ -5,21 +5,12 @@
 // lapped textures" as the alternative; we pack one atlas so that the result
 // opens as a standard textured OBJ/glTF).
 //
-// Every patch's chart (the bounding box of its Inside and Boundary pixels in
-// its res x res raster, flatten_patch.h) is shelf-packed, tallest first, with
-// 2 g + 1 texels between charts and g from the border, g = the mip gutter of
-// geometry/atlas_gutter.h for the atlas side (2^K texels for the K halvings
-// down to `min_mip_size`). The atlas is square, by default the smallest power
-// of two whose gutter lets every chart fit; when even `max_size` cannot (the
-// gutter grows with the side), it is `max_size` with the largest
-// power-of-two gutter that fits (`gutter` and `protected_mip_size` say which
-// levels stay clean). One atlas texel is one patch texel (no resampling).
-// Inside and Boundary pixels (Boundary pixels hold the neighbour's texture,
-// patch_synthesis.h step 7) are the charts; every other texel is filled by
-// dilating them (geometry/atlas_gutter.h: each patch's gutter from its own
-// colours, no background). UV of a corner: its flat (u, v) -> patch pixel ->
-// atlas pixel -> (x / W, 1 - y / H) (v up, as write_mesh and the rasterizer
-// expect).
+// Each patch's chart (the box of its Inside and Boundary pixels) is
+// shelf-packed, tallest first, 2 g + 1 texels apart (g: atlas_gutter.h's mip
+// gutter); the atlas is the smallest fitting power of two, else `max_size`
+// with the largest gutter that fits (`gutter`, `protected_mip_size`). One
+// atlas texel per patch texel; the rest filled by dilation; corner UVs
+// (x / W, 1 - y / H), v up. In full: docs/decisions/302-atlas-gutters.md.
 //
 // Writes kCornerUV (h:uv) for every face corner. Throws InvalidInputError if
 // images and patches disagree in number or size, or options are out of range.

@@ -2,16 +2,10 @@
 #pragma once
 // Other maps of the exemplar (normal, height, roughness, ...) carried
 // through one patch synthesis (issue 16 item 2: "one synthesis, every
-// channel"): every Inside pixel of every patch image takes the map's value
-// where its colour came from (PatchSynthesisResult::sources: pixel of the
-// exemplar rotated as the colour was, rotate_exemplar's bilinear resampling
-// in float), and every Boundary pixel the neighbour patch's value, as step 7
-// of patch_synthesis.h does for the colour. A tangent-space normal map
-// (`tangent_normal`: channels 0-2 = (n + 1) / 2, +Y up) has its (x, y)
-// turned by the same orientation as the texture (rotated_exemplars.h: angle
-// a turns the exemplar counter-clockwise as displayed), so the result is a
-// tangent-space normal map in the patch images' frame (x right, y up: the
-// atlas uv frame of patch_atlas.h).
+// channel"): Inside pixels take the map where their colour came from
+// (PatchSynthesisResult::sources), Boundary pixels the neighbour's; a
+// tangent-space normal map has its (x, y) turned as the texture was, giving
+// normals in the patch images' (atlas uv) frame.
 //
 // Reads the mesh's kFacePatch indirectly through `result.flat`. Throws
 // InvalidInputError if the map's size differs from the exemplar the synthesis

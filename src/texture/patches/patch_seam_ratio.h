@@ -4,17 +4,10 @@
 // (issue 6 figure for Gorla et al. 2003: "seams due to discontinuities
 // between texture element features in adjacent patches", 3.3).
 //
-// Pairs of nearby surface points are drawn at random (seeded): a random
-// continuous point in a random patch's plane (inside one of its triangles)
-// and a second point `step_texels` texels away in a random direction. Both
-// are located in the patch's flattening (patch triangles, or a rotated
-// neighbour triangle - which is a point on the neighbour's face), so both
-// are points of the surface. A pair is "across" when the two faces belong to
-// different patches, "within" otherwise. Colours are looked up through the
-// atlas at each face's own corner UVs (kCornerUV, bilinear, what a renderer
-// shows). The ratio is mean |c1 - c2| (RGB Euclidean) across / within:
-// about 1 when seams are invisible, larger when texture features break at
-// patch boundaries.
+// Seeded pairs of surface points `step_texels` apart, located in the patch
+// flattenings; "across" when their faces lie in different patches. Colours
+// through the atlas at each face's corner UVs; ratio = mean |c1 - c2| across
+// over within (about 1 when seams are invisible).
 //
 // Reads kCornerUV. Throws InvalidInputError (no kCornerUV, empty atlas, bad
 // options).

@@ -3,63 +3,20 @@
 // Patch-based oriented surface texture synthesis (Gorla, Interrante & Sapiro
 // 2003): the whole pipeline of sections 3 and 4, with multi-texturing (5).
 //
-//  1. partition the mesh into near-planar patches (3.1, geometry/
-//     partition_near_planar.h), then split patches whose projection overlaps
-//     itself (3.2, texture/patches/flatten_patch.h);
-//  2. a direction field over the faces (4, "texture orientation options"):
-//       - Constant: a constant vector projected onto the tangent planes
-//         (3.3.2.1; default "up" = +y), a 1-symmetric (signed) field;
-//       - Kmax / Kmin: the direction of greatest / least SIGNED normal
-//         curvature (kmax >= kmin of principal_curvatures.h, sign w.r.t. the
-//         outward normal: kmax is the "most convex" direction);
-//       - KmaxAbs / KminAbs: the direction of greatest / least UNSIGNED
-//         normal curvature, i.e. of max(|kmax|, |kmin|) / min(...): on a
-//         saddle or concave region these swap with respect to the signed
-//         choice. Principal directions are line fields (d and -d are the same
-//         direction), so "signed/unsigned" refers to the curvature, never to
-//         the direction vector;
-//       - None: isotropic (no orientation; each patch uses its own frame).
-//     Principal directions are smoothed first: the faces with the largest
-//     anisotropy (|kmax - kmin|, or ||kmax| - |kmin|| for the unsigned
-//     choices; the top `constraint_fraction`) constrain a smooth 2-symmetric
-//     field (geometry/direction_field.h) that fills the rest;
-//  3. flatten each patch onto its seed plane with rotated neighbour
-//     triangles as boundary and rasterise at a fixed resolution (3.2);
-//  4. visit the patches in order (4): Random = a random start (seeded), then
-//     a random unsynthesised patch adjacent to the synthesised ones (a new
-//     random start when none is adjacent, "filling in any holes at the end");
-//     Curvature = start at and proceed to the adjacent patch with the greatest
-//     mean principal curvature difference;
-//  5. synthesise each patch with two-pass Efros-Leung (3.3,
-//     texture/efros_leung.h): Inside pixels are Fill; Boundary pixels whose
-//     neighbour patch is already synthesised are Known, their colour looked
-//     up through the rotated neighbour triangle (face + barycentrics ->
-//     the neighbour patch's plane -> its image, bilinear over its Inside
-//     pixels); other pixels are Outside. The per-pixel angle is the field
-//     interpolated at the pixel (vertex directions = sign-aligned averages of
-//     face directions, blended by barycentrics) and expressed in the patch
-//     plane (3.3.2: per-pixel re-orientation with pre-rotated exemplars).
-//     Within a patch the fill order is el.order: OnionPeel (most constrained
-//     side first, the paper's default) or Direction (swept along the patch's
-//     mean field direction, "following the direction of the vector field");
-//  6. re-synthesise the patches listed in `resynthesize` (4.1: the paper's
-//     interactive fix-up), keeping all others as boundary conditions;
-//  7. finally, fill every Boundary pixel of every patch image from its
-//     neighbour (so bilinear lookups at patch edges read the neighbour's
-//     texture, not garbage).
-// Multi-texturing (5): with two or more exemplars, the exemplar used at a
-// pixel is floor(t * E) (clamped) for t in [0,1] from Illumination (Lambert
-// n.l of the interpolated normal with `light`), Curvature (mean curvature,
-// normalised over the 5th..95th percentile of vertices), Height (position
-// along `height_axis`, normalised over the mesh) or VertexScalar (the given
-// per-vertex values, normalised over their range).
-//
-// Deterministic: the patch order and every Efros-Leung run are seeded from
-// `seed` (per patch and pass), so the same input gives the same bytes.
-// Parallel: a patch reads only the neighbours that precede it in the order,
-// so it starts as soon as those are done; independent patches run as TBB
-// tasks side by side, with the same result for any thread count. The
-// exemplar rotations are prepared once per run (el_prepare_exemplars).
+// 1. near-planar patches (3.1), split where their projection overlaps (3.2);
+// 2. a direction field (4): Constant (projected "up"), Kmax / Kmin (signed
+//    curvature), KmaxAbs / KminAbs (unsigned) or None; principal directions
+//    smoothed from the top `constraint_fraction` anisotropic faces;
+// 3. each patch flattened with rotated neighbour triangles, rasterised (3.2);
+// 4. patches visited in Random or Curvature order (4);
+// 5. each synthesised by two-pass Efros-Leung (3.3), already synthesised
+//    neighbours as Known pixels, oriented per pixel (3.3.2);
+// 6. `resynthesize` patches redone (4.1); 7. Boundary pixels filled from
+//    their neighbours. Multi-texturing (5): exemplar floor(t E) from
+//    Illumination, Curvature, Height or VertexScalar.
+// Seeded per patch and pass; patches run as TBB tasks once their preceding
+// neighbours are done, same bytes for any thread count. In full:
+// docs/decisions/505-efros-leung-details.md.
 //
 // Writes kFacePatch, kFaceDirection (unless field None), kVertexKmax/Kmin/
 // Dmax/Dmin when curvature is needed, kVertexNormal. Throws InvalidInputError

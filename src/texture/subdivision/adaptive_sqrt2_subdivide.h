@@ -3,13 +3,10 @@
 // Adaptive sqrt(2)-subdivision for an even vertex distribution (Bangay &
 // Morkel 2006, section 3.2.2): at every step the faces whose area exceeds
 // `factor` times the mean face area (a_i > f * mean(a)) are refined with the
-// selective sqrt(2) split of sqrt2_subdivide_selected (transition triangles
-// towards unrefined faces, so the mesh stays manifold and closed if it was;
-// like the paper we do not require neighbouring faces to differ by at most one
-// level). The paper reports the standard deviation of face area as a
-// percentage of the mean (722.9% -> 38.3% after 16 levels on its monarch);
-// this function reports it before and after every step. Polygon areas are
-// Newell vector areas (exact for planar polygons).
+// selective sqrt(2) split (sqrt2_subdivide_selected; like the paper, no
+// one-level rule between neighbours); reports the spread of face area (std as
+// a percentage of the mean, the paper's figure) before and after each step;
+// Newell areas.
 //
 // Stops early when no face is above the threshold. Old vertices do not move.
 // Properties carried as in sqrt2_subdivide.h.

@@ -4,30 +4,13 @@
 // section 3.4, figure 9; after Kwatra et al. 2003). Mesh independent: the
 // caller gives the region's vertices as nodes and its mesh edges.
 //
-// Nodes are the region's vertices, each with its current surface colour C_s
-// (if it has one) and the colour C_t of its corresponding texel of the
-// matched neighbourhood. Terminals: the texture terminal (source) and the
-// surface terminal (sink). Links:
-//   - the target vertex (node `center`) -> texture terminal, infinite;
-//   - every coloured vertex on the region's border (hops == border_hops) ->
-//     surface terminal, infinite (it keeps its colour);
-//   - every uncoloured vertex -> texture terminal, infinite (it has no colour
-//     to keep; documented choice, the paper only discusses coloured ones);
-//   - a `pinned` vertex (the matched neighbourhood has no texel for it: it
-//     falls outside a non-periodic exemplar) -> surface terminal, infinite;
-//     its mismatch term is 0 (it keeps its colour, or stays uncoloured);
-//   - every region edge (A, B): W(A,B) = M(A,B) exp(-(x_A^2 + x_B^2) / (sigma r^2))
-//     both ways, with M(A,B) = |C_s(A) - C_t(A)| + |C_s(B) - C_t(B)| (Euclidean
-//     RGB norms; a term is 0 for an uncoloured vertex), x = the vertex's
-//     distance from the target in texture space (texels), r = the diameter of
-//     the texture neighbourhood (texels), sigma = the weighting parameter
-//     (equation 1).
-// The min cut (GraphCut, Boost.Graph boykov_kolmogorov_max_flow) splits the
-// region: source-side vertices take the texture colour, the rest keep theirs.
-// The seam cost of a labelling is the sum of W over edges whose ends take
-// colour from different sources; the min cut's seam cost is never above that
-// of pasting (every vertex except the coloured border takes the texture),
-// which the result reports for comparison.
+// Nodes: the region's vertices (surface colour C_s if any, texel colour C_t).
+// Infinite links: the centre to the texture side; coloured border vertices
+// and `pinned` ones (no texel: outside a non-periodic exemplar) to the
+// surface side; uncoloured vertices to the texture side (our choice). Edges:
+// W(A,B) = M(A,B) exp(-(x_A^2 + x_B^2) / (sigma r^2)) (eq. 1), M the summed
+// colour mismatch. Source-side vertices take the texture colour; the cut's
+// seam cost never exceeds pasting's, reported beside it. In full: decision 206.
 //
 // Throws InvalidInputError (center out of range, edge index out of range,
 // sigma or r not > 0).

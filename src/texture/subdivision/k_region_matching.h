@@ -5,44 +5,17 @@
 // oversampling, 3.3.4 anti-aliasing).
 //
 // 1. k-region (3.3.1): the vertices at most k edges from the centre P.
-// 2. Local (u,v) of each region vertex, in object units, u along the
-//    orientation field at P (kVertexDirection), v = n x u:
-//    - kTangentProjection: (p_i - p_P) projected on P's tangent plane;
-//    - kUnfolding (default): incrementally along shortest edge paths from P:
-//      uv(w) = uv(p) + step(p, w) for a predecessor p of w (one hop closer to
-//      P), where step is the edge p->w expressed in the frame of p (p's own
-//      field direction and normal) and rescaled to the edge's 3D length (the
-//      edge is unfolded, not shortened). uv(w) is the average over all
-//      shortest paths: predecessors are weighted by their number of shortest
-//      paths from P, which is exactly the mean over all paths (section 3.3.1,
-//      "averaged over all such (shortest) paths"). Ring-1 vertices use P's
-//      frame, so both modes agree up to the length rescaling there.
-// 3. Texture coordinates: offset_i = r_scale * uv_i (level-0 texels); r_scale
-//    = texels per object unit (3.3.2).
-// 4. Size (3.3.2): k solves (k+1)^2 + k^2 = N with N = (a^m n / (r_scale e))^2,
-//    where n = region size in texels relative to stack level m, a = 1 for a
-//    stack and 2 for a pyramid, and e = mean edge length. The paper writes
-//    (a^m n / r_scale)^2, i.e. object units measured in edge lengths; dividing
-//    by e makes that explicit (with it, Table 1's vertex counts per match come
-//    out as the paper reports: ~87 vertices for a 3x3 neighbourhood at
-//    r_scale 30 and 1/e = 110). k is rounded up, at least 1, at most max_k.
-// 5. Anti-aliasing (3.3.4): a vertex with mean edge length e_i is compared at
-//    stack level round(log2(r_scale * e_i)), clamped to the stack.
-// 6. Matching (Algorithm 1): exhaustive search over every texel Q of the
-//    centre's level; d(Q) = sum_i |c_i - I_{l_i}(Q + round(offset_i / a^l))|^2
-//    (SSD, exemplar treated as periodic: offsets wrap). Oversampling (3.3.3):
-//    samples that fall on the same texel of the same level are replaced by
-//    one group with weight m_g and their mean colour; d differs from the naive
-//    sum by a constant independent of Q, so the best match is the same.
-//    Ties go to the lowest texel index (y * width + x). The search is split
-//    over fixed blocks of rows run with TBB and reduced in block order, with
-//    float SSD and early termination per block (a candidate is abandoned as
-//    soon as its partial sum exceeds the block's best): the result does not
-//    depend on the thread count.
-//
-// With a pyramid (a = 2) all samples of a region use the centre's level
-// (mixing pyramid levels has no Q-independent texel offset), so
-// anti-aliasing then chooses only the centre's level.
+// 2. Local (u,v), object units, u along kVertexDirection at P, v = n x u:
+//    tangent projection, or unfolding (default) along shortest edge paths,
+//    averaged over all of them ("averaged over all such paths").
+// 3. offset_i = r_scale * uv_i (level-0 texels; r_scale: texels per object unit).
+// 4. Size (3.3.2): k from (k+1)^2 + k^2 = (a^m n / (r_scale e))^2, rounded up,
+//    in [1, max_k] (e: mean edge; the paper's formula with e made explicit).
+// 5. Anti-aliasing (3.3.4): level round(log2(r_scale e_i)), clamped.
+// 6. Matching (Algorithm 1): exhaustive SSD over every texel of the centre's
+//    level, samples on one texel grouped (3.3.3, same best match), ties to the
+//    lowest index; independent of the thread count. With a pyramid every
+//    sample uses the centre's level. Details: docs/decisions/206.
 
 #include <array>
 #include <cstddef>
@@ -116,13 +89,8 @@ void k_region(const Mesh& mesh, const SurfaceFrames& frames, std::size_t center,
 int region_k(double region_texels, int level, bool pyramid, double r_scale, double mean_edge, int max_k = 32);
 
 /// The exemplar as a Gaussian stack (default) or pyramid, RGB. Levels below
-/// `bounded_levels` are "bounded" (issue 18 item 2: a non-periodic exemplar's
-/// wrap seams must not be copied): blurred with clamped borders, read
-/// clamped, and a match at such a level may only take candidates whose whole
-/// region lies inside the level (MatchBox). The other levels are blurred
-/// toroidally and read wrapping around (all of them for a periodic
-/// exemplar, bounded_levels = 0; for a non-periodic one the coarse, blurred
-/// levels whose regions would not fit in half the exemplar).
+/// `bounded_levels` are blurred and read clamped, and matches there stay inside
+/// (MatchBox; a non-periodic exemplar's wrap is never copied); the others wrap.
 struct ExemplarLevels {
   std::vector<Image> levels;  ///< level 0 = the (RGB) exemplar
   bool pyramid = false;
@@ -180,16 +148,10 @@ struct MatchOptions {
   int rows_per_block = 8;
 };
 
-/// What a match may choose besides the SSD (issue 18 item 2):
-/// - the candidate box: with `restricted`, only texels x0..x1, y0..y1
-///   (inclusive, at the centre's level; clipped to the level) may be taken.
-///   Not restricted: every texel of a wrapping level, and at a bounded
-///   level the box in which every group lies inside the level.
-///   A caller that also copies other region vertices (graph-cut transfer)
-///   gives the box of all their offsets (candidate_box).
-/// - a repetition penalty per exemplar bin: d(Q) starts at
-///   bin_penalty[(y s / bin) * bins_x + (x s / bin)] (s = level-0 texels per
-///   texel of the centre's level) instead of 0; null = none. Values >= 0.
+/// What a match may choose besides the SSD: with `restricted`, only texels
+/// x0..x1, y0..y1 (centre's level, clipped; else all of a wrapping level, or the
+/// inside box at a bounded level); `bin_penalty` per exemplar bin (>= 0, null =
+/// none) starts d(Q).
 struct MatchBox {
   bool restricted = false;
   int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
@@ -230,18 +192,10 @@ void group_into(const ExemplarLevels& ex, const std::vector<RegionSample>& sampl
 void prepare_groups(const ExemplarLevels& ex, const std::vector<RegionSample>& samples, int center_level,
                     bool averaging, std::vector<SampleGroup>& out, GroupScratch& scratch);
 
-/// Exact best match (same result as match_region, bit for bit, ties to the
-/// lowest texel index), single-threaded and allocation-free so that many
-/// vertices can be matched concurrently. The exemplar levels are kept as
-/// separate R, G, B planes; candidates are scanned row by row with the region
-/// as a sparse stencil: each group adds m_g |I(Q + o_g) - c_g|^2 to the whole
-/// row of candidates from one contiguous run of texels (vectorisable), the
-/// heaviest groups first; a row is abandoned once none of its partial sums is
-/// below the best distance so far (checked after 1, 2, 4, ... groups); once
-/// at most W/8 candidates of the row remain, each finishes alone and is
-/// abandoned as soon as its partial sum reaches the best distance.
-/// MatchResult::candidates counts the candidates summed to the end.
-/// Immutable after construction: match() may run concurrently.
+/// Exact best match (bit for bit match_region's, ties to the lowest index),
+/// single-threaded and allocation-free: R, G, B planes scanned row by row with
+/// the region as a sparse stencil, heaviest groups first, rows and then
+/// candidates abandoned once past the best. Immutable: match() is concurrent.
 class ExemplarIndex {
  public:
   explicit ExemplarIndex(const ExemplarLevels& ex);

@@ -3,24 +3,12 @@
 // Other maps of the exemplar (height, roughness, tangent-space normal)
 // carried through one subdivision synthesis (issue 16 item 2: "one synthesis,
 // every channel"; Bangay & Morkel 2006 colour vertices, so every map becomes
-// a per-vertex value). The map is resampled as the exemplar was
-// (resample_as_synthesised), built into the same stack or pyramid
-// (make_exemplar_levels, same bounded levels), and read at every final
-// vertex exactly where its colour was read (SubdivisionSynthesisResult::
-// lookup: level and bilinear position), in float. A vertex without a lookup
-// (a face point whose colour is its face's average and was never matched,
-// rare) takes the mean of its neighbours' values, spread ring by ring; with no
-// lookup at all, the map's mean.
-//
-// Normal maps: channels 0-2 = (n + 1) / 2 in the exemplar's frame, x along
-// its columns (+u, right), y up the image (+v, "+Y up"). The synthesis lays
-// the exemplar at vertex P with +x along P's field direction d (kVertexDirection
-// projected into P's tangent plane, k_region_matching.h) and the image's up
-// along n x d (a region vertex at local v > 0 reads a row above the centre's),
-// so the object-space normal is x d + y (n x d) + z n, n = the vertex normal
-// the synthesis uses (polygon_vertex_normals). Tilts and flat normals thus
-// keep their meaning on the surface; texture/tangent_space_bake.h turns them
-// into a viewer's tangent space.
+// Each map is resampled as the exemplar was, built into the same stack, and
+// read at every final vertex where its colour was read (lookup); vertices
+// without a lookup take their neighbours' mean. Normal maps ((n + 1) / 2, +x
+// right, +y up) become object space x d + y (n x d) + z n, d the vertex's
+// field direction, as the synthesis laid the exemplar; tangent_space_bake.h
+// turns them into a viewer's tangent space. In full: decision 303.
 
 #include <array>
 #include <cstddef>

@@ -3,55 +3,20 @@
 // Texture synthesis on surfaces by graph matching over a sqrt(2)-subdivision
 // hierarchy (Bangay & Morkel 2006, sections 3 and 4): the whole pipeline.
 //
-// 1. Scale (3.3.2), chosen from the inputs (choose_subdivision_scale): the
-//    texture size is given as exemplar widths across the object (`repeats`,
-//    the default: 3 across the longest bounding-box side), as exemplar texels
-//    per mean edge of the input (`texels_per_edge`) or as the paper's r_scale
-//    (texels per object unit; with normalize_units, default, one object unit
-//    is the longest bounding-box side, so r_scale means "texels across the
-//    object" whatever the file's units). The number of uniform levels is the
-//    fewest whose vertex spacing (sqrt(area / faces) of the final quads) is
-//    at most one texel; if that needs more than max_vertices vertices, the
-//    deepest level within the budget is used and the exemplar is reduced so
-//    that one synthesis texel is that level's vertex spacing (same repeats,
-//    coarser texels).
-// 2. Adaptive sqrt(2)-subdivision of the base mesh (3.2.2), default f = 1.5.
-// 3. Orientation field (Turk diffusion from key vertices) and sweep field on
-//    the base mesh (3.1.1); after every subdivision step both are carried to
-//    the new vertices and re-diffused (coarse to fine).
-// 4. Levels: the base mesh, then `levels` uniform sqrt(2) steps (3.2.1).
-//    Old vertices keep their colours; face points start with the average of
-//    their face's colours ("missing entries filled by interpolation", 4).
-// 5. Order (3.1.2): on the base level vertices are visited in increasing sweep
-//    value; on every later level in a random order (std::mt19937_64 from
-//    `seed`). On the base level the first pass skips vertices whose region has
-//    no coloured vertex yet; the very first vertex gets a random texel; after
-//    the first pass, fill passes visit the skipped vertices until all are
-//    coloured (section 4's two-pass process); then passes 2..P refine.
-// 6. Per vertex P (3.3): k from region_k at P's mean edge length and P's
-//    stack level m (the region spans region_texels texels OF LEVEL m, i.e.
-//    n 2^m level-0 texels, about n x n vertices at every mesh level: see
-//    level_relative_region; the graph cut's r is that span), its
-//    k-region with local (u,v), samples = the coloured region vertices other
-//    than P, each at its anti-aliasing level (or, without anti-aliasing, the
-//    level max(0, levels - level index): coarse mesh <-> coarse stack image),
-//    exhaustive match (match_region), then transfer: graph cut over the whole
-//    region (graph_cut_transfer, r = 2^m n texels) or P alone. With
-//    skip_patched, vertices that received colour from a cut earlier in the
-//    same pass are not matched again in that pass (the speed-up of section 4).
-// Colours are read from the stack level of each vertex (3.3.4); each colour
-// remembers that level and is compared against it when it serves as a sample
-// (old vertices carry coarse, blurred colours into the next mesh level).
-// Wrap (issue 18 item 2): the exemplar is treated as periodic only when it
-// tiles (wrap_seam_ratio at most wrap_threshold, or wrap = Periodic); else,
-// at every stack level whose regions fit in half the exemplar (the fine
-// levels, which decide the final texels), matches take only candidates whose
-// whole region lies inside it and the transfer pins the vertices that fall
-// outside, so its wrap seams are never copied; coarser, blurred levels wrap. Repetition: every vertex remembers the level-0 exemplar texel its
-// colour came from; a match adds to d(Q) a penalty for exemplar areas that
-// nearby vertices (within about one exemplar width, outside the region being
-// matched) already show more often than the average area (see
-// repetition_penalty).
+// 1. Scale (3.3.2), from the inputs (choose_subdivision_scale): `repeats`
+//    exemplar widths across the object (default), texels_per_edge, or r_scale;
+//    the fewest uniform levels whose vertex spacing is one texel, within
+//    max_vertices (else the exemplar is reduced).
+// 2. Adaptive sqrt(2)-subdivision of the base (3.2.2).
+// 3. Orientation and sweep fields (3.1.1), carried and re-diffused per level.
+// 4. Levels: the base, then `levels` uniform sqrt(2) steps (3.2.1).
+// 5. Order (3.1.2): by sweep on the base level, random later; fill passes
+//    colour the skipped vertices (section 4's two passes).
+// 6. Per vertex (3.3): its k-region, exhaustive or coherence match, graph-cut
+//    transfer (3.4), at the vertex's stack level (3.3.4).
+// Wrap: periodic only when the exemplar tiles (wrap_threshold); repetition
+// penalty against exemplar areas shown too often nearby. Every step in
+// detail: docs/decisions/206-subdiv-synthesis-pipeline.md.
 //
 // Writes kVertexColor (linear RGB), kVertexDirection, kVertexSweep on the
 // final (finest) mesh, which replaces `mesh`. Throws InvalidInputError (bad
@@ -91,8 +56,7 @@ struct SubdivisionSynthesisOptions {
   /// Uniform sqrt(2) steps after the base level, 0..12; -1 (default) = chosen
   /// (step 1: vertex spacing <= one texel within max_vertices).
   int levels = -1;
-  /// Most vertices of the finest level when levels are chosen, >= 1000.
-  /// Default 150000 (about 20 s at defaults on 2 cores).
+  /// Most vertices of the finest level when levels are chosen, >= 1000. Default 150000.
   std::size_t max_vertices = 150000;
   double adaptive_factor = 1.5; ///< f of 3.2.2 (the paper's choice); 0 = no adaptive subdivision
   int adaptive_steps = 4;       ///< adaptive steps when adaptive_factor > 0, 0..32
@@ -102,46 +66,24 @@ struct SubdivisionSynthesisOptions {
   /// (texture/wrap_seam_ratio.h: jump across its wrap / jump inside) is at
   /// most this, > 0. Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
   double wrap_threshold = 1.3;
-  /// lambda of the repetition term added to a candidate's SSD:
-  /// lambda * sigma^2 * (samples) * max(0, R - 1), sigma^2 the exemplar's
-  /// summed channel variance, R the count of nearby vertices (within the 27
-  /// cells of one exemplar width around the centre, the region's own
-  /// vertices left out) whose source lies in the candidate's exemplar bin
-  /// (16 x 16 bins) over the mean count per bin. >= 0; 0 = off. Default 0.3.
-  /// n: neighbourhood edge length in texels, > 0. 3 is the paper's Table-1 (timing)
-  /// setting; it is too small for structured exemplars at the fine stack levels,
-  /// where SSD favours the most uniform exemplar areas (dark seams of a brick
-  /// wall grow into blobs). 9 keeps brick structure on brick_small_96.
+  /// n: neighbourhood edge length in texels, > 0. Default 9 (the paper's 3 is
+  /// too small for structured exemplars; decision 206).
   double region_texels = 9;
   bool pyramid = false;         ///< Gaussian pyramid (a = 2) instead of the stack (a = 1)
   bool antialias = true;        ///< per-vertex stack level (3.3.4)
   bool averaging = true;        ///< oversampling groups (3.3.3)
   bool graph_cut = true;        ///< graph-cut transfer (3.4), else P alone
   bool skip_patched = true;     ///< do not re-match vertices patched in the same pass
-  /// Count region_texels in texels of the centre's stack level m, i.e. the
-  /// region spans n 2^m level-0 texels (a = 2 in section 3.3.2's formula, as
-  /// for a pyramid), so every level matches about n x n vertices. Default on.
-  /// Off = the paper's a = 1 for a stack: a region of n level-0 texels at
-  /// every level, which at coarse levels (edges longer than n texels) is only
-  /// the 1-ring; its samples are blurred together by the level's stack
-  /// filter, the match then merely continues the colour around it, and the
-  /// structure laid down is far coarser than the exemplar's (on a deep
-  /// hierarchy: cells several times too large, or one uniform colour) which
-  /// the fine levels, whose regions are smaller than those features, cannot
-  /// break. Stack levels still give every sample its own anti-aliased level.
+  /// Count region_texels in texels of the centre's stack level m (a region of
+  /// n 2^m level-0 texels, about n x n vertices per level). Off = the paper's
+  /// a = 1 (coarse levels then see only the 1-ring). Default on.
   bool level_relative_region = true;
+  /// Repetition term lambda * sigma^2 * samples * max(0, R - 1) added to a
+  /// candidate's SSD (R: nearby use of its exemplar bin over the mean). >= 0, 0 = off.
   double repetition_penalty = 0.3;
-  /// Mesh levels from the base on that use the exhaustive search
-  /// (Algorithm 1), 0..13; every later level uses the coherence search
-  /// (section 2.3: search "restricted to regions around points previously
-  /// matched", Ashikhmin 2001, Ying et al. 2001): the candidates are the
-  /// centres that the region's coloured vertices' sources imply (source minus
-  /// offset) and the centre's own source, scored with the same distance and
-  /// penalty; the exhaustive search runs where none is usable. Default 1 (the
-  /// base level lays out the pattern exhaustively; the levels below refine
-  /// it): on brick_small_96, flat square at 256 texels, fidelity ratio 1.71
-  /// and 14 s CPU against 1.81 and 60 s exhaustive everywhere
-  /// (docs/decisions/204). 13 = exhaustive everywhere.
+  /// Mesh levels from the base that use the exhaustive search (Algorithm 1),
+  /// 0..13; later levels use the coherence search (2.3; Ashikhmin 2001).
+  /// Default 1; 13 = exhaustive everywhere (figures: decision 204).
   int exhaustive_levels = 1;
   double sigma = 1.0;           ///< sigma of equation (1), > 0
   int max_k = 24;               ///< cap on k, 1..64
@@ -258,27 +200,17 @@ PassGeometry make_pass_geometry(const Mesh& mesh);
 /// stack level used without anti-aliasing. `r_scale` here is texels per MESH
 /// unit. Returns the pass statistics.
 ///
-/// The pass is the sequential one (each vertex matched against the colours
-/// left by the vertices before it in `order`), computed speculatively in
-/// parallel: chunks of consecutive vertices are matched with TBB against the
-/// colours at the chunk's start and committed in order; a vertex whose region
-/// was written by an earlier commit of its chunk is recomputed. Results do
-/// not depend on the thread count.
+/// Sequential in effect, computed speculatively in parallel (chunks matched
+/// with TBB, committed in order, a vertex recomputed if its region changed);
+/// independent of the thread count.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const std::vector<std::size_t>& order,
                                   std::vector<char>& colored, double r_scale, int hierarchy_level,
                                   const SubdivisionSynthesisOptions& opt, std::mt19937_64& rng);
 /// The same with a prebuilt index of `ex` (reused across passes).
-/// `color_level` (optional, one entry per vertex, updated): the stack level
-/// each vertex's current colour was read from. A sample is compared against
-/// that level, not the vertex's current anti-aliasing level: colours carried
-/// from a coarser mesh level are blurred, and comparing them against sharper
-/// texels makes SSD prefer the exemplar's extreme (dark) texels, which then
-/// grow into blobs. Null = every colour belongs to its vertex's current level.
-/// `source` (optional, one entry per vertex, updated): the level-0 exemplar
-/// texel each colour came from ({-1,-1} = none); the repetition penalty and
-/// the result's source record need it (no penalty without it). `geometry`
-/// (optional): make_pass_geometry(mesh), reused; null = built here.
-/// `lookup` (optional, one entry per vertex, updated): where each colour was read.
+/// Optional, one entry per vertex, updated:
+/// `color_level` (stack level each colour was read from; samples compare at
+/// it), `source` (level-0 texel, {-1,-1} none; needed by the repetition
+/// penalty), `lookup`; `geometry`: make_pass_geometry(mesh), null = built here.
 SynthesisPassStats synthesis_pass(Mesh& mesh, const ExemplarLevels& ex, const ExemplarIndex& index,
                                   const std::vector<std::size_t>& order, std::vector<char>& colored, double r_scale,
                                   int hierarchy_level, const SubdivisionSynthesisOptions& opt,

@@ -4,28 +4,14 @@
 // synthesis on surfaces", section 3; used by Bangay & Morkel 2006, section
 // 3.1.1). Works on any polygon mesh (normals are Newell area-weighted).
 //
-// turk_orientation_field: the user gives orientations at key vertices. Passes
-// are made over the mesh; in each pass (Jacobi: every vertex reads the values
-// of the previous pass) the vector at every non-key vertex is set to the
-// average of its neighbours' defined vectors, projected onto the tangent plane
-// at the vertex and normalised. Key vertices keep their (projected,
-// normalised) vector. First `fill` passes run until every vertex has a value
-// (the diffusion front), then `smoothing_passes` more. A vertex whose
-// component has no key gets the world x axis (or y) projected to its tangent
-// plane and is counted in `unreached`.
-// Coarse to fine (section 3.1.1, "performed in a hierarchical manner"): with
-// from_existing, the current kVertexDirection values (e.g. carried by
-// sqrt2_subdivide, which averages them onto face points) are the start; they
-// are re-projected and normalised, zero vectors count as undefined, and only
-// `smoothing_passes` passes follow.
-//
-// turk_sweep_field: a scalar that increases along the field, to order
-// vertices (Turk's sweep). s(anchor) = 0; every other vertex repeatedly takes
-// the mean over its neighbours n of s(n) + (p_v - p_n) . (d_v + d_n)/|d_v + d_n|
-// (Gauss-Seidel in vertex order, which is deterministic). The first passes
-// spread values out from the anchor breadth first; `passes` relaxation passes
-// follow. Components without the anchor get their first vertex as anchor.
-// With from_existing, the current kVertexSweep values are the start.
+// turk_orientation_field: Jacobi passes setting each non-key vertex to the
+// projected, normalised mean of its neighbours' vectors, `fill` passes until
+// every vertex has one, then `smoothing_passes`; keyless components get the
+// world x (or y) axis, counted in `unreached`. from_existing starts from the
+// current kVertexDirection (coarse to fine, 3.1.1).
+// turk_sweep_field: s(anchor) = 0, every other vertex the mean over its
+// neighbours of s(n) + (p_v - p_n) . (d_v + d_n)/|d_v + d_n| (Gauss-Seidel in
+// vertex order); breadth-first start, then `passes`. In full: decision 206.
 //
 // Reads kVertexDirection (sweep). Writes kVertexDirection / kVertexSweep.
 // Throws InvalidInputError (empty mesh, key or anchor vertex out of range,
