@@ -3,8 +3,9 @@
 // 3; issue 17): 3 meshes of ../shared/data (bunny_6k: +Y up; koala: thin ears
 // and limbs; knot: genus 1) x 4 swatches (the generated weave, chain mail and
 // 16 tilted tori, disjoint elements; the real pebble swatches/rock_1.obj), each
-// quilted and embedded at the CLI's defaults (relative size 0.25, up +Y,
-// shell height 1, 20 stretch sweeps, seed 1; the swatch's thin axis detected).
+// quilted and embedded by the CLI's driver (quilt_swatch_on_surface) at the
+// CLI's defaults (relative size 0.25, up +Y, shell height 1, 20 stretch
+// sweeps, seed 1; the swatch's thin axis detected).
 // Prints one JSON line per case:
 //   faces, elements (the output's connected components) and quilt_elements
 //   (the quilt's own count); intersecting face pairs between / within elements
@@ -59,9 +60,7 @@
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
-#include "shell/element_colors.h"
-#include "shell/quilting/embed_surface_quilt.h"
-#include "shell/quilting/surface_quilting.h"
+#include "shell/quilting/quilt_driver.h"
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
 
@@ -265,8 +264,10 @@ json run_case(const std::string& name, const std::string& outdir) {
     load_input_mesh(mesh_file(mesh_name), base);
     base.collect_garbage();
   }
-  const Swatch s = make_swatch(make_named_swatch(kind), g_old_defaults ? SwatchAxis::kZ : SwatchAxis::kAuto);
-  SurfaceQuiltOptions qo;
+  QuiltSwatchOnSurfaceOptions o;
+  o.swatch_up = g_old_defaults ? SwatchAxis::kZ : SwatchAxis::kAuto;
+  o.mesh_name = mesh_name;
+  SurfaceQuiltOptions& qo = o.quilt;
   qo.relative_size = rel;
   if (g_old_defaults) {
     qo.up = {0, 0, 1};
@@ -284,16 +285,13 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
-  SurfaceQuilt q;
-  Timer tq;
-  const SurfaceQuiltResult r = quilt_surface(base, s, q, qo);
-  const double seconds_quilt = tq.seconds();
-  EmbedSurfaceQuiltOptions eo;
-  eo.stretch.iterations = 20;
+  o.embed.stretch.iterations = 20;
   Mesh out;
-  Timer te;
-  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-  const double seconds_embed = te.seconds();
+  const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
+  const Swatch& s = run.swatch;
+  const SurfaceQuilt& q = run.local;
+  const SurfaceQuiltResult& r = run.quilt;
+  const EmbedSurfaceQuiltResult& er = run.embedding;
   const double faces = static_cast<double>(out.number_of_faces());
   double longest = 0;
   const double emax = edge_max_over_median(out, longest);
@@ -335,17 +333,15 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"outside_vertices", er.embed.outside},
          {"bare", bare_area(base, q, 0.5 * spacing * q.scale, Vector3(0, 1, 0))},
          {"gap", gap_ratio(out, s, q.scale, spacing)},
-         {"seconds", {{"quilt", seconds_quilt}, {"embed", seconds_embed}, {"total", total.seconds()}}},
+         {"seconds", {{"quilt", run.seconds_quilt}, {"embed", run.seconds_embed}, {"total", total.seconds()}}},
          {"user_cpu", user_cpu() - cpu0}};
   j["elements"] = j["gap"]["elements"];
   if (!outdir.empty()) {
     std::string stem = name;
     std::replace(stem.begin(), stem.end(), ':', '_');
-    color_by_element(out, 1);
     write_mesh(outdir + "/" + stem + ".glb", out);
-    Mesh scene = base;
-    get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
-    scene.join(out);
+    Mesh scene;
+    surface_quilt_scene(base, out, scene);
     ViewOptions vo;  // +Y up, as the meshes and glTF
     vo.size = 900;
     vo.azimuth_deg = 30.f;

@@ -4,44 +4,32 @@
 // 2); `surftex elements`: edit the elements of a result by id; the demo step
 // "quilt".
 
-#include <algorithm>
-#include <array>
 #include <cctype>
 #include <cmath>
-#include <map>
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/image_io.h"
-#include "geometry/primitive_meshes.h"
 #include "geometry/mesh.h"
-#include "geometry/mesh_util.h"
-#include "geometry/properties.h"
+#include "geometry/primitive_meshes.h"
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/element_colors.h"
-#include "shell/quilting/embed_surface_quilt.h"
-#include "shell/quilting/mesh_quilting.h"
+#include "shell/quilting/edit_elements.h"
+#include "shell/quilting/quilt_driver.h"
 #include "shell/quilting/quilt_json.h"
-#include "shell/quilting/surface_quilting.h"
 #include "shell/swatch_generators.h"
-#include "surftex/demo_steps.h"
-#include "shell/swatch.h"
 #include "surftex/command.h"
+#include "surftex/demo_steps.h"
 
 namespace surftex::cli {
 namespace {
-
-std::string render_path_for(const std::string& out) {
-  const auto dot = out.find_last_of('.');
-  const auto slash = out.find_last_of('/');
-  const std::string stem = (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? out : out.substr(0, dot);
-  return stem + "_render.png";
-}
 
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto";
@@ -52,37 +40,8 @@ struct QuiltArgs {
   CommonOptions common;
 };
 
-bool is_generated_swatch(const std::string& s) {
-  return s == "chainmail" || s == "weave" || s == "scatter" || s == "tori";
-}
-
 SwatchAxis swatch_axis(const std::string& s) {
   return s == "x" ? SwatchAxis::kX : s == "y" ? SwatchAxis::kY : s == "z" ? SwatchAxis::kZ : SwatchAxis::kAuto;
-}
-
-// The swatch: a file, or one the project generates (seeded by --seed).
-Mesh load_or_generate_swatch(const std::string& name, std::uint64_t seed) {
-  Mesh sm;
-  if (name == "chainmail") {
-    ChainmailOptions o;
-    o.seed = seed;
-    make_chainmail_swatch(sm, o);
-  } else if (name == "weave") {
-    WeaveOptions o;
-    o.seed = seed;
-    make_weave_swatch(sm, o);
-  } else if (name == "scatter") {
-    ScatterOptions o;
-    o.seed = seed;
-    make_scatter_swatch(sm, o);
-  } else if (name == "tori") {
-    ToriOptions o;
-    o.seed = seed;
-    make_tori_swatch(sm, o);
-  } else {
-    read_mesh(name, sm);
-  }
-  return sm;
 }
 
 std::string sibling(const std::string& out, const std::string& ext) {
@@ -98,49 +57,6 @@ std::string lower_ext(const std::string& path) {
   std::string e = path.substr(dot);
   for (char& ch : e) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return e;
-}
-
-// Mean and largest element length of a planar quilt: each element's larger
-// xy bounding-box side, in units of `unit` (the swatch's larger side); a
-// thread-length measure (issue #8: threads ending at patch seams are short).
-std::pair<double, double> element_lengths(const Mesh& m, double unit) {
-  const auto el = find(m, kFaceElement);
-  if (!el.second || !(unit > 0)) return {0, 0};
-  std::map<int, std::array<double, 4>> box;  // id -> xmin, xmax, ymin, ymax
-  for (FaceIndex f : m.faces())
-    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) {
-      const Point3& p = m.point(v);
-      auto it = box.try_emplace(el.first[f], std::array<double, 4>{p.x(), p.x(), p.y(), p.y()}).first;
-      auto& b = it->second;
-      b = {std::min(b[0], p.x()), std::max(b[1], p.x()), std::min(b[2], p.y()), std::max(b[3], p.y())};
-    }
-  double sum = 0, mx = 0;
-  for (const auto& [id, b] : box) {
-    const double l = std::max(b[1] - b[0], b[3] - b[2]) / unit;
-    sum += l;
-    mx = std::max(mx, l);
-  }
-  return {box.empty() ? 0 : sum / static_cast<double>(box.size()), mx};
-}
-
-// Refuses runs whose output could not be held: `placements` swatch copies
-// (the plane's W x H, or the base area over the swatch's) of its faces above
-// kMaxQuiltFaces, or a --cell (in the swatch's units, 0 = automatic) that
-// cuts the swatch into more than kMaxSwatchCells cells across.
-constexpr double kMaxQuiltFaces = 5e7;
-constexpr double kMaxSwatchCells = 200;
-void check_quilt_size(const Swatch& s, double cell, double placements, const std::string& what) {
-  const double faces = placements * static_cast<double>(s.mesh.tris.size());
-  if (!(faces <= kMaxQuiltFaces))
-    throw InvalidInputError("quilt: " + what + " needs about " + std::to_string(static_cast<long long>(std::min(placements, 9e18))) +
-                            " copies of the " + std::to_string(s.mesh.tris.size()) +
-                            "-face swatch, more than the " + std::to_string(static_cast<long long>(kMaxQuiltFaces)) +
-                            " output faces this tool will build (use a smaller area or a larger --scale)");
-  const double across = std::max(s.length(), s.width()) / cell;
-  if (cell > 0 && !(across <= kMaxSwatchCells))
-    throw InvalidInputError("quilt: --cell " + std::to_string(cell) + " cuts the swatch into " +
-                            std::to_string(static_cast<long long>(std::min(across, 9e18))) + " cells across, more than " +
-                            std::to_string(static_cast<int>(kMaxSwatchCells)) + " (0 = automatic, a tenth of the swatch)");
 }
 
 // The inputs of a run (the swatch file unless generated, the base mesh),
@@ -176,7 +92,7 @@ std::vector<std::string> quilt_outputs(QuiltArgs& a, const std::vector<std::stri
   if (!a.base.empty())
     for (const std::string& e : {std::string(".ply"), std::string(".glb")})
       if (ext != e) outputs.push_back(sibling(a.output, e));
-  if (a.render.empty() && !a.no_render) a.render = render_path_for(a.output);
+  if (a.render.empty() && !a.no_render) a.render = sibling(a.output, "_render.png");
   if (!a.render.empty()) outputs.push_back(a.render);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     std::vector<std::string> others = inputs;
@@ -200,46 +116,27 @@ std::pair<double, double> parse_plane(const std::string& plane) {
 }
 
 // Planar mesh quilting (section 2) of the swatch over w x h swatch sizes
-// into `out`, coloured by element; its figures into the report.
-void quilt_on_plane(const QuiltArgs& a, Mesh& sm, double w, double h, Mesh& out, nlohmann::json& rep) {
+// into `out`; its figures into the report.
+void quilt_on_plane(const QuiltArgs& a, const Mesh& sm, double w, double h, Mesh& out, nlohmann::json& rep) {
   // --scale: factor applied to the swatch (the paper's s); the plane is in swatch sizes.
-  const double sc = a.scale > 0 ? a.scale : 1.0;
-  for (VertexIndex v : sm.vertices()) {
-    const Point3 p = sm.point(v);
-    sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
-  }
-  const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
-  check_quilt_size(s, a.cell * sc, w * h, "--plane " + a.plane);
-  check_budget(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())), a.common);
-  PlanarQuiltOptions o;
+  QuiltSwatchOnPlaneOptions o;
+  o.scale = a.scale > 0 ? a.scale : 1.0;
+  o.swatch_up = swatch_axis(a.swatch_up);
+  o.quilt.cell_size = a.cell * o.scale;
+  o.quilt.subpatch_radius = a.subpatch;
+  o.quilt.progress = terminal_progress(a.common.quiet);
   o.seed = a.common.seed;
-  o.cell_size = a.cell * sc;
-  o.subpatch_radius = a.subpatch;
-  o.progress = terminal_progress(a.common.quiet);
-  const QuiltResult r = quilt_plane(s, w * s.length(), h * s.width(), out, o);
-  if (out.number_of_faces() == 0)
-    throw InvalidInputError("quilt: no element was placed on the " + a.plane + " plane");
-  color_by_element(out, a.common.seed);
-  rep.update(to_json(r));
-  rep["plane"] = {w, h};
-  rep["swatch_faces"] = s.mesh.tris.size();
-  rep["swatch_elements"] = s.elements.size();
-  const auto [len_mean, len_max] = element_lengths(out, std::max(s.length(), s.width()));
-  rep["element_length_mean"] = len_mean;
-  rep["element_length_max"] = len_max;
+  o.plane_name = a.plane;
+  o.check_work = [&a](const WorkEstimate& e) { check_budget(e, a.common); };
+  rep.update(to_json(quilt_swatch_on_plane(sm, w, h, out, o)));
 }
 
-// Refuses a surface quilt whose output could not be held: the placements
-// needed are the base area over the scaled swatch's xy area (the base mesh
-// is triangulated by load_method_mesh).
-void check_surface_quilt_size(const QuiltArgs& a, const Mesh& base, const Swatch& s, double relative_size) {
-  const double placements = surface_quilt_placements(base, s, relative_size);
-  check_quilt_size(s, a.cell, placements, "--scale " + std::to_string(relative_size));
-  check_budget(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())), a.common);
-}
-
-// The options of quilt_surface from the command line (the relative size set by the caller).
-void set_surface_quilt_options(const QuiltArgs& a, SurfaceQuiltOptions& o) {
+// The options of quilt_swatch_on_surface from the command line.
+QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
+  QuiltSwatchOnSurfaceOptions d;
+  d.swatch_up = swatch_axis(a.swatch_up);
+  SurfaceQuiltOptions& o = d.quilt;
+  if (a.scale > 0) o.relative_size = a.scale;
   o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
   o.up = {a.up[0], a.up[1], a.up[2]};
   o.cell_size = a.cell;
@@ -248,57 +145,30 @@ void set_surface_quilt_options(const QuiltArgs& a, SurfaceQuiltOptions& o) {
   o.align_to_overlap = !a.no_align;
   o.align_field_max_deg = a.align_bound;
   o.smooth_field = a.smooth_field;
-  o.seed = a.common.seed;
   o.progress = terminal_progress(a.common.quiet);
+  d.embed.shell_height = a.shell_height;
+  d.embed.stretch.iterations = a.stretch_iterations;
+  d.embed.check_self_intersections = !a.no_check;
+  d.embed.progress = o.progress;
+  d.seed = a.common.seed;
+  d.mesh_name = a.base;
+  d.check_work = [&a](const WorkEstimate& e) { check_budget(e, a.common); };
+  return d;
 }
 
-// Surface mesh quilting (section 3.1) of the swatch over the base mesh,
-// embedded through the stretch-minimised shell map (3.2) into `out`,
-// coloured by element; `scene` is the grey base with `out` joined (for the
-// render). Its figures into the report.
-void quilt_on_mesh(const QuiltArgs& a, Mesh& sm, Mesh& out, Mesh& scene, nlohmann::json& rep) {
+// Surface mesh quilting (section 3) of the swatch over the base mesh into
+// `out`; `scene` is the base with `out` joined (for the render). Its figures
+// into the report.
+void quilt_on_mesh(const QuiltArgs& a, const Mesh& sm, Mesh& out, Mesh& scene, nlohmann::json& rep) {
   Timer t;
   Mesh base;
   rep["input_mesh"] = to_json(load_method_mesh(a.base, base, a.common));
   base.collect_garbage();
   const double read_seconds = t.seconds();
-  const Swatch s = make_swatch(sm, swatch_axis(a.swatch_up));
-  SurfaceQuiltOptions o;
-  o.relative_size = a.scale > 0 ? a.scale : 0.25;
-  if (!(o.relative_size <= 10))
-    throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(a.scale) + ")");
-  check_surface_quilt_size(a, base, s, o.relative_size);
-  set_surface_quilt_options(a, o);
-  SurfaceQuilt q;
-  const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-  if (q.elements == 0 || q.tris.empty())
-    throw InvalidInputError("quilt: no element was placed on '" + a.base + "' at --scale " +
-                            std::to_string(o.relative_size) +
-                            " (the swatch may be too large for the mesh: lower --scale)");
-  EmbedSurfaceQuiltOptions eo;
-  eo.shell_height = a.shell_height;
-  eo.stretch.iterations = a.stretch_iterations;
-  eo.stretch.seed = a.common.seed;
-  eo.check_self_intersections = !a.no_check;
-  eo.progress = o.progress;
-  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-  color_by_element(out, a.common.seed);
-  rep.update(to_json(r, er));
+  rep.update(to_json(quilt_swatch_on_surface(base, sm, out, surface_quilt_options(a))));
   rep["mesh"] = a.base;
-  rep["base_faces"] = base.number_of_faces();
-  rep["swatch_faces"] = s.mesh.tris.size();
-  rep["swatch_elements"] = s.elements.size();
-  rep["swatch_up"] = axis_name(s.up_axis);
-  rep["up"] = a.up;
-  rep["scale"] = o.relative_size;
-  rep["field"] = a.field;
-  rep["faces"] = out.number_of_faces();
-  rep["vertices"] = out.number_of_vertices();
-  rep["max_turn_deg"] = o.rotation_max_deg;
   rep["seconds"]["read"] = read_seconds;
-  scene = base;
-  get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
-  scene.join(out);
+  surface_quilt_scene(base, out, scene);
 }
 
 // The quilt into every mesh output, and the render of `scene` when asked.
@@ -443,53 +313,20 @@ int run_elements(const ElementsArgs& a) {
   check_output(a.output, {a.input}, a.common.force);
   Mesh m;
   read_mesh(a.input, m);
-  // Element ids are recomputed as connected components, numbered in order of
-  // their first face in the file (the same numbering quilt writes).
-  const int n = label_elements(m);
-  auto elem = find(m, kFaceElement).first;
-  auto col_found = find(m, kVertexColor);
-  if (!col_found.second) color_by_element(m, a.common.seed);
-  auto col = get_or_add(m, kVertexColor, Color3f{0.8f, 0.8f, 0.8f});
-  for (const std::string& rc : a.recolor) {
-    int id = -1;
-    float r = 0, g = 0, b = 0;
-    int used = 0;
-    if (std::sscanf(rc.c_str(), "%d=%f,%f,%f%n", &id, &r, &g, &b, &used) != 4 || used != static_cast<int>(rc.size()) ||
-        id < 0 || id >= n)
-      throw InvalidInputError("elements: --recolor wants ID=r,g,b with 0 <= ID < " + std::to_string(n) +
-                              " and colours in [0,1] (got '" + rc + "')");
-    for (float c : {r, g, b})
-      if (!(c >= 0 && c <= 1)) throw InvalidInputError("elements: colour out of [0,1] in '" + rc + "'");
-    for (FaceIndex f : m.faces())
-      if (elem[f] == id)
-        for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) col[v] = {r, g, b};
-  }
-  std::size_t removed = 0;
-  for (int id : a.remove) {
-    if (id < 0 || id >= n)
-      throw InvalidInputError("elements: --remove id " + std::to_string(id) + " out of range 0.." + std::to_string(n - 1));
-  }
-  if (!a.remove.empty()) {
-    std::vector<char> gone(static_cast<std::size_t>(n), 0);
-    for (int id : a.remove) gone[id] = 1;
-    std::vector<FaceIndex> faces(m.faces().begin(), m.faces().end());
-    for (FaceIndex f : faces)
-      if (gone[elem[f]]) {
-        CGAL::Euler::remove_face(m.halfedge(f), m);
-        ++removed;
-      }
-    m.collect_garbage();
-  }
+  EditElementsOptions o;
+  o.recolor = a.recolor;
+  o.remove = a.remove;
+  o.seed = a.common.seed;
+  const EditElementsResult r = edit_elements(m, o);
   WriteMeshOptions wo;
   wo.overwrite = a.common.force;
   write_mesh(a.output, m, wo);
-  nlohmann::json rep;
+  nlohmann::json rep = to_json(r);
   rep["input"] = a.input;
   rep["output"] = a.output;
-  rep["elements"] = n;
-  rep["faces_removed"] = removed;
   write_report(a.common, "elements", rep, {{a.input}, {a.output}});
-  if (!a.common.quiet) std::fprintf(stderr, "elements: %d elements, %zu faces removed -> %s\n", n, removed, a.output.c_str());
+  if (!a.common.quiet)
+    std::fprintf(stderr, "elements: %d elements, %zu faces removed -> %s\n", r.elements, r.faces_removed, a.output.c_str());
   return 0;
 }
 
@@ -518,44 +355,40 @@ nlohmann::json step_quilt(DemoContext& ctx) {
   co.seed = ctx.seed;
   Mesh sm;
   make_chainmail_swatch(sm, co);
-  const Swatch s = make_swatch(sm);
   nlohmann::json j;
   Timer t;
-  PlanarQuiltOptions po;
+  QuiltSwatchOnPlaneOptions po;
+  po.swatch_up = SwatchAxis::kZ;
   po.seed = ctx.seed;
+  po.plane_name = "2x2";
   Mesh plane;
-  const QuiltResult pr = quilt_plane(s, 2 * s.length(), 2 * s.width(), plane, po);
-  color_by_element(plane, ctx.seed);
+  const QuiltSwatchOnPlaneResult pr = quilt_swatch_on_plane(sm, 2, 2, plane, po);
   write_mesh(ctx.path("quilt_plane_chainmail.ply"), plane);
   write_image(ctx.path("quilt_plane_chainmail.png"), render_preview(plane));
-  j["plane"] = {{"elements", pr.elements}, {"faces", pr.faces}, {"outputs", {"quilt_plane_chainmail.ply", "quilt_plane_chainmail.png"}}};
+  j["plane"] = {{"elements", pr.quilt.elements}, {"faces", pr.quilt.faces}, {"outputs", {"quilt_plane_chainmail.ply", "quilt_plane_chainmail.png"}}};
   j["seconds"]["plane"] = t.seconds();
   t.reset();
   Mesh base;
   make_icosphere(base, 2);
-  SurfaceQuiltOptions so;
-  so.relative_size = 0.45;
+  QuiltSwatchOnSurfaceOptions so;
+  so.swatch_up = SwatchAxis::kZ;
+  so.quilt.relative_size = 0.45;
+  so.quilt.progress = ctx.progress;
+  so.embed.stretch.iterations = 10;
   so.seed = ctx.seed;
-  so.progress = ctx.progress;
-  SurfaceQuilt q;
-  const SurfaceQuiltResult sr = quilt_surface(base, s, q, so);
-  EmbedSurfaceQuiltOptions eo;
-  eo.stretch.iterations = 10;
-  eo.stretch.seed = ctx.seed;
+  so.mesh_name = "icosphere";
   Mesh out;
-  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-  color_by_element(out, ctx.seed);
+  const QuiltSwatchOnSurfaceResult sr = quilt_swatch_on_surface(base, sm, out, so);
   write_mesh(ctx.path("quilt_sphere_chainmail.ply"), out);
   write_mesh(ctx.path("quilt_sphere_chainmail.glb"), out);
-  Mesh scene = base;
-  get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
-  scene.join(out);
+  Mesh scene;
+  surface_quilt_scene(base, out, scene);
   write_image(ctx.path("quilt_sphere_chainmail.png"), render_preview(scene));
-  j["sphere"] = {{"elements", sr.elements},
-                 {"faces", out.number_of_faces()},
-                 {"stretch_before", er.stretch.stretch_before},
-                 {"stretch_after", er.stretch.stretch_after},
-                 {"self_intersections", er.embed.self_intersecting_pairs},
+  j["sphere"] = {{"elements", sr.quilt.elements},
+                 {"faces", sr.faces},
+                 {"stretch_before", sr.embedding.stretch.stretch_before},
+                 {"stretch_after", sr.embedding.stretch.stretch_after},
+                 {"self_intersections", sr.embedding.embed.self_intersecting_pairs},
                  {"outputs", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
   j["seconds"]["sphere"] = t.seconds();
   return j;

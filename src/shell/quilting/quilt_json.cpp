@@ -121,4 +121,33 @@ nlohmann::json to_json(const SurfaceQuiltResult& r, const EmbedSurfaceQuiltResul
   return j;
 }
 
+nlohmann::json to_json(const QuiltSwatchOnPlaneResult& r) {
+  nlohmann::json j = to_json(r.quilt);
+  j["plane"] = {r.width, r.height};
+  j["swatch_faces"] = r.swatch.mesh.tris.size();
+  j["swatch_elements"] = r.swatch.elements.size();
+  j["element_length_mean"] = r.element_length_mean;
+  j["element_length_max"] = r.element_length_max;
+  return j;
+}
+
+nlohmann::json to_json(const QuiltSwatchOnSurfaceResult& r) {
+  nlohmann::json j = to_json(r.quilt, r.embedding);
+  j["base_faces"] = r.base_faces;
+  j["swatch_faces"] = r.swatch.mesh.tris.size();
+  j["swatch_elements"] = r.swatch.elements.size();
+  j["swatch_up"] = axis_name(r.swatch.up_axis);
+  j["up"] = r.up;
+  j["scale"] = r.relative_size;
+  j["field"] = r.field == SurfaceQuiltOptions::Field::kUp ? "up" : "none";
+  j["faces"] = r.faces;
+  j["vertices"] = r.vertices;
+  j["max_turn_deg"] = r.rotation_max_deg;
+  return j;
+}
+
+nlohmann::json to_json(const EditElementsResult& r) {
+  return {{"elements", r.elements}, {"faces_removed", r.faces_removed}};
+}
+
 }  // namespace surftex

@@ -6,8 +6,10 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "shell/quilting/edit_elements.h"
 #include "shell/quilting/embed_surface_quilt.h"
 #include "shell/quilting/mesh_quilting.h"
+#include "shell/quilting/quilt_driver.h"
 #include "shell/quilting/quilt_step.h"
 #include "shell/quilting/surface_quilting.h"
 
@@ -27,5 +29,17 @@ nlohmann::json to_json(const QuiltResult& result);
 /// counts, element quality, stretch, what lies outside the shell, the exact
 /// self-intersection counts (null when not checked) and "seconds" per stage.
 nlohmann::json to_json(const SurfaceQuiltResult& quilt, const EmbedSurfaceQuiltResult& embedding);
+
+/// quilt_swatch_on_plane: the planar quilt's figures, "plane" [W, H],
+/// swatch_faces, swatch_elements, element_length_mean / _max.
+nlohmann::json to_json(const QuiltSwatchOnPlaneResult& result);
+
+/// quilt_swatch_on_surface: the surface quilt's and embedding's figures,
+/// base_faces, swatch_faces, swatch_elements, swatch_up, up, scale, field,
+/// faces, vertices, max_turn_deg.
+nlohmann::json to_json(const QuiltSwatchOnSurfaceResult& result);
+
+/// edit_elements: elements, faces_removed.
+nlohmann::json to_json(const EditElementsResult& result);
 
 }  // namespace surftex

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "shell/quilting/quilt_driver.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/timer.h"
+#include "shell/element_colors.h"
+#include "shell/swatch_generators.h"
+
+namespace surftex {
+
+bool is_generated_swatch(const std::string& s) {
+  return s == "chainmail" || s == "weave" || s == "scatter" || s == "tori";
+}
+
+Mesh load_or_generate_swatch(const std::string& name, std::uint64_t seed) {
+  Mesh sm;
+  if (name == "chainmail") {
+    ChainmailOptions o;
+    o.seed = seed;
+    make_chainmail_swatch(sm, o);
+  } else if (name == "weave") {
+    WeaveOptions o;
+    o.seed = seed;
+    make_weave_swatch(sm, o);
+  } else if (name == "scatter") {
+    ScatterOptions o;
+    o.seed = seed;
+    make_scatter_swatch(sm, o);
+  } else if (name == "tori") {
+    ToriOptions o;
+    o.seed = seed;
+    make_tori_swatch(sm, o);
+  } else {
+    read_mesh(name, sm);
+  }
+  return sm;
+}
+
+void check_quilt_size(const Swatch& s, double cell, double placements, const std::string& what) {
+  const double faces = placements * static_cast<double>(s.mesh.tris.size());
+  if (!(faces <= kMaxQuiltFaces))
+    throw InvalidInputError("quilt: " + what + " needs about " + std::to_string(static_cast<long long>(std::min(placements, 9e18))) +
+                            " copies of the " + std::to_string(s.mesh.tris.size()) +
+                            "-face swatch, more than the " + std::to_string(static_cast<long long>(kMaxQuiltFaces)) +
+                            " output faces this tool will build (use a smaller area or a larger --scale)");
+  const double across = std::max(s.length(), s.width()) / cell;
+  if (cell > 0 && !(across <= kMaxSwatchCells))
+    throw InvalidInputError("quilt: --cell " + std::to_string(cell) + " cuts the swatch into " +
+                            std::to_string(static_cast<long long>(std::min(across, 9e18))) + " cells across, more than " +
+                            std::to_string(static_cast<int>(kMaxSwatchCells)) + " (0 = automatic, a tenth of the swatch)");
+}
+
+std::pair<double, double> element_lengths(const Mesh& m, double unit) {
+  const auto el = find(m, kFaceElement);
+  if (!el.second || !(unit > 0)) return {0, 0};
+  std::map<int, std::array<double, 4>> box;  // id -> xmin, xmax, ymin, ymax
+  for (FaceIndex f : m.faces())
+    for (VertexIndex v : m.vertices_around_face(m.halfedge(f))) {
+      const Point3& p = m.point(v);
+      auto it = box.try_emplace(el.first[f], std::array<double, 4>{p.x(), p.x(), p.y(), p.y()}).first;
+      auto& b = it->second;
+      b = {std::min(b[0], p.x()), std::max(b[1], p.x()), std::min(b[2], p.y()), std::max(b[3], p.y())};
+    }
+  double sum = 0, mx = 0;
+  for (const auto& [id, b] : box) {
+    const double l = std::max(b[1] - b[0], b[3] - b[2]) / unit;
+    sum += l;
+    mx = std::max(mx, l);
+  }
+  return {box.empty() ? 0 : sum / static_cast<double>(box.size()), mx};
+}
+
+QuiltSwatchOnPlaneResult quilt_swatch_on_plane(const Mesh& swatch_mesh, double w, double h, Mesh& out,
+                                               const QuiltSwatchOnPlaneOptions& opt) {
+  Mesh sm = swatch_mesh;
+  const double sc = opt.scale;
+  for (VertexIndex v : sm.vertices()) {
+    const Point3 p = sm.point(v);
+    sm.point(v) = Point3(p.x() * sc, p.y() * sc, p.z() * sc);
+  }
+  QuiltSwatchOnPlaneResult r;
+  r.swatch = make_swatch(sm, opt.swatch_up);
+  const Swatch& s = r.swatch;
+  check_quilt_size(s, opt.quilt.cell_size, w * h, "--plane " + opt.plane_name);
+  if (opt.check_work) opt.check_work(estimate_quilt(0, w * h * static_cast<double>(s.mesh.tris.size())));
+  PlanarQuiltOptions o = opt.quilt;
+  o.seed = opt.seed;
+  r.quilt = quilt_plane(s, w * s.length(), h * s.width(), out, o);
+  if (out.number_of_faces() == 0)
+    throw InvalidInputError("quilt: no element was placed on the " + opt.plane_name + " plane");
+  color_by_element(out, opt.seed);
+  r.width = w;
+  r.height = h;
+  std::tie(r.element_length_mean, r.element_length_max) = element_lengths(out, std::max(s.length(), s.width()));
+  return r;
+}
+
+namespace {
+
+// The swatch's size on the base, checked before the work: relative size at
+// most 10, the output's faces and the grid (check_quilt_size), the budget.
+void check_surface_quilt_size(const Mesh& base, const Swatch& s, const QuiltSwatchOnSurfaceOptions& opt) {
+  const double rel = opt.quilt.relative_size;
+  if (!(rel <= 10))
+    throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(rel) + ")");
+  const double placements = surface_quilt_placements(base, s, rel);
+  check_quilt_size(s, opt.quilt.cell_size, placements, "--scale " + std::to_string(rel));
+  if (opt.check_work)
+    opt.check_work(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())));
+}
+
+}  // namespace
+
+QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh& swatch_mesh, Mesh& out,
+                                                   const QuiltSwatchOnSurfaceOptions& opt) {
+  QuiltSwatchOnSurfaceResult r;
+  r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
+  check_surface_quilt_size(base, r.swatch, opt);
+  SurfaceQuiltOptions qo = opt.quilt;
+  qo.seed = opt.seed;
+  Timer t;
+  r.quilt = quilt_surface(base, r.swatch, r.local, qo);
+  r.seconds_quilt = t.seconds();
+  if (r.local.elements == 0 || r.local.tris.empty())
+    throw InvalidInputError("quilt: no element was placed on '" + opt.mesh_name + "' at --scale " +
+                            std::to_string(qo.relative_size) +
+                            " (the swatch may be too large for the mesh: lower --scale)");
+  EmbedSurfaceQuiltOptions eo = opt.embed;
+  eo.stretch.seed = opt.seed;
+  t.reset();
+  r.embedding = embed_surface_quilt(base, r.local, out, eo);
+  r.seconds_embed = t.seconds();
+  color_by_element(out, opt.seed);
+  r.base_faces = base.number_of_faces();
+  r.faces = out.number_of_faces();
+  r.vertices = out.number_of_vertices();
+  r.field = qo.field;
+  r.up = qo.up;
+  r.relative_size = qo.relative_size;
+  r.rotation_max_deg = qo.rotation_max_deg;
+  return r;
+}
+
+void surface_quilt_scene(const Mesh& base, const Mesh& quilt, Mesh& scene) {
+  scene = base;
+  get_or_add(scene, kVertexColor, Color3f{0.72f, 0.72f, 0.75f});
+  scene.join(quilt);
+}
+
+}  // namespace surftex

@@ -1,0 +1,229 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The mesh-quilting drivers (shell/quilting/quilt_driver.h) that the quilt
+// command, the demo and bench_quilt call: size checks, element lengths, the
+// plane and surface drivers and their reports.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
+#include "geometry/properties.h"
+#include "shell/element_colors.h"
+#include "shell/quilting/quilt_driver.h"
+#include "shell/quilting/quilt_json.h"
+#include "shell/swatch_generators.h"
+
+namespace surftex {
+namespace {
+
+// The small 3x3-ring chain mail of the shell tests, as a mesh.
+Mesh small_chainmail_mesh(std::uint64_t seed = 1) {
+  ChainmailOptions o;
+  o.rings_x = o.rings_y = 3;
+  o.segments = 12;
+  o.sides = 6;
+  o.seed = seed;
+  Mesh m;
+  make_chainmail_swatch(m, o);
+  return m;
+}
+
+void add_triangle(Mesh& m, Point3 a, Point3 b, Point3 c) {
+  m.add_face(m.add_vertex(a), m.add_vertex(b), m.add_vertex(c));
+}
+
+// The message of the InvalidInputError `f` throws ("" if none).
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InvalidInputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(QuiltDriver, ElementLengthsAreEachElementsLargerXySideOverTheUnit) {
+  Mesh m;
+  add_triangle(m, Point3(0, 0, 0), Point3(2, 0, 5), Point3(0, 1, 0));  // element 0: 2 x 1 (z ignored)
+  add_triangle(m, Point3(5, 0, 0), Point3(6, 0, 0), Point3(5, 4, 0));  // element 1: 1 x 4
+  add_triangle(m, Point3(5, 0, 1), Point3(5, 1, 1), Point3(5.5, 1, 1));  // element 1 too: its box grows to 1 x 4 still
+  EXPECT_EQ(element_lengths(m, 2.0), std::make_pair(0.0, 0.0));  // no kFaceElement
+  auto el = get_or_add(m, kFaceElement, 0);
+  el[FaceIndex(1)] = el[FaceIndex(2)] = 1;
+  const auto [mean, max] = element_lengths(m, 2.0);
+  EXPECT_DOUBLE_EQ(mean, (1.0 + 2.0) / 2);
+  EXPECT_DOUBLE_EQ(max, 2.0);
+  EXPECT_EQ(element_lengths(m, 0.0), std::make_pair(0.0, 0.0));
+}
+
+TEST(QuiltDriver, SizeCheckRefusesTooManyFacesNamingTheRunAndTooFineCellsNamingCell) {
+  Mesh sm;
+  make_grid(sm, 2, 2, 1.0, 1.0);  // 8 faces, 1 x 1
+  const Swatch s = make_swatch(sm);
+  EXPECT_EQ(error_of([&] { check_quilt_size(s, 0, 1000, "--plane 30x30"); }), "");
+  EXPECT_EQ(error_of([&] { check_quilt_size(s, 0.0078125, 1000, "--plane 30x30"); }), "");  // 128 cells across
+  const std::string faces = error_of([&] { check_quilt_size(s, 0, 1e7, "--plane 4000x2500"); });
+  EXPECT_TRUE(has(faces, "--plane 4000x2500 needs about 10000000 copies of the 8-face swatch")) << faces;
+  const std::string cells = error_of([&] { check_quilt_size(s, 0.0009765625, 1, "--scale 0.25"); });
+  EXPECT_TRUE(has(cells, "--cell 0.000977 cuts the swatch into 1024 cells across, more than 200")) << cells;
+}
+
+TEST(QuiltDriver, PlaneDriverScalesTheSwatchQuiltsColoursAndReports) {
+  const Mesh sm = small_chainmail_mesh();
+  QuiltSwatchOnPlaneOptions o;
+  o.scale = 2;
+  o.plane_name = "2x1.5";
+  int checked = 0;
+  o.check_work = [&](const WorkEstimate& e) {
+    ++checked;
+    EXPECT_GT(e.bytes, 0);
+  };
+  Mesh out;
+  const QuiltSwatchOnPlaneResult r = quilt_swatch_on_plane(sm, 2, 1.5, out, o);
+  EXPECT_EQ(checked, 1);
+  EXPECT_NEAR(r.swatch.length(), 2 * make_swatch(sm).length(), 1e-12);
+  EXPECT_GT(r.quilt.elements, 0);
+  EXPECT_EQ(r.quilt.faces, out.number_of_faces());
+  ASSERT_TRUE(find(out, kVertexColor).second);
+  EXPECT_TRUE(find(out, kFaceElement).second);
+  const auto [mean, max] = element_lengths(out, std::max(r.swatch.length(), r.swatch.width()));
+  EXPECT_DOUBLE_EQ(r.element_length_mean, mean);
+  EXPECT_DOUBLE_EQ(r.element_length_max, max);
+  EXPECT_GT(mean, 0);
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j["plane"], nlohmann::json({2.0, 1.5}));
+  EXPECT_EQ(j["elements"], r.quilt.elements);
+  EXPECT_EQ(j["swatch_faces"], r.swatch.mesh.tris.size());
+  EXPECT_EQ(j["swatch_elements"], r.swatch.elements.size());
+  EXPECT_DOUBLE_EQ(j["element_length_max"].get<double>(), max);
+  for (const char* key : {"element_length_mean", "stitched", "faces", "vertices", "steps", "seconds"})
+    EXPECT_TRUE(j.contains(key)) << key;
+
+  // The same as quilt_plane on the scaled swatch, coloured with the seed.
+  Mesh scaled = sm, by_hand;
+  for (VertexIndex v : scaled.vertices()) scaled.point(v) = Point3(CGAL::ORIGIN + 2 * (scaled.point(v) - CGAL::ORIGIN));
+  const Swatch s = make_swatch(scaled, SwatchAxis::kAuto);
+  quilt_plane(s, 2 * s.length(), 1.5 * s.width(), by_hand);
+  ASSERT_EQ(by_hand.number_of_vertices(), out.number_of_vertices());
+  for (VertexIndex v : out.vertices()) EXPECT_EQ(out.point(v), by_hand.point(v));
+  color_by_element(by_hand, 1);
+  EXPECT_EQ(find(by_hand, kVertexColor).first[VertexIndex(0)], find(out, kVertexColor).first[VertexIndex(0)]);
+}
+
+TEST(QuiltDriver, PlaneDriverRefusesBeforeQuiltingWithTheRunsName) {
+  const Mesh sm = small_chainmail_mesh();
+  Mesh out;
+  QuiltSwatchOnPlaneOptions o;
+  o.plane_name = "9000x9000";
+  std::string e = error_of([&] { quilt_swatch_on_plane(sm, 9000, 9000, out, o); });
+  EXPECT_TRUE(has(e, "quilt: --plane 9000x9000 needs about 81000000 copies")) << e;
+  // A cell so coarse that the swatch covers under 3 cells: named by its axes and --cell.
+  o.plane_name = "1x1";
+  o.quilt.cell_size = 0.6 * make_swatch(sm).length();
+  e = error_of([&] { quilt_swatch_on_plane(sm, 1, 1, out, o); });
+  EXPECT_TRUE(has(e, "along its x and y axes")) << e;
+  EXPECT_TRUE(has(e, "--cell")) << e;
+  // The work check runs before the quilt.
+  o.quilt.cell_size = 0;
+  o.check_work = [](const WorkEstimate&) { throw InvalidInputError("over budget"); };
+  EXPECT_EQ(error_of([&] { quilt_swatch_on_plane(sm, 1, 1, out, o); }), "over budget");
+  EXPECT_EQ(out.number_of_faces(), 0u);
+}
+
+TEST(QuiltDriver, SurfaceDriverIsTheQuiltThenTheEmbeddingColouredAndReportsItsOptions) {
+  Mesh base;
+  make_icosphere(base, 1);
+  Mesh sm;  // irregular blobs: the seed changes the quilt
+  ScatterOptions so;
+  so.size = 6;
+  so.subdivisions = 1;
+  make_scatter_swatch(sm, so);
+  QuiltSwatchOnSurfaceOptions o;
+  o.quilt.relative_size = 0.5;
+  o.quilt.field = SurfaceQuiltOptions::Field::kNone;
+  o.quilt.rotation_max_deg = 10;
+  o.quilt.up = {0, 0, 2};
+  o.embed.stretch.iterations = 2;
+  o.embed.check_self_intersections = false;
+  o.seed = 7;
+  Mesh out;
+  const QuiltSwatchOnSurfaceResult r = quilt_swatch_on_surface(base, sm, out, o);
+  EXPECT_GT(r.quilt.elements, 0);
+  EXPECT_EQ(r.local.elements, r.quilt.elements);
+  EXPECT_EQ(r.faces, out.number_of_faces());
+  EXPECT_EQ(r.base_faces, base.number_of_faces());
+  ASSERT_TRUE(find(out, kVertexColor).second);
+
+  // By hand, with the seed in every stage.
+  const Swatch s = make_swatch(sm, SwatchAxis::kAuto);
+  SurfaceQuiltOptions qo = o.quilt;
+  qo.seed = 7;
+  SurfaceQuilt q;
+  quilt_surface(base, s, q, qo);
+  EmbedSurfaceQuiltOptions eo = o.embed;
+  eo.stretch.seed = 7;
+  Mesh by_hand;
+  embed_surface_quilt(base, q, by_hand, eo);
+  ASSERT_EQ(by_hand.number_of_vertices(), out.number_of_vertices());
+  for (VertexIndex v : out.vertices()) EXPECT_EQ(out.point(v), by_hand.point(v));
+
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j["field"], "none");
+  EXPECT_EQ(j["up"], nlohmann::json({0.0, 0.0, 2.0}));
+  EXPECT_DOUBLE_EQ(j["scale"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["max_turn_deg"].get<double>(), 10.0);
+  EXPECT_EQ(j["swatch_up"], axis_name(s.up_axis));
+  EXPECT_EQ(j["faces"], out.number_of_faces());
+  EXPECT_EQ(j["base_faces"], base.number_of_faces());
+  EXPECT_TRUE(j["self_intersections"].is_null());  // not checked
+  for (const char* key : {"vertices", "swatch_faces", "swatch_elements", "stretch_after", "stitched", "seconds"})
+    EXPECT_TRUE(j.contains(key)) << key;
+
+  Mesh scene;
+  surface_quilt_scene(base, out, scene);
+  EXPECT_EQ(scene.number_of_faces(), base.number_of_faces() + out.number_of_faces());
+  EXPECT_EQ(find(scene, kVertexColor).first[VertexIndex(0)], (Color3f{0.72f, 0.72f, 0.75f}));
+}
+
+TEST(QuiltDriver, SurfaceDriverRefusesAScaleAbove10AndOversizedRunsBeforeQuilting) {
+  Mesh base;
+  make_icosphere(base, 1);
+  const Mesh sm = small_chainmail_mesh();
+  Mesh out;
+  QuiltSwatchOnSurfaceOptions o;
+  o.quilt.relative_size = 12;
+  EXPECT_EQ(error_of([&] { quilt_swatch_on_surface(base, sm, out, o); }),
+            "quilt: --scale must be <= 10 on a mesh (got 12.000000)");
+  o.quilt.relative_size = 0.001;  // millions of copies
+  std::string e = error_of([&] { quilt_swatch_on_surface(base, sm, out, o); });
+  EXPECT_TRUE(has(e, "quilt: --scale 0.001000 needs about")) << e;
+  o.quilt.relative_size = 0.45;
+  o.check_work = [](const WorkEstimate& w) { throw InvalidInputError("budget " + w.what); };
+  e = error_of([&] { quilt_swatch_on_surface(base, sm, out, o); });
+  EXPECT_TRUE(has(e, "budget ")) << e;
+  EXPECT_EQ(out.number_of_faces(), 0u);
+}
+
+TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
+  EXPECT_TRUE(is_generated_swatch("weave"));
+  EXPECT_TRUE(is_generated_swatch("tori"));
+  EXPECT_FALSE(is_generated_swatch("weave.obj"));
+  Mesh expected;
+  ScatterOptions so;
+  so.seed = 5;
+  make_scatter_swatch(expected, so);
+  const Mesh m = load_or_generate_swatch("scatter", 5);
+  ASSERT_EQ(m.number_of_vertices(), expected.number_of_vertices());
+  for (VertexIndex v : m.vertices()) EXPECT_EQ(m.point(v), expected.point(v));
+  EXPECT_THROW(load_or_generate_swatch("/nonexistent/swatch.obj", 1), Error);
+}
+
+}  // namespace
+}  // namespace surftex
