@@ -60,7 +60,7 @@ struct SubdivisionSynthesisOptions {
   std::size_t max_vertices = 150000;
   double adaptive_factor = 1.5; ///< f of 3.2.2 (the paper's choice); 0 = no adaptive subdivision
   int adaptive_steps = 4;       ///< adaptive steps when adaptive_factor > 0, 0..32
-  int passes = 1;               ///< passes per level, 1..16 (2: brick_small_96 flat square 1.77 vs 1.81, 1.8x the time)
+  int passes = 1;               ///< passes per level, 1..16 (default 1; docs/decisions/204)
   ExemplarWrap wrap = ExemplarWrap::Auto;
   /// Auto wrap: the exemplar counts as periodic when its wrap-seam ratio
   /// (texture/wrap_seam_ratio.h: jump across its wrap / jump inside) is at
