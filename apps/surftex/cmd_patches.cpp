@@ -40,6 +40,7 @@ struct PatchArgs {
   int patch_res = 128, max_faces = 200, window = 11, preselect = 0, rotations = 64,
       exemplar_size = 0;
   double max_angle = 30.0, bump = 2.0;
+  bool patch_res_given = false;  ///< --patch-res on the command line: refused, not lowered, when the atlas cannot hold it
   CommonOptions common;
 };
 
@@ -179,6 +180,7 @@ int run(const PatchArgs& a) {
   po.partition.max_faces = a.max_faces;
   po.flatten.resolution = a.patch_res;
   po.flatten.margin = std::max(2, a.patch_res / 32);
+  po.fit_resolution = !a.patch_res_given;
   po.order = a.order == "curvature" ? PatchOrder::Curvature : PatchOrder::Random;
   po.el.window = a.window;
   po.el.preselect = a.preselect;
@@ -191,6 +193,10 @@ int run(const PatchArgs& a) {
                                 a.patch_res, a.max_faces, a.window, a.rotations),
                a.common);
   nlohmann::json rep = run_pipeline(mesh, ex, to, a.outdir, maps);
+  if (rep.contains("patch_resolution_requested") && !a.common.quiet)
+    std::fprintf(stderr, "note: %d patches at %d texels a side do not fit one %d px atlas: %d texels a side used "
+                         "(--patch-res to choose; --max-patch-faces for fewer, larger patches)\n",
+                 rep["patches"].get<int>(), a.patch_res, po.atlas.max_size, rep["patch_resolution"].get<int>());
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
@@ -232,8 +238,11 @@ SubcommandRegistrar reg{
                       "normal curvature), kmax-abs|kmin-abs (greatest/least absolute curvature), "
                       "none (isotropic) (default up)")
            ->check(CLI::IsMember({"up", "kmax", "kmin", "kmax-abs", "kmin-abs", "none"}));
-       app.add_option("--patch-res", a->patch_res, "Texels per patch side, 16..1024 (default 128)")
-           ->check(CLI::Range(16, 1024));
+       app.add_option("--patch-res", a->patch_res,
+                      "Texels per patch side, 16..1024 (default 128, lowered by eighths when the patches would "
+                      "not fit one 4096 px atlas; given: refused then, before any synthesis)")
+           ->check(CLI::Range(16, 1024))
+           ->each([a](const std::string&) { a->patch_res_given = true; });
        app.add_option("--max-angle", a->max_angle,
                       "Largest angle between a triangle normal and its patch's reference normal, "
                       "degrees, 1..89 (default 30)")

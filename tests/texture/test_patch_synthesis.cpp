@@ -34,6 +34,40 @@ PatchSynthesisOptions small_options(int res) {
   return o;
 }
 
+// More patches than one atlas holds (fandisk at 116K faces made 1,955 patches
+// of 128 texels, which failed in the atlas packer after the whole synthesis):
+// the resolution is lowered before synthesis, or refused up front when given.
+TEST(PatchSynthesis, ResolutionIsLoweredBeforeSynthesisWhenOneAtlasCannotHoldThePatches) {
+  Mesh m;
+  make_icosphere(m, 3);
+  const Image ex = make_noise(32, 4, 7);
+  PatchSynthesisOptions o = small_options(64);
+  o.field = PatchField::None;
+  o.atlas.max_size = 256;
+  PatchSynthesisResult r = synthesize_patches(m, {ex}, o);
+  EXPECT_LT(r.resolution, 64);
+  EXPECT_GE(r.resolution, 16);
+  EXPECT_EQ(r.flat.patches[0].res, r.resolution);
+  EXPECT_GT(r.flat.patches.size(), 16u);
+  const PatchAtlas at = pack_patch_atlas(m, r.flat, r.images, o.atlas);  // throws if it did not fit
+  EXPECT_LE(at.image.width, 256);
+  o.fit_resolution = false;
+  Mesh m2;
+  make_icosphere(m2, 3);
+  try {
+    synthesize_patches(m2, {ex}, o);
+    ADD_FAILURE() << "a given resolution that does not fit must be refused";
+  } catch (const InvalidInputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--patch-res"), std::string::npos) << e.what();
+  }
+  // When one atlas holds them, the resolution is the one asked for.
+  o.atlas.max_size = 4096;
+  o.flatten.resolution = 24;
+  Mesh m3;
+  make_icosphere(m3, 3);
+  EXPECT_EQ(synthesize_patches(m3, {ex}, o).resolution, 24);
+}
+
 TEST(PatchSynthesis, SeamRatioOnSphereWithNoiseIsLow) {
   Mesh m;
   make_icosphere(m, 3);

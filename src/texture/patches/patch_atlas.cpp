@@ -50,9 +50,10 @@ bool shelf_pack(const std::vector<Box>& box, const std::vector<int>& order, int 
 }
 
 // The smallest side (a power of two unless !power_of_two) whose gutter lets
-// the boxes fit; at max_size the largest power-of-two gutter that fits.
-int atlas_layout(const std::vector<Box>& box, const std::vector<int>& order, const PatchAtlasOptions& opt,
-                 int& gutter, std::vector<std::array<int, 2>>& at) {
+// the boxes fit; at max_size the largest power-of-two gutter that fits; 0
+// when nothing fits.
+int try_atlas_layout(const std::vector<Box>& box, const std::vector<int>& order, const PatchAtlasOptions& opt,
+                     int& gutter, std::vector<std::array<int, 2>>& at) {
   for (int s = 64; s <= opt.max_size; s = opt.power_of_two ? 2 * s : s + std::max(1, s / 16)) {
     gutter = atlas_gutter_texels(s, opt.min_mip_size);
     if (shelf_pack(box, order, s, gutter, at)) return s;
@@ -64,8 +65,27 @@ int atlas_layout(const std::vector<Box>& box, const std::vector<int>& order, con
   }() : opt.max_size;
   for (gutter = atlas_gutter_texels(s, opt.min_mip_size); gutter >= 1; gutter /= 2)
     if (shelf_pack(box, order, s, gutter, at)) return s;
-  throw InvalidInputError("pack_patch_atlas: " + std::to_string(box.size()) + " patches do not fit in max_size " +
-                          std::to_string(opt.max_size) + " (fewer, larger patches or a smaller patch resolution)");
+  return 0;
+}
+
+int atlas_layout(const std::vector<Box>& box, const std::vector<int>& order, const PatchAtlasOptions& opt,
+                 int& gutter, std::vector<std::array<int, 2>>& at) {
+  const int s = try_atlas_layout(box, order, opt, gutter, at);
+  if (s == 0)
+    throw InvalidInputError("pack_patch_atlas: " + std::to_string(box.size()) + " patches do not fit in max_size " +
+                            std::to_string(opt.max_size) + " (fewer, larger patches or a smaller patch resolution)");
+  return s;
+}
+
+// The chart boxes, tallest first (the packing order).
+std::vector<int> packing_order(const FlattenResult& flat, std::vector<Box>& box) {
+  const int P = static_cast<int>(flat.patches.size());
+  box.resize(static_cast<std::size_t>(P));
+  for (int p = 0; p < P; ++p) box[p] = chart_box(flat.patches[p]);
+  std::vector<int> order(P);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return box[a].h() > box[b].h(); });
+  return order;
 }
 
 }  // namespace
@@ -85,11 +105,8 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
         flat.patches[p].res != R)
       throw InvalidInputError("pack_patch_atlas: patch " + std::to_string(p) +
                               " image does not match the raster size " + std::to_string(R));
-  std::vector<Box> box(P);
-  for (int p = 0; p < P; ++p) box[p] = chart_box(flat.patches[p]);
-  std::vector<int> order(P);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return box[a].h() > box[b].h(); });
+  std::vector<Box> box;
+  const std::vector<int> order = packing_order(flat, box);
   std::vector<std::array<int, 2>> corner(P);
   PatchAtlas at;
   const int W = atlas_layout(box, order, opt, at.gutter, corner), H = W;
@@ -130,6 +147,15 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
     }
   }
   return at;
+}
+
+bool patch_rasters_fit(const FlattenResult& flat, const PatchAtlasOptions& opt) {
+  if (flat.patches.empty()) return true;
+  std::vector<Box> box;
+  const std::vector<int> order = packing_order(flat, box);
+  std::vector<std::array<int, 2>> at(box.size());
+  int gutter = 0;
+  return try_atlas_layout(box, order, opt, gutter, at) > 0;
 }
 
 }  // namespace surftex

@@ -42,4 +42,8 @@ struct PatchAtlas {
 PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::vector<Image>& images,
                             const PatchAtlasOptions& options = {});
 
+/// Whether pack_patch_atlas would fit the rasters of `flat` (it throws when
+/// not); cheap: the chart boxes and the packing only, no image.
+bool patch_rasters_fit(const FlattenResult& flat, const PatchAtlasOptions& options = {});
+
 }  // namespace surftex

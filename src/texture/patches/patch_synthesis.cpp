@@ -384,7 +384,7 @@ class PatchSynthesizer {
         patches_(res.flat.patches),
         vnormal_(find(mesh, kVertexNormal).first),
         C_(exemplars[0].channels),
-        R_(opt.flatten.resolution),
+        R_(res.resolution),
         E_(static_cast<int>(exemplars.size())),
         light_(normalized_or(vec(opt.light), Vector3(0, 0, 1))),
         // Exemplar rotations prepared once for every patch (not once per patch).
@@ -609,6 +609,29 @@ void fill_boundary_pixels(PatchSynthesisResult& res, const PatchFaces& pf, int R
 
 }  // namespace
 
+namespace {
+// Step 3 with the atlas check (see PatchSynthesisOptions::atlas): the rasters
+// at flatten.resolution, or lowered by eighths until one atlas holds them.
+FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& seeds, const PatchSynthesisOptions& opt,
+                                   int& resolution) {
+  FlattenOptions fo = opt.flatten;
+  for (;;) {
+    FlattenResult flat = flatten_patches(mesh, seeds, fo);
+    if (!opt.check_atlas || patch_rasters_fit(flat, opt.atlas)) {
+      resolution = fo.resolution;
+      return flat;
+    }
+    const int lower = std::max(16, fo.resolution * 7 / 8);
+    if (!opt.fit_resolution || lower == fo.resolution || fo.margin > lower / 4)
+      throw InvalidInputError("synthesize_patches: " + std::to_string(flat.patches.size()) + " patches of " +
+                              std::to_string(fo.resolution) + " texels a side do not fit one " +
+                              std::to_string(opt.atlas.max_size) + " px atlas: lower --patch-res or raise "
+                              "--max-patch-faces (fewer, larger patches)");
+    fo.resolution = lower;
+  }
+}
+}  // namespace
+
 PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& exemplars,
                                         const PatchSynthesisOptions& opt) {
   validate(mesh, exemplars, opt);
@@ -634,7 +657,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   // 3. Flatten and rasterise (3.2).
   t.reset();
   report_progress(opt.progress, "flatten", 0.0);
-  res.flat = flatten_patches(mesh, seeds, opt.flatten);
+  res.flat = flatten_to_fit_atlas(mesh, seeds, opt, res.resolution);
   res.seconds_flatten = t.seconds();
   const PatchFaces faces = index_patch_faces(res.flat.patches, mesh.num_faces());
   for (int id : opt.resynthesize)
@@ -656,7 +679,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   resynthesize(synth, P, opt.resynthesize);
   synth.add_counts();
   res.seconds_synthesis = t.seconds();
-  fill_boundary_pixels(res, faces, opt.flatten.resolution, exemplars[0].channels);
+  fill_boundary_pixels(res, faces, res.resolution, exemplars[0].channels);
   res.seconds_total = total.seconds();
   return res;
 }

@@ -32,6 +32,7 @@
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
 #include "texture/patches/partition_near_planar.h"
+#include "texture/patches/patch_atlas.h"
 #include "geometry/progress.h"
 #include "texture/efros_leung.h"
 
@@ -59,6 +60,13 @@ struct PatchSynthesisOptions {
   std::vector<double> vertex_scalar;                 ///< VertexScalar: one per vertex index
   /// Patch ids to re-synthesise after the main pass (each 0..patches-1).
   std::vector<int> resynthesize;
+  /// The rasters must pack into one atlas of these options (pack_patch_atlas)
+  /// before any synthesis: when they do not, fit_resolution lowers
+  /// flatten.resolution by eighths (down to 16) until they do; otherwise, or
+  /// below 16, InvalidInputError. check_atlas = false skips the check.
+  PatchAtlasOptions atlas;
+  bool check_atlas = true;
+  bool fit_resolution = true;
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< stages "partition", "field", "flatten", "synthesis"
 };
@@ -73,6 +81,7 @@ struct PatchSynthesisResult {
   std::vector<std::vector<ElSource>> sources;
   std::vector<int> order;        ///< patch ids in synthesis order (main pass)
   int split_patches = 0;         ///< patches split because their projection overlapped
+  int resolution = 0;            ///< texels per patch side used (flatten.resolution unless lowered to fit the atlas)
   std::size_t texels = 0;        ///< pixels synthesised (main pass + resynthesis)
   std::size_t seeded = 0;        ///< of which seeded by random patches
   std::size_t known_boundary = 0;  ///< Known boundary pixels given to the synthesis

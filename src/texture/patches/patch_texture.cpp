@@ -21,7 +21,7 @@ void pack_atlases(Mesh& mesh, const std::vector<Image>& exemplars, const PatchEx
   const PatchSynthesisResult& s = r.synthesis;
   const std::array<int, 2> ex_size{exemplars[0].width, exemplars[0].height};
   auto map_atlas = [&](const Image& m, bool normal) {
-    return pack_patch_atlas(mesh, s.flat, resample_patch_map(s, m, ex_size, o.synthesis.el, normal)).image;
+    return pack_patch_atlas(mesh, s.flat, resample_patch_map(s, m, ex_size, o.synthesis.el, normal), o.synthesis.atlas).image;
   };
   if (o.pbr_maps) {
     if (!maps.height.empty()) {
@@ -32,7 +32,7 @@ void pack_atlases(Mesh& mesh, const std::vector<Image>& exemplars, const PatchEx
     if (!maps.roughness.empty())
       r.metallic_roughness = metallic_roughness_from_roughness(height_from_luminance(map_atlas(maps.roughness, false)));
   }
-  r.atlas = pack_patch_atlas(mesh, s.flat, s.images);
+  r.atlas = pack_patch_atlas(mesh, s.flat, s.images, o.synthesis.atlas);
   if (!o.pbr_maps) return;
   r.height_from_exemplar = !r.height.empty();
   r.normal_from_exemplar = !r.normal.empty();
@@ -47,9 +47,10 @@ PatchTextureResult synthesize_patch_texture(Mesh& mesh, const std::vector<Image>
   Timer total;
   PatchTextureResult r;
   r.bump = o.bump;
-  r.patch_resolution = o.synthesis.flatten.resolution;
+  r.requested_resolution = o.synthesis.flatten.resolution;
   const std::clock_t c0 = std::clock();
   r.synthesis = synthesize_patches(mesh, exemplars, o.synthesis);  // step 1
+  r.patch_resolution = r.synthesis.resolution;
   r.cpu_seconds_synthesis = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   Timer t;
   pack_atlases(mesh, exemplars, maps, o, r);  // steps 2-3
@@ -77,6 +78,8 @@ nlohmann::json to_json(const PatchTextureResult& t) {
   j["reassigned_faces"] = r.partition.reassigned_faces;
   j["max_normal_deviation_deg"] = r.partition.max_deviation_deg;
   j["patch_resolution"] = t.patch_resolution;
+  if (t.patch_resolution != t.requested_resolution)  // lowered to fit one atlas
+    j["patch_resolution_requested"] = t.requested_resolution;
   j["texel_size"] = r.flat.texel;
   j["dropped_boundary_triangles"] = r.flat.dropped_boundary;
   j["texels_synthesized"] = r.texels;

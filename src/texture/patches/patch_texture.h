@@ -51,7 +51,8 @@ struct PatchTextureResult {
   Image height, normal, metallic_roughness;  ///< empty without pbr_maps; metallic_roughness without a roughness map
   bool height_from_exemplar = false, normal_from_exemplar = false;
   double bump = 0;
-  int patch_resolution = 0;         ///< texels per patch side (the options')
+  int patch_resolution = 0;         ///< texels per patch side used
+  int requested_resolution = 0;     ///< the options' (larger when lowered to fit one atlas)
   SeamRatioResult seam;
   double seam_step_texels = 0;
   nlohmann::json fidelity;          ///< atlas_fidelity_report (null without `fidelity`)
