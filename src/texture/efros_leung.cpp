@@ -411,7 +411,7 @@ class Synthesizer {
   int search_key(int p) const { return key_[p]; }
   void gather_known(int p, const SearchImage& s);
   int pass1(const SearchImage& s, std::size_t n);
-  void pass1_short_list(const SearchImage& s, std::size_t n);
+  void pass1_short_list(const SearchImage& s, std::size_t n, int p);
   void select_smallest(const SearchImage& s, std::size_t n);
   void score_full(const SearchImage& s, const std::vector<int>& ids, std::vector<Scored>& out);
   void synthesize_pixel(int p);
@@ -454,7 +454,7 @@ class Synthesizer {
   std::vector<float> err_, sample_, p2_err_;
   std::vector<int> pre_;
   std::vector<Scored> scored_, collect_;
-  std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0;
+  std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0, widened_ = 0;
   std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
   std::vector<ElSource> source_;         // per pixel: where its value came from
   void record_source(int q, int p, int id, const SearchImage& s) {
@@ -687,32 +687,68 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // candidates gathered with the known neighbours and the kd-tree's nearest
 // first-pass neighbourhoods -- deduplicated and ranked exactly by the
 // first-pass SSD; the n best (by (error, position)) go to pre_.
-void Synthesizer::pass1_short_list(const SearchImage& s, std::size_t n) {
+//
+// Ties: when at least ann_candidates of the short list are within the
+// pick tolerance of its best (a flat or repeated region: many candidates
+// share the query's known pixels, often with identical PCA coefficients),
+// the kd-tree's hits are an arbitrary subset of a larger tie set -- the
+// same leaf for the same query, typically deep inside one region -- and
+// the synthesis can lock into it (issue 19: uniform blue from a stripes
+// exemplar). Such a pixel also ranks a jittered stratified sample of n
+// candidates over the whole exemplar (one in each run of N/n consecutive
+// candidates, drawn from a hash of the seed and the pixel, so the
+// synthesis's random stream is untouched), as the exhaustive pass would
+// see them. Pixels without such ties are unchanged.
+void Synthesizer::pass1_short_list(const SearchImage& s, std::size_t n, int p) {
   const int nk = static_cast<int>(p1_slot_.size());
   s.ann->query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
                static_cast<float>(opt_.ann_eps), short_, ann_scratch_);
   std::sort(short_.begin(), short_.end());
   short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
   pre_.clear();
-  pass1_candidates_ += short_.size();
-  if (short_.size() <= n) {
-    pre_ = short_;
-    return;
-  }
   const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
   const float* P = s.planes.data();
-  scored_.clear();
-  for (int id : short_) {
+  auto ssd = [&](int id) {
     float e = 0;
     for (int k = 0; k < nk; ++k)
       for (int c = 0; c < C; ++c) {
         const float d = P[c * ps + id + p1_delta_[k]] - p1_value_[k * C + c];
         e += d * d;
       }
-    scored_.push_back({e, id});
+    return e;
+  };
+  scored_.clear();
+  float best = std::numeric_limits<float>::infinity();
+  for (int id : short_) {
+    scored_.push_back({ssd(id), id});
+    best = std::min(best, scored_.back().first);
   }
-  std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
-  for (std::size_t i = 0; i < n; ++i) pre_.push_back(scored_[i].second);
+  const float tol = static_cast<float>(std::max(opt_.error_tolerance, 0.0));
+  const float tie = best * (1.f + tol) + 1e-6f * static_cast<float>(nk * C);
+  std::size_t ties = 0;
+  for (const auto& v : scored_) ties += v.first <= tie;
+  const std::size_t N = s.ids.size();
+  if (ties >= static_cast<std::size_t>(opt_.ann_candidates) && N > short_.size()) {
+    const std::size_t m = std::min(n, N);
+    const std::size_t step = N / m;
+    std::uint64_t h = opt_.seed ^ (0x9e3779b97f4a7c15ull * (static_cast<std::uint64_t>(p) + 1));
+    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+    h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+    h ^= h >> 31;
+    for (std::size_t j = 0; j < m; ++j) {
+      h = h * 6364136223846793005ull + 1442695040888963407ull;  // one draw per stratum
+      const int id = s.ids[j * step + static_cast<std::size_t>((h >> 33) % step)];
+      if (std::binary_search(short_.begin(), short_.end(), id)) continue;
+      scored_.push_back({ssd(id), id});
+    }
+    ++widened_;
+  }
+  pass1_candidates_ += scored_.size();
+  if (scored_.size() > n) {
+    std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
+    scored_.resize(n);
+  }
+  for (const auto& v : scored_) pre_.push_back(v.second);
 }
 
 // The n smallest (err_[i], ids[i]) into scored_ (in no particular order:
@@ -840,7 +876,7 @@ void Synthesizer::synthesize_pixel(int p) {
       n = opt_.preselect > 0 ? n : static_cast<std::size_t>(ex[in_.exemplar_index[p]].width);
     n = std::min(n, total);
     if (s.ann && !p1_slot_.empty())
-      pass1_short_list(s, n);
+      pass1_short_list(s, n, p);
     else
       pass1(s, n);
     score_full(s, pre_, scored_);
@@ -1006,6 +1042,7 @@ ElResult Synthesizer::run() {
     res.synthesized = synthesized_;
     res.seeded = seeded_;
     res.pass1_candidates = pass1_candidates_;
+    res.pass1_widened = widened_;
   }
   res.image = std::move(out_);
   res.source = std::move(source_);

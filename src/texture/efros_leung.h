@@ -35,7 +35,9 @@ enum class PixelState : std::uint8_t {
 enum class ElSearch {
   /// A short list independent of the exemplar size: the coherent candidates
   /// (Ashikhmin 2001) and the `ann_candidates` nearest by a kd-tree over PCA
-  /// coefficients (partial_neighbourhood_index.h), ranked exactly by pass 1.
+  /// coefficients (partial_neighbourhood_index.h), ranked exactly by pass 1;
+  /// widened by a sample of the whole exemplar when its best candidates tie
+  /// (flat regions; decision 501).
   Approximate,
   /// Every candidate position (Gorla's pass 1 as published; cost grows with
   /// the exemplar area). The reference.
@@ -148,6 +150,9 @@ struct ElResult {
   int rotations_used = 0;      ///< distinct (exemplar, orientation) pairs searched
   /// Candidates ranked by pass 1, summed over the pixels.
   std::size_t pass1_candidates = 0;
+  /// Approximate search: pixels whose short list was widened by a sample of
+  /// the whole exemplar (its best candidates tied; efros_leung.cpp).
+  std::size_t pass1_widened = 0;
   double seconds = 0.0;
 };
 

@@ -578,3 +578,31 @@ TEST(EfrosLeung, ApproximateSearchSameBytesForOneAndTwoThreadsAndPrepared) {
   other.ann_stride = 1;
   EXPECT_THROW(efros_leung_synthesize(prep, other), InvalidInputError);
 }
+
+// Issue 19: flat two-colour stripes (like stripes_blue_white_256). The known
+// part of most windows is one flat colour, so thousands of candidates tie
+// exactly (identical PCA coefficients); the kd-tree returned the same few,
+// deep inside one stripe, and the approximate search grew a single flat
+// colour. The tie safeguard (a sample of the whole exemplar for such pixels)
+// keeps both colours, like the exhaustive search.
+TEST(EfrosLeung, ApproximateSearchKeepsBothColoursOfFlatStripes) {
+  const int size = 128, half = 14;  // vertical stripes, 14 px blue, 14 px white
+  Image ex(size, size, 3);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const bool white = (x / half) % 2 == 1;
+      const float rgb[3] = {white ? 1.f : 0.05f, white ? 1.f : 0.6f, white ? 1.f : 0.93f};
+      for (int c = 0; c < 3; ++c) ex.at(x, y, c) = rgb[c];
+    }
+  ElOptions opt;  // the surftex synth defaults: window 11, preselect = exemplar width
+  for (std::uint64_t seed : {1u, 2u}) {
+    opt.seed = seed;
+    const Image out = efros_leung_synthesize(ex, 64, 64, opt);
+    std::size_t white = 0;
+    for (int y = 0; y < out.height; ++y)
+      for (int x = 0; x < out.width; ++x) white += out.at(x, y, 0) > 0.5f;
+    const double frac = static_cast<double>(white) / (out.width * out.height);
+    EXPECT_GT(frac, 0.2) << "seed " << seed;
+    EXPECT_LT(frac, 0.8) << "seed " << seed;
+  }
+}
