@@ -190,7 +190,7 @@ int run(const PatchArgs& a) {
   po.seed = a.common.seed;
   po.progress = terminal_progress(a.common.quiet);
   check_budget(estimate_patches(mesh.number_of_faces(), ex[0].width, ex[0].height, static_cast<int>(ex.size()),
-                                a.patch_res, a.max_faces, a.window, a.rotations),
+                                a.patch_res, a.max_faces, a.window, a.rotations, a.search == "exhaustive"),
                a.common);
   nlohmann::json rep = run_pipeline(mesh, ex, to, a.outdir, maps);
   if (rep.contains("patch_resolution_requested") && !a.common.quiet)

@@ -52,7 +52,7 @@ std::string check_work_budget(const WorkEstimate& e);
 
 // The estimates, one per subcommand. Sizes are counts (faces, pixels).
 WorkEstimate estimate_patches(std::size_t faces, int exemplar_width, int exemplar_height, int exemplars, int patch_res,
-                              int max_patch_faces, int window, int rotations);
+                              int max_patch_faces, int window, int rotations, bool exhaustive_search = false);
 WorkEstimate estimate_subdiv(std::size_t faces, int exemplar_width, int exemplar_height, int levels, int atlas);
 WorkEstimate estimate_material_map(std::size_t faces, std::size_t tile_bytes, int render_size, int atlas_size);
 WorkEstimate estimate_material_tile(int size, int layers, int keys, int key_width, int key_height);

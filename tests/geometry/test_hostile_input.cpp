@@ -358,3 +358,17 @@ TEST(WorkBudget, MaterialMapEstimateCoversTheBakedAtlas) {
   EXPECT_LT(big.bytes, 2.0 * 955.0 * MiB);  // not so far above that it refuses what fits
   EXPECT_NE(big.shrink.find("--atlas-size"), std::string::npos);
 }
+
+// The patches time estimate followed the exhaustive search (exemplar area x
+// window^2 per texel): "38.9 min" was printed for a 116K-face run of 90 CPU s
+// at the default approximate search, whose cost barely grows with the exemplar.
+TEST(WorkBudget, PatchesTimeEstimateFollowsTheSearchInUse) {
+  const auto approx64 = surftex::estimate_patches(116514, 64, 64, 1, 128, 200, 11, 64);
+  const auto approx512 = surftex::estimate_patches(116514, 512, 512, 1, 128, 200, 11, 64);
+  const auto exact512 = surftex::estimate_patches(116514, 512, 512, 1, 128, 200, 11, 64, true);
+  EXPECT_LT(approx512.seconds, 3.0 * approx64.seconds);
+  EXPECT_LT(approx512.seconds, 600.0);  // measured: 90 CPU s with a 256 px exemplar
+  EXPECT_GT(approx512.seconds, 60.0);
+  EXPECT_GT(exact512.seconds, 10.0 * approx512.seconds);
+  EXPECT_EQ(approx512.bytes, exact512.bytes);
+}
