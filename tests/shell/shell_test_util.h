@@ -28,8 +28,8 @@ inline void set_planar_uv(Mesh& m, double s, double off) {
   }
 }
 
-/// A small generated chain-mail swatch (3x3 rings) for fast tests.
-inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, int sides = 6) {
+/// A small generated chain mail (3x3 rings) as a mesh, for fast tests.
+inline Mesh small_chainmail_mesh(std::uint64_t seed = 1, int segments = 12, int sides = 6) {
   ChainmailOptions o;
   o.rings_x = o.rings_y = 3;
   o.segments = segments;
@@ -37,7 +37,12 @@ inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, 
   o.seed = seed;
   Mesh m;
   make_chainmail_swatch(m, o);
-  return make_swatch(m);
+  return m;
+}
+
+/// The same as a swatch.
+inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, int sides = 6) {
+  return make_swatch(small_chainmail_mesh(seed, segments, sides));
 }
 
 /// A small generated scatter swatch for fast tests.

@@ -17,20 +17,12 @@
 #include "shell/quilting/quilt_json.h"
 #include "shell/swatch_generators.h"
 
+#include "shell_test_util.h"
+
 namespace surftex {
 namespace {
 
-// The small 3x3-ring chain mail of the shell tests, as a mesh.
-Mesh small_chainmail_mesh(std::uint64_t seed = 1) {
-  ChainmailOptions o;
-  o.rings_x = o.rings_y = 3;
-  o.segments = 12;
-  o.sides = 6;
-  o.seed = seed;
-  Mesh m;
-  make_chainmail_swatch(m, o);
-  return m;
-}
+using test::small_chainmail_mesh;
 
 void add_triangle(Mesh& m, Point3 a, Point3 b, Point3 c) {
   m.add_face(m.add_vertex(a), m.add_vertex(b), m.add_vertex(c));
