@@ -4,8 +4,9 @@
 // and limbs; knot: genus 1) x 4 swatches (the generated weave, chain mail and
 // 16 tilted tori, disjoint elements; the real pebble swatches/rock_1.obj), each
 // quilted and embedded by the CLI's driver (quilt_swatch_on_surface) at the
-// CLI's defaults (relative size 0.25, up +Y, shell height 1, 20 stretch
-// sweeps, seed 1; the swatch's thin axis detected).
+// CLI's defaults (relative size default_surface_quilt_size: 0.25, the single
+// rock 0.0625; up +Y, shell height 1, 20 stretch sweeps, seed 1; the swatch's
+// thin axis detected).
 // Prints one JSON line per case:
 //   faces, elements (the output's connected components) and quilt_elements
 //   (the quilt's own count); intersecting face pairs between / within elements
@@ -253,7 +254,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   Timer total;
   Mesh base;
   std::string mesh_name, kind;
-  double rel = 0.25;
+  double rel = 0;  // the CLI's default (default_surface_quilt_size)
   if (name == "bunny5k") {
     bunny5k(base);
     mesh_name = "bunny5k", kind = "weave", rel = 0.12;
@@ -274,13 +275,15 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.step.resolve_crossings = false;
     qo.resolve_crossings = false;
     qo.refill_rounds = 0;
+    qo.scatter_attempts = 0;
     qo.max_edge_stretch = 12;
   }
-  // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS,
+  // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER,
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
   // BENCH_CLEARANCE (swatch units; negative = automatic).
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
+  if (const char* e = std::getenv("BENCH_SCATTER")) qo.scatter_attempts = std::atoi(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
@@ -299,7 +302,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   json j{{"case", name},
          {"mesh", mesh_name},
          {"swatch", kind},
-         {"relative_size", rel},
+         {"relative_size", run.relative_size},
          {"base_faces", base.number_of_faces()},
          {"swatch_faces", s.mesh.tris.size()},
          {"swatch_elements", s.elements.size()},
@@ -326,6 +329,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},
          {"faces_refilled", r.faces_refilled},
+         {"scatter_placed", r.scatter_placed},
          {"bare_quilt", r.bare_fraction},
          {"steps", r.steps},
          {"stretch_before", er.stretch.stretch_before},

@@ -136,7 +136,7 @@ QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
   QuiltSwatchOnSurfaceOptions d;
   d.swatch_up = swatch_axis(a.swatch_up);
   SurfaceQuiltOptions& o = d.quilt;
-  if (a.scale > 0) o.relative_size = a.scale;
+  o.relative_size = a.scale;  // (0: the swatch's default, default_surface_quilt_size)
   o.field = a.field == "up" ? SurfaceQuiltOptions::Field::kUp : SurfaceQuiltOptions::Field::kNone;
   o.up = {a.up[0], a.up[1], a.up[2]};
   o.cell_size = a.cell;
@@ -258,8 +258,9 @@ SubcommandRegistrar reg_quilt{
        app.add_flag("--no-render", a->no_render, "Do not write a render");
        app.add_option("--scale", a->scale,
                       "The paper's s. On a mesh: the swatch's larger side as a fraction of the base mesh's "
-                      "bounding-box diagonal, (0, 10], 0 = 0.25. On a plane: factor applied to the swatch, "
-                      "0 = 1 (default 0)")
+                      "bounding-box diagonal, (0, 10]; 0 = 0.25, or less for a swatch of few large compact "
+                      "elements (a single pebble) so that one element is at most 1/16 of the diagonal. On a "
+                      "plane: factor applied to the swatch, 0 = 1 (default 0)")
            ->check(number_above(0, false));
        app.add_option("--field", a->field,
                       "Guidance field aligning the swatch's +y on a mesh: up (the projected --up vector) or none "

@@ -243,6 +243,41 @@ TEST(SurfaceQuiltingCrossings, DisjointToriOnASphereHaveNoIntersectingPairs) {
   EXPECT_LT(ron.bare_fraction, 0.08);
 }
 
+// Issue 17 item 4 (even coverage): the holes the crossing and stretch checks
+// leave (about one element each, which whole-swatch refills do not fill) get
+// single compact elements, which neither cross nor come near their
+// neighbours: the bare fraction falls while the embedded quilt keeps 0
+// intersecting pairs.
+TEST(SurfaceQuiltingCoverage, ScatterFillCoversTheHolesLeftByRemovedElements) {
+  for (const char* kind : {"tori", "chainmail"}) {
+    Mesh base;
+    make_icosphere(base, 3);
+    const Swatch s = std::string(kind) == "tori" ? small_tori(3) : test::small_chainmail_swatch();
+    auto run = [&](int attempts) {
+      SurfaceQuiltOptions o;
+      o.relative_size = 0.3;
+      o.scatter_attempts = attempts;
+      SurfaceQuilt q;
+      const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+      EmbedSurfaceQuiltOptions eo;
+      eo.stretch.iterations = 4;
+      eo.measure_outside_shell = false;
+      Mesh out;
+      const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+      std::cout << "[ sphere " << kind << " ] scatter " << attempts << ": " << r.elements << " elements, placed "
+                << r.scatter_placed << ", bare " << r.bare_fraction << ", pairs " << er.self_intersections_between << "\n";
+      return std::make_pair(r, er);
+    };
+    const auto [roff, eoff] = run(0);
+    const auto [ron, eon] = run(SurfaceQuiltOptions{}.scatter_attempts);
+    EXPECT_EQ(roff.scatter_placed, 0u) << kind;
+    EXPECT_GT(ron.scatter_placed, 0u) << kind;
+    EXPECT_GT(ron.elements, roff.elements) << kind;
+    EXPECT_LT(ron.bare_fraction, 0.6 * roff.bare_fraction) << kind;
+    EXPECT_EQ(eon.self_intersections_between, 0u) << kind;
+  }
+}
+
 // A +Y-up mesh (an ellipsoid standing on y) and a swatch modelled Y-thin
 // (flattened blobs lying in xz): with the thin axis detected every element
 // lies flat on the surface (its own thin axis along the base normal).

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <iostream>
 #include <string>
 
 #include "geometry/errors.h"
@@ -201,6 +202,42 @@ TEST(QuiltDriver, SurfaceDriverRefusesAScaleAbove10AndOversizedRunsBeforeQuiltin
   e = error_of([&] { quilt_swatch_on_surface(base, sm, out, o); });
   EXPECT_TRUE(has(e, "budget ")) << e;
   EXPECT_EQ(out.number_of_faces(), 0u);
+}
+
+// A single pebble as the swatch (bench_quilt's rock case): at 0.25 of the
+// base's diagonal every placement on a small sphere is stretched or crosses
+// and nothing is left ("no element was placed"); the default size gives one
+// element 1/16 of the diagonal, and the sphere gets covered with pebbles.
+// Swatches of several elements (tori) or of threads (weave) keep 0.25.
+TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOnly) {
+  Mesh pebble;
+  make_ellipsoid(pebble, 1.0, 0.8, 0.35, 2);
+  const Swatch one = make_swatch(pebble);
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(one), 0.0625);
+  Mesh tori, weave;
+  make_tori_swatch(tori, ToriOptions{});
+  make_weave_swatch(weave, WeaveOptions{});
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(tori)), 0.25);
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(weave)), 0.25);
+
+  Mesh base;
+  make_icosphere(base, 3);
+  QuiltSwatchOnSurfaceOptions o;
+  o.embed.stretch.iterations = 2;
+  o.embed.measure_outside_shell = false;
+  o.quilt.relative_size = 0.25;
+  Mesh out;
+  const std::string err = error_of([&] { quilt_swatch_on_surface(base, pebble, out, o); });
+  std::size_t at_quarter = 0;
+  if (err.empty()) at_quarter = static_cast<std::size_t>(quilt_swatch_on_surface(base, pebble, out, o).quilt.elements);
+  o.quilt.relative_size = 0;  // the default
+  const QuiltSwatchOnSurfaceResult r = quilt_swatch_on_surface(base, pebble, out, o);
+  std::cout << "[ sphere pebble ] 0.25: " << (err.empty() ? std::to_string(at_quarter) + " elements" : err)
+            << "; default " << r.relative_size << ": " << r.quilt.elements << " elements, bare " << r.quilt.bare_fraction << "\n";
+  EXPECT_DOUBLE_EQ(r.relative_size, 0.0625);
+  EXPECT_GE(r.quilt.elements, 40);
+  EXPECT_GT(r.quilt.elements, 4 * static_cast<int>(at_quarter) + 10);
+  EXPECT_LT(r.quilt.bare_fraction, 0.05);
 }
 
 TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {

@@ -570,7 +570,8 @@ TEST(SurfaceQuilting, StretchedElementsAreRemovedAtTheEnd) {
   const Swatch sw = tiny_scatter();
   SurfaceQuiltOptions o;
   o.relative_size = 0.5;
-  o.refill_rounds = 0;  // (refilled elements would be counted again)
+  o.refill_rounds = 0;  // (refilled or scattered elements would be counted again)
+  o.scatter_attempts = 0;
   SurfaceQuilt q;
   o.max_edge_stretch = 0;
   const SurfaceQuiltResult keep = quilt_surface(base, sw, q, o);

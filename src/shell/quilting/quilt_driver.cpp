@@ -124,8 +124,10 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                                                    const QuiltSwatchOnSurfaceOptions& opt) {
   QuiltSwatchOnSurfaceResult r;
   r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
-  check_surface_quilt_size(base, r.swatch, opt);
-  SurfaceQuiltOptions qo = opt.quilt;
+  QuiltSwatchOnSurfaceOptions o2 = opt;
+  if (!(opt.quilt.relative_size > 0)) o2.quilt.relative_size = default_surface_quilt_size(r.swatch);
+  check_surface_quilt_size(base, r.swatch, o2);
+  SurfaceQuiltOptions qo = o2.quilt;
   qo.seed = opt.seed;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);

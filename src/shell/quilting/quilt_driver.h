@@ -78,7 +78,8 @@ QuiltSwatchOnPlaneResult quilt_swatch_on_plane(const Mesh& swatch_mesh, double w
 struct QuiltSwatchOnSurfaceOptions {
   /// The swatch's thin axis, turned onto z (make_swatch). Default kAuto.
   SwatchAxis swatch_up = SwatchAxis::kAuto;
-  /// quilt_surface's options (relative_size at most 10); its seed is replaced by `seed`.
+  /// quilt_surface's options (relative_size at most 10; 0 = default_surface_quilt_size
+  /// of the swatch); its seed is replaced by `seed`.
   SurfaceQuiltOptions quilt;
   /// embed_surface_quilt's options; its stretch seed is replaced by `seed`.
   EmbedSurfaceQuiltOptions embed;

@@ -58,6 +58,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["crossings_resolved"] = r.crossings_resolved;
   j["fragments_removed"] = r.fragments_removed;
   j["faces_refilled"] = r.faces_refilled;
+  j["scatter_placed"] = r.scatter_placed;
   j["bare_fraction"] = r.bare_fraction;
   j["elements_not_expressible"] = r.elements_not_expressible;
   j["elements_not_expressed"] = r.elements_not_expressed;

@@ -424,8 +424,70 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.field_min_projection > 0 && o.field_min_projection <= 1))
     bad("field_min_projection must be in (0, 1]", o.field_min_projection);
   if (o.refill_rounds < 0 || o.refill_rounds > 8) bad("refill_rounds must be in [0, 8]", o.refill_rounds);
+  if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
+}
+
+// Points on the base (element vertices' feet) bucketed for "is any within
+// radius" queries (bare-face detection and the scatter fill).
+class FootGrid {
+ public:
+  explicit FootGrid(double radius) : rad_(radius) {}
+  void add(const P3& p) { grid_[key(p, 0, 0, 0)].push_back(p); }
+  bool covered(const P3& x) const {
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          auto it = grid_.find(key(x, i, j, k));
+          if (it == grid_.end()) continue;
+          for (const P3& q : it->second)
+            if (dot3(sub3(x, q), sub3(x, q)) <= rad_ * rad_) return true;
+        }
+    return false;
+  }
+
+ private:
+  long long key(const P3& p, int di, int dj, int dk) const {
+    const long long i = static_cast<long long>(std::floor(p[0] / rad_)) + di, j = static_cast<long long>(std::floor(p[1] / rad_)) + dj,
+                    k = static_cast<long long>(std::floor(p[2] / rad_)) + dk;
+    return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
+  }
+  double rad_;
+  std::unordered_map<long long, std::vector<P3>> grid_;
+};
+
+// A base face is bare if two or more of four sample points (its centroid and
+// its corner triangles' centroids) have no foot within the grid's radius.
+bool face_is_bare(const Base& b, int f, const FootGrid& feet) {
+  const auto& t = b.faces[f];
+  int nbare = feet.covered(b.centroid[f]) ? 0 : 1;
+  for (int k = 0; k < 3; ++k) {
+    const P3 &a = b.pts[t[k]], &b1 = b.pts[t[(k + 1) % 3]], &b2 = b.pts[t[(k + 2) % 3]];
+    const P3 s{(4 * a[0] + b1[0] + b2[0]) / 6, (4 * a[1] + b1[1] + b2[1]) / 6, (4 * a[2] + b1[2] + b2[2]) / 6};
+    nbare += feet.covered(s) ? 0 : 1;
+  }
+  return nbare >= 2;
+}
+
+// The swatch's compact elements (rings, pebbles: is_compact_element), each
+// moved so that its xy centroid is the origin (swatch units, z kept): what
+// the scatter fill places one at a time.
+std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
+  std::vector<std::vector<int>> tris_of(s.elements.size());
+  for (std::size_t t = 0; t < s.mesh.tris.size(); ++t) tris_of[static_cast<std::size_t>(s.face_element[t])].push_back(static_cast<int>(t));
+  std::vector<ElementMesh> out;
+  for (const std::vector<int>& tris : tris_of) {
+    ElementMesh m = extract_triangles(s.mesh, tris);
+    if (m.points.empty() || !is_compact_element(m)) continue;
+    double cx = 0, cy = 0;
+    for (const P3& q : m.points) cx += q[0], cy += q[1];
+    cx /= static_cast<double>(m.points.size());
+    cy /= static_cast<double>(m.points.size());
+    for (P3& q : m.points) q[0] -= cx, q[1] -= cy;
+    out.push_back(std::move(m));
+  }
+  return out;
 }
 
 // One surface patch of the loop (steps 2-5 of the header).
@@ -466,9 +528,10 @@ class SurfaceQuilter {
 
   // Stages (public for the tests through quilt_surface's results only; see the header).
   int find_seed() const;
-  void grow_and_flatten(int seed, Patch& p);
+  void grow_and_flatten(int seed, Patch& p, double radius);
   void orient(Patch& p);
   void align(Patch& p);
+  void frame_triangles(Patch& p);
   FrameElements express(const Patch& p);
   double search_turn(const Patch& p, const FrameElements& fe, const PatchLocator& loc0);
   void apply_turn(Patch& p, FrameElements& fe, double turn);
@@ -476,6 +539,7 @@ class SurfaceQuilter {
   void quilt_unprocessed();
   void finish();
   std::size_t refill();
+  void scatter_into_bare();
   void emit(SurfaceQuilt& out);
 
  private:
@@ -490,6 +554,10 @@ class SurfaceQuilter {
   void mark(int f);
   void drift(const Patch& p);
   P3 lifted(const SurfaceQuiltVertex& v) const;
+  ElementMesh lifted_mesh(const Element& el) const;
+  FootGrid element_feet() const;
+  bool place_scatter_element(const Patch& p, const PatchLocator& loc, const ElementMesh& tpl, int quarter, const V2& offset,
+                             ElementCollider& coll, Element& el);
   void fit_z(Element& el);
   void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
@@ -589,9 +657,9 @@ int SurfaceQuilter::find_seed() const {
 }
 
 // 2-3. Surface patch and its flattening, shrunk while the area distortion exceeds the bound.
-void SurfaceQuilter::grow_and_flatten(int seed, Patch& p) {
+void SurfaceQuilter::grow_and_flatten(int seed, Patch& p, double radius) {
   p.seed = seed;
-  p.R = opt_.patch_radius * swatch_diag_;
+  p.R = radius;
   bool ok = false;
   std::string err;
   const P3 c0 = b_.centroid[seed], n0 = b_.normal[seed];
@@ -764,12 +832,18 @@ void SurfaceQuilter::align(Patch& p) {
       }
     }
   }
+  frame_triangles(p);
+}
+
+// The frame triangles of the patch, its faces' slots, and the grid extent:
+// the patch plus one swatch on each side (the same for every turn).
+void SurfaceQuilter::frame_triangles(Patch& p) {
+  Flat& flat = p.flat;
   p.ftris.resize(flat.faces.size());
   for (std::size_t k = 0; k < flat.faces.size(); ++k) {
     patch_slot_[flat.faces[k]] = static_cast<int>(k);
     for (int j = 0; j < 3; ++j) p.ftris[k][j] = flat.uv[flat.local[b_.faces[flat.faces[k]][j]]];
   }
-  // Grid over the patch plus one swatch on each side (the same for every turn).
   double ext = 0;
   for (const auto& q : flat.uv) ext = std::max(ext, std::hypot(q[0], q[1]));
   p.ilo = static_cast<int>(std::floor(-ext / c_ - 0.5)) - sx_, p.ihi = static_cast<int>(std::ceil(ext / c_ + 0.5)) + sx_;
@@ -1246,7 +1320,7 @@ void SurfaceQuilter::quilt_unprocessed() {
     report_progress(opt_.progress, "quilt", static_cast<double>(done_) / nf_);
     Timer tp;
     Patch p;
-    grow_and_flatten(seed, p);
+    grow_and_flatten(seed, p, opt_.patch_radius * swatch_diag_);
     orient(p);
     align(p);
     const PatchLocator loc0(p.ftris, c_);
@@ -1401,10 +1475,7 @@ void SurfaceQuilter::resolve_crossings_lifted() {
   std::vector<int> id;  // element index per lifted element
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     if (!elements_[e].alive || elements_[e].mesh.tris.empty()) continue;
-    ElementMesh m;
-    m.tris = elements_[e].mesh.tris;
-    for (const auto& v : elements_[e].loc) m.points.push_back(lifted(v));
-    lifted_els.push_back(std::move(m));
+    lifted_els.push_back(lifted_mesh(elements_[e]));
     id.push_back(static_cast<int>(e));
   }
   ElementCollider coll(lifted_els, {});
@@ -1453,42 +1524,18 @@ void SurfaceQuilter::finish() {
 // Base faces at least half bare: of four sample points (the centroid and the
 // corner triangles' centroids) two or more have no element vertex's foot
 // within half the swatch's element spacing (swatch_element_spacing, scaled).
-std::vector<char> SurfaceQuilter::bare_faces() const {
-  const double rad = 0.5 * swatch_element_spacing(swatch_) * S_;
-  std::unordered_map<long long, std::vector<P3>> grid;
-  auto key = [&](const P3& p, int di, int dj, int dk) {
-    const long long i = static_cast<long long>(std::floor(p[0] / rad)) + di, j = static_cast<long long>(std::floor(p[1] / rad)) + dj,
-                    k = static_cast<long long>(std::floor(p[2] / rad)) + dk;
-    return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
-  };
+FootGrid SurfaceQuilter::element_feet() const {
+  FootGrid feet(0.5 * swatch_element_spacing(swatch_) * S_);
   for (const Element& el : elements_)
     if (el.alive)
-      for (const auto& v : el.loc) {
-        const P3 p = base_point(b_, v);
-        grid[key(p, 0, 0, 0)].push_back(p);
-      }
-  auto covered = [&](const P3& x) {
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k) {
-          auto it = grid.find(key(x, i, j, k));
-          if (it == grid.end()) continue;
-          for (const P3& q : it->second)
-            if (dot3(sub3(x, q), sub3(x, q)) <= rad * rad) return true;
-        }
-    return false;
-  };
+      for (const auto& v : el.loc) feet.add(base_point(b_, v));
+  return feet;
+}
+
+std::vector<char> SurfaceQuilter::bare_faces() const {
+  const FootGrid feet = element_feet();
   std::vector<char> bare(static_cast<std::size_t>(nf_), 0);
-  for (int f = 0; f < nf_; ++f) {
-    const auto& t = b_.faces[f];
-    int nbare = covered(b_.centroid[f]) ? 0 : 1;
-    for (int k = 0; k < 3; ++k) {
-      const P3 &a = b_.pts[t[k]], &b1 = b_.pts[t[(k + 1) % 3]], &b2 = b_.pts[t[(k + 2) % 3]];
-      const P3 s{(4 * a[0] + b1[0] + b2[0]) / 6, (4 * a[1] + b1[1] + b2[1]) / 6, (4 * a[2] + b1[2] + b2[2]) / 6};
-      nbare += covered(s) ? 0 : 1;
-    }
-    bare[static_cast<std::size_t>(f)] = nbare >= 2;
-  }
+  for (int f = 0; f < nf_; ++f) bare[static_cast<std::size_t>(f)] = face_is_bare(b_, f, feet);
   return bare;
 }
 
@@ -1510,6 +1557,96 @@ std::size_t SurfaceQuilter::refill() {
   }
   res_.faces_refilled += n;
   return n;
+}
+
+// An element's vertices lifted (lifted()), its triangles.
+ElementMesh SurfaceQuilter::lifted_mesh(const Element& el) const {
+  ElementMesh m;
+  m.tris = el.mesh.tris;
+  m.points.reserve(el.loc.size());
+  for (const auto& v : el.loc) m.points.push_back(lifted(v));
+  return m;
+}
+
+// One scatter candidate: the template turned by `quarter` quarter turns,
+// moved by `offset` (frame units) from the patch's seed. Kept (in `el`) only
+// if every vertex lies on the patch (no extrapolation), no lifted edge is
+// stretched past kScatterMaxStretch times its swatch length (nor past the
+// shard bound, SurfaceQuiltOptions::max_edge_stretch), and the lifted
+// element neither crosses nor comes within half the swatch's smallest gap of
+// an element already placed.
+bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& loc, const ElementMesh& tpl, int quarter,
+                                           const V2& offset, ElementCollider& coll, Element& el) {
+  constexpr double kScatterMaxStretch = 1.5;
+  static constexpr int kCos[4] = {1, 0, -1, 0}, kSin[4] = {0, 1, 0, -1};
+  const int c = kCos[quarter & 3], sn = kSin[quarter & 3];
+  el = Element{};
+  el.compact = true;
+  el.mesh.tris = tpl.tris;
+  el.loc.resize(tpl.points.size());
+  for (std::size_t v = 0; v < tpl.points.size(); ++v) {
+    const P3& q = tpl.points[v];
+    std::array<double, 3> w{1, 0, 0};
+    const int k = loc.locate({c * q[0] - sn * q[1] + offset[0], sn * q[0] + c * q[1] + offset[1]}, w);
+    if (k < 0) return false;
+    el.loc[v] = {p.flat.faces[static_cast<std::size_t>(k)], w[1], w[2], q[2]};
+  }
+  const ElementMesh m = lifted_mesh(el);
+  const double lim2 = kScatterMaxStretch * kScatterMaxStretch * S_ * S_;
+  for (const Tri& t : tpl.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+      const P3 d1 = sub3(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+      if (dot3(d1, d1) > lim2 * dot3(d0, d0) || (stretch_bound2_ > 0 && dot3(d1, d1) > stretch_bound2_)) return false;
+    }
+  const std::vector<char> hit = coll.hits(m, -1, 0.5 * swatch_.min_gap * S_);
+  if (std::find(hit.begin(), hit.end(), 1) != hit.end()) return false;
+  coll.add(m, static_cast<int>(elements_.size()));
+  return true;
+}
+
+// Scatter fill (issue 17 item 4): the refill rounds quilt bare faces with
+// whole swatch patches, whose compact elements then cross their neighbours
+// and are removed again, so holes of about one element stay. Here each face
+// still bare gets, on a small patch around it (flattened and oriented as a
+// quilting patch, section 3.1), one of the swatch's compact elements at a
+// time: tried in four quarter turns at the face, then moved by up to half
+// the element spacing, and kept where it fits
+// (place_scatter_element). Threads (weaves) are not scattered: a cut thread
+// is no element.
+void SurfaceQuilter::scatter_into_bare() {
+  const std::vector<ElementMesh> tpl = compact_swatch_elements(swatch_);
+  if (tpl.empty()) return;
+  double reach = 0;  // the largest template's xy radius (swatch units)
+  for (const ElementMesh& m : tpl)
+    for (const P3& q : m.points) reach = std::max(reach, std::hypot(q[0], q[1]));
+  std::vector<ElementMesh> lifted_els;
+  for (const Element& el : elements_)
+    if (el.alive && !el.mesh.tris.empty()) lifted_els.push_back(lifted_mesh(el));
+  ElementCollider coll(lifted_els, {});
+  FootGrid feet = element_feet();
+  const double jitter = 0.5 * swatch_element_spacing(swatch_);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int f = 0; f < nf_; ++f) {
+    if (!face_is_bare(b_, f, feet)) continue;
+    Patch p;
+    grow_and_flatten(f, p, 2 * reach * S_);
+    orient(p);
+    frame_triangles(p);
+    const PatchLocator loc(p.ftris, c_);
+    Element el;
+    bool placed = false;
+    for (int a = 0; a < opt_.scatter_attempts && !placed; ++a) {
+      const ElementMesh& t = tpl[static_cast<std::size_t>(rng_() % tpl.size())];
+      const V2 off = a < 4 ? V2{0, 0} : V2{jitter * unit(rng_), jitter * unit(rng_)};
+      placed = place_scatter_element(p, loc, t, a, off, coll, el);
+    }
+    for (int g : p.flat.faces) patch_slot_[g] = -1;
+    if (!placed) continue;
+    for (const auto& v : el.loc) feet.add(base_point(b_, v));
+    elements_.push_back(std::move(el));
+    ++res_.scatter_placed;
+  }
 }
 
 // The output: every live element (fitted into the z range by finish)
@@ -1571,6 +1708,11 @@ SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
     quilt_unprocessed();
     finish();
   }
+  if (opt_.scatter_attempts > 0) {
+    Timer ts;
+    scatter_into_bare();
+    res_.seconds_finish += ts.seconds();
+  }
   res_.bare_fraction = 0;
   {
     const std::vector<char> bare = bare_faces();
@@ -1598,6 +1740,20 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
   }
   const double diag = base.is_empty() ? 0.0 : norm3(sub3(hi, lo));
   return relative_size * diag / std::max(swatch.length(), swatch.width());
+}
+
+double default_surface_quilt_size(const Swatch& swatch) {
+  constexpr double kSize = 0.25, kElementSize = 0.0625;
+  std::vector<double> sides;  // larger xy side of each compact element (is_compact_element's ratio)
+  for (const SwatchElement& e : swatch.elements) {
+    const double a = e.bbox_max[0] - e.bbox_min[0], b = e.bbox_max[1] - e.bbox_min[1];
+    const double lo = std::min(a, b), hi = std::max(a, b);
+    if (hi > 0 && hi <= 2.5 * lo) sides.push_back(hi);
+  }
+  const double side = std::max(swatch.length(), swatch.width());
+  if (sides.empty() || !(side > 0)) return kSize;
+  std::nth_element(sides.begin(), sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2), sides.end());
+  return std::min(kSize, kElementSize * side / sides[sides.size() / 2]);
 }
 
 double surface_quilt_placements(const Mesh& base, const Swatch& swatch, double relative_size) {

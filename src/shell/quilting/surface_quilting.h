@@ -83,6 +83,11 @@ struct SurfaceQuiltOptions {
   /// Rounds re-quilting the base faces left bare (no element vertex within half
   /// the element spacing). In [0, 8]; 0 = none. Default 3.
   int refill_rounds = 3;
+  /// Scatter fill after the refills: per face still bare, up to this many
+  /// tries to place one compact swatch element (a ring, a pebble) there
+  /// without crossing or stretching (four quarter turns, then moved by up to
+  /// half the element spacing). In [0, 64]; 0 = none. Default 16.
+  int scatter_attempts = 16;
   /// The output's z range may grow past the swatch's by this many swatch
   /// heights per side; elements beyond are shifted (squeezed) in. [0, 10], default 0.
   double max_z_growth = 0;
@@ -170,6 +175,8 @@ struct SurfaceQuiltResult {
   std::size_t fragments_removed = 0;
   /// Base faces reopened by refill_rounds; bare area fraction at the end.
   std::size_t faces_refilled = 0;
+  /// Single compact elements placed by the scatter fill (scatter_attempts).
+  std::size_t scatter_placed = 0;
   double bare_fraction = 0;
   /// Elements and vertices fitted into the z range; its growth below / above (swatch units).
   std::size_t z_fitted_elements = 0, z_fitted_vertices = 0;
@@ -189,6 +196,13 @@ struct SurfaceQuiltResult {
 /// relative_size times the diagonal of the base's bounding box (0 for a base
 /// of zero size).
 double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relative_size);
+
+/// The default relative size (the CLI's, when --scale is not given): 0.25,
+/// lowered for swatches of few large compact elements (a single pebble) so
+/// that the median compact element's larger xy side is at most 1/16 of the
+/// base's diagonal, i.e. 0.0625 * (swatch side / element side). Swatches of
+/// threads only (weaves) keep 0.25.
+double default_surface_quilt_size(const Swatch& swatch);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
 /// scaled swatch's xy area (0 when the swatch has no area).
