@@ -22,6 +22,10 @@
 // the lines; ann_stride defaults to the library's).
 // SURFTEX_BENCH_EL_REFERENCE=FILE takes the exhaustive figures from an
 // earlier run's output instead of recomputing them.
+// SURFTEX_BENCH_EL_SEEDS=N (default 1) runs both searches with seeds 1..N and
+// compares their mean BDS (textures whose synthesis is bimodal, such as two
+// flat colours in stripes wider than the window, make one seed's ratio a coin
+// toss); the per-seed figures are printed as well. Not with a reference file.
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
@@ -60,7 +64,7 @@ struct AnnSetting {
   int stride = 0;
 };
 
-Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann = nullptr) {
+Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann = nullptr, std::uint64_t seed = 1) {
   ElOptions o;  // the `surftex synth` defaults are the library's
   o.search = search;
   if (ann) {
@@ -69,7 +73,7 @@ Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann
     o.ann_eps = ann->eps;
     if (ann->stride > 0) o.ann_stride = ann->stride;
   }
-  o.seed = 1;
+  o.seed = seed;
   Run r;
   Timer t;
   const std::clock_t c0 = std::clock();
@@ -108,8 +112,10 @@ int main(int argc, char** argv) {
   }
   // SURFTEX_BENCH_EL_REFERENCE=FILE: exhaustive figures from an earlier run's
   // JSON lines (same size; the exhaustive search is deterministic).
+  const char* seeds_env = std::getenv("SURFTEX_BENCH_EL_SEEDS");
+  const int seeds = seeds_env && std::atoi(seeds_env) > 1 ? std::atoi(seeds_env) : 1;
   std::map<std::string, std::pair<double, double>> reference;
-  if (const char* ref = std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
+  if (const char* ref = seeds > 1 ? nullptr : std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
     std::ifstream in(ref);
     for (std::string line; std::getline(in, line);) {
       if (line.empty() || line[0] != '{') continue;
@@ -137,7 +143,19 @@ int main(int argc, char** argv) {
       } else {
         a = synthesize(ex, size, ElSearch::Exhaustive);
       }
-      const Run b = synthesize(ex, size, ElSearch::Approximate);
+      Run b = synthesize(ex, size, ElSearch::Approximate);
+      nlohmann::json per_seed = nlohmann::json::array();
+      if (seeds > 1) {
+        per_seed.push_back({{"seed", 1}, {"exhaustive", a.bds}, {"approximate", b.bds}});
+        for (int sd = 2; sd <= seeds; ++sd) {
+          const Run a2 = synthesize(ex, size, ElSearch::Exhaustive, nullptr, static_cast<std::uint64_t>(sd));
+          const Run b2 = synthesize(ex, size, ElSearch::Approximate, nullptr, static_cast<std::uint64_t>(sd));
+          per_seed.push_back({{"seed", sd}, {"exhaustive", a2.bds}, {"approximate", b2.bds}});
+          a.bds += a2.bds, a.cpu += a2.cpu, a.wall += a2.wall;
+          b.bds += b2.bds, b.cpu += b2.cpu, b.wall += b2.wall;
+        }
+        a.bds /= seeds, b.bds /= seeds;
+      }
       nlohmann::json tried = nlohmann::json::array();
       for (const AnnSetting& st : settings) {
         const Run c = synthesize(ex, size, ElSearch::Approximate, &st);
@@ -162,6 +180,7 @@ int main(int argc, char** argv) {
       j["cpu_seconds"] = {{"exhaustive", a.cpu}, {"approximate", b.cpu}};
       j["wall_seconds"] = {{"exhaustive", a.wall}, {"approximate", b.wall}};
       if (!settings.empty()) j["settings"] = tried;
+      if (seeds > 1) j["seeds"] = per_seed;  // (bds_* above: the means; cpu and wall: the sums)
       std::printf("%s\n", j.dump().c_str());
       std::fflush(stdout);
     }
