@@ -276,14 +276,16 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.resolve_crossings = false;
     qo.refill_rounds = 0;
     qo.scatter_attempts = 0;
+    qo.max_shape_ratio = 0;
     qo.max_edge_stretch = 12;
   }
-  // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER,
+  // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SHAPE,
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
   // BENCH_CLEARANCE (swatch units; negative = automatic).
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER")) qo.scatter_attempts = std::atoi(e);
+  if (const char* e = std::getenv("BENCH_SHAPE")) qo.max_shape_ratio = std::atof(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
@@ -330,6 +332,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"new_trimmed", r.new_trimmed},
          {"faces_refilled", r.faces_refilled},
          {"scatter_placed", r.scatter_placed},
+         {"elements_misshapen", r.elements_misshapen},
          {"bare_quilt", r.bare_fraction},
          {"steps", r.steps},
          {"stretch_before", er.stretch.stretch_before},

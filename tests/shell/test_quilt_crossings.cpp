@@ -278,6 +278,73 @@ TEST(SurfaceQuiltingCoverage, ScatterFillCoversTheHolesLeftByRemovedElements) {
   }
 }
 
+// The largest extent of `pts` along the 13 directions quilt_surface's shape
+// bound uses (cube axes, face and body diagonals).
+double spread13(const std::vector<Vec3>& pts) {
+  const double a = 1 / std::sqrt(2.0), b = 1 / std::sqrt(3.0);
+  const double d[13][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {a, a, 0}, {a, -a, 0}, {a, 0, a}, {a, 0, -a},
+                           {0, a, a}, {0, a, -a}, {b, b, b}, {b, b, -b}, {b, -b, b}, {-b, b, b}};
+  double best = 0;
+  for (const auto& u : d) {
+    double lo = 1e300, hi = -1e300;
+    for (const Vec3& p : pts) {
+      const double t = p[0] * u[0] + p[1] * u[1] + p[2] * u[2];
+      lo = std::min(lo, t), hi = std::max(hi, t);
+    }
+    best = std::max(best, hi - lo);
+  }
+  return best;
+}
+
+// Issue 17 item 2 (Zhou 2006's elements keep their shape): a compact element
+// that merging (2.7) or deformation (2.6) spread wider than max_shape_ratio
+// times the swatch's largest compact element is removed, and its space
+// refilled. Without the bound, pebbles quilted on a sphere spread to 3x.
+TEST(SurfaceQuiltingShape, CompactElementsSpreadNoWiderThanTheShapeBound) {
+  Mesh base, pebble;
+  make_icosphere(base, 3);
+  make_ellipsoid(pebble, 1.0, 0.8, 0.35, 2);  // one pebble as the swatch: overlapping placements merge
+  const Swatch s = make_swatch(pebble);
+  double ref = 0;  // the swatch's largest element spread (swatch units)
+  {
+    std::vector<std::vector<Vec3>> pts(s.elements.size());
+    for (std::size_t t = 0; t < s.mesh.tris.size(); ++t)
+      for (int v : s.mesh.tris[t]) {
+        const P3& p = s.mesh.points[static_cast<std::size_t>(v)];
+        pts[static_cast<std::size_t>(s.face_element[t])].push_back({p[0], p[1], p[2]});
+      }
+    for (const auto& e : pts) ref = std::max(ref, spread13(e));
+  }
+  auto run = [&](double ratio) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.12;
+    o.max_shape_ratio = ratio;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    Mesh out;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, out);
+    const auto el = find(out, kFaceElement).first;
+    std::vector<std::vector<Vec3>> pts(static_cast<std::size_t>(q.elements));
+    for (FaceIndex f : out.faces())
+      for (VertexIndex v : out.vertices_around_face(out.halfedge(f))) {
+        const Point3& p = out.point(v);
+        pts[static_cast<std::size_t>(el[f])].push_back({p.x(), p.y(), p.z()});
+      }
+    double worst = 0;
+    for (const auto& e : pts) worst = std::max(worst, spread13(e) / (ref * q.scale));
+    std::cout << "[ sphere pebble ] shape bound " << ratio << ": " << r.elements << " elements, " << r.elements_misshapen
+              << " removed, widest " << worst << ", bare " << r.bare_fraction << "\n";
+    return std::make_pair(worst, r);
+  };
+  const auto [off, roff] = run(0);
+  const auto [on, ron] = run(SurfaceQuiltOptions{}.max_shape_ratio);
+  EXPECT_GT(off, 1.6);
+  EXPECT_EQ(roff.elements_misshapen, 0u);
+  EXPECT_GT(ron.elements_misshapen, 0u);
+  EXPECT_LE(on, 1.6);  // (the bound is on the lifted element; the displaced one uses face normals)
+  EXPECT_LT(ron.bare_fraction, 0.02);
+}
+
 // A +Y-up mesh (an ellipsoid standing on y) and a swatch modelled Y-thin
 // (flattened blobs lying in xz): with the thin axis detected every element
 // lies flat on the surface (its own thin axis along the base normal).

@@ -54,6 +54,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["patches_turned"] = r.patches_turned;
   j["elements_past_border"] = r.elements_past_border;
   j["elements_stretched"] = r.elements_stretched;
+  j["elements_misshapen"] = r.elements_misshapen;
   j["edge_stretch_max"] = r.edge_stretch_max;
   j["crossings_resolved"] = r.crossings_resolved;
   j["fragments_removed"] = r.fragments_removed;

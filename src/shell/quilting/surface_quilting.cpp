@@ -424,6 +424,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.field_min_projection > 0 && o.field_min_projection <= 1))
     bad("field_min_projection must be in (0, 1]", o.field_min_projection);
   if (o.refill_rounds < 0 || o.refill_rounds > 8) bad("refill_rounds must be in [0, 8]", o.refill_rounds);
+  if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
@@ -468,6 +469,25 @@ bool face_is_bare(const Base& b, int f, const FootGrid& feet) {
     nbare += feet.covered(s) ? 0 : 1;
   }
   return nbare >= 2;
+}
+
+// The largest extent of `pts` along 13 directions (the axes, the face and
+// the body diagonals of a cube): the diameter within about 10%, whatever the
+// points' orientation.
+double spread13(const std::vector<P3>& pts) {
+  static const double r2 = 1 / std::sqrt(2.0), r3 = 1 / std::sqrt(3.0);
+  static const P3 dirs[13] = {{1, 0, 0},   {0, 1, 0},    {0, 0, 1},    {r2, r2, 0},  {r2, -r2, 0},  {r2, 0, r2},  {r2, 0, -r2},
+                              {0, r2, r2}, {0, r2, -r2}, {r3, r3, r3}, {r3, r3, -r3}, {r3, -r3, r3}, {-r3, r3, r3}};
+  double best = 0;
+  for (const P3& d : dirs) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const P3& q : pts) {
+      const double t = dot3(q, d);
+      lo = std::min(lo, t), hi = std::max(hi, t);
+    }
+    if (hi > lo) best = std::max(best, hi - lo);
+  }
+  return best;
 }
 
 // The swatch's compact elements (rings, pebbles: is_compact_element), each
@@ -561,6 +581,7 @@ class SurfaceQuilter {
   void fit_z(Element& el);
   void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
+  void remove_misshapen();
   std::vector<char> bare_faces() const;
 
   const Mesh& mesh_;
@@ -595,6 +616,8 @@ class SurfaceQuilter {
   int done_ = 0;
   bool refilling_ = false;
   double stretch_bound2_ = 0;  // squared (mesh units); 0 = none (settle_and_trim)
+  double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
+  bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   SurfaceQuiltResult res_;
 };
 
@@ -634,6 +657,9 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     const double ln = norm3(n);
     if (ln > 0) n = {n[0] / ln, n[1] / ln, n[2] / ln};
   }
+  const std::vector<ElementMesh> compact = compact_swatch_elements(swatch);
+  for (const ElementMesh& m : compact) compact_spread_ = std::max(compact_spread_, spread13(m.points));
+  all_compact_ = !compact.empty() && compact.size() == swatch.elements.size();
   processed_.assign(nf_, 0);
   constrained_.assign(nf_, 0);
   patch_slot_.assign(nf_, -1);
@@ -1510,9 +1536,27 @@ void SurfaceQuilter::resolve_crossings_lifted() {
   }
 }
 
+// Finish: compact elements that lost their shape (issue 17 item 2; Zhou
+// 2006's elements keep theirs): merged with a neighbour (2.7) or deformed
+// (2.6) so that, lifted, they spread wider than max_shape_ratio times the
+// swatch's largest compact element, scaled (spread13), are removed; their
+// space is refilled and scattered. When every swatch element is compact,
+// every output element is held to it (a doubled pebble is no thread).
+void SurfaceQuilter::remove_misshapen() {
+  if (!(opt_.max_shape_ratio > 0) || !(compact_spread_ > 0)) return;
+  const double lim = opt_.max_shape_ratio * compact_spread_ * S_;
+  for (Element& el : elements_) {
+    if (!el.alive || el.mesh.tris.empty() || !(el.compact || all_compact_)) continue;
+    if (spread13(lifted_mesh(el).points) <= lim) continue;
+    el.alive = false;
+    ++res_.elements_misshapen;
+  }
+}
+
 void SurfaceQuilter::finish() {
   Timer t;
   settle_and_trim(0);
+  remove_misshapen();
   if (opt_.resolve_crossings) {
     const std::size_t n = elements_.size();
     resolve_crossings_lifted();

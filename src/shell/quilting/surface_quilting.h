@@ -77,6 +77,11 @@ struct SurfaceQuiltOptions {
   /// longer, lifted, than this many swatch longest edges is cut out (threads) or
   /// its element removed, then refilled. >= 0, 0 = none. Default 3.
   double max_edge_stretch = 3.0;
+  /// Shape bound for compact elements (rings, pebbles): one that, lifted,
+  /// spreads wider than this many times the swatch's largest compact element
+  /// (merged with a neighbour, or deformed) is removed, then refilled. >= 0,
+  /// 0 = none. Default 1.5.
+  double max_shape_ratio = 1.5;
   /// After the loop, elements that cross when lifted are resolved exactly (the
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
@@ -165,6 +170,8 @@ struct SurfaceQuiltResult {
   std::size_t elements_trimmed = 0;
   /// Elements with a stretched edge at the finish (SurfaceQuiltOptions::max_edge_stretch), trimmed or removed.
   std::size_t elements_stretched = 0;
+  /// Compact elements removed for spreading past max_shape_ratio.
+  std::size_t elements_misshapen = 0;
   /// Longest lifted element edge over the swatch's longest, scaled.
   double edge_stretch_max = 0;
   /// Of elements_not_expressible, those left out of the step entirely.
