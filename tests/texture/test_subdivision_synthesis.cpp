@@ -21,6 +21,7 @@
 #include "texture/procedural_texture.h"
 #include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/wrap_seam_ratio.h"
+#include "wrap_test_images.h"
 
 using namespace surftex;
 
@@ -610,8 +611,9 @@ TEST(SubdivisionSynthesis, DeepHierarchyKeepsTheExemplarsFeatureSize) {
   o.r_scale = n;                      // one texel per final edge
   o.keys = {{0, {1, 0, 0}}};
   o.seed = 1;
+  o.wrap = ExemplarWrap::Bounded;  // the regression was in the bounded levels (make_cells itself tiles)
   const SubdivisionSynthesisResult res = synthesize_on_subdivision(m, img, o);
-  EXPECT_FALSE(res.periodic);  // make_cells does not tile (wrap-seam ratio 1.59): its fine levels are bounded
+  EXPECT_FALSE(res.periodic);
   EXPECT_GE(res.bounded_levels, 1);
   // Vertex grey binned on the final grid (vertices near the border are moved
   // off the lattice by the smoothing, so bin rather than pick lattice points).
@@ -770,4 +772,32 @@ TEST(SubdivisionSynthesis, NonPeriodicExemplarIsNotCopiedAcrossItsWrap) {
   EXPECT_TRUE(forced.first);
   EXPECT_EQ(automatic.second, 0);
   EXPECT_GT(forced.second, 10) << "the test does not see wrap copies";
+}
+
+// Issue 18's flat-square goal (docs/decisions/207): --wrap auto follows the
+// texture, not where a feature happens to lie. A brick wall cut along its
+// mortar tiles though its plain wrap-seam ratio is above 1.3 (the wrap row
+// is a mortar line): it is wrapped, as brick_small_96 now is, and so is
+// make_cells (Worley cells on a torus, periodic by construction, plain ratio
+// 1.59). Stripes whose period does not divide the width are not (wrapping
+// them pastes a hairline between two joined stripes).
+TEST(SubdivisionSynthesis, AutoWrapFollowsTheTextureNotWhereItsFeaturesLie) {
+  auto periodic = [](const Image& ex) {
+    Mesh m;
+    make_quad_plane(m, 4, 0.25);
+    SubdivisionSynthesisOptions o;
+    o.levels = 0;
+    o.r_scale = 16;
+    o.keys = {{0, {1, 0, 0}}};
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+    EXPECT_EQ(r.periodic, r.wrap_seamless);
+    EXPECT_EQ(r.bounded_levels == 0, r.periodic);
+    return r.periodic;
+  };
+  const Image wall = test::mortar_cut_brick_wall(1);
+  EXPECT_GT(wrap_seam_ratio(wall), 1.3);
+  EXPECT_TRUE(periodic(wall));
+  EXPECT_GT(wrap_seam_ratio(make_cells(64, 4, 1)), 1.3);
+  EXPECT_TRUE(periodic(make_cells(64, 4, 1)));
+  EXPECT_FALSE(periodic(test::stripes_cut_mid_period()));
 }

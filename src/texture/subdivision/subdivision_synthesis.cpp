@@ -757,9 +757,16 @@ void prepare_exemplar(const Image& exemplar, const SubdivisionSynthesisOptions& 
   Image rgb = resample_as_synthesised(to_rgb(exemplar), res.scale);
   res.scale.exemplar_width = rgb.width;
   res.scale.exemplar_height = rgb.height;
-  res.wrap_seam_ratio = (rgb.width >= 2 && rgb.height >= 2) ? wrap_seam_ratio(rgb) : 1.0;
-  res.periodic = opt.wrap == ExemplarWrap::Periodic ||
-                 (opt.wrap == ExemplarWrap::Auto && res.wrap_seam_ratio <= opt.wrap_threshold);
+  if (rgb.width >= 2 && rgb.height >= 2) {
+    // Windows of the matching neighbourhood's side (region_texels, odd).
+    const int window = 2 * static_cast<int>(opt.region_texels / 2) + 1;
+    const WrapVerdict v = wrap_verdict(rgb, opt.wrap_threshold, window);
+    res.wrap_seam_ratio = v.seam_ratio;
+    res.wrap_lines_within_interior = v.lines_within_interior;
+    res.wrap_window_ratio = v.window_ratio;
+    res.wrap_seamless = v.seamless;
+  }
+  res.periodic = opt.wrap == ExemplarWrap::Periodic || (opt.wrap == ExemplarWrap::Auto && res.wrap_seamless);
   res.exemplar = std::move(rgb);
 }
 
@@ -953,7 +960,8 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSyn
                 {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
                 {"predicted_vertices", sc.predicted_vertices}};
   j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
-               {"bounded_levels", r.bounded_levels}};
+               {"lines_within_interior", r.wrap_lines_within_interior}, {"window_ratio", r.wrap_window_ratio},
+               {"seamless", r.wrap_seamless}, {"bounded_levels", r.bounded_levels}};
   j["repetition_penalty"] = o.repetition_penalty;
   j["exhaustive_levels"] = o.exhaustive_levels;
   j["r_scale"] = sc.r_scale;

@@ -39,7 +39,7 @@
 namespace surftex {
 
 enum class ExemplarWrap {
-  Auto,      ///< periodic when wrap_seam_ratio(exemplar) <= wrap_threshold
+  Auto,      ///< periodic when wrap_verdict(exemplar, wrap_threshold, region) finds the wrap seamless
   Periodic,  ///< always wrap (the exemplar is a seamless tile)
   Bounded    ///< never wrap
 };
@@ -64,7 +64,10 @@ struct SubdivisionSynthesisOptions {
   ExemplarWrap wrap = ExemplarWrap::Auto;
   /// Auto wrap: the exemplar counts as periodic when its wrap-seam ratio
   /// (texture/wrap_seam_ratio.h: jump across its wrap / jump inside) is at
-  /// most this, > 0. Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
+  /// most this, or, when a feature runs along the wrap, its wrap lines and
+  /// region-sized windows across the wrap look like its interior ones
+  /// (wrap_verdict, the window ratio at most this; decision 207), > 0.
+  /// Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
   double wrap_threshold = 1.3;
   /// n: neighbourhood edge length in texels, > 0. Default 9 (the paper's 3 is
   /// too small for structured exemplars; decision 206).
@@ -150,6 +153,12 @@ struct SubdivisionSynthesisResult {
   int stack_levels = 0;
   SubdivisionScale scale;
   double wrap_seam_ratio = 0;  ///< of the exemplar as synthesised
+  /// wrap_verdict (texture/wrap_seam_ratio.h) of the exemplar as synthesised,
+  /// with windows of region_texels (odd): its line check, window ratio (-1 =
+  /// not computed) and verdict (what ExemplarWrap::Auto follows).
+  bool wrap_lines_within_interior = false;
+  double wrap_window_ratio = -1;
+  bool wrap_seamless = true;
   bool periodic = true;        ///< treated as periodic (wrapped)
   int bounded_levels = 0;      ///< stack levels matched without wrapping (ExemplarLevels)
   Image exemplar;              ///< the exemplar as synthesised (RGB, reduced if exemplar_scale < 1)
