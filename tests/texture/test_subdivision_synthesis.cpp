@@ -21,6 +21,8 @@
 #include "texture/procedural_texture.h"
 #include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/wrap_seam_ratio.h"
+#include "geometry/image_io.h"
+#include "test_support.h"
 #include "wrap_test_images.h"
 
 using namespace surftex;
@@ -800,4 +802,27 @@ TEST(SubdivisionSynthesis, AutoWrapFollowsTheTextureNotWhereItsFeaturesLie) {
   EXPECT_GT(wrap_seam_ratio(make_cells(64, 4, 1)), 1.3);
   EXPECT_TRUE(periodic(make_cells(64, 4, 1)));
   EXPECT_FALSE(periodic(test::stripes_cut_mid_period()));
+}
+
+// Decision 207: an exemplar that tiles still tiles when the vertex budget
+// reduces it (bunny_6k at defaults: pebbles_256 and wood_512 reduced to
+// 61 px were blurred and resampled with clamped borders, measured wrap-seam
+// ratios 1.53 and 1.56, from 0.76 and 1.11, and were synthesised bounded).
+TEST(SubdivisionSynthesis, AReducedPeriodicExemplarStillTiles) {
+  const Image ex = read_image(test::shared_data("textures/pebbles_256.png"));
+  ASSERT_LE(wrap_seam_ratio(ex), 1.3);
+  Mesh m;
+  make_quad_plane(m, 4, 0.25);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 512;         // two exemplars across: one texel per vertex would need ~260k vertices
+  o.max_vertices = 4000;   // the budget reduces the exemplar
+  o.keys = {{0, {1, 0, 0}}};
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  ASSERT_TRUE(r.scale.budget_limited);
+  ASSERT_LT(r.scale.exemplar_scale, 0.5);
+  EXPECT_TRUE(r.periodic);
+  const double reduced = wrap_seam_ratio(r.exemplar);
+  const double clamped = wrap_seam_ratio(resample_as_synthesised(ex, r.scale, false));
+  EXPECT_GT(clamped, 1.3) << "the test needs an exemplar that clamped borders break";
+  EXPECT_LE(reduced, 1.3) << "clamped reduction: " << clamped;
 }

@@ -152,8 +152,9 @@ struct SubdivisionSynthesisResult {
   double object_unit = 1;  ///< mesh units per object unit
   int stack_levels = 0;
   SubdivisionScale scale;
-  double wrap_seam_ratio = 0;  ///< of the exemplar as synthesised
-  /// wrap_verdict (texture/wrap_seam_ratio.h) of the exemplar as synthesised,
+  double wrap_seam_ratio = 0;  ///< of the input exemplar (RGB, at its own resolution)
+  /// wrap_verdict (texture/wrap_seam_ratio.h) of the input exemplar (a
+  /// periodic one is then reduced wrapping, so it tiles as well),
   /// with windows of region_texels (odd): its line check, window ratio (-1 =
   /// not computed) and verdict (what ExemplarWrap::Auto follows).
   bool wrap_lines_within_interior = false;
@@ -189,9 +190,11 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& result, const Subdivisi
 
 /// An image of the input exemplar's size resampled as the exemplar was for
 /// the synthesis (SubdivisionScale: reduced when exemplar_scale < 1: halved
-/// with the binomial blur while more than twice the target, then bilinear),
-/// any channel count, float. Throws InvalidInputError if `img` is empty.
-Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale);
+/// with the binomial blur while more than twice the target, then bilinear;
+/// `periodic`: blurred and resampled around the borders, so an image that
+/// tiles still does, as for an exemplar treated as periodic), any channel
+/// count, float. Throws InvalidInputError if `img` is empty.
+Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic = false);
 
 /// The per-level geometry a pass reads: vertex frames and the region graph.
 /// Built once per mesh level and shared by all its passes (they do not move
