@@ -109,8 +109,8 @@ double window_nn(const Image& img, int x0, int y0, int n) {
 
 WrapWindowStats wrap_window_stats(const Image& img, int n, int per_line) {
   if (n < 1 || per_line < 1)
-    throw InvalidInputError("wrap_window_stats: window and windows_per_line must be >= 1 (got " + std::to_string(n) +
-                            ", " + std::to_string(per_line) + ")");
+    throw InvalidInputError("wrap_window_stats: window and windows_per_line must be >= 1 (got " +
+                            std::to_string(n) + ", " + std::to_string(per_line) + ")");
   if (img.empty() || img.width < 2 * n + 1 || img.height < 2 * n + 1)
     throw InvalidInputError("wrap_window_stats: the image must be at least " + std::to_string(2 * n + 1) +
                             " pixels on a side for " + std::to_string(n) + "-pixel windows, got " +
@@ -125,7 +125,8 @@ WrapWindowStats wrap_window_stats(const Image& img, int n, int per_line) {
   s.wrap_nn /= 2.0 * per_line;
   constexpr int kGrid = 8;  // interior windows: an 8 x 8 grid, borders included
   for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i) s.interior_nn += window_nn(img, i * (W - n) / (kGrid - 1), j * (H - n) / (kGrid - 1), n);
+    for (int i = 0; i < kGrid; ++i)
+      s.interior_nn += window_nn(img, i * (W - n) / (kGrid - 1), j * (H - n) / (kGrid - 1), n);
   s.interior_nn /= kGrid * kGrid;
   if (s.interior_nn > 0.0)
     s.ratio = s.wrap_nn / s.interior_nn;
@@ -149,13 +150,15 @@ bool wrap_lines_within_interior(const Image& img) {
 }  // namespace
 
 WrapVerdict wrap_verdict(const Image& img, double threshold, int window) {
-  if (!(threshold > 0.0)) throw InvalidInputError("wrap_verdict: threshold must be > 0 (got " + std::to_string(threshold) + ")");
+  if (!(threshold > 0.0))
+    throw InvalidInputError("wrap_verdict: threshold must be > 0 (got " + std::to_string(threshold) + ")");
   WrapVerdict v;
   v.seam_ratio = wrap_seam_ratio(img);
   v.seamless = v.seam_ratio <= threshold;
   if (v.seamless) return v;
   v.lines_within_interior = wrap_lines_within_interior(img);
-  if (!v.lines_within_interior || window < 1 || img.width < 2 * window + 1 || img.height < 2 * window + 1) return v;
+  if (!v.lines_within_interior || window < 1 || img.width < 2 * window + 1 || img.height < 2 * window + 1)
+    return v;
   v.window_ratio = wrap_window_stats(img, window).ratio;
   v.seamless = v.window_ratio <= threshold;
   return v;

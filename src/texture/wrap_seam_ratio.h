@@ -82,7 +82,7 @@ struct WrapVerdict {
   double seam_ratio = 1.0;             ///< wrap_seam_ratio
   bool lines_within_interior = false;  ///< check 1
   double window_ratio = -1.0;          ///< check 2's ratio; -1 when not computed
-  bool seamless = false;               ///< seam_ratio <= threshold, or checks 1 and 2 (window_ratio <= threshold)
+  bool seamless = false;  ///< seam_ratio <= threshold, or checks 1 and 2 (window_ratio <= threshold)
 };
 
 /// The verdict for `img` (at least 2x2): the windows are only compared when

@@ -11,18 +11,18 @@
 #include <random>
 
 #include "geometry/errors.h"
+#include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "texture/subdivision/turk_orientation_field.h"
+#include "test_support.h"
 #include "texture/displace_by_vertex_color.h"
+#include "texture/procedural_texture.h"
 #include "texture/subdivision/graph_cut_transfer.h"
 #include "texture/subdivision/k_region_matching.h"
-#include "texture/procedural_texture.h"
 #include "texture/subdivision/subdivision_synthesis.h"
+#include "texture/subdivision/turk_orientation_field.h"
 #include "texture/wrap_seam_ratio.h"
-#include "geometry/image_io.h"
-#include "test_support.h"
 #include "wrap_test_images.h"
 
 using namespace surftex;
@@ -814,8 +814,8 @@ TEST(SubdivisionSynthesis, AReducedPeriodicExemplarStillTiles) {
   Mesh m;
   make_quad_plane(m, 4, 0.25);
   SubdivisionSynthesisOptions o;
-  o.r_scale = 512;         // two exemplars across: one texel per vertex would need ~260k vertices
-  o.max_vertices = 4000;   // the budget reduces the exemplar
+  o.r_scale = 512;        // two exemplars across: one texel per vertex would need ~260k vertices
+  o.max_vertices = 4000;  // the budget reduces the exemplar
   o.keys = {{0, {1, 0, 0}}};
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
   ASSERT_TRUE(r.scale.budget_limited);

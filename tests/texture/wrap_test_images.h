@@ -24,9 +24,11 @@ inline Image mortar_cut_brick_wall(std::uint64_t seed) {
     for (int x = 0; x < 64; ++x) {
       const int row = y % 16, course = y / 16;
       const int bx = (x + (course % 2) * 16) % 32;
-      float r = 0.55f, g = 0.25f, b = 0.2f;                     // brick
-      if (row < 2 || bx < 2) r = 0.8f, g = 0.78f, b = 0.75f;    // mortar (bed and head joints)
-      else if (row == 15) r = 0.15f, g = 0.1f, b = 0.1f;        // shadow under the brick
+      float r = 0.55f, g = 0.25f, b = 0.2f;  // brick
+      if (row < 2 || bx < 2)
+        r = 0.8f, g = 0.78f, b = 0.75f;  // mortar (bed and head joints)
+      else if (row == 15)
+        r = 0.15f, g = 0.1f, b = 0.1f;  // shadow under the brick
       const float n = noise(rng);
       im.at(x, y, 0) = r + n, im.at(x, y, 1) = g + n, im.at(x, y, 2) = b + n;
     }
@@ -42,7 +44,8 @@ inline Image stripes_cut_mid_period() {
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 51; ++x) {
       const bool blue = x % 20 < 10;
-      im.at(x, y, 0) = blue ? 0.05f : 1.0f, im.at(x, y, 1) = blue ? 0.6f : 1.0f, im.at(x, y, 2) = blue ? 0.9f : 1.0f;
+      im.at(x, y, 0) = blue ? 0.05f : 1.0f, im.at(x, y, 1) = blue ? 0.6f : 1.0f,
+                  im.at(x, y, 2) = blue ? 0.9f : 1.0f;
     }
   return im;
 }

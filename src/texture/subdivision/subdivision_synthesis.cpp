@@ -87,7 +87,8 @@ Image resize_wrapped(const Image& img, int w, int h) {
   Image out(w, h, img.channels);
   const double sx = static_cast<double>(img.width) / w, sy = static_cast<double>(img.height) / h;
   for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) sample_bilinear(img, (i + 0.5) * sx - 0.5, (j + 0.5) * sy - 0.5, true, out.pixel(i, j));
+    for (int i = 0; i < w; ++i)
+      sample_bilinear(img, (i + 0.5) * sx - 0.5, (j + 0.5) * sy - 0.5, true, out.pixel(i, j));
   return out;
 }
 
@@ -120,7 +121,8 @@ Image to_rgb(const Image& in) {
 
 Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic) {
   if (img.empty()) throw InvalidInputError("resample_as_synthesised: the image is empty");
-  if (scale.exemplar_scale < 1.0) return reduce_exemplar(img, scale.exemplar_width, scale.exemplar_height, periodic);
+  if (scale.exemplar_scale < 1.0)
+    return reduce_exemplar(img, scale.exemplar_width, scale.exemplar_height, periodic);
   return img;
 }
 
@@ -973,9 +975,13 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSyn
                 {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},
                 {"max_vertices", o.max_vertices}, {"spacing_texels", sc.spacing_texels},
                 {"predicted_vertices", sc.predicted_vertices}};
-  j["wrap"] = {{"periodic", r.periodic}, {"wrap_seam_ratio", r.wrap_seam_ratio}, {"threshold", o.wrap_threshold},
-               {"lines_within_interior", r.wrap_lines_within_interior}, {"window_ratio", r.wrap_window_ratio},
-               {"seamless", r.wrap_seamless}, {"bounded_levels", r.bounded_levels}};
+  j["wrap"] = {{"periodic", r.periodic},
+               {"wrap_seam_ratio", r.wrap_seam_ratio},
+               {"threshold", o.wrap_threshold},
+               {"lines_within_interior", r.wrap_lines_within_interior},
+               {"window_ratio", r.wrap_window_ratio},
+               {"seamless", r.wrap_seamless},
+               {"bounded_levels", r.bounded_levels}};
   j["repetition_penalty"] = o.repetition_penalty;
   j["exhaustive_levels"] = o.exhaustive_levels;
   j["r_scale"] = sc.r_scale;
