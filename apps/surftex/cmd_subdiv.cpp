@@ -305,9 +305,12 @@ SubcommandRegistrar reg_subdiv{
                       "exemplar's resolution needs more, the synthesis texel grows (the exemplar is reduced, the "
                       "scale kept)")
            ->check(CLI::Range(std::size_t(1000), std::size_t(50000000)));
-       app.add_option("--wrap", a->wrap,
-                      "auto (default): wrap the exemplar around its edges only if its wrap-seam ratio is <= 1.3 "
-                      "(it tiles); periodic: always (a seamless tile, e.g. from `surftex tile`); bounded: never")
+       app.add_option(
+              "--wrap", a->wrap,
+              "auto (default): wrap the exemplar around its edges only if it tiles: its wrap-seam ratio is "
+              "<= 1.3, or, where a feature runs along the wrap, its wrap lines and neighbourhoods look like "
+              "its interior ones (report: wrap); periodic: always (a seamless tile, e.g. from `surftex "
+              "tile`); bounded: never")
            ->check(CLI::IsMember({"auto", "periodic", "bounded"}));
        app.add_option("--repetition-penalty", a->repetition,
                       "Weight of the penalty for matching exemplar areas that nearby regions already show more "

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
 
@@ -60,6 +62,107 @@ WrapSeamStats wrap_seam_stats(const Image& img) {
 }
 
 double wrap_seam_ratio(const Image& img) { return wrap_seam_stats(img).ratio; }
+
+namespace {
+
+// The n x n window of `img` whose top-left pixel is (x0, y0), read wrapping.
+std::vector<float> wrapped_window(const Image& img, int x0, int y0, int n) {
+  const int W = img.width, H = img.height, C = img.channels;
+  std::vector<float> w(static_cast<std::size_t>(n) * n * C);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const float* p = img.pixel(((x0 + i) % W + W) % W, ((y0 + j) % H + H) % H);
+      std::copy(p, p + C, w.begin() + (static_cast<std::ptrdiff_t>(j) * n + i) * C);
+    }
+  return w;
+}
+
+// The mean squared difference (per pixel, summed over channels) between the
+// window `q` at (qx, qy) and its nearest window lying wholly inside `img`,
+// leaving out the windows that overlap (qx, qy) on the torus.
+double nearest_interior_window(const Image& img, const std::vector<float>& q, int qx, int qy, int n) {
+  const int W = img.width, H = img.height, C = img.channels;
+  qx = (qx % W + W) % W, qy = (qy % H + H) % H;
+  double best = std::numeric_limits<double>::infinity();
+  for (int y = 0; y + n <= H; ++y) {
+    const int dy = std::min(std::abs(y - qy), H - std::abs(y - qy));
+    for (int x = 0; x + n <= W; ++x) {
+      const int dx = std::min(std::abs(x - qx), W - std::abs(x - qx));
+      if (dx < n && dy < n) continue;
+      double d = 0.0;
+      for (int j = 0; j < n && d < best; ++j) {
+        const float* r = img.pixel(x, y + j);
+        const float* a = q.data() + static_cast<std::ptrdiff_t>(j) * n * C;
+        for (int k = 0; k < n * C; ++k) d += double(r[k] - a[k]) * double(r[k] - a[k]);
+      }
+      best = std::min(best, d);
+    }
+  }
+  return best / (static_cast<double>(n) * n);
+}
+
+double window_nn(const Image& img, int x0, int y0, int n) {
+  return nearest_interior_window(img, wrapped_window(img, x0, y0, n), x0, y0, n);
+}
+
+}  // namespace
+
+WrapWindowStats wrap_window_stats(const Image& img, int n, int per_line) {
+  if (n < 1 || per_line < 1)
+    throw InvalidInputError("wrap_window_stats: window and windows_per_line must be >= 1 (got " +
+                            std::to_string(n) + ", " + std::to_string(per_line) + ")");
+  if (img.empty() || img.width < 2 * n + 1 || img.height < 2 * n + 1)
+    throw InvalidInputError("wrap_window_stats: the image must be at least " + std::to_string(2 * n + 1) +
+                            " pixels on a side for " + std::to_string(n) + "-pixel windows, got " +
+                            std::to_string(img.width) + "x" + std::to_string(img.height));
+  const int W = img.width, H = img.height, h = n / 2;
+  WrapWindowStats s;
+  // Wrap windows: the seam between their columns (rows) h and h + 1.
+  for (int i = 0; i < per_line; ++i) {
+    s.wrap_nn += window_nn(img, W - h - 1, (2 * i + 1) * H / (2 * per_line) - h, n);
+    s.wrap_nn += window_nn(img, (2 * i + 1) * W / (2 * per_line) - h, H - h - 1, n);
+  }
+  s.wrap_nn /= 2.0 * per_line;
+  constexpr int kGrid = 8;  // interior windows: an 8 x 8 grid, borders included
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i)
+      s.interior_nn += window_nn(img, i * (W - n) / (kGrid - 1), j * (H - n) / (kGrid - 1), n);
+  s.interior_nn /= kGrid * kGrid;
+  if (s.interior_nn > 0.0)
+    s.ratio = s.wrap_nn / s.interior_nn;
+  else
+    s.ratio = s.wrap_nn > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+  return s;
+}
+
+namespace {
+
+// Check 1 of wrap_verdict: each wrap line jumps no more than the most
+// contrasted interior line of its orientation.
+bool wrap_lines_within_interior(const Image& img) {
+  if (img.width < 3 || img.height < 3) return false;
+  const LineJumpProfile torus = line_jump_profile(img, true), inside = line_jump_profile(img, false);
+  const double col = *std::max_element(inside.column.begin() + 1, inside.column.end());
+  const double row = *std::max_element(inside.row.begin() + 1, inside.row.end());
+  return torus.column[0] <= col && torus.row[0] <= row;
+}
+
+}  // namespace
+
+WrapVerdict wrap_verdict(const Image& img, double threshold, int window) {
+  if (!(threshold > 0.0))
+    throw InvalidInputError("wrap_verdict: threshold must be > 0 (got " + std::to_string(threshold) + ")");
+  WrapVerdict v;
+  v.seam_ratio = wrap_seam_ratio(img);
+  v.seamless = v.seam_ratio <= threshold;
+  if (v.seamless) return v;
+  v.lines_within_interior = wrap_lines_within_interior(img);
+  if (!v.lines_within_interior || window < 1 || img.width < 2 * window + 1 || img.height < 2 * window + 1)
+    return v;
+  v.window_ratio = wrap_window_stats(img, window).ratio;
+  v.seamless = v.window_ratio <= threshold;
+  return v;
+}
 
 LineJumpProfile line_jump_profile(const Image& img, bool periodic) {
   const int min_side = periodic ? 2 : 3;

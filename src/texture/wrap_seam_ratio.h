@@ -47,6 +47,49 @@ WrapSeamStats wrap_seam_stats(const Image& img);
 /// wrap_seam_stats(img).ratio.
 double wrap_seam_ratio(const Image& img);
 
+// Whether the wrap of an image is invisible, for the texture's own structure
+// (subdivision synthesis's --wrap auto; docs/decisions/207-wrap-verdict.md).
+// The plain ratio above is fooled when a feature of the texture runs along
+// the wrap (decision 306): a brick wall cut along its mortar tiles, yet its
+// wrap row jumps like a mortar line, far above the mean. Two checks replace
+// it there, each a comparison with the image itself:
+// 1. lines: the mean jump across each wrap line (column line 0, row line 0)
+//    is no larger than across the most contrasted interior line of the same
+//    orientation (the wrap looks like some line of the texture);
+// 2. windows: the window x window neighbourhoods straddling the wrap have
+//    as close a match among the image's interior windows as interior
+//    windows have among the others (a period that does not divide the
+//    image, e.g. stripes cut mid-period, passes 1 but makes a neighbourhood
+//    found nowhere inside: a stripe of double width).
+
+/// Windows straddling the wrap against interior windows: the mean, over
+/// windows_per_line windows evenly spread along each wrap line (the seam in
+/// their middle, read wrapping), of the mean squared colour difference to
+/// the nearest window lying wholly inside the image; and the same for an
+/// 8 x 8 grid of interior windows. Candidates overlapping the query on the
+/// torus are left out for both, so no window is matched to itself.
+struct WrapWindowStats {
+  double wrap_nn = 0.0;      ///< mean nearest-neighbour distance of the wrap windows
+  double interior_nn = 0.0;  ///< the same for the interior windows
+  double ratio = 1.0;        ///< wrap_nn / interior_nn (1 if both are 0, +inf if only interior_nn is)
+};
+
+/// Throws InvalidInputError if window < 1 or the image is smaller than
+/// 2 window + 1 on a side (no candidate would remain).
+WrapWindowStats wrap_window_stats(const Image& img, int window, int windows_per_line = 32);
+
+struct WrapVerdict {
+  double seam_ratio = 1.0;             ///< wrap_seam_ratio
+  bool lines_within_interior = false;  ///< check 1
+  double window_ratio = -1.0;          ///< check 2's ratio; -1 when not computed
+  bool seamless = false;  ///< seam_ratio <= threshold, or checks 1 and 2 (window_ratio <= threshold)
+};
+
+/// The verdict for `img` (at least 2x2): the windows are only compared when
+/// the plain ratio is above `threshold` (> 0) and the lines pass, and when
+/// the image is at least 2 window + 1 on each side (else not seamless).
+WrapVerdict wrap_verdict(const Image& img, double threshold, int window);
+
 // Worst-line ratio: every line of the torus (column line x: pairs (x-1, x)
 // mod W; row line y likewise), its mean jump over the mean jump of all pairs
 // of its orientation (per orientation, for anisotropic textures; unchanged by

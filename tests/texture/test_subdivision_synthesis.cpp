@@ -11,16 +11,19 @@
 #include <random>
 
 #include "geometry/errors.h"
+#include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
-#include "texture/subdivision/turk_orientation_field.h"
+#include "test_support.h"
 #include "texture/displace_by_vertex_color.h"
+#include "texture/procedural_texture.h"
 #include "texture/subdivision/graph_cut_transfer.h"
 #include "texture/subdivision/k_region_matching.h"
-#include "texture/procedural_texture.h"
 #include "texture/subdivision/subdivision_synthesis.h"
+#include "texture/subdivision/turk_orientation_field.h"
 #include "texture/wrap_seam_ratio.h"
+#include "wrap_test_images.h"
 
 using namespace surftex;
 
@@ -610,8 +613,9 @@ TEST(SubdivisionSynthesis, DeepHierarchyKeepsTheExemplarsFeatureSize) {
   o.r_scale = n;                      // one texel per final edge
   o.keys = {{0, {1, 0, 0}}};
   o.seed = 1;
+  o.wrap = ExemplarWrap::Bounded;  // the regression was in the bounded levels (make_cells itself tiles)
   const SubdivisionSynthesisResult res = synthesize_on_subdivision(m, img, o);
-  EXPECT_FALSE(res.periodic);  // make_cells does not tile (wrap-seam ratio 1.59): its fine levels are bounded
+  EXPECT_FALSE(res.periodic);
   EXPECT_GE(res.bounded_levels, 1);
   // Vertex grey binned on the final grid (vertices near the border are moved
   // off the lattice by the smoothing, so bin rather than pick lattice points).
@@ -770,4 +774,55 @@ TEST(SubdivisionSynthesis, NonPeriodicExemplarIsNotCopiedAcrossItsWrap) {
   EXPECT_TRUE(forced.first);
   EXPECT_EQ(automatic.second, 0);
   EXPECT_GT(forced.second, 10) << "the test does not see wrap copies";
+}
+
+// Issue 18's flat-square goal (docs/decisions/207): --wrap auto follows the
+// texture, not where a feature happens to lie. A brick wall cut along its
+// mortar tiles though its plain wrap-seam ratio is above 1.3 (the wrap row
+// is a mortar line): it is wrapped, as brick_small_96 now is, and so is
+// make_cells (Worley cells on a torus, periodic by construction, plain ratio
+// 1.59). Stripes whose period does not divide the width are not (wrapping
+// them pastes a hairline between two joined stripes).
+TEST(SubdivisionSynthesis, AutoWrapFollowsTheTextureNotWhereItsFeaturesLie) {
+  auto periodic = [](const Image& ex) {
+    Mesh m;
+    make_quad_plane(m, 4, 0.25);
+    SubdivisionSynthesisOptions o;
+    o.levels = 0;
+    o.r_scale = 16;
+    o.keys = {{0, {1, 0, 0}}};
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+    EXPECT_EQ(r.periodic, r.wrap_seamless);
+    EXPECT_EQ(r.bounded_levels == 0, r.periodic);
+    return r.periodic;
+  };
+  const Image wall = test::mortar_cut_brick_wall(1);
+  EXPECT_GT(wrap_seam_ratio(wall), 1.3);
+  EXPECT_TRUE(periodic(wall));
+  EXPECT_GT(wrap_seam_ratio(make_cells(64, 4, 1)), 1.3);
+  EXPECT_TRUE(periodic(make_cells(64, 4, 1)));
+  EXPECT_FALSE(periodic(test::stripes_cut_mid_period()));
+}
+
+// Decision 207: an exemplar that tiles still tiles when the vertex budget
+// reduces it (bunny_6k at defaults: pebbles_256 and wood_512 reduced to
+// 61 px were blurred and resampled with clamped borders, measured wrap-seam
+// ratios 1.53 and 1.56, from 0.76 and 1.11, and were synthesised bounded).
+TEST(SubdivisionSynthesis, AReducedPeriodicExemplarStillTiles) {
+  const Image ex = read_image(test::shared_data("textures/pebbles_256.png"));
+  ASSERT_LE(wrap_seam_ratio(ex), 1.3);
+  Mesh m;
+  make_quad_plane(m, 4, 0.25);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 512;        // two exemplars across: one texel per vertex would need ~260k vertices
+  o.max_vertices = 4000;  // the budget reduces the exemplar
+  o.keys = {{0, {1, 0, 0}}};
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  ASSERT_TRUE(r.scale.budget_limited);
+  ASSERT_LT(r.scale.exemplar_scale, 0.5);
+  EXPECT_TRUE(r.periodic);
+  const double reduced = wrap_seam_ratio(r.exemplar);
+  const double clamped = wrap_seam_ratio(resample_as_synthesised(ex, r.scale, false));
+  EXPECT_GT(clamped, 1.3) << "the test needs an exemplar that clamped borders break";
+  EXPECT_LE(reduced, 1.3) << "clamped reduction: " << clamped;
 }

@@ -59,7 +59,7 @@ VertexMapValues read_map_at_vertices(const Mesh& mesh, const SubdivisionSynthesi
   if (r.lookup.size() != nv || mesh.has_garbage())
     throw InvalidInputError("read_map_at_vertices: the synthesis result has " + std::to_string(r.lookup.size()) +
                             " lookups for " + std::to_string(nv) + " vertices");
-  const Image as_synthesised = resample_as_synthesised(map, r.scale);
+  const Image as_synthesised = resample_as_synthesised(map, r.scale, r.periodic);
   const ExemplarLevels lv = make_exemplar_levels(as_synthesised, r.pyramid, 0, r.bounded_levels);
   VertexMapValues out;
   out.channels = map.channels >= 3 ? 3 : 1;

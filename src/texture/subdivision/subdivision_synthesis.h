@@ -39,7 +39,7 @@
 namespace surftex {
 
 enum class ExemplarWrap {
-  Auto,      ///< periodic when wrap_seam_ratio(exemplar) <= wrap_threshold
+  Auto,      ///< periodic when wrap_verdict(exemplar, wrap_threshold, region) finds the wrap seamless
   Periodic,  ///< always wrap (the exemplar is a seamless tile)
   Bounded    ///< never wrap
 };
@@ -64,7 +64,10 @@ struct SubdivisionSynthesisOptions {
   ExemplarWrap wrap = ExemplarWrap::Auto;
   /// Auto wrap: the exemplar counts as periodic when its wrap-seam ratio
   /// (texture/wrap_seam_ratio.h: jump across its wrap / jump inside) is at
-  /// most this, > 0. Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
+  /// most this, or, when a feature runs along the wrap, its wrap lines and
+  /// region-sized windows across the wrap look like its interior ones
+  /// (wrap_verdict, the window ratio at most this; decision 207), > 0.
+  /// Default 1.3 (the tileable-tile criterion of Ray 2009 s.1).
   double wrap_threshold = 1.3;
   /// n: neighbourhood edge length in texels, > 0. Default 9 (the paper's 3 is
   /// too small for structured exemplars; decision 206).
@@ -149,7 +152,14 @@ struct SubdivisionSynthesisResult {
   double object_unit = 1;  ///< mesh units per object unit
   int stack_levels = 0;
   SubdivisionScale scale;
-  double wrap_seam_ratio = 0;  ///< of the exemplar as synthesised
+  double wrap_seam_ratio = 0;  ///< of the input exemplar (RGB, at its own resolution)
+  /// wrap_verdict (texture/wrap_seam_ratio.h) of the input exemplar (a
+  /// periodic one is then reduced wrapping, so it tiles as well),
+  /// with windows of region_texels (odd): its line check, window ratio (-1 =
+  /// not computed) and verdict (what ExemplarWrap::Auto follows).
+  bool wrap_lines_within_interior = false;
+  double wrap_window_ratio = -1;
+  bool wrap_seamless = true;
   bool periodic = true;        ///< treated as periodic (wrapped)
   int bounded_levels = 0;      ///< stack levels matched without wrapping (ExemplarLevels)
   Image exemplar;              ///< the exemplar as synthesised (RGB, reduced if exemplar_scale < 1)
@@ -180,9 +190,11 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& result, const Subdivisi
 
 /// An image of the input exemplar's size resampled as the exemplar was for
 /// the synthesis (SubdivisionScale: reduced when exemplar_scale < 1: halved
-/// with the binomial blur while more than twice the target, then bilinear),
-/// any channel count, float. Throws InvalidInputError if `img` is empty.
-Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale);
+/// with the binomial blur while more than twice the target, then bilinear;
+/// `periodic`: blurred and resampled around the borders, so an image that
+/// tiles still does, as for an exemplar treated as periodic), any channel
+/// count, float. Throws InvalidInputError if `img` is empty.
+Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic = false);
 
 /// The per-level geometry a pass reads: vertex frames and the region graph.
 /// Built once per mesh level and shared by all its passes (they do not move
