@@ -79,14 +79,18 @@ std::vector<float> wrapped_window(const Image& img, int x0, int y0, int n) {
 
 // The mean squared difference (per pixel, summed over channels) between the
 // window `q` at (qx, qy) and its nearest window lying wholly inside `img`,
-// leaving out the windows that overlap (qx, qy) on the torus.
+// leaving out the windows that overlap (qx, qy) on the torus. Candidates on
+// every pixel up to 128 px a side, else on every (side / 128)-th (the
+// verdict runs on the input exemplar: a 4096 px one would otherwise cost
+// minutes; the wrap and the interior windows are searched alike).
 double nearest_interior_window(const Image& img, const std::vector<float>& q, int qx, int qy, int n) {
   const int W = img.width, H = img.height, C = img.channels;
+  const int step = std::max(1, std::min(W, H) / 128);
   qx = (qx % W + W) % W, qy = (qy % H + H) % H;
   double best = std::numeric_limits<double>::infinity();
-  for (int y = 0; y + n <= H; ++y) {
+  for (int y = 0; y + n <= H; y += step) {
     const int dy = std::min(std::abs(y - qy), H - std::abs(y - qy));
-    for (int x = 0; x + n <= W; ++x) {
+    for (int x = 0; x + n <= W; x += step) {
       const int dx = std::min(std::abs(x - qx), W - std::abs(x - qx));
       if (dx < n && dy < n) continue;
       double d = 0.0;
