@@ -234,7 +234,9 @@ SubcommandRegistrar reg{
                       "and normal texture), render.png, report.json")
            ->required();
        app.add_option("--field", a->field,
-                      "Texture orientation: up (projected +y), kmax|kmin (greatest/least signed "
+                      "Texture orientation: the exemplar's +x (its rows) follows this field (Gorla 2003: the "
+                      "pattern's dominant direction follows the field), so with up a horizontal grain runs up "
+                      "the surface. up (projected +y), kmax|kmin (greatest/least signed "
                       "normal curvature), kmax-abs|kmin-abs (greatest/least absolute curvature), "
                       "none (isotropic) (default up)")
            ->check(CLI::IsMember({"up", "kmax", "kmin", "kmax-abs", "kmin-abs", "none"}));
