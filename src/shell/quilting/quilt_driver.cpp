@@ -108,14 +108,15 @@ namespace {
 
 // The swatch's size on the base, checked before the work: relative size at
 // most 10, the output's faces and the grid (check_quilt_size), the budget.
-void check_surface_quilt_size(const Mesh& base, const Swatch& s, const QuiltSwatchOnSurfaceOptions& opt) {
-  const double rel = opt.quilt.relative_size;
+void check_surface_quilt_size(const Mesh& base, const Swatch& s, const SurfaceQuiltOptions& qo,
+                              const std::function<void(const WorkEstimate&)>& check_work) {
+  const double rel = qo.relative_size;
   if (!(rel <= 10))
     throw InvalidInputError("quilt: --scale must be <= 10 on a mesh (got " + std::to_string(rel) + ")");
   const double placements = surface_quilt_placements(base, s, rel);
-  check_quilt_size(s, opt.quilt.cell_size, placements, "--scale " + std::to_string(rel));
-  if (opt.check_work)
-    opt.check_work(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())));
+  check_quilt_size(s, qo.cell_size, placements, "--scale " + std::to_string(rel));
+  if (check_work)
+    check_work(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())));
 }
 
 }  // namespace
@@ -124,10 +125,9 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                                                    const QuiltSwatchOnSurfaceOptions& opt) {
   QuiltSwatchOnSurfaceResult r;
   r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
-  QuiltSwatchOnSurfaceOptions o2 = opt;
-  if (!(opt.quilt.relative_size > 0)) o2.quilt.relative_size = default_surface_quilt_size(r.swatch);
-  check_surface_quilt_size(base, r.swatch, o2);
-  SurfaceQuiltOptions qo = o2.quilt;
+  SurfaceQuiltOptions qo = opt.quilt;
+  if (!(qo.relative_size > 0)) qo.relative_size = default_surface_quilt_size(r.swatch);
+  check_surface_quilt_size(base, r.swatch, qo, opt.check_work);
   qo.seed = opt.seed;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);

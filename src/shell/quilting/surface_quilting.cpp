@@ -616,6 +616,7 @@ class SurfaceQuilter {
   int done_ = 0;
   bool refilling_ = false;
   double stretch_bound2_ = 0;  // squared (mesh units); 0 = none (settle_and_trim)
+  std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   SurfaceQuiltResult res_;
@@ -657,9 +658,9 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     const double ln = norm3(n);
     if (ln > 0) n = {n[0] / ln, n[1] / ln, n[2] / ln};
   }
-  const std::vector<ElementMesh> compact = compact_swatch_elements(swatch);
-  for (const ElementMesh& m : compact) compact_spread_ = std::max(compact_spread_, spread13(m.points));
-  all_compact_ = !compact.empty() && compact.size() == swatch.elements.size();
+  compact_ = compact_swatch_elements(swatch);
+  for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
+  all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   processed_.assign(nf_, 0);
   constrained_.assign(nf_, 0);
   patch_slot_.assign(nf_, -1);
@@ -1659,7 +1660,7 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // (place_scatter_element). Threads (weaves) are not scattered: a cut thread
 // is no element.
 void SurfaceQuilter::scatter_into_bare() {
-  const std::vector<ElementMesh> tpl = compact_swatch_elements(swatch_);
+  const std::vector<ElementMesh>& tpl = compact_;
   if (tpl.empty()) return;
   double reach = 0;  // the largest template's xy radius (swatch units)
   for (const ElementMesh& m : tpl)
@@ -1788,16 +1789,19 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 
 double default_surface_quilt_size(const Swatch& swatch) {
   constexpr double kSize = 0.25, kElementSize = 0.0625;
-  std::vector<double> sides;  // larger xy side of each compact element (is_compact_element's ratio)
-  for (const SwatchElement& e : swatch.elements) {
-    const double a = e.bbox_max[0] - e.bbox_min[0], b = e.bbox_max[1] - e.bbox_min[1];
-    const double lo = std::min(a, b), hi = std::max(a, b);
-    if (hi > 0 && hi <= 2.5 * lo) sides.push_back(hi);
+  std::vector<double> sides;  // larger xy side of each compact element
+  for (const ElementMesh& m : compact_swatch_elements(swatch)) {
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    const double side = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+    if (side > 0) sides.push_back(side);
   }
-  const double side = std::max(swatch.length(), swatch.width());
-  if (sides.empty() || !(side > 0)) return kSize;
+  const double whole = std::max(swatch.length(), swatch.width());
+  if (sides.empty() || !(whole > 0)) return kSize;
   std::nth_element(sides.begin(), sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2), sides.end());
-  return std::min(kSize, kElementSize * side / sides[sides.size() / 2]);
+  return std::min(kSize, kElementSize * whole / sides[sides.size() / 2]);
 }
 
 double surface_quilt_placements(const Mesh& base, const Swatch& swatch, double relative_size) {
