@@ -78,7 +78,7 @@ void sample_bilinear(const Image& img, double x, double y, bool wrap, float* out
   }
 }
 
-Image resize_bilinear(const Image& img, int w, int h) {
+Image resize_bilinear(const Image& img, int w, int h, bool wrap) {
   require_image(img, "resize_bilinear: image");
   if (w <= 0 || h <= 0)
     throw InvalidInputError("resize_bilinear: size " + std::to_string(w) + "x" +
@@ -87,9 +87,9 @@ Image resize_bilinear(const Image& img, int w, int h) {
   const double sx = static_cast<double>(img.width) / w, sy = static_cast<double>(img.height) / h;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      double x = std::clamp((i + 0.5) * sx - 0.5, 0.0, img.width - 1.0);
-      double y = std::clamp((j + 0.5) * sy - 0.5, 0.0, img.height - 1.0);
-      sample_bilinear(img, x, y, false, out.pixel(i, j));
+      double x = (i + 0.5) * sx - 0.5, y = (j + 0.5) * sy - 0.5;
+      if (!wrap) x = std::clamp(x, 0.0, img.width - 1.0), y = std::clamp(y, 0.0, img.height - 1.0);
+      sample_bilinear(img, x, y, wrap, out.pixel(i, j));
     }
   return out;
 }

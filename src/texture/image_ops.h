@@ -20,9 +20,10 @@ Image luminance(const Image& img);
 Image crop(const Image& img, int x, int y, int w, int h, bool wrap = false);
 
 /// Bilinear resize to w x h (pixel centres aligned: sample (i+0.5)*W/w-0.5,
-/// clamped to the border). Suitable for moderate scale changes; for strong
-/// minification build a pyramid first.
-Image resize_bilinear(const Image& img, int w, int h);
+/// clamped to the border, or read around it with `wrap`: a tile stays a
+/// tile). Suitable for moderate scale changes; for strong minification build
+/// a pyramid first.
+Image resize_bilinear(const Image& img, int w, int h, bool wrap = false);
 
 /// Bilinear sample at continuous pixel coordinates (x, y) (pixel centres at
 /// integers). With `wrap`, coordinates wrap around; without, they are clamped.

@@ -82,16 +82,6 @@ MeshFigures mesh_figures(const Mesh& mesh) {
   return f;
 }
 
-// Bilinear resize to w x h as resize_bilinear, reading around the borders.
-Image resize_wrapped(const Image& img, int w, int h) {
-  Image out(w, h, img.channels);
-  const double sx = static_cast<double>(img.width) / w, sy = static_cast<double>(img.height) / h;
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i)
-      sample_bilinear(img, (i + 0.5) * sx - 0.5, (j + 0.5) * sy - 0.5, true, out.pixel(i, j));
-  return out;
-}
-
 // An exemplar reduced to w x h: halved with the binomial blur while more than
 // twice the target, then bilinear (no aliasing for strong reductions). A
 // periodic one is blurred and resampled around its borders, so that it still
@@ -105,7 +95,7 @@ Image reduce_exemplar(const Image& img, int w, int h, bool periodic) {
     po.toroidal = periodic;
     cur = gaussian_pyramid(cur, po)[1];
   }
-  return periodic ? resize_wrapped(cur, w, h) : resize_bilinear(cur, w, h);
+  return resize_bilinear(cur, w, h, periodic);
 }
 
 Image to_rgb(const Image& in) {
