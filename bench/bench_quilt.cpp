@@ -340,7 +340,18 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"outside_vertices", er.embed.outside},
          {"bare", bare_area(base, q, 0.5 * spacing * q.scale, Vector3(0, 1, 0))},
          {"gap", gap_ratio(out, s, q.scale, spacing)},
-         {"seconds", {{"quilt", run.seconds_quilt}, {"embed", run.seconds_embed}, {"total", total.seconds()}}},
+         {"seconds",
+          {{"quilt", run.seconds_quilt},
+           {"embed", run.seconds_embed},
+           {"total", total.seconds()},
+           {"patches", r.seconds_patch},
+           {"turn", r.seconds_turn},
+           {"match", r.stats.seconds_match},
+           {"correspond", r.stats.seconds_correspond},
+           {"deform", r.stats.seconds_deform},
+           {"merge", r.stats.seconds_merge},
+           {"resolve", r.stats.seconds_resolve},
+           {"finish", r.seconds_finish}}},
          {"user_cpu", user_cpu() - cpu0}};
   j["elements"] = j["gap"]["elements"];
   if (!outdir.empty()) {

@@ -57,6 +57,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["elements_misshapen"] = r.elements_misshapen;
   j["edge_stretch_max"] = r.edge_stretch_max;
   j["crossings_resolved"] = r.crossings_resolved;
+  j["finish_elements_checked"] = r.finish_elements_checked;
   j["fragments_removed"] = r.fragments_removed;
   j["faces_refilled"] = r.faces_refilled;
   j["scatter_placed"] = r.scatter_placed;

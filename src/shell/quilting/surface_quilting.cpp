@@ -253,6 +253,7 @@ struct Element {
   std::vector<SurfaceQuiltVertex> loc;  // per vertex
   bool alive = true;
   bool compact = false;                 // is_compact_element in the frame it was last placed in
+  bool finished = false;                // through finish() and unchanged since (a refill round skips it)
 };
 
 P3 base_point(const Base& b, const SurfaceQuiltVertex& v) {
@@ -1167,6 +1168,7 @@ void SurfaceQuilter::write_back_old(std::size_t k, FrameElements& fe, const std:
     return;
   }
   if (now_m.tris == before[k].tris && now_m.points == before[k].points) return;
+  el.finished = false;
   if (pt.inner.empty()) {
     el.compact = is_compact_element(now_m);
     el.mesh.tris = now_m.tris;
@@ -1432,7 +1434,7 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
   // (The pieces appended are checked in turn: a cap's edges, lifted along
   // the vertex normals, may pass the bound where they diverge, at a rim.)
   for (std::size_t e = from; e < elements_.size(); ++e) {
-    if (!elements_[e].alive || elements_[e].mesh.tris.empty()) continue;
+    if (!elements_[e].alive || elements_[e].mesh.tris.empty() || elements_[e].finished) continue;
     Element& el = elements_[e];
     fit_z(el);
     std::vector<char> past_v(el.loc.size(), 0);
@@ -1496,7 +1498,9 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
 // triangle-triangle tests, element_clearance.h); from the last element to
 // the first, one that hits an earlier one yields: removed if compact, else
 // the triangles that hit (and opt.step.trim_rings rings) cut out and the
-// pieces capped; a piece that still hits is removed.
+// pieces capped; a piece that still hits is removed. Elements a previous
+// finish checked and nothing changed since (Element::finished) cross none
+// of each other, so only the others are tested (against all).
 void SurfaceQuilter::resolve_crossings_lifted() {
   std::vector<ElementMesh> lifted_els;
   std::vector<int> id;  // element index per lifted element
@@ -1509,6 +1513,8 @@ void SurfaceQuilter::resolve_crossings_lifted() {
   std::vector<char> dead(lifted_els.size(), 0);
   const double cap_max = 2 * swatch_h_ * S_;
   for (std::size_t i = lifted_els.size(); i-- > 0;) {
+    if (elements_[static_cast<std::size_t>(id[i])].finished) continue;
+    ++res_.finish_elements_checked;
     const std::vector<char> hit = coll.hits(lifted_els[i], static_cast<int>(i), 0.0, &dead);
     if (std::find(hit.begin(), hit.end(), 1) == hit.end()) continue;
     ++res_.crossings_resolved;
@@ -1547,7 +1553,7 @@ void SurfaceQuilter::remove_misshapen() {
   if (!(opt_.max_shape_ratio > 0) || !(compact_spread_ > 0)) return;
   const double lim = opt_.max_shape_ratio * compact_spread_ * S_;
   for (Element& el : elements_) {
-    if (!el.alive || el.mesh.tris.empty() || !(el.compact || all_compact_)) continue;
+    if (!el.alive || el.finished || el.mesh.tris.empty() || !(el.compact || all_compact_)) continue;
     if (spread13(lifted_mesh(el).points) <= lim) continue;
     el.alive = false;
     ++res_.elements_misshapen;
@@ -1563,6 +1569,7 @@ void SurfaceQuilter::finish() {
     resolve_crossings_lifted();
     settle_and_trim(n);  // the pieces it cut, against the stretch bound
   }
+  for (Element& el : elements_) el.finished = el.alive;
   res_.seconds_finish += t.seconds();
 }
 

@@ -178,6 +178,9 @@ struct SurfaceQuiltResult {
   std::size_t elements_not_expressed = 0;
   /// Elements that crossed an earlier one when lifted and yielded (SurfaceQuiltOptions::resolve_crossings).
   std::size_t crossings_resolved = 0;
+  /// Elements the finish tested for crossings, summed over the refill rounds
+  /// (a round tests only what changed since the previous finish).
+  std::size_t finish_elements_checked = 0;
   /// Output pieces left out for being smaller than a tenth of the swatch's smallest element.
   std::size_t fragments_removed = 0;
   /// Base faces reopened by refill_rounds; bare area fraction at the end.
