@@ -138,7 +138,7 @@ struct SubdivArgs {
   std::string exemplar_normal, exemplar_height, exemplar_roughness;
   double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
   int levels = -1, passes = 1, adaptive_steps = 4, atlas = 1024, exhaustive_levels = 1;
-  std::size_t max_vertices = 150000;
+  std::size_t max_vertices = SubdivisionSynthesisOptions{}.max_vertices;
   double bump = 2;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
   CommonOptions common;
@@ -301,7 +301,7 @@ SubcommandRegistrar reg_subdiv{
                       "count; -1 (default) = the fewest that bring the vertex spacing down to one texel")
            ->check(CLI::Range(-1, 12));
        app.add_option("--max-vertices", a->max_vertices,
-                      "With --levels -1: most vertices of the finest level, >= 1000 (default 150000); when the "
+                      "With --levels -1: most vertices of the finest level, >= 1000 (default 300000); when the "
                       "exemplar's resolution needs more, the synthesis texel grows (the exemplar is reduced, the "
                       "scale kept)")
            ->check(CLI::Range(std::size_t(1000), std::size_t(50000000)));

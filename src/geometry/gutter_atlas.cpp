@@ -69,11 +69,12 @@ struct Candidate {
 // it is narrowed (decision 302).
 constexpr double kMinDensityShare = 0.25;
 
-Candidate pack_candidate(Mesh& mesh, int N, int full_gutter, double cone) {
+Candidate pack_candidate(Mesh& mesh, int N, int full_gutter, double cone, std::size_t max_chart_faces) {
   Candidate c;
   BaseMeshAtlasOptions ao;
   ao.max_normal_angle_deg = cone;
   ao.merge_charts = true;  // merges weigh the full gutter's gap (2 g + 3 texels)
+  ao.max_chart_faces = max_chart_faces;
   ao.margin = std::min(0.099, (2.0 * full_gutter + 3.0) / N);
   c.atlas = compute_base_mesh_atlas(mesh, ao);
   auto uv = find(mesh, kCornerUV).first;
@@ -126,7 +127,7 @@ Candidate pack_candidate(Mesh& mesh, int N, int full_gutter, double cone) {
 
 }  // namespace
 
-GutterAtlas compute_gutter_atlas(Mesh& mesh, int N, int min_mip_size) {
+GutterAtlas compute_gutter_atlas(Mesh& mesh, int N, int min_mip_size, std::size_t max_chart_faces) {
   Timer t;
   GutterAtlas g;
   const int full = atlas_gutter_texels(N, min_mip_size);
@@ -134,9 +135,9 @@ GutterAtlas compute_gutter_atlas(Mesh& mesh, int N, int min_mip_size) {
   // merged; if they cannot keep the full gutter, also in an 85-degree one
   // (fewer, larger charts: less gutter, more distortion); the one with the
   // higher texel density (discounted by its distortion) wins.
-  Candidate c = pack_candidate(mesh, N, full, 50.0);
+  Candidate c = pack_candidate(mesh, N, full, 50.0, max_chart_faces);
   if (c.gutter < full) {
-    Candidate wide = pack_candidate(mesh, N, full, 85.0);
+    Candidate wide = pack_candidate(mesh, N, full, 85.0, max_chart_faces);
     if (wide.scale > 0 && (c.scale <= 0 || wide.density() > c.density())) c = std::move(wide);
   }
   if (c.scale <= 0)

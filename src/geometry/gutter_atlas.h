@@ -32,7 +32,8 @@ struct GutterAtlas {
   double seconds = 0;
 };
 
-/// `size` x `size` texels; mips down to `min_mip_size` kept clean.
-GutterAtlas compute_gutter_atlas(Mesh& mesh, int size, int min_mip_size = 64);
+/// `size` x `size` texels; mips down to `min_mip_size` kept clean; charts of
+/// at most `max_chart_faces` faces (BaseMeshAtlasOptions, >= 1).
+GutterAtlas compute_gutter_atlas(Mesh& mesh, int size, int min_mip_size = 64, std::size_t max_chart_faces = 4000);
 
 }  // namespace surftex

@@ -14,10 +14,12 @@
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
+#include "geometry/read_mesh.h"
 #include "geometry/properties.h"
 #include "test_support.h"
 #include "texture/displace_by_vertex_color.h"
 #include "texture/procedural_texture.h"
+#include "texture/subdivision/adaptive_sqrt2_subdivide.h"
 #include "texture/subdivision/graph_cut_transfer.h"
 #include "texture/subdivision/k_region_matching.h"
 #include "texture/subdivision/subdivision_synthesis.h"
@@ -713,6 +715,26 @@ TEST(SubdivisionSynthesis, VertexBudgetCoarsensTheTexelNotTheScale) {
   EXPECT_NEAR(s.repeats, 4.0, 1e-9);
   EXPECT_NEAR(s.spacing_texels, 1.0, 1e-9);
   EXPECT_EQ(s.exemplar_width, static_cast<int>(std::lround(64 * s.exemplar_scale)));
+}
+
+// Decision 208: at the default budget a 512 px exemplar at the default scale
+// (3 across) kept 61 px on bunny_6k and 70 px on spot (150K vertices: one
+// level short), which blurred wood_512's grain away; now 87 and 99 px.
+TEST(SubdivisionSynthesis, DefaultBudgetKeepsA512PxExemplarAbove80PxOnSixThousandFaceMeshes) {
+  const SubdivisionSynthesisOptions o;
+  for (const char* name : {"meshes/bunny_6k.obj", "meshes/spot.ply"}) {
+    Mesh m;
+    read_mesh(test::shared_data(name), m);
+    AdaptiveSubdivideOptions ao;  // as synthesize_on_subdivision does before choosing the scale
+    ao.factor = o.adaptive_factor;
+    ao.steps = o.adaptive_steps;
+    adaptive_sqrt2_subdivide(m, ao);
+    const SubdivisionScale s = choose_subdivision_scale(m, 512, 512, 0.01, o);
+    EXPECT_TRUE(s.budget_limited) << name;
+    EXPECT_LE(s.predicted_vertices, o.max_vertices) << name;
+    EXPECT_GE(s.exemplar_width, 80) << name;
+    EXPECT_NEAR(s.repeats, 3.0, 1e-9) << name;
+  }
 }
 
 namespace {

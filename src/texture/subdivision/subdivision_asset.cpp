@@ -96,7 +96,7 @@ SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVerte
   a.mesh = std::make_unique<Mesh>();
   const std::vector<std::uint32_t> from = triangulated_copy(mesh, *a.mesh);
   Mesh& tri = *a.mesh;
-  a.atlas = compute_gutter_atlas(tri, options.atlas_size);
+  a.atlas = compute_gutter_atlas(tri, options.atlas_size, 64, options.max_chart_faces);
   BakeOptions bo;
   bo.size = options.atlas_size;
   a.color = bake_vertex_colors(tri, bo);
@@ -114,7 +114,7 @@ nlohmann::json to_json(const SubdivisionAsset& a) {
   const int size = a.options.atlas_size;
   const double N2 = double(size) * size;
   const GutterAtlas& ga = a.atlas;
-  nlohmann::json j = {{"charts", ga.atlas.num_charts},
+  nlohmann::json j = {{"charts", ga.atlas.num_charts}, {"max_chart_faces", a.options.max_chart_faces},
                       {"size", size},
                       {"coverage", double(a.color.covered) / N2},
                       {"gutter", ga.gutter},

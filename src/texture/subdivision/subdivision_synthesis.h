@@ -56,8 +56,9 @@ struct SubdivisionSynthesisOptions {
   /// Uniform sqrt(2) steps after the base level, 0..12; -1 (default) = chosen
   /// (step 1: vertex spacing <= one texel within max_vertices).
   int levels = -1;
-  /// Most vertices of the finest level when levels are chosen, >= 1000. Default 150000.
-  std::size_t max_vertices = 150000;
+  /// Most vertices of the finest level when levels are chosen, >= 1000.
+  /// Default 300000 (a 6K-face mesh keeps a 512 px exemplar at 87-99 px; decision 208).
+  std::size_t max_vertices = 300000;
   double adaptive_factor = 1.5; ///< f of 3.2.2 (the paper's choice); 0 = no adaptive subdivision
   int adaptive_steps = 4;       ///< adaptive steps when adaptive_factor > 0, 0..32
   int passes = 1;               ///< passes per level, 1..16 (default 1; docs/decisions/204)
