@@ -23,7 +23,7 @@
 //   over the swatch's elements, scaled); seconds (quilt, embed, total) and user
 //   CPU seconds.
 // Usage: bench_quilt [CASE ...] [--out DIR]
-//   CASE = mesh:swatch (e.g. bunny:weave; meshes bunny, koala, knot; swatches
+//   CASE = mesh:swatch (e.g. bunny:weave; meshes bunny, koala, knot or a file name of shared/data/meshes such as elephant.off; swatches
 //   weave, chainmail, tori, rock) or bunny5k (the issue 8 benchmark: CGAL's
 //   bunny00.off decimated to about 5K faces, weave at relative size 0.12; goals
 //   <= 60 s and stretch <= 1.05). No CASE: the 12 cases of the matrix.
@@ -145,7 +145,8 @@ std::string mesh_file(const std::string& name) {
   if (name == "bunny") return d + "bunny_6k.obj";
   if (name == "koala") return d + "koala.obj";
   if (name == "knot") return d + "knot.off";
-  throw InvalidInputError("bench_quilt: unknown mesh '" + name + "' (bunny, koala, knot)");
+  if (name.find('.') != std::string::npos) return d + name;  // any other mesh of shared/data/meshes, by file name
+  throw InvalidInputError("bench_quilt: unknown mesh '" + name + "' (bunny, koala, knot or a file of " + d + ")");
 }
 
 // CGAL's bunny00.off decimated to about 5K faces (the issue 8 benchmark's base).
@@ -279,9 +280,10 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.max_shape_ratio = 0;
     qo.max_edge_stretch = 12;
   }
-  // Experiments (not the benchmark's figures): BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SHAPE,
+  // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SHAPE,
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
   // BENCH_CLEARANCE (swatch units; negative = automatic).
+  if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER")) qo.scatter_attempts = std::atoi(e);

@@ -240,6 +240,28 @@ TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOnly) {
   EXPECT_LT(r.quilt.bare_fraction, 0.05);
 }
 
+// The height cap: a pebble as tall as it is wide (splaying more when lifted
+// over curved ground) gets a smaller default than a flat one of the same
+// width: its height is at most 1/32 of the diagonal; flat rings (tori, chain
+// mail) keep 0.25.
+TEST(QuiltDriver, DefaultSizeIsSmallerForATallElementThanForAFlatOne) {
+  Mesh flat, tall, tori, mail;
+  make_ellipsoid(flat, 1.0, 0.8, 0.35, 2);
+  make_ellipsoid(tall, 1.0, 0.9, 0.8, 2);
+  make_tori_swatch(tori, ToriOptions{});
+  make_chainmail_swatch(mail, ChainmailOptions{});
+  const Swatch sf = make_swatch(flat, SwatchAxis::kAuto), st = make_swatch(tall, SwatchAxis::kAuto);
+  const double df = default_surface_quilt_size(sf), dt = default_surface_quilt_size(st);
+  // (1/32) x larger side / height, the ellipsoid's 2.0 / 1.6 up to its tessellation.
+  const double expect = (1.0 / 32) * std::max(st.length(), st.width()) / (st.bbox_max[2] - st.bbox_min[2]);
+  std::cout << "[ default size ] flat " << df << ", tall " << dt << " (expected " << expect << ")\n";
+  EXPECT_DOUBLE_EQ(df, 0.0625);
+  EXPECT_NEAR(dt, expect, 1e-9);
+  EXPECT_LT(dt, 0.045);
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(tori, SwatchAxis::kAuto)), 0.25);
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(mail, SwatchAxis::kAuto)), 0.25);
+}
+
 TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
   EXPECT_TRUE(is_generated_swatch("weave"));
   EXPECT_TRUE(is_generated_swatch("tori"));

@@ -1795,20 +1795,26 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 }
 
 double default_surface_quilt_size(const Swatch& swatch) {
-  constexpr double kSize = 0.25, kElementSize = 0.0625;
-  std::vector<double> sides;  // larger xy side of each compact element
+  constexpr double kSize = 0.25, kElementSize = 1.0 / 16, kElementHeight = 1.0 / 32;
+  std::vector<double> sides, heights;  // larger xy side and z extent of each compact element
   for (const ElementMesh& m : compact_swatch_elements(swatch)) {
-    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    double hi[2] = {-lo[0], -lo[1]};
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) lo[d] = std::numeric_limits<double>::infinity(), hi[d] = -lo[d];
     for (const P3& q : m.points)
-      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
     const double side = std::max(hi[0] - lo[0], hi[1] - lo[1]);
-    if (side > 0) sides.push_back(side);
+    if (side > 0) sides.push_back(side), heights.push_back(std::max(0.0, hi[2] - lo[2]));
   }
   const double whole = std::max(swatch.length(), swatch.width());
   if (sides.empty() || !(whole > 0)) return kSize;
-  std::nth_element(sides.begin(), sides.begin() + static_cast<std::ptrdiff_t>(sides.size() / 2), sides.end());
-  return std::min(kSize, kElementSize * whole / sides[sides.size() / 2]);
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  double size = std::min(kSize, kElementSize * whole / median(sides));
+  const double h = median(heights);
+  if (h > 0) size = std::min(size, kElementHeight * whole / h);
+  return size;
 }
 
 double surface_quilt_placements(const Mesh& base, const Swatch& swatch, double relative_size) {

@@ -210,8 +210,11 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 /// The default relative size (the CLI's, when --scale is not given): 0.25,
 /// lowered for swatches of few large compact elements (a single pebble) so
 /// that the median compact element's larger xy side is at most 1/16 of the
-/// base's diagonal, i.e. 0.0625 * (swatch side / element side). Swatches of
-/// threads only (weaves) keep 0.25.
+/// base's diagonal, i.e. 0.0625 * (swatch side / element side), and its
+/// height (z, along the normal) at most 1/32: lifted along the normals over
+/// curved ground an element splays in proportion to its height, so a pebble
+/// as tall as it is wide gets smaller than a flat ring of the same width.
+/// Swatches of threads only (weaves) keep 0.25.
 double default_surface_quilt_size(const Swatch& swatch);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
