@@ -3,9 +3,13 @@
 // a triangle copy with its atlas, the maps' sources, the report's keys.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <nlohmann/json.hpp>
 
+#include "geometry/gutter_atlas.h"
 #include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "texture/subdivision/subdivision_asset.h"
 
@@ -82,6 +86,27 @@ TEST(SubdivisionAsset, MapsFromVertexValues) {
 }
 
 // The keys the subdiv report's "export.atlas" block carries.
+// Decision 208: a default-budget hierarchy (hundreds of thousands of
+// faces) cut into charts of the other atlases' 4000 faces loses its texel
+// density to the gutters; the asset's larger default chart cap keeps more
+// texels per mesh length (measured here on an 80K-face sphere).
+TEST(SubdivisionAsset, DefaultChartCapKeepsMoreTexelsOnAFineMeshThanTheGeneralOne) {
+  auto density = [](std::size_t cap, int& charts) {
+    Mesh m;
+    make_icosphere(m, 6);
+    const GutterAtlas g = compute_gutter_atlas(m, 1024, 64, cap);
+    charts = g.atlas.num_charts;
+    return g.atlas.uv_per_length;
+  };
+  int n_general = 0, n_asset = 0;
+  const double general = density(4000, n_general);
+  const double asset = density(SubdivisionAssetOptions{}.max_chart_faces, n_asset);
+  std::cout << "[ 80K sphere ] charts " << n_general << " -> " << n_asset << ", atlas uv per length " << general
+            << " -> " << asset << "\n";
+  EXPECT_LT(n_asset, n_general);
+  EXPECT_GT(asset, 1.05 * general);
+}
+
 TEST(SubdivisionAsset, JsonHasTheReportKeys) {
   const Mesh m = coloured_quad_cube();
   SubdivisionAssetOptions o;

@@ -128,7 +128,7 @@ nlohmann::json to_json(const SubdivisionAsset& a) {
                       {"normal_source", a.normal_from_exemplar ? "exemplar_normal" : "height"},
                       {"height_source", a.height_from_exemplar ? "exemplar_height" : "luminance"},
                       {"roughness", !a.metallic_roughness.empty()},
-                      {"seconds", {{"bake", a.seconds}}}};
+                      {"seconds", {{"bake", a.seconds}, {"charts", a.atlas.seconds}}}};
   if (a.seam_measured) j["seam"] = to_json(a.seam);
   return j;
 }
