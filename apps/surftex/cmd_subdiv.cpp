@@ -115,6 +115,7 @@ void parse_texel_size(const std::string& spec, SubdivisionSynthesisOptions& o) {
     o.texels_per_edge = number(spec.substr(0, spec.size() - edge.size()));
   } else if (spec.size() > 1 && (spec.back() == 'x' || spec.back() == 'X')) {
     o.repeats = number(spec.substr(0, spec.size() - 1));
+    o.repeats_fixed = true;
   } else {
     number("");  // throws the explanation
   }
@@ -131,6 +132,12 @@ void print_scale(const SubdivisionSynthesisResult& r) {
                s.spacing_texels, s.predicted_vertices, s.exemplar_width, s.exemplar_height,
                s.exemplar_scale < 1 ? " (reduced to fit --max-vertices)" : "",
                r.periodic ? "wrapped as periodic" : "not wrapped", r.wrap_seam_ratio);
+  if (s.repeats < s.repeats_requested)
+    std::fprintf(stderr,
+                 "subdiv: %.3g exemplar widths across instead of the default %.3g: reduced further to fit "
+                 "--max-vertices, the exemplar would lose its fine detail (%.0f%% of it kept now; give "
+                 "--texel-size %gx to insist)\n",
+                 s.repeats, s.repeats_requested, 100 * s.relative_detail, s.repeats_requested);
 }
 
 struct SubdivArgs {
@@ -289,7 +296,9 @@ SubcommandRegistrar reg_subdiv{
            ->required();
        auto* ts = app.add_option("--texel-size", a->texel_size,
                                  "Texture scale: Nx = N exemplar widths across the longest bounding-box side, or "
-                                 "N/edge = N exemplar texels per mean edge of the input mesh (default 3x)");
+                                 "N/edge = N exemplar texels per mean edge of the input mesh (default 3x; fewer, down to 1x, "
+                                 "when --max-vertices would reduce the exemplar so far that less than a third of "
+                                 "its fine detail survives: a given Nx is kept)");
        app.add_option("--rscale", a->rscale,
                       "The paper's r_scale instead of --texel-size: exemplar texels per object unit, the object "
                       "unit being the longest bounding-box side; larger = smaller texture features; 1e-3..1e6 "

@@ -37,11 +37,23 @@ TEST(CmdSubdivFidelity, DefaultsAreChosenPrintedAndReportedWithTheFidelity) {
   auto r = test::run_surftex("subdiv '" + dir + "/ball.obj' '" + ex + "' -o '" + dir +
                              "/out' --max-vertices 4000 --atlas-size 128 --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("scale from repeats: 3 exemplar widths across"), std::string::npos) << r.err;
+  // 4000 vertices would reduce leather_64 to 12 px at 3 widths across, which
+  // keeps too little of its detail: fewer repeats, said so (decision 209).
+  EXPECT_NE(r.err.find("scale from repeats: 2.1 exemplar widths across"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("instead of the default 3"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("uniform levels (chosen"), std::string::npos) << r.err;
   const auto j = report(dir + "/out");
   EXPECT_EQ(j["scale"]["from"], "repeats");
-  EXPECT_NEAR(j["scale"]["repeats"].get<double>(), 3.0, 1e-9);
+  EXPECT_NEAR(j["scale"]["repeats_requested"].get<double>(), 3.0, 1e-9);
+  EXPECT_LT(j["scale"]["repeats"].get<double>(), 3.0);
+  EXPECT_GE(j["scale"]["relative_detail"].get<double>(), 1.0 / 3.0);
+  // asked for: kept
+  auto given = test::run_surftex("subdiv '" + dir + "/ball.obj' '" + ex + "' -o '" + dir +
+                                 "/given' --texel-size 3x --max-vertices 4000 --atlas-size 128 --threads 2");
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  EXPECT_NE(given.err.find("scale from repeats: 3 exemplar widths across"), std::string::npos) << given.err;
+  EXPECT_EQ(given.err.find("instead of the default"), std::string::npos) << given.err;
+  EXPECT_NEAR(report(dir + "/given")["scale"]["repeats"].get<double>(), 3.0, 1e-9);
   EXPECT_TRUE(j["scale"]["levels_chosen"].get<bool>());
   EXPECT_LE(j["scale"]["predicted_vertices"].get<double>(), 4000);
   EXPECT_GT(j["fidelity"]["bds"].get<double>(), 0.0) << j["fidelity"].dump();

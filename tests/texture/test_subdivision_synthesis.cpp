@@ -739,6 +739,110 @@ TEST(SubdivisionSynthesis, DefaultBudgetKeepsA512PxExemplarAbove80PxOnSixThousan
 
 namespace {
 
+// A gingham-like check: squares of `cell` pixels alternating red and pale.
+Image fine_check(int size, int cell) {
+  Image im(size, size, 3);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const bool pale = ((x / cell) + (y / cell)) % 2 == 0;
+      im.at(x, y, 0) = 0.95f;
+      im.at(x, y, 1) = pale ? 0.85f : 0.25f;
+      im.at(x, y, 2) = pale ? 0.8f : 0.2f;
+    }
+  return im;
+}
+
+}  // namespace
+
+// The measure behind the default scale's trade: a check of 4-pixel squares
+// (period 8) keeps most of its detail unreduced and none of it reduced 2.6x
+// (period 3: what the cow with red_checked_384 got); a flat image keeps all,
+// a smooth one nearly all.
+TEST(SubdivisionSynthesis, DetailKeptIsLostWhenAFineCheckIsReducedPastItsPeriod) {
+  const Image check = fine_check(128, 4);
+  EXPECT_GT(detail_kept(check, 1.0), 0.3);
+  EXPECT_LT(detail_kept(check, 0.385), 0.1);
+  EXPECT_GT(detail_kept(check, 1.0), detail_kept(check, 0.75));
+  Image flat(64, 64, 3);
+  for (float& v : flat.data) v = 0.5f;
+  EXPECT_EQ(detail_kept(flat, 0.25), 1.0);
+  Image ramp(64, 64, 3);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) ramp.at(x, y, c) = 0.5f + 0.4f * std::sin(x / 10.0f) * std::cos(y / 13.0f);
+  EXPECT_GT(detail_kept(ramp, 0.4), 0.9);
+  EXPECT_THROW(detail_kept(Image{}, 0.5), InvalidInputError);
+}
+
+// Issue 18 (a plain red cow from red_checked_384 at the defaults): when the
+// vertex budget would reduce the exemplar so far that its fine detail is
+// lost, the default scale shows fewer repeats (down to one) instead; a scale
+// the user gave (repeats_fixed), or an exemplar whose detail survives the
+// reduction, keeps its repeats.
+TEST(SubdivisionSynthesis, DefaultScaleShowsFewerRepeatsRatherThanBlurAFineCheckAway) {
+  Mesh m;
+  make_icosphere(m, 2, 1.0);
+  SubdivisionSynthesisOptions o;
+  o.max_vertices = 20000;
+  const Image check = fine_check(128, 4);
+  const SubdivisionScale plain = choose_subdivision_scale(m, 128, 128, 0.1, o);
+  const SubdivisionScale kept = choose_subdivision_scale(m, 128, 128, 0.1, o, &check);
+  ASSERT_TRUE(plain.budget_limited);
+  EXPECT_NEAR(plain.repeats, 3.0, 1e-9);
+  EXPECT_LT(detail_kept(check, plain.exemplar_scale) / detail_kept(check, 1.0), o.min_relative_detail);
+  EXPECT_LT(kept.repeats, 3.0);
+  EXPECT_GE(kept.repeats, 1.0);
+  EXPECT_NEAR(kept.repeats_requested, 3.0, 1e-9);
+  EXPECT_GT(kept.exemplar_scale, plain.exemplar_scale);
+  EXPECT_LE(kept.predicted_vertices, o.max_vertices);
+  EXPECT_TRUE(kept.repeats == 1.0 || kept.relative_detail >= o.min_relative_detail)
+      << kept.repeats << " repeats keep " << kept.relative_detail;
+  EXPECT_NEAR(kept.relative_detail, detail_kept(check, kept.exemplar_scale) / detail_kept(check, 1.0), 1e-9);
+  // asked for: kept
+  SubdivisionSynthesisOptions fixed = o;
+  fixed.repeats_fixed = true;
+  EXPECT_NEAR(choose_subdivision_scale(m, 128, 128, 0.1, fixed, &check).repeats, 3.0, 1e-9);
+  // a smooth exemplar survives the reduction: kept
+  Image smooth(128, 128, 3);
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x)
+      for (int c = 0; c < 3; ++c) smooth.at(x, y, c) = 0.5f + 0.4f * std::sin(x / 12.0f + c) * std::cos(y / 15.0f);
+  EXPECT_NEAR(choose_subdivision_scale(m, 128, 128, 0.1, o, &smooth).repeats, 3.0, 1e-9);
+}
+
+// The same end to end: with the default trade the synthesised check keeps
+// its contrast on the vertices; reduced as far as the budget alone asks
+// (min_relative_detail 0) it averages to a flat colour.
+TEST(SubdivisionSynthesis, AFineCheckKeepsItsContrastAtTheDefaultScale) {
+  const Image check = fine_check(96, 3);
+  std::vector<double> ex_grey;
+  for (int y = 0; y < check.height; ++y)
+    for (int x = 0; x < check.width; ++x)
+      ex_grey.push_back(grey({check.at(x, y, 0), check.at(x, y, 1), check.at(x, y, 2)}));
+  auto vertex_contrast = [&](double min_detail, double& repeats) {
+    Mesh m;
+    make_icosphere(m, 2, 1.0);
+    SubdivisionSynthesisOptions o;
+    o.max_vertices = 8000;
+    o.min_relative_detail = min_detail;
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, check, o);
+    repeats = r.scale.repeats;
+    std::vector<double> g;
+    auto col = find(m, kVertexColor).first;
+    for (VertexIndex v : m.vertices()) g.push_back(grey(col[v]));
+    return grey_std(g) / grey_std(ex_grey);
+  };
+  double r_default = 0, r_off = 0;
+  const double c_default = vertex_contrast(SubdivisionSynthesisOptions{}.min_relative_detail, r_default);
+  const double c_off = vertex_contrast(0.0, r_off);
+  EXPECT_NEAR(r_off, 3.0, 1e-9);
+  EXPECT_LT(r_default, r_off);
+  EXPECT_GT(c_default, 0.5) << "the check is washed out at " << r_default << " repeats";
+  EXPECT_GT(c_default, 1.5 * c_off) << "contrast " << c_default << " against " << c_off << " without the trade";
+}
+
+namespace {
+
 // A non-periodic exemplar with a strong edge at its wrap: a left-to-right
 // ramp from dark to bright with a fine random texture on top.
 Image ramp_exemplar(int w, int h, std::uint64_t seed) {

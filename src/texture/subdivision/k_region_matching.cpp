@@ -252,12 +252,6 @@ std::vector<SampleGroup> group_samples(const ExemplarLevels& ex, const std::vect
   return g;
 }
 
-std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
-  const Image& im = ex.levels[level];
-  const float* p = ex.wraps(level) ? im.pixel(wrap(x, im.width), wrap(y, im.height))
-                               : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
-  return {p[0], p[1], p[2]};
-}
 
 std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y) {
   const double fx = std::floor(x), fy = std::floor(y);

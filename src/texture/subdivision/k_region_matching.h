@@ -219,7 +219,19 @@ class ExemplarIndex {
 /// centres at integers), wrapping, or clamped at a bounded level.
 std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y);
 
-/// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level.
-std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y);
+/// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level
+/// (inline: the coherence search's inner loop).
+inline std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
+  const Image& im = ex.levels[level];
+  if (ex.wraps(level)) {
+    x %= im.width, y %= im.height;
+    x += x < 0 ? im.width : 0, y += y < 0 ? im.height : 0;
+  } else {
+    x = x < 0 ? 0 : (x >= im.width ? im.width - 1 : x);
+    y = y < 0 ? 0 : (y >= im.height ? im.height - 1 : y);
+  }
+  const float* p = im.pixel(x, y);
+  return {p[0], p[1], p[2]};
+}
 
 }  // namespace surftex

@@ -43,6 +43,8 @@ void validate(const SubdivisionSynthesisOptions& o) {
   if (!(o.texels_per_edge >= 0) || !std::isfinite(o.texels_per_edge))
     bad("texels_per_edge", o.texels_per_edge, "> 0, or 0 for the repeats");
   if (!(o.repeats > 0) || !std::isfinite(o.repeats)) bad("repeats", o.repeats, "> 0");
+  if (!(o.min_relative_detail >= 0 && o.min_relative_detail <= 1))
+    bad("min_relative_detail", o.min_relative_detail, "in [0, 1]");
   if (o.levels < -1 || o.levels > 12) bad("levels", o.levels, "in 0..12, or -1 to choose");
   if (o.max_vertices < 1000) bad("max_vertices", static_cast<double>(o.max_vertices), ">= 1000");
   if (!(o.adaptive_factor >= 0) || !std::isfinite(o.adaptive_factor)) bad("adaptive_factor", o.adaptive_factor, ">= 0");
@@ -109,6 +111,27 @@ Image to_rgb(const Image& in) {
 
 }  // namespace
 
+double detail_kept(const Image& img, double scale) {
+  if (img.empty()) throw InvalidInputError("detail_kept: the image is empty");
+  const Image lum = luminance(img);
+  const int w = lum.width, h = lum.height;
+  const int rw = std::max(1, static_cast<int>(std::lround(w * scale / 2))),
+            rh = std::max(1, static_cast<int>(std::lround(h * scale / 2)));
+  const Image back = resize_bilinear(reduce_exemplar(lum, rw, rh, false), w, h, false);
+  double mean = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) mean += lum.at(x, y, 0);
+  mean /= static_cast<double>(w) * h;
+  double total = 0, lost = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double v = lum.at(x, y, 0), d = v - back.at(x, y, 0);
+      total += (v - mean) * (v - mean);
+      lost += d * d;
+    }
+  return total > 0 ? std::max(0.0, 1.0 - lost / total) : 1.0;
+}
+
 Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic) {
   if (img.empty()) throw InvalidInputError("resample_as_synthesised: the image is empty");
   if (scale.exemplar_scale < 1.0)
@@ -116,31 +139,16 @@ Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, b
   return img;
 }
 
-SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double input_mean_edge,
-                                          const SubdivisionSynthesisOptions& opt) {
-  validate(opt);
-  if (w < 1 || h < 1) throw InvalidInputError("subdivision synthesis: the exemplar is empty");
-  const MeshFigures f = mesh_figures(mesh);
-  if (!(f.longest > 0) || !std::isfinite(f.longest) || !(f.area > 0))
-    throw InvalidInputError("subdivision synthesis: the mesh has no extent (or non-finite coordinates)");
-  SubdivisionScale sc;
+namespace {
+
+// The depth and exemplar reduction for r_mesh exemplar texels per mesh unit
+// (step 1): the fewest levels whose vertex spacing is one texel, within
+// max_vertices, else the exemplar reduced to the spacing reached.
+void choose_depth(const MeshFigures& f, int w, int h, double r_mesh, const SubdivisionSynthesisOptions& opt,
+                  SubdivisionScale& sc) {
   const double unit = opt.normalize_units ? f.longest : 1.0;
-  double r_mesh = 0;  // exemplar texels per mesh unit
-  if (opt.r_scale > 0) {
-    sc.scale_from = "rscale";
-    r_mesh = opt.r_scale / unit;
-  } else if (opt.texels_per_edge > 0) {
-    if (!(input_mean_edge > 0) || !std::isfinite(input_mean_edge))
-      throw InvalidInputError("subdivision synthesis: texels_per_edge needs a mesh with edges of positive length");
-    sc.scale_from = "texels_per_edge";
-    r_mesh = opt.texels_per_edge / input_mean_edge;
-  } else {
-    sc.scale_from = "repeats";
-    r_mesh = opt.repeats * w / f.longest;
-  }
   sc.r_scale = r_mesh * unit;
   sc.repeats = r_mesh * f.longest / w;
-  sc.texels_per_edge = r_mesh * input_mean_edge;
   // Counts after L uniform steps: F_L = E_{L-1}, E_L = 2 E_{L-1}, V_L = V_{L-1} + F_{L-1}
   // (sqrt2_subdivide.h: one face per edge, two edges per old edge); the
   // vertex spacing of the final quads is sqrt(area / F_L).
@@ -153,6 +161,7 @@ SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double
   auto spacing = [&](int l) { return l == 0 ? f.mean_edge : std::sqrt(f.area / F[l]); };
   const double texel0 = 1.0 / r_mesh;
   int L = opt.levels;
+  sc.budget_limited = false;
   if (L < 0) {
     sc.levels_chosen = true;
     L = 0;
@@ -175,6 +184,58 @@ SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double
   sc.exemplar_height = std::max(1, static_cast<int>(std::lround(h * sc.exemplar_scale)));
   sc.texel_size = texel;
   sc.spacing_texels = spacing(L) / texel;
+}
+
+// The default scale's trade (SubdivisionSynthesisOptions::min_relative_detail):
+// while the budget's reduction keeps less than that share of the detail the
+// unreduced exemplar keeps, show fewer repeats (5% steps, down to one) so the
+// exemplar is reduced less.
+void keep_exemplar_detail(const MeshFigures& f, const Image& exemplar, const SubdivisionSynthesisOptions& opt,
+                          SubdivisionScale& sc) {
+  if (!(opt.min_relative_detail > 0) || sc.exemplar_scale >= 1.0 || !sc.budget_limited) return;
+  const double full = detail_kept(exemplar, 1.0);
+  if (!(full > 0)) return;
+  auto relative = [&](const SubdivisionScale& s) { return detail_kept(exemplar, s.exemplar_scale) / full; };
+  sc.relative_detail = relative(sc);
+  double repeats = opt.repeats;
+  while (sc.relative_detail < opt.min_relative_detail && sc.exemplar_scale < 1.0 && repeats > 1.0) {
+    repeats = std::max(1.0, repeats * 0.95);
+    choose_depth(f, exemplar.width, exemplar.height, repeats * exemplar.width / f.longest, opt, sc);
+    sc.relative_detail = sc.exemplar_scale < 1.0 ? relative(sc) : 1.0;
+  }
+}
+
+}  // namespace
+
+SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double input_mean_edge,
+                                          const SubdivisionSynthesisOptions& opt, const Image* exemplar) {
+  validate(opt);
+  if (w < 1 || h < 1) throw InvalidInputError("subdivision synthesis: the exemplar is empty");
+  if (exemplar && (exemplar->width != w || exemplar->height != h))
+    throw InvalidInputError("subdivision synthesis: the exemplar is not w x h");
+  const MeshFigures f = mesh_figures(mesh);
+  if (!(f.longest > 0) || !std::isfinite(f.longest) || !(f.area > 0))
+    throw InvalidInputError("subdivision synthesis: the mesh has no extent (or non-finite coordinates)");
+  SubdivisionScale sc;
+  const double unit = opt.normalize_units ? f.longest : 1.0;
+  double r_mesh = 0;  // exemplar texels per mesh unit
+  if (opt.r_scale > 0) {
+    sc.scale_from = "rscale";
+    r_mesh = opt.r_scale / unit;
+  } else if (opt.texels_per_edge > 0) {
+    if (!(input_mean_edge > 0) || !std::isfinite(input_mean_edge))
+      throw InvalidInputError("subdivision synthesis: texels_per_edge needs a mesh with edges of positive length");
+    sc.scale_from = "texels_per_edge";
+    r_mesh = opt.texels_per_edge / input_mean_edge;
+  } else {
+    sc.scale_from = "repeats";
+    r_mesh = opt.repeats * w / f.longest;
+  }
+  choose_depth(f, w, h, r_mesh, opt, sc);
+  sc.repeats_requested = sc.repeats;
+  if (exemplar && sc.scale_from == std::string("repeats") && !opt.repeats_fixed)
+    keep_exemplar_detail(f, *exemplar, opt, sc);
+  sc.texels_per_edge = sc.repeats * w / f.longest * input_mean_edge;
   return sc;
 }
 
@@ -909,7 +970,7 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
     ao.steps = opt.adaptive_steps;
     res.adaptive_area_std_percent = adaptive_sqrt2_subdivide(mesh, ao).area_std_percent;
   }
-  res.scale = choose_subdivision_scale(mesh, exemplar.width, exemplar.height, input.mean_edge, opt);
+  res.scale = choose_subdivision_scale(mesh, exemplar.width, exemplar.height, input.mean_edge, opt, &exemplar);
   prepare_exemplar(exemplar, opt, res);
   const double r_mesh = 1.0 / res.scale.texel_size;  // synthesis texels per mesh unit
   const int levels = res.scale.levels;
@@ -959,7 +1020,9 @@ SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& ex
 nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSynthesisOptions& o) {
   nlohmann::json j;
   const SubdivisionScale& sc = r.scale;
-  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"texels_per_edge", sc.texels_per_edge},
+  j["scale"] = {{"from", sc.scale_from}, {"repeats", sc.repeats}, {"repeats_requested", sc.repeats_requested},
+                {"relative_detail", sc.relative_detail}, {"min_relative_detail", o.min_relative_detail},
+                {"texels_per_edge", sc.texels_per_edge},
                 {"r_scale", sc.r_scale}, {"texel_size", sc.texel_size}, {"exemplar_scale", sc.exemplar_scale},
                 {"exemplar_size", {sc.exemplar_width, sc.exemplar_height}}, {"levels", sc.levels},
                 {"levels_chosen", sc.levels_chosen}, {"budget_limited", sc.budget_limited},

@@ -6,7 +6,8 @@
 // 1. Scale (3.3.2), from the inputs (choose_subdivision_scale): `repeats`
 //    exemplar widths across the object (default), texels_per_edge, or r_scale;
 //    the fewest uniform levels whose vertex spacing is one texel, within
-//    max_vertices (else the exemplar is reduced).
+//    max_vertices (else the exemplar is reduced, or, for the default
+//    repeats, fewer repeats shown where reducing would lose its detail).
 // 2. Adaptive sqrt(2)-subdivision of the base (3.2.2).
 // 3. Orientation and sweep fields (3.1.1), carried and re-diffused per level.
 // 4. Levels: the base, then `levels` uniform sqrt(2) steps (3.2.1).
@@ -53,6 +54,15 @@ struct SubdivisionSynthesisOptions {
   bool normalize_units = true;  ///< object unit = longest bounding-box side
   double texels_per_edge = 0;
   double repeats = 3;
+  /// The default scale's trade: when max_vertices forces the exemplar's
+  /// reduction and that keeps less than this share of the detail the
+  /// unreduced exemplar keeps (detail_kept(e, s) / detail_kept(e, 1)), fewer
+  /// repeats are shown (down to one) so it is reduced less: a fine gingham
+  /// reduced 2.6x shows no check at all, only moire. Only for `repeats`
+  /// not given by the user (repeats_fixed false); 0 = off. Default 1/3
+  /// (decision 209).
+  double min_relative_detail = 1.0 / 3.0;
+  bool repeats_fixed = false;  ///< `repeats` was asked for: never lowered
   /// Uniform sqrt(2) steps after the base level, 0..12; -1 (default) = chosen
   /// (step 1: vertex spacing <= one texel within max_vertices).
   int levels = -1;
@@ -135,6 +145,10 @@ struct ExemplarLookup {
 struct SubdivisionScale {
   const char* scale_from = "repeats";  ///< "rscale", "texels_per_edge" or "repeats"
   double repeats = 0;          ///< exemplar widths across the longest bounding-box side
+  double repeats_requested = 0;  ///< before keeping the exemplar's detail (min_relative_detail)
+  /// detail_kept at exemplar_scale over detail_kept at 1 (1 = unreduced or
+  /// not measured: the scale was given, or the budget did not reduce it).
+  double relative_detail = 1;
   double texels_per_edge = 0;  ///< exemplar texels per mean edge of the input mesh
   double r_scale = 0;          ///< exemplar texels per object unit
   double texel_size = 0;       ///< mesh units per synthesis texel
@@ -177,9 +191,12 @@ struct SubdivisionSynthesisResult {
 /// Step 1 alone: the scale and depth synthesize_on_subdivision would use on
 /// `mesh` (after adaptive subdivision) for an exemplar of w x h pixels.
 /// `input_mean_edge` is the mean edge of the mesh as given (texels_per_edge).
-/// Throws InvalidInputError (options out of range, no extent).
+/// With the exemplar's pixels (w x h), the default repeats may be lowered to
+/// keep its detail (min_relative_detail). Throws InvalidInputError (options
+/// out of range, no extent, an exemplar not w x h).
 SubdivisionScale choose_subdivision_scale(const Mesh& mesh, int w, int h, double input_mean_edge,
-                                          const SubdivisionSynthesisOptions& opt);
+                                          const SubdivisionSynthesisOptions& opt,
+                                          const Image* exemplar = nullptr);
 
 SubdivisionSynthesisResult synthesize_on_subdivision(Mesh& mesh, const Image& exemplar,
                                                      const SubdivisionSynthesisOptions& opt = {});
@@ -196,6 +213,15 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& result, const Subdivisi
 /// tiles still does, as for an exemplar treated as periodic), any channel
 /// count, float. Throws InvalidInputError if `img` is empty.
 Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic = false);
+
+/// Share of `img`'s luminance detail (its variance about the mean) that
+/// survives at periods of at least four synthesis texels when the exemplar is
+/// reduced by `scale` (synthesis texels per exemplar pixel, <= 1): the image
+/// reduced as for the synthesis to scale / 2, enlarged back bilinearly,
+/// 1 - squared error / variance, in [0, 1] (1 for a flat image). A vertex
+/// spacing of about one texel carries features of 4 texels and more; finer
+/// ones alias (moire). Throws InvalidInputError if `img` is empty.
+double detail_kept(const Image& img, double scale);
 
 /// The per-level geometry a pass reads: vertex frames and the region graph.
 /// Built once per mesh level and shared by all its passes (they do not move
