@@ -238,6 +238,7 @@ TEST(SubdivisionSynthesis, BadInputErrors) {
 // vertex from the exemplar.
 TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
   const Image ex = make_cells(32, 3, 5);
+  std::size_t coherent_matched = 0, coherent_searched_all = 0, exhaustive_matched = 0, exhaustive_searched_all = 0;
   auto run = [&](int threads, int exhaustive_levels) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
     Mesh m;
@@ -248,7 +249,13 @@ TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
     o.adaptive_factor = 0;
     o.exhaustive_levels = exhaustive_levels;
     o.seed = 2;
-    synthesize_on_subdivision(m, ex, o);
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+    for (const SynthesisLevelStats& l : r.levels)
+      for (const SynthesisPassStats& p : l.pass_stats) {
+        const bool coherent = l.level >= exhaustive_levels;
+        (coherent ? coherent_matched : exhaustive_matched) += p.matched;
+        (coherent ? coherent_searched_all : exhaustive_searched_all) += p.searched_all;
+      }
     std::vector<float> c;
     auto col = find(m, kVertexColor).first;
     for (VertexIndex v : m.vertices())
@@ -257,6 +264,11 @@ TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
   };
   const auto one = run(1, 1), two = run(2, 1), exhaustive = run(2, 13);
   EXPECT_EQ(one, two);
+  // the report's count of full searches: every match of an exhaustive level,
+  // few of a coherent one
+  EXPECT_EQ(exhaustive_searched_all, exhaustive_matched);
+  EXPECT_GT(coherent_matched, 0u);
+  EXPECT_LT(coherent_searched_all, coherent_matched / 4);
   ASSERT_EQ(one.size(), exhaustive.size());
   EXPECT_NE(one, exhaustive);
   float lo = 1, hi = 0;

@@ -258,6 +258,7 @@ struct VertexJob {
     ExemplarLookup lookup;      ///< where the colour was read
   };
   std::vector<Write> writes;  ///< centre first
+  bool searched_all = false;  ///< the index searched the candidate box (no coherent candidate, or an exhaustive level)
   double t_region = 0, t_match = 0, t_transfer = 0;
 };
 
@@ -468,6 +469,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
     box.bins_x = c.grid->bins_x();
   }
   job.m = c.coherent ? coherent_match(c, reg, lp, box, s) : MatchResult{};
+  job.searched_all = !job.m.found;
   if (!job.m.found) job.m = c.index.match(s.groups, lp, box);
   auto t2 = std::chrono::steady_clock::now();
   job.t_match = std::chrono::duration<double>(t2 - t1).count();
@@ -730,6 +732,7 @@ class SynthesisPass {
     sum_region_ += job.reg.vertices.size();
     sum_groups_ += job.groups;
     st_.candidates += job.m.candidates;
+    st_.searched_all += job.searched_all ? 1 : 0;
     std::vector<std::array<int, 2>>& source = *source_;
     for (const auto& w : job.writes) {
       color_[w.vertex] = {w.color[0], w.color[1], w.color[2]};
@@ -1052,6 +1055,7 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSyn
     for (const auto& p : l.pass_stats)
       lj["pass_stats"].push_back({{"matched", p.matched}, {"patched", p.patched}, {"skipped", p.skipped},
                                   {"mean_k", p.mean_k}, {"mean_region", p.mean_region}, {"mean_groups", p.mean_groups},
+                                  {"searched_all", p.searched_all}, {"candidates", p.candidates},
                                   {"seconds_region", p.seconds_region}, {"seconds_match", p.seconds_match},
                                   {"seconds_transfer", p.seconds_transfer}});
     j["levels"].push_back(lj);

@@ -117,6 +117,7 @@ struct SynthesisPassStats {
   double mean_region = 0;    ///< vertices per region
   double mean_groups = 0;    ///< compared groups per match (after averaging)
   std::size_t candidates = 0;  ///< exemplar texels scored over all matches (branch and bound)
+  std::size_t searched_all = 0;  ///< matches that searched the whole candidate box (no coherent candidate fitted)
   std::size_t recomputed = 0;  ///< speculative jobs redone at commit (their region changed)
   /// Thread time summed over vertices (so it can exceed the wall time).
   double seconds_match = 0, seconds_transfer = 0, seconds_region = 0;
