@@ -394,6 +394,34 @@ TEST(SubdivisionSynthesis, PassIsIndependentOfTheThreadCount) {
   }
 }
 
+// The speculative chunks shrink where their jobs are thrown away: on the base
+// level's sweep every match patches its whole region, so most vertices of a
+// large chunk were patched by an earlier commit of the same chunk before
+// their own (already computed) job could be committed. The colours do not
+// depend on the thread count either way.
+TEST(SubdivisionSynthesis, BaseLevelSweepDoesNotComputeJobsItThrowsAway) {
+  const Image img = make_cells(48, 6, 3);
+  std::vector<float> colours[2];
+  for (int threads : {1, 2}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    Mesh m;
+    make_icosphere(m, 4);
+    SubdivisionSynthesisOptions o;
+    o.r_scale = 60;
+    o.levels = 0;
+    o.adaptive_factor = 0;
+    const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, img, o);
+    const SynthesisPassStats& p = r.levels.at(0).pass_stats.at(0);
+    ASSERT_GT(p.matched, 0u);
+    EXPECT_GT(p.patched, 10 * p.matched) << "regions too small for the test";
+    EXPECT_LT(p.wasted, 3 * p.matched) << p.wasted << " jobs thrown away for " << p.matched << " matches";
+    auto col = find(m, kVertexColor).first;
+    for (VertexIndex v : m.vertices())
+      for (int k = 0; k < 3; ++k) colours[threads - 1].push_back(col[v][k]);
+  }
+  EXPECT_EQ(colours[0], colours[1]);
+}
+
 // --displace: a flat grid (normals +z) with grey colours g moves to z = H g.
 TEST(DisplaceByVertexColor, FlatGridMovesAlongTheNormalByHeightTimesGrey) {
   Mesh m;

@@ -623,12 +623,18 @@ class SynthesisPass {
     std::size_t chunk = 16;
     for (std::size_t begin = 0; begin < order.size();) {
       const std::size_t end = std::min(order.size(), begin + chunk);
-      const std::size_t conflicts = run_chunk(order, begin, end, rng);
+      std::size_t wasted = 0;
+      const std::size_t conflicts = run_chunk(order, begin, end, rng, wasted);
       st_.recomputed += conflicts;
+      st_.wasted += wasted;
       const std::size_t n = end - begin;
-      if (16 * conflicts > n)
+      // A job whose vertex an earlier commit of its chunk patched is thrown
+      // away like a recomputed one: on the base level's sweep each match
+      // patches its whole region, so large chunks there were mostly waste.
+      const std::size_t lost = conflicts + wasted;
+      if (16 * lost > n)
         chunk = std::max<std::size_t>(1, chunk / 2);
-      else if (64 * conflicts < n)
+      else if (64 * lost < n)
         chunk = std::min<std::size_t>(1024, chunk * 2);
       begin = end;
     }
@@ -652,9 +658,10 @@ class SynthesisPass {
   }
 
   // One chunk order[begin, end): matched in parallel, committed in order;
-  // returns the jobs recomputed at commit time.
+  // returns the jobs recomputed at commit time; `wasted`: jobs computed for
+  // vertices that an earlier commit of the chunk patched (not committed).
   std::size_t run_chunk(const std::vector<std::size_t>& order, std::size_t begin, std::size_t end,
-                        std::mt19937_64& rng) {
+                        std::mt19937_64& rng, std::size_t& wasted) {
     ++stamp_;
     if (jobs_.size() < end - begin) jobs_.resize(end - begin);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1),
@@ -669,7 +676,10 @@ class SynthesisPass {
     std::size_t conflicts = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const std::size_t p = order[i];
-      if (opt_.skip_patched && patched_[p]) continue;
+      if (opt_.skip_patched && patched_[p]) {
+        wasted += jobs_[i - begin].p == p ? 1 : 0;
+        continue;
+      }
       if (graph_.offset[p] == graph_.offset[p + 1]) continue;  // isolated
       if (!any_colored_) {                                     // the very first vertex: a random texel
         seed_vertex(p, rng);
@@ -1056,6 +1066,7 @@ nlohmann::json to_json(const SubdivisionSynthesisResult& r, const SubdivisionSyn
       lj["pass_stats"].push_back({{"matched", p.matched}, {"patched", p.patched}, {"skipped", p.skipped},
                                   {"mean_k", p.mean_k}, {"mean_region", p.mean_region}, {"mean_groups", p.mean_groups},
                                   {"searched_all", p.searched_all}, {"candidates", p.candidates},
+                                  {"recomputed", p.recomputed}, {"wasted", p.wasted},
                                   {"seconds_region", p.seconds_region}, {"seconds_match", p.seconds_match},
                                   {"seconds_transfer", p.seconds_transfer}});
     j["levels"].push_back(lj);

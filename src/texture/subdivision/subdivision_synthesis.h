@@ -119,6 +119,7 @@ struct SynthesisPassStats {
   std::size_t candidates = 0;  ///< exemplar texels scored over all matches (branch and bound)
   std::size_t searched_all = 0;  ///< matches that searched the whole candidate box (no coherent candidate fitted)
   std::size_t recomputed = 0;  ///< speculative jobs redone at commit (their region changed)
+  std::size_t wasted = 0;      ///< speculative jobs dropped (an earlier commit of their chunk patched the vertex)
   /// Thread time summed over vertices (so it can exceed the wall time).
   double seconds_match = 0, seconds_transfer = 0, seconds_region = 0;
   double seconds_setup = 0;    ///< frames, region graph (wall)
