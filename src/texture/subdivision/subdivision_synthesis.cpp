@@ -111,9 +111,10 @@ Image to_rgb(const Image& in) {
 
 }  // namespace
 
-double detail_kept(const Image& img, double scale) {
-  if (img.empty()) throw InvalidInputError("detail_kept: the image is empty");
-  const Image lum = luminance(img);
+namespace {
+
+// detail_kept of an image's luminance (one channel).
+double luminance_detail_kept(const Image& lum, double scale) {
   const int w = lum.width, h = lum.height;
   const int rw = std::max(1, static_cast<int>(std::lround(w * scale / 2))),
             rh = std::max(1, static_cast<int>(std::lround(h * scale / 2)));
@@ -130,6 +131,13 @@ double detail_kept(const Image& img, double scale) {
       lost += d * d;
     }
   return total > 0 ? std::max(0.0, 1.0 - lost / total) : 1.0;
+}
+
+}  // namespace
+
+double detail_kept(const Image& img, double scale) {
+  if (img.empty()) throw InvalidInputError("detail_kept: the image is empty");
+  return luminance_detail_kept(luminance(img), scale);
 }
 
 Image resample_as_synthesised(const Image& img, const SubdivisionScale& scale, bool periodic) {
@@ -193,9 +201,10 @@ void choose_depth(const MeshFigures& f, int w, int h, double r_mesh, const Subdi
 void keep_exemplar_detail(const MeshFigures& f, const Image& exemplar, const SubdivisionSynthesisOptions& opt,
                           SubdivisionScale& sc) {
   if (!(opt.min_relative_detail > 0) || sc.exemplar_scale >= 1.0 || !sc.budget_limited) return;
-  const double full = detail_kept(exemplar, 1.0);
+  const Image lum = luminance(exemplar);  // once: up to 22 evaluations below
+  const double full = luminance_detail_kept(lum, 1.0);
   if (!(full > 0)) return;
-  auto relative = [&](const SubdivisionScale& s) { return detail_kept(exemplar, s.exemplar_scale) / full; };
+  auto relative = [&](const SubdivisionScale& s) { return luminance_detail_kept(lum, s.exemplar_scale) / full; };
   sc.relative_detail = relative(sc);
   double repeats = opt.repeats;
   while (sc.relative_detail < opt.min_relative_detail && sc.exemplar_scale < 1.0 && repeats > 1.0) {
