@@ -144,7 +144,7 @@ struct SubdivArgs {
   std::string mesh, exemplar, outdir, texel_size, wrap = "auto";
   std::string exemplar_normal, exemplar_height, exemplar_roughness;
   double rscale = 0, adaptive = 1.5, displace = 0, region = 9, sigma = 1, repetition = 0.3;
-  int levels = -1, passes = 1, adaptive_steps = 4, atlas = 1024, exhaustive_levels = 1;
+  int levels = -1, passes = 1, adaptive_steps = 4, atlas = 0, exhaustive_levels = 1;
   std::size_t max_vertices = SubdivisionSynthesisOptions{}.max_vertices;
   double bump = 2;
   bool pyramid = false, fixed_region = false, no_antialias = false, no_averaging = false, no_cut = false, projection = false;
@@ -220,7 +220,9 @@ int run_subdiv(const SubdivArgs& a) {
     const double faces = std::max<double>(1.0, static_cast<double>(mesh.number_of_faces()));
     est_levels = std::max(0, static_cast<int>(std::floor(std::log2(2.0 * static_cast<double>(a.max_vertices) / faces))));
   }
-  check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, est_levels, a.atlas), a.common);
+  // --atlas-size 0 follows the final vertex count, at most max_vertices.
+  const int est_atlas = a.atlas > 0 ? a.atlas : default_subdivision_atlas_size(a.max_vertices);
+  check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, est_levels, est_atlas), a.common);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
   if (!a.common.quiet) print_scale(r);
   const nlohmann::json fidelity = subdivision_fidelity_report(mesh, r, a.common.seed);
@@ -229,7 +231,7 @@ int run_subdiv(const SubdivArgs& a) {
   // frames of the surface as written (after --displace)
   const SubdivisionVertexMaps vmaps = exemplar_maps_at_vertices(mesh, r, maps, ex.width, ex.height);
   SubdivisionAssetOptions ao;
-  ao.atlas_size = a.atlas;
+  ao.atlas_size = a.atlas > 0 ? a.atlas : default_subdivision_atlas_size(mesh.number_of_vertices());
   ao.bump = a.bump;
   ao.texels_per_length = r.scale.r_scale / r.object_unit;
   ao.texel_size = r.scale.texel_size;
@@ -348,9 +350,10 @@ SubcommandRegistrar reg_subdiv{
        app.add_option("--sigma", a->sigma, "sigma of the graph-cut edge weight (equation 1), > 0 (default 1)")
            ->check(CLI::Range(1e-3, 1e3));
        app.add_option("--atlas-size", a->atlas,
-                      "Baked atlas width = height in pixels, 64..8192 (default 1024; charts keep a gutter of "
-                      "size/64 texels so every mip level down to 64 px is free of bleeding)")
-           ->check(CLI::Range(64, 8192));
+                      "Baked atlas width = height in pixels, 64..8192, or 0 (default) = from the synthesised "
+                      "vertices: 1024 up to 157K, 2048 up to 629K, else 4096 (about a texel per vertex); charts "
+                      "keep a gutter of size/64 texels so every mip level down to 64 px is free of bleeding")
+           ->check(CLI::Range(64, 8192) | CLI::IsMember({0}));
        app.add_option("--bump", a->bump,
                       "Normal-map strength (surface_atlas_normal.png, from the height = luminance or "
                       "--exemplar-height): tilt per unit height slope, height per exemplar texel, 0..100 (default 2)")

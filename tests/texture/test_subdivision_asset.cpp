@@ -12,6 +12,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "texture/subdivision/subdivision_asset.h"
+#include "texture/subdivision/subdivision_synthesis.h"
 
 namespace surftex {
 namespace {
@@ -105,6 +106,24 @@ TEST(SubdivisionAsset, DefaultChartCapKeepsMoreTexelsOnAFineMeshThanTheGeneralOn
             << " -> " << asset << "\n";
   EXPECT_LT(n_asset, n_general);
   EXPECT_GT(asset, 1.05 * general);
+}
+
+// The CLI's default atlas side follows the synthesised vertices: at the 15%
+// coverage the mip-safe gutters leave, 1024 px held 0.45 atlas texels per
+// synthesis texel on the cow's 195K vertices, 2048 px 0.93 (decision 209).
+TEST(SubdivisionAsset, DefaultAtlasSizeHoldsATexelPerVertex) {
+  EXPECT_EQ(default_subdivision_atlas_size(0), 1024);
+  EXPECT_EQ(default_subdivision_atlas_size(40962), 1024);
+  EXPECT_EQ(default_subdivision_atlas_size(157000), 1024);
+  EXPECT_EQ(default_subdivision_atlas_size(194978), 2048);
+  EXPECT_EQ(default_subdivision_atlas_size(SubdivisionSynthesisOptions{}.max_vertices), 2048);
+  EXPECT_EQ(default_subdivision_atlas_size(700000), 4096);
+  EXPECT_EQ(default_subdivision_atlas_size(50000000), 4096);
+  for (std::size_t v : {1000u, 100000u, 300000u, 2000000u}) {
+    const int n = default_subdivision_atlas_size(v);
+    EXPECT_TRUE(n == 4096 || 0.15 * n * n >= static_cast<double>(v)) << v;
+    EXPECT_TRUE(n == 1024 || 0.15 * (n / 2) * (n / 2) < static_cast<double>(v)) << v << ": not the smallest";
+  }
 }
 
 TEST(SubdivisionAsset, JsonHasTheReportKeys) {

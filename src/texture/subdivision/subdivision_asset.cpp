@@ -85,6 +85,13 @@ void bake_maps(SubdivisionAsset& a, const SubdivisionVertexMaps& maps, const std
 
 }  // namespace
 
+int default_subdivision_atlas_size(std::size_t vertices) {
+  constexpr double kCoverage = 0.15;
+  int n = 1024;
+  while (n < 4096 && kCoverage * n * n < static_cast<double>(vertices)) n *= 2;
+  return n;
+}
+
 SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVertexMaps& maps,
                                         const SubdivisionAssetOptions& options) {
   if (!(options.texels_per_length > 0))

@@ -91,6 +91,13 @@ struct SubdivisionAsset {
   SubdivisionAsset& operator=(SubdivisionAsset&&) noexcept;
 };
 
+/// The atlas side the CLI defaults to for a synthesised mesh of `vertices`
+/// vertices: the smallest power of two from 1024 to 4096 whose charts, at
+/// the ~15% coverage measured with the mip-safe gutters (decision 209), hold
+/// a texel per vertex (a synthesis texel); 1024 up to 157K vertices, 2048
+/// up to 629K.
+int default_subdivision_atlas_size(std::size_t vertices);
+
 SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVertexMaps& maps,
                                         const SubdivisionAssetOptions& options = {});
 
