@@ -2,6 +2,9 @@
 #include "geometry/base_mesh_atlas.h"
 
 #include <CGAL/Polygon_mesh_processing/compute_normal.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +13,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
-#include <queue>
+#include <set>
 #include <string>
 
 #include "geometry/disc_chart.h"
@@ -31,6 +34,7 @@ struct Chart {
   double area3d = 0;
   double distortion = 1;  // the flattening's area_distortion
   bool alive = true;      // false once merged into another chart
+  int version = 0;        // changes when a chart merges into this one
 };
 
 // Greedy region growing into disc charts (see header, step 1; the growth is
@@ -86,7 +90,7 @@ double signed_area(const std::array<double, 2>& a, const std::array<double, 2>& 
 DiscChartFlattening flatten(const Mesh& mesh, const std::vector<FaceIndex>& faces) {
   std::vector<int> idx;
   for (FaceIndex f : faces) idx.push_back(static_cast<int>(f.idx()));
-  return flatten_disc_chart(mesh, idx);
+  return flatten_disc_chart(mesh, idx, LscmSolver::kDirect);
 }
 
 // A chart from its flattening, turned to its smallest bounding box.
@@ -101,21 +105,18 @@ Chart make_chart(std::vector<FaceIndex> faces, DiscChartFlattening&& fl) {
   return ch;
 }
 
-// Flattens grown chart `faces` (see header, step 2). A flattening that is
-// not an embedding (LSCM folded the chart over itself) is split: its faces
-// regrown into discs of at most half its size, each flattened the same way.
-void flatten_or_split(const Mesh& mesh, std::vector<FaceIndex> faces, DiscGrowthState& state,
-                      std::vector<char>& free_face, std::vector<Chart>& out) {
-  DiscChartFlattening fl = flatten(mesh, faces);
+// Throws for a chart flattening that failed (not for one that folds).
+void check_flattening(const DiscChartFlattening& fl, const std::vector<FaceIndex>& faces) {
   const std::string what = "base mesh atlas: chart of " + std::to_string(faces.size()) + " faces from face " +
                            std::to_string(faces.front().idx()) + ": ";
   if (fl.status == DiscChartFlattening::Status::kTopology)
     throw TopologyError(what + fl.error + " (non-manifold base mesh?)");
   if (fl.status != DiscChartFlattening::Status::kOk) throw SolverError(what + fl.error);
-  if (fl.embedded() || faces.size() == 1) {
-    out.push_back(make_chart(std::move(faces), std::move(fl)));
-    return;
-  }
+}
+
+// The faces of a folded chart regrown into discs of at most half its size.
+std::vector<std::vector<FaceIndex>> split_chart(const Mesh& mesh, std::vector<FaceIndex> faces,
+                                                DiscGrowthState& state, std::vector<char>& free_face) {
   std::sort(faces.begin(), faces.end());
   for (FaceIndex f : faces) free_face[f.idx()] = 1;
   auto accept = [&](int f) { return free_face[static_cast<std::size_t>(f)] != 0; };
@@ -128,7 +129,46 @@ void flatten_or_split(const Mesh& mesh, std::vector<FaceIndex> faces, DiscGrowth
       parts.back().push_back(FaceIndex(static_cast<Mesh::size_type>(f)));
     }
   }
-  for (auto& part : parts) flatten_or_split(mesh, std::move(part), state, free_face, out);
+  return parts;
+}
+
+// Flattens the grown charts (see header, step 2). A flattening that is not
+// an embedding (LSCM folded the chart over itself) is split: its faces
+// regrown into discs of at most half its size, each flattened the same way.
+// Each round's charts are flattened in parallel; the charts come out in the
+// depth-first order of a serial recursion (grown chart, then its parts).
+std::vector<Chart> flatten_or_split(const Mesh& mesh, std::vector<std::vector<FaceIndex>> grown) {
+  struct Pending {
+    std::vector<FaceIndex> faces;
+    std::vector<int> path;  // grown chart index, then part indices
+  };
+  std::vector<Pending> round;
+  for (std::size_t i = 0; i < grown.size(); ++i) round.push_back({std::move(grown[i]), {static_cast<int>(i)}});
+  std::vector<std::pair<std::vector<int>, Chart>> done;
+  DiscGrowthState state(mesh);
+  std::vector<char> free_face(mesh.num_faces(), 0);
+  while (!round.empty()) {
+    std::vector<DiscChartFlattening> fl(round.size());
+    tbb::parallel_for(std::size_t(0), round.size(), [&](std::size_t i) { fl[i] = flatten(mesh, round[i].faces); });
+    std::vector<Pending> next;
+    for (std::size_t i = 0; i < round.size(); ++i) {
+      check_flattening(fl[i], round[i].faces);
+      if (fl[i].embedded() || round[i].faces.size() == 1) {
+        done.emplace_back(std::move(round[i].path), make_chart(std::move(round[i].faces), std::move(fl[i])));
+        continue;
+      }
+      int k = 0;
+      for (auto& part : split_chart(mesh, std::move(round[i].faces), state, free_face)) {
+        next.push_back({std::move(part), round[i].path});
+        next.back().path.push_back(k++);
+      }
+    }
+    round = std::move(next);
+  }
+  std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Chart> charts;
+  for (auto& d : done) charts.push_back(std::move(d.second));
+  return charts;
 }
 
 // The side of the square the chart boxes pack into with a gap of `margin`
@@ -165,30 +205,122 @@ std::vector<int> neighbours(const Mesh& mesh, const Chart& c, int id, const std:
   return out;
 }
 
-// Chart c merged into chart d when their union is a disc whose flattening is
-// an embedding, no more distorted than max(max_merge_distortion, the parts'
-// area-weighted distortion), whose padded box is smaller than the two.
-bool try_merge(const Mesh& mesh, const BaseMeshAtlasOptions& opt, std::vector<Chart>& charts, int c, int d,
-               std::vector<int>& chart_of, PackedSide& side) {
-  Chart &a = charts[c], &b = charts[d];
-  if (a.faces.size() + b.faces.size() > opt.max_chart_faces) return false;
-  const double gap = side.gap(), before = padded_box(a, gap) + padded_box(b, gap);
-  const double area = a.area3d + b.area3d;
-  if (area + 2 * gap * std::sqrt(area) + gap * gap >= before) return false;  // no box of that area is smaller
+// The faces chart c merged into chart d flattens: d's, then c's.
+std::vector<FaceIndex> union_faces(const Chart& a, const Chart& b) {
   std::vector<FaceIndex> faces = b.faces;
   faces.insert(faces.end(), a.faces.begin(), a.faces.end());
-  DiscChartFlattening fl = flatten(mesh, faces);
+  return faces;
+}
+
+// try_merge's tests before flattening: the union stays within
+// max_chart_faces and a box of its area could pack smaller than the two.
+bool may_merge(const BaseMeshAtlasOptions& opt, const Chart& a, const Chart& b, double gap) {
+  if (a.faces.size() + b.faces.size() > opt.max_chart_faces) return false;
+  const double before = padded_box(a, gap) + padded_box(b, gap), area = a.area3d + b.area3d;
+  return area + 2 * gap * std::sqrt(area) + gap * gap < before;
+}
+
+// Chart c merged into chart d when may_merge holds and the flattening `fl`
+// of their union_faces is an embedding, no more distorted than
+// max(max_merge_distortion, the parts' area-weighted distortion), whose
+// padded box is smaller than the two.
+bool try_merge(const BaseMeshAtlasOptions& opt, std::vector<Chart>& charts, int c, int d, DiscChartFlattening&& fl,
+               std::vector<int>& chart_of, PackedSide& side) {
+  Chart &a = charts[c], &b = charts[d];
+  const double gap = side.gap(), before = padded_box(a, gap) + padded_box(b, gap);
+  const double area = a.area3d + b.area3d;
   const double parts = (a.distortion * a.area3d + b.distortion * b.area3d) / area;
   if (!fl.embedded() || fl.area_distortion > std::max(opt.max_merge_distortion, parts)) return false;
-  Chart u = make_chart(std::move(faces), std::move(fl));
+  Chart u = make_chart(union_faces(a, b), std::move(fl));
   if (padded_box(u, gap) >= before) return false;
   side.add(a, -1), side.add(b, -1), side.add(u, 1);
   for (FaceIndex f : a.faces) chart_of[f.idx()] = d;
+  u.version = a.version > b.version ? a.version + 1 : b.version + 1;
   b = std::move(u);
   a = Chart();
   a.alive = false;
   return true;
 }
+
+using MergeQueue = std::set<std::pair<double, int>>;  // area, chart: smallest first
+
+// Union flattenings computed ahead of the serial merge loop, which takes
+// them in its own order: the same merges as flattening each union when
+// tried, in less time when threads are free (2 threads: decision 210).
+class UnionFlattenings {
+ public:
+  /// The flattening of chart c's union with chart d. When it was not computed
+  /// ahead, it is computed now in parallel with the unions the next queued
+  /// charts would try first (charts not in any union of the batch).
+  DiscChartFlattening take(const Mesh& mesh, const BaseMeshAtlasOptions& opt, const std::vector<Chart>& charts,
+                           int c, int d, const MergeQueue& queue, const std::vector<int>& chart_of, double gap) {
+    auto hit = find(charts, c, d);
+    if (hit == entries_.end()) {
+      compute(mesh, next_jobs(mesh, opt, charts, c, d, queue, chart_of, gap), charts);
+      hit = find(charts, c, d);
+    }
+    DiscChartFlattening fl = std::move(hit->fl);
+    entries_.erase(hit);
+    return fl;
+  }
+
+ private:
+  struct Entry {
+    int c, d, vc, vd;  // charts and their versions when flattened
+    DiscChartFlattening fl;
+  };
+  std::vector<Entry> entries_;
+
+  std::vector<Entry>::iterator find(const std::vector<Chart>& charts, int c, int d) {
+    return std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) {
+      return e.c == c && e.d == d && e.vc == charts[c].version && e.vd == charts[d].version;
+    });
+  }
+
+  // (c, d), then for the next queued charts (up to 4 per thread looked at)
+  // the first neighbour passing may_merge, while both are in no earlier pair.
+  std::vector<std::pair<int, int>> next_jobs(const Mesh& mesh, const BaseMeshAtlasOptions& opt,
+                                             const std::vector<Chart>& charts, int c, int d, const MergeQueue& queue,
+                                             const std::vector<int>& chart_of, double gap) {
+    const std::size_t threads = std::min(
+        static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency())),
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    std::vector<std::pair<int, int>> jobs{{c, d}};
+    std::vector<int> used{c, d};
+    auto is_used = [&](int x) { return std::find(used.begin(), used.end(), x) != used.end(); };
+    std::size_t looked = 0;
+    for (auto it = queue.begin(); it != queue.end() && jobs.size() < threads && looked < 4 * threads; ++it) {
+      const int a = it->second;
+      if (!charts[a].alive || it->first != charts[a].area3d || is_used(a)) continue;
+      ++looked;
+      for (int b : neighbours(mesh, charts[a], a, chart_of)) {
+        if (!may_merge(opt, charts[a], charts[b], gap)) continue;
+        if (!is_used(b) && find(charts, a, b) == entries_.end()) jobs.emplace_back(a, b);
+        used.push_back(a), used.push_back(b);
+        break;
+      }
+    }
+    return jobs;
+  }
+
+  // Flattens the jobs' unions in parallel; drops entries of changed charts.
+  void compute(const Mesh& mesh, const std::vector<std::pair<int, int>>& jobs, const std::vector<Chart>& charts) {
+    entries_.erase(std::remove_if(entries_.begin(), entries_.end(),
+                                  [&](const Entry& e) {
+                                    return e.vc != charts[e.c].version || e.vd != charts[e.d].version ||
+                                           !charts[e.c].alive || !charts[e.d].alive;
+                                  }),
+                   entries_.end());
+    std::vector<DiscChartFlattening> fl(jobs.size());
+    tbb::parallel_for(std::size_t(0), jobs.size(), [&](std::size_t i) {
+      fl[i] = flatten(mesh, union_faces(charts[jobs[i].first], charts[jobs[i].second]));
+    });
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      const auto [a, b] = jobs[i];
+      entries_.push_back({a, b, charts[a].version, charts[b].version, std::move(fl[i])});
+    }
+  }
+};
 
 // Greedy merging (see header, step 2b; Sander et al. 2001, section 4.1):
 // the smallest chart (3D area) first, into the neighbour sharing the longest
@@ -197,21 +329,24 @@ void merge_charts(const Mesh& mesh, const BaseMeshAtlasOptions& opt, std::vector
                   std::vector<int>& chart_of) {
   PackedSide side;
   side.margin = opt.margin;
-  using Item = std::pair<double, int>;  // area, chart
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  MergeQueue queue;
   for (std::size_t c = 0; c < charts.size(); ++c) {
     side.add(charts[c], 1);
-    queue.push({charts[c].area3d, static_cast<int>(c)});
+    queue.insert({charts[c].area3d, static_cast<int>(c)});
   }
+  UnionFlattenings ahead;
   while (!queue.empty()) {
-    const auto [area, c] = queue.top();
-    queue.pop();
+    const auto [area, c] = *queue.begin();
+    queue.erase(queue.begin());
     if (!charts[c].alive || area != charts[c].area3d) continue;  // merged, or queued again since
-    for (int d : neighbours(mesh, charts[c], c, chart_of))
-      if (try_merge(mesh, opt, charts, c, d, chart_of, side)) {
-        queue.push({charts[d].area3d, d});
+    for (int d : neighbours(mesh, charts[c], c, chart_of)) {
+      if (!may_merge(opt, charts[c], charts[d], side.gap())) continue;
+      DiscChartFlattening fl = ahead.take(mesh, opt, charts, c, d, queue, chart_of, side.gap());
+      if (try_merge(opt, charts, c, d, std::move(fl), chart_of, side)) {
+        queue.insert({charts[d].area3d, d});
         break;
       }
+    }
   }
 }
 
@@ -221,10 +356,7 @@ std::vector<Chart> make_charts(const Mesh& mesh, const BaseMeshAtlasOptions& opt
                                int num_grown) {
   std::vector<std::vector<FaceIndex>> grown(num_grown);
   for (FaceIndex f : mesh.faces()) grown[chart_of[f.idx()]].push_back(f);
-  std::vector<Chart> charts;
-  DiscGrowthState state(mesh);
-  std::vector<char> free_face(mesh.num_faces(), 0);
-  for (auto& faces : grown) flatten_or_split(mesh, std::move(faces), state, free_face, charts);
+  std::vector<Chart> charts = flatten_or_split(mesh, std::move(grown));
   for (std::size_t c = 0; c < charts.size(); ++c)
     for (FaceIndex f : charts[c].faces) chart_of[f.idx()] = static_cast<int>(c);
   if (opt.merge_charts) merge_charts(mesh, opt, charts, chart_of);

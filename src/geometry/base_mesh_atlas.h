@@ -8,11 +8,14 @@
 // 1. Segmentation (disc_chart.h): greedy region growing from the first free
 //    face, within max_normal_angle_deg and max_chart_faces, keeping discs
 //    (verified; TopologyError otherwise).
-// 2. Flattening: CGAL LSCM per chart, mirrored if negative, scaled to its 3D
-//    area, rotated to its smallest bounding box; folded charts regrown smaller.
+// 2. Flattening: LSCM per chart (disc_chart.h, LscmSolver::kDirect), mirrored
+//    if negative, scaled to its 3D area, rotated to its smallest bounding box;
+//    folded charts regrown smaller. Charts flattened in parallel.
 // 2b. Merging (merge_charts; Sander et al. 2001, 4.1): smallest charts merged
 //    into neighbours while the union is a disc, embeds, stays within
-//    max_merge_distortion and packs smaller.
+//    max_merge_distortion and packs smaller. Serial greedy order; the unions
+//    the next merges try are flattened ahead in parallel.
+// Same bytes on any number of threads (decision 210).
 // 3. Packing: shelf packing with `margin` gaps, one uniform scale into [0,1]^2.
 // In full: docs/decisions/104-shell-space.md.
 //

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <map>
@@ -232,6 +233,40 @@ TEST(BaseMeshAtlas, MergingLeavesFewerDiscChartsThatNeitherFlipNorOverlap) {
     if (!merged.is_border(h)) {
       ASSERT_EQ(ua[h], ub[h]);
     }
+}
+
+namespace {
+// The atlas of `name` with `threads` TBB threads: corner uvs and face charts.
+std::pair<std::vector<UV>, std::vector<int>> atlas_on_threads(const char* name, bool merge, std::size_t threads) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  Mesh m;
+  read_mesh(test::shared_data(name), m);
+  BaseMeshAtlasOptions opt;
+  opt.merge_charts = merge;
+  opt.margin = 0.03;
+  compute_base_mesh_atlas(m, opt);
+  auto uv = find(m, kCornerUV).first;
+  auto patch = find(m, kFacePatch).first;
+  std::pair<std::vector<UV>, std::vector<int>> out;
+  for (HalfedgeIndex h : m.halfedges()) out.first.push_back(uv[h]);
+  for (FaceIndex f : m.faces()) out.second.push_back(patch[f]);
+  return out;
+}
+}  // namespace
+
+// Deterministic parallel stages (decision 210): the charts flattened (and
+// split where they fold) in parallel rounds, and the merges' unions
+// flattened ahead in parallel, give the same bytes on one and two threads.
+// elephant's flattenings fold (FlatteningsNeverFoldOverThemselves), so both
+// rounds and splits run; merging is on in the second case.
+TEST(BaseMeshAtlas, SameUvOnOneAndTwoThreads) {
+  for (bool merge : {false, true}) {
+    SCOPED_TRACE(merge ? "merged" : "not merged");
+    const auto one = atlas_on_threads("meshes/elephant.off", merge, 1);
+    const auto two = atlas_on_threads("meshes/elephant.off", merge, 2);
+    EXPECT_TRUE(one.first == two.first);
+    EXPECT_TRUE(one.second == two.second);
+  }
 }
 
 TEST(BaseMeshAtlas, RejectsBadOptions) {

@@ -2,11 +2,13 @@
 // The base-mesh atlas repacked in texels with mip gutters (issue 16 item 3,
 // decision 302): many-chart meshes keep the full 2^K gutter.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "atlas_checks.h"
 #include "geometry/atlas_gutter.h"
 #include "geometry/gutter_atlas.h"
 #include "geometry/mesh.h"
+#include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "test_support.h"
 
@@ -31,4 +33,23 @@ TEST(GutterAtlas, ManySmallChartsKeepTheFullGutter) {
   EXPECT_EQ(g.atlas.flipped_faces, 0u);
   EXPECT_EQ(test::uv_flipped_faces(m), 0u);
   EXPECT_EQ(test::uv_overlap_texels(m, N), 0u);
+}
+
+// The subdiv asset's case (decision 210): a fine mesh at 1024 texels with
+// charts of up to 8000 faces, whose flattenings and merges run in parallel,
+// gives the same atlas bytes on one and two threads.
+TEST(GutterAtlas, SameAtlasOnOneAndTwoThreads) {
+  auto run = [](std::size_t threads) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    Mesh m;
+    read_mesh(test::shared_data("meshes/bunny_75k.off"), m);
+    const GutterAtlas g = compute_gutter_atlas(m, 1024, 64, 8000);
+    auto uv = find(m, kCornerUV).first;
+    std::vector<UV> uvs;
+    for (HalfedgeIndex h : m.halfedges()) uvs.push_back(uv[h]);
+    return std::make_pair(uvs, g.chart);
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_TRUE(one.first == two.first);
+  EXPECT_TRUE(one.second == two.second);
 }
