@@ -36,6 +36,17 @@ Image random_image(int w, int h, std::mt19937_64& rng) {
   for (float& v : im.data) v = u(rng);
   return im;
 }
+
+// Every vertex's colour (kVertexColor, which must exist), r g b in vertex order.
+std::vector<float> vertex_colours(const Mesh& m) {
+  const auto col = find(m, kVertexColor);
+  EXPECT_TRUE(col.second) << "no vertex colours";
+  std::vector<float> c;
+  if (!col.second) return c;
+  for (VertexIndex v : m.vertices())
+    for (int k = 0; k < 3; ++k) c.push_back(col.first[v][k]);
+  return c;
+}
 }  // namespace
 
 // Section 3.3.3: the averaged metric differs from the naive one by a constant
@@ -181,12 +192,7 @@ TEST(SubdivisionSynthesis, SameSeedSameColoursAndEveryVertexColoured) {
     o.seed = seed;
     const auto r = synthesize_on_subdivision(m, ex, o);
     EXPECT_EQ(r.levels.size(), 4u);
-    std::vector<float> c;
-    auto col = find(m, kVertexColor);
-    EXPECT_TRUE(col.second);
-    for (VertexIndex v : m.vertices())
-      for (int k = 0; k < 3; ++k) c.push_back(col.first[v][k]);
-    return c;
+    return vertex_colours(m);
   };
   const auto a = run(3), b = run(3), c = run(4);
   EXPECT_EQ(a, b);
@@ -256,11 +262,7 @@ TEST(SubdivisionSynthesis, CoherenceSearchIsThreadIndependentAndUsed) {
         (coherent ? coherent_matched : exhaustive_matched) += p.matched;
         (coherent ? coherent_searched_all : exhaustive_searched_all) += p.searched_all;
       }
-    std::vector<float> c;
-    auto col = find(m, kVertexColor).first;
-    for (VertexIndex v : m.vertices())
-      for (int k = 0; k < 3; ++k) c.push_back(col[v][k]);
-    return c;
+    return vertex_colours(m);
   };
   const auto one = run(1, 1), two = run(2, 1), exhaustive = run(2, 13);
   EXPECT_EQ(one, two);
@@ -383,11 +385,7 @@ TEST(SubdivisionSynthesis, PassIsIndependentOfTheThreadCount) {
       SubdivisionSynthesisOptions o;
       o.graph_cut = cut;
       for (int pass = 0; pass < 3; ++pass) synthesis_pass(m, ex, order, colored, 30.0, 0, o, rng);
-      std::vector<float> c;
-      auto col = find(m, kVertexColor).first;
-      for (VertexIndex v : m.vertices())
-        for (int k = 0; k < 3; ++k) c.push_back(col[v][k]);
-      return c;
+      return vertex_colours(m);
     };
     const auto a = run(1), b = run(2);
     EXPECT_EQ(a, b) << "graph cut " << cut;
@@ -415,9 +413,7 @@ TEST(SubdivisionSynthesis, BaseLevelSweepDoesNotComputeJobsItThrowsAway) {
     ASSERT_GT(p.matched, 0u);
     EXPECT_GT(p.patched, 10 * p.matched) << "regions too small for the test";
     EXPECT_LT(p.wasted, 3 * p.matched) << p.wasted << " jobs thrown away for " << p.matched << " matches";
-    auto col = find(m, kVertexColor).first;
-    for (VertexIndex v : m.vertices())
-      for (int k = 0; k < 3; ++k) colours[threads - 1].push_back(col[v][k]);
+    colours[threads - 1] = vertex_colours(m);
   }
   EXPECT_EQ(colours[0], colours[1]);
 }

@@ -25,10 +25,6 @@ inline double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] +
 inline V3 cross(const V3& a, const V3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-inline int wrap(int x, int n) {
-  x %= n;
-  return x < 0 ? x + n : x;
-}
 
 }  // namespace
 
@@ -252,7 +248,6 @@ std::vector<SampleGroup> group_samples(const ExemplarLevels& ex, const std::vect
   return g;
 }
 
-
 std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y) {
   const double fx = std::floor(x), fy = std::floor(y);
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
@@ -307,8 +302,8 @@ void group_table(const ExemplarLevels& ex, const std::vector<SampleGroup>& group
   t.gy.resize(G);
   for (std::size_t g = 0; g < G; ++g) {
     t.base[g] = ex.levels[groups[g].level].data.data();
-    t.gx[g] = wrap(groups[g].dx, W);
-    t.gy[g] = wrap(groups[g].dy, H);
+    t.gx[g] = wrap_coordinate(groups[g].dx, W);
+    t.gy[g] = wrap_coordinate(groups[g].dy, H);
   }
 }
 
@@ -625,8 +620,8 @@ MatchResult ExemplarIndex::match(const std::vector<SampleGroup>& groups, int cen
   rowp.resize(3 * G);
   // Periodic: offsets wrapped into [0, W); non-periodic: as they are (the box keeps them inside).
   for (std::size_t g = 0; g < G; ++g) {
-    gx[g] = wraps ? wrap(groups[g].dx, W) : groups[g].dx,
-    gy[g] = wraps ? wrap(groups[g].dy, H) : groups[g].dy;
+    gx[g] = wraps ? wrap_coordinate(groups[g].dx, W) : groups[g].dx,
+    gy[g] = wraps ? wrap_coordinate(groups[g].dy, H) : groups[g].dy;
     for (int c = 0; c < 3; ++c) planes[3 * g + c] = levels_[groups[g].level].plane[c].data();
   }
   const RowStencil s{groups, planes.data(), gx.data(), gy.data(), W, H, x0, nx, wraps};

@@ -17,6 +17,7 @@
 //    lowest index; independent of the thread count. With a pyramid every
 //    sample uses the centre's level. Details: docs/decisions/206.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -219,18 +220,18 @@ class ExemplarIndex {
 /// centres at integers), wrapping, or clamped at a bounded level.
 std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double x, double y);
 
+/// x wrapped into [0, n).
+inline int wrap_coordinate(int x, int n) {
+  x %= n;
+  return x < 0 ? x + n : x;
+}
+
 /// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level
 /// (inline: the coherence search's inner loop).
 inline std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
   const Image& im = ex.levels[level];
-  if (ex.wraps(level)) {
-    x %= im.width, y %= im.height;
-    x += x < 0 ? im.width : 0, y += y < 0 ? im.height : 0;
-  } else {
-    x = x < 0 ? 0 : (x >= im.width ? im.width - 1 : x);
-    y = y < 0 ? 0 : (y >= im.height ? im.height - 1 : y);
-  }
-  const float* p = im.pixel(x, y);
+  const float* p = ex.wraps(level) ? im.pixel(wrap_coordinate(x, im.width), wrap_coordinate(y, im.height))
+                                   : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
   return {p[0], p[1], p[2]};
 }
 

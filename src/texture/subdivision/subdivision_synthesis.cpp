@@ -109,10 +109,6 @@ Image to_rgb(const Image& in) {
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 // detail_kept of an image's luminance (one channel).
 double luminance_detail_kept(const Image& lum, double scale) {
   const int w = lum.width, h = lum.height;
@@ -375,7 +371,7 @@ MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, con
     if (bounded) {
       if (qx < box.x0 || qx > box.x1 || qy < box.y0 || qy > box.y1) continue;
     } else {
-      qx = ((qx % W) + W) % W, qy = ((qy % H) + H) % H;
+      qx = wrap_coordinate(qx, W), qy = wrap_coordinate(qy, H);
     }
     bool dup = false;
     for (int k = 0; k < nseen && !dup; ++k) dup = seen[k][0] == qx && seen[k][1] == qy;
@@ -522,7 +518,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
         int sx = job.m.qx + o[0], sy = job.m.qy + o[1];
         if (!bounded) {
           const int W = c.ex.width(lp), H = c.ex.height(lp);
-          sx = ((sx % W) + W) % W, sy = ((sy % H) + H) % H;
+          sx = wrap_coordinate(sx, W), sy = wrap_coordinate(sy, H);
         }
         job.writes.push_back({reg.vertices[i], s.nodes[i].texture, c.ex.pyramid ? lp : c.level[reg.vertices[i]],
                               {sx * sc, sy * sc}, s.lookups[i]});
