@@ -39,7 +39,7 @@ struct PatchArgs {
                                      multi = "none", fill = "onion", search = "approximate";
   int patch_res = 128, max_faces = 200, window = 11, preselect = 0, rotations = 64,
       exemplar_size = 0;
-  double max_angle = 30.0, bump = 2.0;
+  double max_angle = 30.0, bump = 2.0, coherence = ElOptions{}.coherence;
   bool patch_res_given = false;  ///< --patch-res on the command line: refused, not lowered, when the atlas cannot hold it
   CommonOptions common;
 };
@@ -184,6 +184,7 @@ int run(const PatchArgs& a) {
   po.order = a.order == "curvature" ? PatchOrder::Curvature : PatchOrder::Random;
   po.el.window = a.window;
   po.el.preselect = a.preselect;
+  po.el.coherence = a.coherence;
   po.el.rotations = a.rotations;
   po.el.search = a.search == "exhaustive" ? ElSearch::Exhaustive : ElSearch::Approximate;
   po.el.order = a.fill == "direction" ? FillOrder::Direction : FillOrder::OnionPeel;
@@ -284,6 +285,11 @@ SubcommandRegistrar reg{
            ->check(CLI::IsMember({"none", "illumination", "curvature", "height"}));
        app.add_option("--window", a->window, "Efros-Leung window, 3..51 (default 11)")
            ->check(CLI::Range(3, 51));
+       app.add_option("--coherence", a->coherence,
+                      "Continue a neighbour's source region when its error is within (1 + this) of the best "
+                      "match, so that bricks and tiles come out whole; 0 = Gorla's random pick among the best "
+                      "(default 5)")
+           ->check(CLI::Range(0.0, 100.0));
        app.add_option("--preselect", a->preselect,
                       "First-pass candidates kept, >= 0; 0 = exemplar width (one scanline) (default 0)")
            ->check(CLI::NonNegativeNumber);

@@ -25,7 +25,7 @@ namespace {
 struct SynthArgs {
   std::string exemplar, output, size = "256x256", method = "el2pass", angle_field;
   int window = 11, first_window = 0, preselect = 0, rotations = 64;
-  double angle_deg = 0.0;
+  double angle_deg = 0.0, coherence = ElOptions{}.coherence;
   std::string search = "approximate";
   bool has_angle = false, periodic = false;
   CommonOptions common;
@@ -78,6 +78,7 @@ ElResult run_el2pass(const SynthArgs& a, const Image& exemplar, int w, int h) {
   opt.rotations = a.rotations;
   opt.search = a.search == "exhaustive" ? ElSearch::Exhaustive : ElSearch::Approximate;
   opt.periodic_exemplar = a.periodic;
+  opt.coherence = a.coherence;
   opt.seed = a.common.seed;
   opt.progress = terminal_progress(a.common.quiet);
   return efros_leung_synthesize(in, opt);
@@ -187,6 +188,11 @@ SubcommandRegistrar reg{
                       "of the exemplar size) or exhaustive (every exemplar position, Gorla 2003 as "
                       "published; slow on large exemplars) (default approximate)")
            ->check(CLI::IsMember({"approximate", "exhaustive"}));
+       app.add_option("--coherence", a->coherence,
+                      "el2pass: continue a neighbour's source region when its error is within (1 + this) "
+                      "of the best match, so that bricks and tiles come out whole; 0 = Gorla's random "
+                      "pick among the best (default 5)")
+           ->check(CLI::Range(0.0, 100.0));
        app.add_flag("--periodic", a->periodic,
                     "The exemplar tiles seamlessly: neighbourhoods wrap around its edges "
                     "(default off)");

@@ -466,6 +466,12 @@ class Synthesizer {
   std::vector<int> src_;
   std::vector<int> p1_slot_;
   std::vector<int> short_;
+  // Coherent candidates of the current pixel (sorted, unique); see
+  // ElOptions::coherence.
+  std::vector<int> coh_;
+  bool given_in_window_ = false;  // a Known (given) pixel lies in the current window
+  void add_coherent_to_preselect();
+  bool pick_coherent(int& id) const;
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
 };
 
@@ -487,6 +493,8 @@ void Synthesizer::validate() {
     bad("ann_stride " + std::to_string(opt_.ann_stride) + " outside 1..4");
   if (!(opt_.ann_eps >= 0.0) || !std::isfinite(opt_.ann_eps))
     bad("ann_eps " + std::to_string(opt_.ann_eps) + " must be finite and >= 0");
+  if (!(opt_.coherence >= 0.0) || !std::isfinite(opt_.coherence))
+    bad("coherence " + std::to_string(opt_.coherence) + " must be finite and >= 0");
   if (!(opt_.gaussian_sigma >= 0.0) || !std::isfinite(opt_.gaussian_sigma))
     bad("gaussian_sigma " + std::to_string(opt_.gaussian_sigma) + " must be finite and >= 0");
   if (!(opt_.pick_fraction >= 0.0 && opt_.pick_fraction <= 1.0))
@@ -599,6 +607,8 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   p1_value_.clear();
   p1_slot_.clear();
   short_.clear();
+  coh_.clear();
+  given_in_window_ = false;
   const int px = p % W, py = p / W;
   const int lo = lo_of(window_), hi = hi_of(window_);
   const int flo = lo_of(first_), fhi = hi_of(first_);
@@ -614,17 +624,19 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
       const int q = y * W + x;
       if (!known_[q]) continue;
       const float* v = out_.pixel(x, y);
+      given_in_window_ = given_in_window_ || state_[q] == PixelState::Known;
       if (dx >= flo && dx <= fhi && dy >= flo && dy <= fhi) {
         p1_delta_.push_back(dy * s.pw + dx);
         p1_value_.insert(p1_value_.end(), v, v + C);
+        // Coherent candidate: q's source shifted back by q's offset (same search image only).
+        int c = -1;
+        if (src_[q] >= 0 && key_[q] == key_[p])
+          c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
         if (s.ann) {
           p1_slot_.push_back((dy - flo) * first_ + (dx - flo));
-          // Coherent candidate: q's source shifted back by q's offset (same search image only).
-          if (src_[q] >= 0 && key_[q] == key_[p]) {
-            const int c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
-            if (c >= 0) short_.push_back(c);
-          }
+          if (c >= 0) short_.push_back(c);
         }
+        if (c >= 0 && opt_.coherence > 0) coh_.push_back(c);
       }
       delta_.push_back(dy * s.pw + dx);
       weight_.push_back(gauss_[g]);
@@ -879,6 +891,7 @@ void Synthesizer::synthesize_pixel(int p) {
       pass1_short_list(s, n, p);
     else
       pass1(s, n);
+    add_coherent_to_preselect();
     score_full(s, pre_, scored_);
   }
   const std::size_t m = scored_.size();
@@ -893,13 +906,40 @@ void Synthesizer::synthesize_pixel(int p) {
     while (within < k && scored_[within].first <= limit) ++within;
     k = within;
   }
-  const int id = scored_[k > 1 ? rng_() % k : 0].second;
+  int id = scored_[k > 1 ? rng_() % k : 0].second;
+  pick_coherent(id);
   const int px = p % W, py = p / W;
   for (int c = 0; c < C; ++c) out_.at(px, py, c) = s.plane(c)[id];
   record_source(p, p, id, s);
   src_[p] = id;
   mark_filled(p);
   ++synthesized_;
+}
+
+// Coherent candidates join pass 2 even when pass 1 ranked them out.
+void Synthesizer::add_coherent_to_preselect() {
+  if (coh_.empty()) return;
+  std::sort(coh_.begin(), coh_.end());
+  coh_.erase(std::unique(coh_.begin(), coh_.end()), coh_.end());
+  const std::size_t n0 = pre_.size();
+  std::sort(pre_.begin(), pre_.end());
+  for (int c : coh_)
+    if (!std::binary_search(pre_.begin(), pre_.begin() + static_cast<std::ptrdiff_t>(n0), c)) pre_.push_back(c);
+}
+
+// ElOptions::coherence: the best coherent candidate of pass 2 replaces the
+// random pick when its error is within (1 + coherence) of the best error
+// (scored_ holds every pass-2 candidate, its best first). Not next to given
+// (Known) pixels: there the boundary condition decides (a patch's seams).
+// Returns whether it did.
+bool Synthesizer::pick_coherent(int& id) const {
+  if (coh_.empty() || scored_.empty() || given_in_window_) return false;
+  const Scored* best = nullptr;
+  for (const Scored& v : scored_)
+    if (std::binary_search(coh_.begin(), coh_.end(), v.second) && (!best || v < *best)) best = &v;
+  if (!best || best->first > scored_[0].first * (1.0 + opt_.coherence) + 1e-12) return false;
+  id = best->second;
+  return true;
 }
 
 // The canvas from the input: sizes, windows, pixel states, the target's

@@ -69,6 +69,15 @@ struct ElOptions {
   /// Efros-Leung epsilon: candidates with error > (1 + eps) * best error are
   /// not picked. Negative = off (pure Gorla rule). Default 0.1.
   double error_tolerance = 0.1;
+  /// Coherence (an addition to Gorla's rule, after Ashikhmin 2001 and
+  /// Hertzmann et al. 2001): a candidate that continues a synthesised
+  /// neighbour's source (its source shifted by the offset) is taken when its
+  /// full-window error is at most (1 + coherence) times the best; the best
+  /// such, ties by position; not where the window holds given (Known)
+  /// pixels, whose boundary condition decides. Larger features (bricks, tiles) then come out
+  /// whole instead of in fragments. >= 0; 0 = off (the published rule).
+  /// Default 5 (decision 506).
+  double coherence = 5.0;
   /// Order in which Fill pixels are synthesised.
   FillOrder order = FillOrder::OnionPeel;
   /// Sweep direction for FillOrder::Direction (pixel coordinates, y down);
