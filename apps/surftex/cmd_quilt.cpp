@@ -374,7 +374,7 @@ nlohmann::json step_quilt(DemoContext& ctx) {
   make_icosphere(base, 2);
   QuiltSwatchOnSurfaceOptions so;
   so.swatch_up = SwatchAxis::kZ;
-  so.quilt.relative_size = 0.45;
+  so.quilt.relative_size = 0;  // the CLI's default, default_surface_quilt_size of the swatch
   so.quilt.progress = ctx.progress;
   so.embed.stretch.iterations = 10;
   so.seed = ctx.seed;
@@ -391,6 +391,7 @@ nlohmann::json step_quilt(DemoContext& ctx) {
                  {"stretch_before", sr.embedding.stretch.stretch_before},
                  {"stretch_after", sr.embedding.stretch.stretch_after},
                  {"self_intersections", sr.embedding.embed.self_intersecting_pairs},
+                 {"bare_fraction", sr.quilt.bare_fraction},
                  {"outputs", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
   j["seconds"]["sphere"] = t.seconds();
   return j;
