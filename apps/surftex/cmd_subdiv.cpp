@@ -353,7 +353,7 @@ SubcommandRegistrar reg_subdiv{
                       "Baked atlas width = height in pixels, 64..8192, or 0 (default) = from the synthesised "
                       "vertices: 1024 up to 157K, 2048 up to 629K, else 4096 (about a texel per vertex); charts "
                       "keep a gutter of size/64 texels so every mip level down to 64 px is free of bleeding")
-           ->check(CLI::Range(64, 8192) | CLI::IsMember({0}));
+           ->check(zero_or_range(64, 8192, "from the vertices"));
        app.add_option("--bump", a->bump,
                       "Normal-map strength (surface_atlas_normal.png, from the height = luminance or "
                       "--exemplar-height): tilt per unit height slope, height per exemplar texel, 0..100 (default 2)")

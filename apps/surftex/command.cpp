@@ -67,6 +67,19 @@ CLI::Validator number_above(double lo, bool strict) {
       "NUMBER " + bound);
 }
 
+CLI::Validator zero_or_range(long long lo, long long hi, const std::string& zero_means) {
+  const std::string want =
+      "0 (" + zero_means + ") or " + std::to_string(lo) + ".." + std::to_string(hi);
+  return CLI::Validator(
+      [lo, hi, want](std::string& in) -> std::string {
+        double v = 0;
+        if (!parse_whole_number(in, v) || v != std::floor(v)) return "must be " + want + " (got '" + in + "')";
+        if (v != 0 && (v < lo || v > hi)) return "must be " + want + " (got " + in + ")";
+        return "";
+      },
+      "0 or " + std::to_string(lo) + ".." + std::to_string(hi));
+}
+
 void add_common_options(CLI::App& app, CommonOptions& opt) {
   app.add_option("--seed", opt.seed,
                  "Seed for every random choice; the same input and seed give the same output "

@@ -38,6 +38,10 @@ struct CommonOptions {
 /// "must be > 0 (got -1)" (CLI11's PositiveNumber prints a 300-digit range).
 CLI::Validator number_above(double lo, bool strict);
 
+/// A CLI11 check: 0 (meaning `zero_means`) or a whole number in lo..hi; the
+/// message reads "must be 0 (from the vertices) or 64..8192 (got 10)".
+CLI::Validator zero_or_range(long long lo, long long hi, const std::string& zero_means);
+
 /// A CLI11 check: a whole unsigned 64-bit integer ("18446744073709551616"
 /// and "-1" are refused, not saturated or wrapped).
 CLI::Validator whole_unsigned_64();

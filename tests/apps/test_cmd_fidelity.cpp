@@ -87,6 +87,14 @@ TEST(CmdSubdivFidelity, TexelSizeForms) {
   EXPECT_EQ(both.exit_code, 2) << both.err;
   auto wrap = test::run_surftex(base + "-o '" + dir + "/d' --wrap sometimes -q");
   EXPECT_EQ(wrap.exit_code, 2) << wrap.err;
+  // --atlas-size: 0 (from the vertices) or 64..8192, said in one sentence.
+  for (const char* bad : {"10", "9000", "-1", "1.5"}) {
+    auto b = test::run_surftex(base + "-o '" + dir + "/f' --atlas-size " + bad + " -q");
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find("error: --atlas-size: must be 0 (from the vertices) or 64..8192"), std::string::npos)
+        << bad << ": " << b.err;
+    EXPECT_FALSE(fs::exists(dir + "/f"));
+  }
 }
 
 // patches and material-map reports carry the same fidelity block, with the
