@@ -357,7 +357,10 @@ struct ElPreparedExemplars {
 
   const SearchImage& get(int e, int k) const {
     const std::size_t i = static_cast<std::size_t>(e) * rotations + k;
-    std::call_once(once[i], [&] { slots[i] = build(e, k); });
+    // Isolated: while the build's parallel_for waits, this thread must not
+    // take another synthesis task that could ask for the same slot (a
+    // recursive call_once on one flag deadlocks).
+    std::call_once(once[i], [&] { tbb::this_task_arena::isolate([&] { slots[i] = build(e, k); }); });
     return *slots[i];
   }
 
