@@ -29,6 +29,7 @@ function(surftex_add_module name)
     target_include_directories(surftex_${name} PUBLIC "${PROJECT_SOURCE_DIR}/src")
     target_link_libraries(surftex_${name} PUBLIC ${ARG_DEPS})
     surftex_target_options(surftex_${name})
+    surftex_unity(surftex_${name})
     add_library(surftex::${name} ALIAS surftex_${name})
   else()  # a module with no sources yet
     add_library(surftex_${name} INTERFACE)
@@ -43,5 +44,14 @@ endfunction()
 function(surftex_precompile target)
   if(SURFTEX_PCH)
     target_precompile_headers(${target} PRIVATE ${ARGN})
+  endif()
+endfunction()
+
+# SURFTEX_UNITY: the target's sources joined 8 at a time (CMake's unity
+# build). Sources keep their file-local names apart: no two sources of one
+# target may define the same name in an anonymous namespace.
+function(surftex_unity target)
+  if(SURFTEX_UNITY)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
   endif()
 endfunction()

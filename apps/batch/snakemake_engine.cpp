@@ -84,7 +84,7 @@ namespace {
 volatile std::sig_atomic_t g_signals = 0;
 volatile std::sig_atomic_t g_first = 0;
 
-void on_signal(int sig) {
+void on_engine_signal(int sig) {
   if (g_first == 0) g_first = sig;
   g_signals = g_signals + 1;
 }
@@ -95,7 +95,7 @@ struct SignalScope {
   SignalScope() {
     g_signals = 0, g_first = 0;
     struct sigaction sa{};
-    sa.sa_handler = on_signal;
+    sa.sa_handler = on_engine_signal;
     sigemptyset(&sa.sa_mask);
     for (int i = 0; i < 3; ++i) ::sigaction(sigs[i], &sa, &old[i]);
   }

@@ -34,6 +34,7 @@ namespace fs = std::filesystem;
 
 namespace surftex::cli {
 namespace {
+namespace batch_command {  // named: the unity build joins these files
 
 using namespace surftex::batch;
 
@@ -330,5 +331,6 @@ SubcommandRegistrar reg_batch{
        return [a] { return run_batch(*a); };
      }}};
 
+}  // namespace batch_command
 }  // namespace
 }  // namespace surftex::cli

@@ -19,6 +19,7 @@ namespace fs = std::filesystem;
 
 namespace surftex::cli {
 namespace {
+namespace convert_command {  // named: the unity build joins these files
 
 struct ConvertArgs {
   std::string input, output, texture;
@@ -133,5 +134,6 @@ SubcommandRegistrar reg{
        return [a] { return run(*a); };
      }}};
 
+}  // namespace convert_command
 }  // namespace
 }  // namespace surftex::cli

@@ -41,6 +41,7 @@ std::vector<DemoStep>& demo_steps() {
 }
 
 namespace {
+namespace demo_command {  // named: the unity build joins these files
 
 constexpr const char* kMarker = ".surftex-demo";
 
@@ -217,5 +218,6 @@ std::function<int()> setup(CLI::App& app) {
 SubcommandRegistrar reg{{"demo", "Tour of every method on built-in inputs the project generates (writes into out/demo)",
                          setup}};
 
+}  // namespace demo_command
 }  // namespace
 }  // namespace surftex::cli

@@ -12,6 +12,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace info_command {  // named: the unity build joins these files
 
 struct MeshTopology {
   std::size_t components = 0, boundary_loops = 0, boundary_edges = 0;
@@ -123,5 +124,6 @@ SubcommandRegistrar reg{
        };
      }}};
 
+}  // namespace info_command
 }  // namespace
 }  // namespace surftex::cli

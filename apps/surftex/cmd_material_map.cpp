@@ -46,6 +46,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace material_map_command {  // named: the unity build joins these files
 
 namespace fs = std::filesystem;
 
@@ -350,5 +351,6 @@ DemoStepRegistrar demo_reg{{40, "material-map",
                             "a 4-layer noise-to-cells material tile mapped on a torus with a stroke and a material gradient",
                             demo_material_map}};
 
+}  // namespace material_map_command
 }  // namespace
 }  // namespace surftex::cli

@@ -14,6 +14,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace material_tile_command {  // named: the unity build joins these files
 
 struct Args {
   std::vector<std::string> inputs, masks;
@@ -173,5 +174,6 @@ SubcommandRegistrar reg{
        return [a] { return run(*a); };
      }}};
 
+}  // namespace material_tile_command
 }  // namespace
 }  // namespace surftex::cli

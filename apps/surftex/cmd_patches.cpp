@@ -32,6 +32,7 @@ namespace fs = std::filesystem;
 
 namespace surftex::cli {
 namespace {
+namespace patches_command {  // named: the unity build joins these files
 
 struct PatchArgs {
   std::string exemplar_normal, exemplar_height, exemplar_roughness;
@@ -332,5 +333,6 @@ DemoStepRegistrar demo{{30, "patches",
                           return j;
                         }}};
 
+}  // namespace patches_command
 }  // namespace
 }  // namespace surftex::cli

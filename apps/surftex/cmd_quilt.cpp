@@ -30,6 +30,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace quilt_command {  // named: the unity build joins these files
 
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto";
@@ -400,5 +401,6 @@ nlohmann::json step_quilt(DemoContext& ctx) {
 DemoStepRegistrar reg_demo_quilt{
     {60, "quilt", "mesh quilting: chain mail on a plane and on an icosphere (shell-map embedding)", step_quilt}};
 
+}  // namespace quilt_command
 }  // namespace
 }  // namespace surftex::cli

@@ -21,6 +21,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace render_command {  // named: the unity build joins these files
 
 struct RenderArgs {
   std::string input, output, texture;
@@ -242,5 +243,6 @@ SubcommandRegistrar reg{{"render", "Render a mesh to an image with the software 
   return [a] { return run(*a); };
 }}};
 
+}  // namespace render_command
 }  // namespace
 }  // namespace surftex::cli

@@ -17,6 +17,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace repair_command {  // named: the unity build joins these files
 
 struct RepairArgs {
   std::string input, output;
@@ -135,5 +136,6 @@ SubcommandRegistrar reg{
        return [a] { return run_repair(*a); };
      }}};
 
+}  // namespace repair_command
 }  // namespace
 }  // namespace surftex::cli

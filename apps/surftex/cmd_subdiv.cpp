@@ -31,6 +31,7 @@ namespace fs = std::filesystem;
 
 namespace surftex::cli {
 namespace {
+namespace subdiv_command {  // named: the unity build joins these files
 
 struct Outputs {
   std::string ply, glb, obj, render;
@@ -407,5 +408,6 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  return j;
                                }}};
 
+}  // namespace subdiv_command
 }  // namespace
 }  // namespace surftex::cli

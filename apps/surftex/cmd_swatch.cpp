@@ -13,6 +13,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace swatch_command {  // named: the unity build joins these files
 
 struct SwatchArgs {
   std::string kind, output;
@@ -79,5 +80,6 @@ SubcommandRegistrar reg{
        return [a] { return run_swatch(*a); };
      }}};
 
+}  // namespace swatch_command
 }  // namespace
 }  // namespace surftex::cli

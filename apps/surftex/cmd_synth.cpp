@@ -21,6 +21,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace synth_command {  // named: the unity build joins these files
 
 struct SynthArgs {
   std::string exemplar, output, size = "256x256", method = "el2pass", angle_field;
@@ -200,5 +201,6 @@ SubcommandRegistrar reg{
        return [a] { return run(*a); };
      }}};
 
+}  // namespace synth_command
 }  // namespace
 }  // namespace surftex::cli

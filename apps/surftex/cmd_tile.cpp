@@ -12,6 +12,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace tile_command {  // named: the unity build joins these files
 
 struct TileArgs {
   std::string input, output, preview;
@@ -124,5 +125,6 @@ SubcommandRegistrar reg{
        return [a] { return run_tile(*a); };
      }}};
 
+}  // namespace tile_command
 }  // namespace
 }  // namespace surftex::cli

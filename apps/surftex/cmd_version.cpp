@@ -11,6 +11,7 @@
 
 namespace surftex::cli {
 namespace {
+namespace version_command {  // named: the unity build joins these files
 SubcommandRegistrar reg{{"version", "Print the versions of surftex and its libraries",
                          [](CLI::App&) -> std::function<int()> {
                            return [] {
@@ -22,5 +23,6 @@ SubcommandRegistrar reg{{"version", "Print the versions of surftex and its libra
                              return 0;
                            };
                          }}};
+}  // namespace version_command
 }  // namespace
 }  // namespace surftex::cli

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/base_mesh_atlas.h"
+#include "geometry/constants.h"
 
 #include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <tbb/global_control.h>
@@ -24,7 +25,6 @@ namespace surftex {
 
 namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
-constexpr double kPi = 3.14159265358979323846;
 
 struct Chart {
   std::vector<FaceIndex> faces;
@@ -78,11 +78,6 @@ void rotate_to_small_box(Chart& ch) {
     x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
   }
   ch.min_u = x0, ch.min_v = y0, ch.w = x1 - x0, ch.h = y1 - y0;
-}
-
-double signed_area(const std::array<double, 2>& a, const std::array<double, 2>& b,
-                   const std::array<double, 2>& c) {
-  return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
 }
 
 // LSCM flattening of `faces` (geometry/disc_chart.h: disc check, oriented,
@@ -435,7 +430,7 @@ BaseMeshAtlasResult compute_base_mesh_atlas(Mesh& mesh, const BaseMeshAtlasOptio
         uvmap[h] = q;
         t[k++] = q;
       }
-      const double auv = signed_area(t[0], t[1], t[2]) / (scale * scale);
+      const double auv = uv_signed_area(t[0], t[1], t[2]) / (scale * scale);
       HalfedgeIndex h = mesh.halfedge(f);
       const double a3 = std::sqrt(CGAL::squared_area(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
                                                      mesh.point(mesh.target(mesh.next(h)))));

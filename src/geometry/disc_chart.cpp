@@ -21,13 +21,16 @@
 #include "geometry/mesh.h"
 
 namespace surftex {
+
+double uv_signed_area(const std::array<double, 2>& a, const std::array<double, 2>& b,
+                      const std::array<double, 2>& c) {
+  return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+}
+
 namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
 namespace SMP = CGAL::Surface_mesh_parameterization;
 
-double signed_area(const std::array<double, 2>& a, const std::array<double, 2>& b, const std::array<double, 2>& c) {
-  return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-}
 
 Point2 pt(const std::array<double, 2>& p) {
   return Point2(p[0], p[1]);
@@ -259,7 +262,7 @@ DiscChartFlattening flatten_with_map(const Mesh& mesh, const std::vector<int>& f
   double auv = 0;
   for (FaceIndex f : sub.faces()) {
     const HalfedgeIndex h = sub.halfedge(f);
-    auv += signed_area(out.uv[sub.source(h).idx()], out.uv[sub.target(h).idx()], out.uv[sub.target(sub.next(h)).idx()]);
+    auv += uv_signed_area(out.uv[sub.source(h).idx()], out.uv[sub.target(h).idx()], out.uv[sub.target(sub.next(h)).idx()]);
   }
   if (!(std::abs(auv) > 0)) return fail(DiscChartFlattening::Status::kSolver, "LSCM gave a zero-area chart");
   if (auv < 0)
@@ -272,7 +275,7 @@ DiscChartFlattening flatten_with_map(const Mesh& mesh, const std::vector<int>& f
     const auto &a = out.uv[sub.source(h).idx()], &b = out.uv[sub.target(h).idx()],
                &c = out.uv[sub.target(sub.next(h)).idx()];
     if (CGAL::orientation(pt(a), pt(b), pt(c)) != CGAL::LEFT_TURN) ++out.flipped_faces;
-    const double a2 = signed_area(a, b, c);
+    const double a2 = uv_signed_area(a, b, c);
     const double a3 = std::sqrt(CGAL::squared_area(sub.point(sub.source(h)), sub.point(sub.target(h)),
                                                    sub.point(sub.target(sub.next(h)))));
     if (a2 > 0 && a3 > 0) weighted += a3 * std::max(a3 / a2, a2 / a3);

@@ -23,6 +23,11 @@
 
 namespace surftex {
 
+/// The signed area of uv triangle (a, b, c),
+/// positive when counter-clockwise.
+double uv_signed_area(const std::array<double, 2>& a, const std::array<double, 2>& b,
+                      const std::array<double, 2>& c);
+
 /// Stamps shared by successive growths (no clearing between charts).
 struct DiscGrowthState {
   std::vector<int> face, vertex;  ///< last growth id that took the face / touched the vertex

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/primitive_meshes.h"
+#include "geometry/constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,6 @@
 namespace surftex {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw InvalidInputError(what);

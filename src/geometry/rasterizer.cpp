@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "geometry/rasterizer.h"
+#include "geometry/constants.h"
 #include "geometry/vec3.h"
 
 #include <tbb/blocked_range.h>
@@ -34,7 +35,6 @@ std::string str3(const Vec3f& a) {
 }
 
 // ---------------------------------------------------------------- constants
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kSubBits = 8;                 // fixed point: 1/256 sample
 constexpr std::int64_t kOne = 1 << kSubBits;
 constexpr std::int64_t kHalf = kOne / 2;    // sample centres sit at half-integers

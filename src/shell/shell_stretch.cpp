@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/shell_stretch.h"
+#include "geometry/constants.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,7 +19,6 @@ namespace surftex {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kPi = 3.14159265358979323846;
 
 // Squared Frobenius norm of S T^-1 over 3 (= L2^2), or inf if det T <= 0.
 // Columns of S and T are the edge vectors from vertex 0.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/swatch_generators.h"
+#include "geometry/constants.h"
 
 #include <cmath>
 #include <random>
@@ -13,7 +14,6 @@
 
 namespace surftex {
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 void check(bool ok, const std::string& what, double value) {
   if (!ok) throw InvalidInputError("swatch generator: " + what + " out of range (" + std::to_string(value) + ")");

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/procedural_texture.h"
+#include "geometry/constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +13,6 @@
 namespace surftex {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 void check_size(int size) {
   if (size < 4 || size > 8192)

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/quilting/surface_quilting.h"
+#include "geometry/constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +26,6 @@ namespace surftex {
 
 namespace {
 using V2 = std::array<double, 2>;
-constexpr double kPi = 3.14159265358979323846;
 // Cosine of the largest angle between an off-patch vertex's face and its
 // nearest patch face for the element to be expressed in the patch frame.
 constexpr double kFrameCos = 0.5;

@@ -54,14 +54,14 @@ bool normalise(D3& a) {
 }
 
 // A face's corner positions and vertex normals, in PGP corner order.
-struct FaceFrame {
+struct BakeFaceFrame {
   D3 p[3], n[3];
 };
 
 // The object-space normal of tile normal `tn` (decoded, tile frame) at
 // barycentrics b of face `ff`, the chart's (s,t) at the corners being `c`.
 // Falls back to the interpolated normal where the chart is degenerate.
-D3 object_normal(const FaceFrame& ff, const std::array<StmPoint, 3>& c, const std::array<double, 3>& b, const D3& tn) {
+D3 object_normal(const BakeFaceFrame& ff, const std::array<StmPoint, 3>& c, const std::array<double, 3>& b, const D3& tn) {
   D3 N{0, 0, 0};
   for (int k = 0; k < 3; ++k) N = axpy(b[k], ff.n[k], N);
   if (!normalise(N)) {
@@ -101,7 +101,7 @@ namespace {
 
 // Corner positions and vertex normals of every face (kVertexNormal, else the
 // area-weighted normals the mesh writers compute).
-std::vector<FaceFrame> face_frames(const Mesh& mesh) {
+std::vector<BakeFaceFrame> face_frames(const Mesh& mesh) {
   std::vector<Vector3> vn;
   if (auto m = find(mesh, kVertexNormal); m.second) {
     vn.resize(mesh.number_of_vertices());
@@ -109,7 +109,7 @@ std::vector<FaceFrame> face_frames(const Mesh& mesh) {
   } else {
     vn = polygon_vertex_normals(mesh);
   }
-  std::vector<FaceFrame> frames(mesh.num_faces());
+  std::vector<BakeFaceFrame> frames(mesh.num_faces());
   for (FaceIndex f : mesh.faces()) {
     int k = 0;
     for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) {
@@ -155,7 +155,7 @@ MaterialBakeResult bake_material_space(Mesh& mesh, const PgpSingularities& sing,
   r.height_from_tile = !tile.height_layers.empty();
   if (!tile.roughness_layers.empty()) r.roughness = Image(N, N, 1, 0.f);
   const bool normals = !tile.normal_layers.empty();
-  std::vector<FaceFrame> frames;
+  std::vector<BakeFaceFrame> frames;
   if (normals) frames = face_frames(mesh);
   if (normals) r.object_normal = Image(N, N, 3, 0.f);
   // Every channel through the same lookups (for_each_lookup): colour, the

@@ -252,7 +252,7 @@ void optimise_map(IndirectionMap& map, const ExemplarLevel& L, const Image& targ
   }
 }
 
-std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
+std::uint64_t mix_tile_seed(std::uint64_t seed, std::uint64_t a, std::uint64_t b) {
   std::uint64_t z = seed ^ (a * 0x9E3779B97F4A7C15ull) ^ (b * 0xC2B2AE3D27D4EB4Full + 0x165667B19E3779F9ull);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
@@ -342,7 +342,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
     if (k == 0) {
       m = identity_map(cw, chh);
       if (opt.random_first_layer) {
-        std::mt19937_64 rng(mix_seed(opt.seed, 0xF1, 0));
+        std::mt19937_64 rng(mix_tile_seed(opt.seed, 0xF1, 0));
         for (std::size_t t = 0; t < m.coords.size(); t += 2) {
           m.coords[t] = static_cast<std::int32_t>(rng() % std::uint64_t(cw));
           m.coords[t + 1] = static_cast<std::int32_t>(rng() % std::uint64_t(chh));
@@ -352,7 +352,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
       m = res.maps[k - 1][0];
     }
     if (k > 0 || opt.random_first_layer)
-      optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_seed(opt.seed, k, 0), opt,
+      optimise_map(m, ex[0], tmask_pyr[k][0], opt.coarse_passes, mix_tile_seed(opt.seed, k, 0), opt,
                    opt.exclude_radius * ex[0].w / W, opt.coarse_passes, false);
     report_progress(opt.progress, "tile synthesis", 0.05 + 0.25 * (k + 1) / K);
   }
@@ -366,7 +366,7 @@ ConstrainedSynthesisResult synthesize_constrained_tiles(const Image& exemplar, c
         continue;
       }
       m = upsample_map(res.maps[k][r - 1], ex[r].w, ex[r].h);
-      optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_seed(opt.seed, k, r), opt,
+      optimise_map(m, ex[r], tmask_pyr[k][r], opt.fine_passes, mix_tile_seed(opt.seed, k, r), opt,
                    opt.exclude_radius * ex[r].w / W, opt.fine_ann_passes, opt.fine_ann_only_mismatched);
     }
     int d = ++done;

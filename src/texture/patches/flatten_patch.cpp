@@ -9,6 +9,7 @@
 #include <deque>
 #include <string>
 
+#include "geometry/image.h"
 #include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 
@@ -366,6 +367,30 @@ FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seeds,
     }
   }
   return res;
+}
+
+bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, float* out) {
+  const int C = img.channels;
+  const double fx = px - 0.5, fy = py - 0.5;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  const double ax = fx - x0, ay = fy - y0;
+  double small[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  std::vector<double> large;  // more than 8 channels: rare
+  double* acc = small;
+  if (C > 8) large.assign(static_cast<std::size_t>(C), 0.0), acc = large.data();
+  double wsum = 0;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int x = x0 + i, y = y0 + j;
+      if (x < 0 || y < 0 || x >= fp.res || y >= fp.res) continue;
+      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Inside) continue;
+      const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay) + 1e-6;
+      for (int c = 0; c < C; ++c) acc[c] += w * img.at(x, y, c);
+      wsum += w;
+    }
+  if (wsum <= 0) return false;
+  for (int c = 0; c < C; ++c) out[c] = static_cast<float>(acc[c] / wsum);
+  return true;
 }
 
 }  // namespace surftex

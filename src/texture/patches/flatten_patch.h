@@ -90,4 +90,11 @@ int split_overlapping_patches(Mesh& mesh, std::vector<int>& seed_faces, double m
 FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seed_faces,
                               const FlattenOptions& options = {});
 
+struct Image;
+
+/// Bilinear lookup at pixel position (px, py) of an image laid over patch
+/// `fp`, restricted to its Inside pixels (weights renormalised); writes
+/// img.channels values to `out`; false if none of the four texels is Inside.
+bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, float* out);
+
 }  // namespace surftex

@@ -15,28 +15,6 @@ namespace surftex {
 
 namespace {
 
-// Bilinear lookup restricted to Inside pixels (weights renormalised), as the
-// synthesis's boundary step reads a neighbour; false if none is Inside.
-bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, float* out) {
-  const int C = img.channels;
-  const double fx = px - 0.5, fy = py - 0.5;
-  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
-  const double ax = fx - x0, ay = fy - y0;
-  std::vector<double> acc(C, 0.0);
-  double wsum = 0;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) {
-      const int x = x0 + i, y = y0 + j;
-      if (x < 0 || y < 0 || x >= fp.res || y >= fp.res) continue;
-      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Inside) continue;
-      const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay) + 1e-6;
-      for (int c = 0; c < C; ++c) acc[c] += w * img.at(x, y, c);
-      wsum += w;
-    }
-  if (wsum <= 0) return false;
-  for (int c = 0; c < C; ++c) out[c] = static_cast<float>(acc[c] / wsum);
-  return true;
-}
 
 // Turns an encoded tangent-space normal by `a` (counter-clockwise, x right, y up).
 void turn_normal(float* n, double a) {

@@ -99,28 +99,6 @@ std::vector<DirectionConstraint> principal_constraints(const Mesh& mesh, PatchFi
   return out;
 }
 
-// Bilinear lookup in a patch image restricted to its Inside pixels (weights
-// renormalised); false if none of the four texels is Inside.
-bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, float* out) {
-  const int C = img.channels;
-  const double fx = px - 0.5, fy = py - 0.5;
-  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
-  const double ax = fx - x0, ay = fy - y0;
-  double acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  double wsum = 0;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) {
-      const int x = x0 + i, y = y0 + j;
-      if (x < 0 || y < 0 || x >= fp.res || y >= fp.res) continue;
-      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Inside) continue;
-      const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay) + 1e-6;
-      for (int c = 0; c < C && c < 8; ++c) acc[c] += w * img.at(x, y, c);
-      wsum += w;
-    }
-  if (wsum <= 0) return false;
-  for (int c = 0; c < C && c < 8; ++c) out[c] = static_cast<float>(acc[c] / wsum);
-  return true;
-}
 
 // Partition (3.1) and overlap splitting (3.2): the seed face of every patch.
 std::vector<int> partition_into_patches(Mesh& mesh, const PatchSynthesisOptions& opt,
