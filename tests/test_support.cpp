@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +26,29 @@ std::string file_bytes(const std::string& p) {
   std::stringstream ss;
   ss << f.rdbuf();
   return ss.str();
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  const fs::path p(path);
+  if (p.has_parent_path()) fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+
+double cv(const std::vector<long long>& counts) {
+  double mean = 0, var = 0;
+  for (long long v : counts) mean += static_cast<double>(v);
+  mean /= static_cast<double>(counts.size());
+  for (long long v : counts) var += (v - mean) * (v - mean);
+  return std::sqrt(var / static_cast<double>(counts.size())) / mean;
 }
 
 std::string shared_data(const std::string& rel) {

@@ -2,6 +2,8 @@
 #pragma once
 // Shared helpers for the test suites: where the real data lives, temporary
 // folders, running the surftex binary.
+#include <nlohmann/json_fwd.hpp>
+
 #include <string>
 #include <vector>
 
@@ -16,6 +18,16 @@ std::string cgal_data(const std::string& name);
 std::string temp_dir(const std::string& tag);
 /// The whole file, bytes as they are ("" if it cannot be read).
 std::string file_bytes(const std::string& path);
+/// Writes `text` to `path`, creating its folders.
+void write_text_file(const std::string& path, const std::string& text);
+/// The JSON document in `path` (throws if it cannot be parsed).
+nlohmann::json read_json(const std::string& path);
+/// `s` in single quotes, for a shell command line (paths without quotes).
+std::string q(const std::string& s);
+/// True in the sanitizer suite (SURFTEX_SANITIZED set): tests shrink their work.
+bool sanitized();
+/// Coefficient of variation (standard deviation over mean) of counts.
+double cv(const std::vector<long long>& counts);
 
 struct RunResult {
   int exit_code = -1;

@@ -26,17 +26,8 @@ using surftex::InvalidInputError;
 
 namespace {
 
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-void write(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-}
+using surftex::test::file_bytes;
+using surftex::test::write_text_file;
 
 int count_substr(const std::string& t, const std::string& what) {
   int n = 0;
@@ -116,7 +107,7 @@ TEST(BatchManifest, ErrorsNameTheFileAndLine) {
 
 TEST(BatchManifest, ReadingAnEmptyManifestIsRefused) {
   const std::string dir = surftex::test::temp_dir("batch-empty");
-  write(fs::path(dir) / "jobs.txt", "# nothing\n\n");
+  write_text_file(fs::path(dir) / "jobs.txt", "# nothing\n\n");
   EXPECT_THROW(read_batch_manifest(dir + "/jobs.txt"), InvalidInputError);
   EXPECT_THROW(read_batch_manifest(dir + "/absent.txt"), surftex::IOError);
   fs::remove_all(dir);
@@ -124,11 +115,11 @@ TEST(BatchManifest, ReadingAnEmptyManifestIsRefused) {
 
 TEST(BatchSnakefile, InputsAreExistingFilesThatLookLikePathsOutsideOut) {
   const fs::path dir = surftex::test::temp_dir("batch-inputs");
-  write(dir / "m.off", "OFF\n");
-  write(dir / "up", "a file named like an option value\n");
-  write(dir / "tile" / "tile.json", "{}");
-  write(dir / "tile" / "layer_000.png", "x");
-  write(dir / "out" / "a" / "x.obj", "");
+  write_text_file(dir / "m.off", "OFF\n");
+  write_text_file(dir / "up", "a file named like an option value\n");
+  write_text_file(dir / "tile" / "tile.json", "{}");
+  write_text_file(dir / "tile" / "layer_000.png", "x");
+  write_text_file(dir / "out" / "a" / "x.obj", "");
   BatchJob j;
   j.subcommand = "material-map";
   j.args = {"m.off", "--field", "up", "--tile", "tile", "--other=m.off", "missing.off", "out/a/x.obj", "0.5"};
@@ -160,7 +151,7 @@ TEST(BatchSnakefile, OneRulePerJobWithQuotedCommandAndDirectoryOutput) {
 
 TEST(BatchSnakefile, TheFingerprintFollowsTheCommandAndTheInputFiles) {
   const fs::path dir = surftex::test::temp_dir("batch-fingerprint");
-  write(dir / "m.off", "OFF\n0 0 0\n");
+  write_text_file(dir / "m.off", "OFF\n0 0 0\n");
   BatchJob j;
   j.subcommand = "render";
   j.args = {"m.off", "--size", "64"};
@@ -174,7 +165,7 @@ TEST(BatchSnakefile, TheFingerprintFollowsTheCommandAndTheInputFiles) {
   fs::last_write_time(dir / "m.off", fs::last_write_time(dir / "m.off") - std::chrono::seconds(10));
   const std::string f1 = job_fingerprint(j, dir.string(), out);
   EXPECT_NE(f1, f0);
-  write(dir / "m.off", "OFF\n0 0 0 \n");
+  write_text_file(dir / "m.off", "OFF\n0 0 0 \n");
   EXPECT_NE(job_fingerprint(j, dir.string(), out), f1);
   fs::remove_all(dir);
 }
@@ -183,8 +174,8 @@ TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
   const fs::path out = surftex::test::temp_dir("batch-job-ok");
   const fs::path work = surftex::test::temp_dir("batch-job-work");
   // A stand-in for surftex: /bin/sh runs the script with "-o STAGE --report R".
-  write(work / "job.sh", "echo note: working >&2\necho hello > \"$2/out.txt\"\ncat input.txt > \"$2/copy.txt\"\n");
-  write(work / "input.txt", "from the manifest folder\n");
+  write_text_file(work / "job.sh", "echo note: working >&2\necho hello > \"$2/out.txt\"\ncat input.txt > \"$2/copy.txt\"\n");
+  write_text_file(work / "input.txt", "from the manifest folder\n");
   JobRunOptions o;
   o.name = "j1";
   o.out_dir = out.string();
@@ -192,10 +183,10 @@ TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
   o.surftex_exe = "/bin/sh";
   o.command = {"job.sh"};
   EXPECT_EQ(run_batch_job(o), 0);
-  EXPECT_EQ(read_all(out / "j1" / "out.txt"), "hello\n");
-  EXPECT_EQ(read_all(out / "j1" / "copy.txt"), "from the manifest folder\n");
+  EXPECT_EQ(file_bytes(out / "j1" / "out.txt"), "hello\n");
+  EXPECT_EQ(file_bytes(out / "j1" / "copy.txt"), "from the manifest folder\n");
   EXPECT_FALSE(fs::exists(out / job_stage_path("j1")));
-  EXPECT_NE(read_all(out / job_log_path("j1")).find("note: working"), std::string::npos);
+  EXPECT_NE(file_bytes(out / job_log_path("j1")).find("note: working"), std::string::npos);
   JobStatus s;
   ASSERT_TRUE(read_job_status((out / job_status_path("j1")).string(), s));
   EXPECT_EQ(s.status, "ok");
@@ -206,7 +197,7 @@ TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
   EXPECT_EQ(s.fingerprint, job_fingerprint(as_job, work.string(), out.string()));
   EXPECT_GE(s.seconds, 0.0);
   // A second run replaces the folder whole.
-  write(work / "job.sh", "echo again > \"$2/other.txt\"\n");
+  write_text_file(work / "job.sh", "echo again > \"$2/other.txt\"\n");
   EXPECT_EQ(run_batch_job(o), 0);
   EXPECT_FALSE(fs::exists(out / "j1" / "out.txt"));
   EXPECT_TRUE(fs::exists(out / "j1" / "other.txt"));
@@ -216,7 +207,7 @@ TEST(BatchJob, AJobThatSucceedsIsMovedIntoPlaceWhole) {
 
 TEST(BatchJob, AFailedJobLeavesNoFolderAndRecordsItsErrorLine) {
   const fs::path out = surftex::test::temp_dir("batch-job-fail");
-  write(out / "job.sh", "echo partial > \"$2/part.txt\"\necho 'error: mesh is broken' >&2\necho more >&2\nexit 2\n");
+  write_text_file(out / "job.sh", "echo partial > \"$2/part.txt\"\necho 'error: mesh is broken' >&2\necho more >&2\nexit 2\n");
   JobRunOptions o;
   o.name = "bad";
   o.out_dir = out.string();
@@ -232,7 +223,7 @@ TEST(BatchJob, AFailedJobLeavesNoFolderAndRecordsItsErrorLine) {
   EXPECT_EQ(s.exit_code, 2);
   EXPECT_EQ(s.error, "error: mesh is broken");
   // Exit 0 without output is a failure too.
-  write(out / "job.sh", "true\n");
+  write_text_file(out / "job.sh", "true\n");
   EXPECT_NE(run_batch_job(o), 0);
   ASSERT_TRUE(read_job_status((out / job_status_path("bad")).string(), s));
   EXPECT_EQ(s.error, "error: the job wrote no output");
@@ -242,7 +233,7 @@ TEST(BatchJob, AFailedJobLeavesNoFolderAndRecordsItsErrorLine) {
 
 TEST(BatchJob, OptionsGoBeforeTheJobsArguments) {
   const fs::path out = surftex::test::temp_dir("batch-job-argv");
-  write(out / "job.sh", "printf '%s|' \"$@\" > \"$(dirname \"$2\")/argv.txt\"\n");
+  write_text_file(out / "job.sh", "printf '%s|' \"$@\" > \"$(dirname \"$2\")/argv.txt\"\n");
   JobRunOptions o;
   o.name = "a";
   o.out_dir = out.string();
@@ -253,7 +244,7 @@ TEST(BatchJob, OptionsGoBeforeTheJobsArguments) {
   o.command = {"job.sh", "x.off", "--", "y"};
   ASSERT_EQ(run_batch_job(o), 0);
   // $2 was STAGE/render.png, a file: the script wrote argv.txt next to it, in the job folder.
-  const std::string argv = read_all(out / "a" / "argv.txt");
+  const std::string argv = file_bytes(out / "a" / "argv.txt");
   const std::string stage = (out / job_stage_path("a")).string();
   EXPECT_EQ(argv, "-o|" + stage + "/render.png|--report|" + stage + "/report.json|--threads|1|x.off|--|y|");
   fs::remove_all(out);
@@ -286,13 +277,13 @@ TEST(BatchSummary, AJobIsOkOnlyWithItsFolderAndAStatusForItsCurrentCommand) {
   const BatchManifest m = parse_batch_manifest("a: render m.off\nb: render n.off\nc: render o.off\n", "j.txt");
   JobStatus st;
   st.name = "a", st.command = job_command_line(m.jobs[0]), st.status = "ok", st.seconds = 1.5;
-  write(out / job_status_path("a"), to_json(st).dump());
-  write(out / "a" / "render.png", "png");
-  write(out / "a" / "report.json", R"({"coverage":0.5,"seconds":{"total":1.2}})");
+  write_text_file(out / job_status_path("a"), to_json(st).dump());
+  write_text_file(out / "a" / "render.png", "png");
+  write_text_file(out / "a" / "report.json", R"({"coverage":0.5,"seconds":{"total":1.2}})");
   st.name = "b", st.command = job_command_line(m.jobs[1]), st.status = "failed", st.exit_code = 2, st.error = "error: x";
-  write(out / job_status_path("b"), to_json(st).dump());
+  write_text_file(out / job_status_path("b"), to_json(st).dump());
   st.name = "c", st.command = "surftex render other.off", st.status = "failed";  // an older command
-  write(out / job_status_path("c"), to_json(st).dump());
+  write_text_file(out / job_status_path("c"), to_json(st).dump());
   const JobSummary a = summarize_job(m.jobs[0], out.string());
   EXPECT_EQ(a.status, "ok");
   EXPECT_DOUBLE_EQ(a.seconds, 1.5);
@@ -305,7 +296,7 @@ TEST(BatchSummary, AJobIsOkOnlyWithItsFolderAndAStatusForItsCurrentCommand) {
   EXPECT_EQ(b.error, "error: x");
   EXPECT_EQ(b.exit_code, 2);
   EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "not_run");
-  write(out / "c" / "render.png", "png");  // a folder made by the older command is not this job's output
+  write_text_file(out / "c" / "render.png", "png");  // a folder made by the older command is not this job's output
   EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "not_run");
   fs::remove(out / job_status_path("c"));  // a folder without any status (status removed) counts
   EXPECT_EQ(summarize_job(m.jobs[2], out.string()).status, "ok");
@@ -341,7 +332,7 @@ TEST(ContactSheet, DemoCardsClaimTheImagesOfTheirSteps) {
   std::vector<std::string> files;  // the demo run's outputs
   for (const char* f : {"synth_el2pass.png", "tile_noise.png", "exemplar_cells.png", "torus_tiled.png",
                         "patches/render.png", "patches_exemplar.png"}) {
-    write(dir / f, "png");
+    write_text_file(dir / f, "png");
     files.push_back((dir / f).string());
   }
   const nlohmann::json report = nlohmann::json::parse(R"({"seconds": {"synthesis": 1.0, "textured_torus": 0.5,
@@ -351,7 +342,7 @@ TEST(ContactSheet, DemoCardsClaimTheImagesOfTheirSteps) {
     "textured_torus": {"faces": 10, "outputs": ["torus_tiled.obj", "torus_tiled.png"]},
     "patches": {"patches": 4, "outputs": ["render.png"]}}})");
   write_demo_contact_sheet(dir.string(), report, files);
-  const std::string h = read_all(dir / "index.html");
+  const std::string h = file_bytes(dir / "index.html");
   auto card = [&](const std::string& name) {
     const std::size_t a = h.find("id=\"card-" + name + "\"");
     return a == std::string::npos ? std::string() : h.substr(a, h.find("</article>", a) - a);

@@ -29,21 +29,12 @@ using surftex::test::temp_dir;
 
 namespace {
 
-std::string read_all(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using surftex::test::file_bytes;
+using surftex::test::write_text_file;
 
-void write(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-}
+using surftex::test::q;
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
-
-nlohmann::json read_json(const fs::path& p) { return nlohmann::json::parse(read_all(p)); }
+using surftex::test::read_json;
 
 const nlohmann::json* job(const nlohmann::json& summary, const std::string& name) {
   for (const auto& j : summary["jobs"])
@@ -98,7 +89,7 @@ void check_isolation_and_summary(const surftex::test::RunResult& run, const fs::
   EXPECT_NE((*broken)["command"].get<std::string>().find("truncated.off"), std::string::npos);
   EXPECT_FALSE(fs::exists(out / "broken"));
   EXPECT_TRUE(!fs::exists(out / ".surftex" / "stage") || fs::is_empty(out / ".surftex" / "stage"));
-  EXPECT_NE(read_all(out / ".surftex" / "logs" / "broken.log").find("error:"), std::string::npos);
+  EXPECT_NE(file_bytes(out / ".surftex" / "logs" / "broken.log").find("error:"), std::string::npos);
   for (const char* ok : {"spot", "beans", "eight"}) {
     const nlohmann::json* j = job(s, ok);
     ASSERT_NE(j, nullptr) << ok;
@@ -118,7 +109,7 @@ void check_isolation_and_summary(const surftex::test::RunResult& run, const fs::
   EXPECT_FALSE(job(s, "eight")->at("figures").empty());  // seam ratio, patches, faces
   EXPECT_TRUE(job(s, "eight")->at("figures").contains("seam ratio"));
   // The Snakefile has one rule per job and declares the inputs it found.
-  const std::string sf = read_all(out / "Snakefile");
+  const std::string sf = file_bytes(out / "Snakefile");
   EXPECT_EQ(count_of(sf, "\nrule job_"), 4);
   EXPECT_NE(sf.find(shared_data("meshes/spot.ply")), std::string::npos);
 }
@@ -135,7 +126,7 @@ void check_pipe_progress(const surftex::test::RunResult& run) {
 }
 
 void check_contact_sheet(const fs::path& out) {
-  const std::string html = read_all(out / "index.html");
+  const std::string html = file_bytes(out / "index.html");
   EXPECT_EQ(count_of(html, "<article class=\"card"), 4);
   EXPECT_LT(html.find("id=\"card-broken\""), html.find("id=\"card-spot\""));  // failed first
   EXPECT_EQ(html.find("src=\"/"), std::string::npos);
@@ -148,7 +139,7 @@ void check_contact_sheet(const fs::path& out) {
       " --virtual-time-budget=10000 --dump-dom " + q("file://" + (out / "index.html").string()) + " > " +
       q(dom.string()) + " 2>/dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << "chromium failed (scripts/setup.sh --tests installs it)";
-  const std::string d = read_all(dom);
+  const std::string d = file_bytes(dom);
   EXPECT_EQ(count_of(d, "<article class=\"card"), 4) << d.substr(0, 2000);
   const int images = count_of(d, "<img ");
   EXPECT_GE(images, 3);
@@ -162,24 +153,24 @@ void check_contact_sheet(const fs::path& out) {
 
 TEST(BatchCli, ABadManifestIsRefusedWithFileAndLineAndNothingIsWritten) {
   const std::string dir = temp_dir("batch-bad");
-  write(fs::path(dir) / "jobs.txt", "a: render x.off\n# two lines later\nA: render y.off\n");
+  write_text_file(fs::path(dir) / "jobs.txt", "a: render x.off\n# two lines later\nA: render y.off\n");
   auto r = run_surftex("batch " + q(dir + "/jobs.txt") + " -o " + q(dir + "/out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("error: " + dir + "/jobs.txt:3: the job name 'A' is used again (first on line 1)"),
             std::string::npos)
       << r.err;
-  write(fs::path(dir) / "jobs.txt", "a: render x.off -o mine.png\n");
+  write_text_file(fs::path(dir) / "jobs.txt", "a: render x.off -o mine.png\n");
   r = run_surftex("batch " + q(dir + "/jobs.txt") + " -o " + q(dir + "/out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("jobs.txt:1: job 'a' gives -o"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(fs::path(dir) / "out"));
   // A folder the batch did not make is not taken over.
-  write(fs::path(dir) / "jobs.txt", "a: render x.off\n");
-  write(fs::path(dir) / "mine" / "keep.txt", "user file");
+  write_text_file(fs::path(dir) / "jobs.txt", "a: render x.off\n");
+  write_text_file(fs::path(dir) / "mine" / "keep.txt", "user file");
   r = run_surftex("batch " + q(dir + "/jobs.txt") + " -o " + q(dir + "/mine"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("was not made by `surftex batch`"), std::string::npos) << r.err;
-  EXPECT_EQ(read_all(fs::path(dir) / "mine" / "keep.txt"), "user file");
+  EXPECT_EQ(file_bytes(fs::path(dir) / "mine" / "keep.txt"), "user file");
   fs::remove_all(dir);
 }
 
@@ -212,7 +203,7 @@ TEST(BatchCli, EverySubcommandIsBatchableOrRefusedOnPurpose) {
 // runs each test in its own process and the batch is the costly part.
 TEST(BatchCli, FourJobsOneBrokenIsolatedSummarizedAndShownOnTheContactSheet) {
   const fs::path dir = temp_dir("batch-four");
-  write(dir / "jobs.txt", four_jobs());
+  write_text_file(dir / "jobs.txt", four_jobs());
   const auto run =
       run_surftex("batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) + " --jobs 2");
   {
@@ -235,7 +226,7 @@ TEST(BatchCli, ASecondRunRerunsOnlyMissingOrChangedJobs) {
   fs::copy_file(shared_data("meshes/eight_genus2.off"), dir / "local.off");
   const std::string tex = q(shared_data("textures/coffee_beans_64.png"));
   auto manifest = [&](const std::string& size_a) {
-    write(dir / "jobs.txt", "a: render " + q(shared_data("meshes/fish_blub.obj")) + " --size " + size_a +
+    write_text_file(dir / "jobs.txt", "a: render " + q(shared_data("meshes/fish_blub.obj")) + " --size " + size_a +
                                 "\nb: synth " + tex + " --size 16x16 --window 5\nc: render local.off --size 32\n");
   };
   manifest("32");
@@ -282,7 +273,7 @@ TEST(BatchCli, ASecondRunRerunsOnlyMissingOrChangedJobs) {
 // reads the report the subcommand wrote.
 TEST(BatchCli, FolderJobsThatWriteTheirOwnReportSucceedAndAreSummarized) {
   const fs::path dir = temp_dir("batch-folder-jobs");
-  write(dir / "jobs.txt", "sub: subdiv " + q(shared_data("meshes/eight_genus2.off")) + " " +
+  write_text_file(dir / "jobs.txt", "sub: subdiv " + q(shared_data("meshes/eight_genus2.off")) + " " +
                               q(shared_data("textures/leather_64.png")) +
                               " --levels 0 --passes 1 --region 5 --pyramid --atlas-size 256\n");
   const auto r =
@@ -303,7 +294,7 @@ TEST(BatchCli, FolderJobsThatWriteTheirOwnReportSucceedAndAreSummarized) {
 TEST(BatchCli, ABadInputIsNotRetriedUntilItChangesOrRetryFailedIsGiven) {
   const fs::path dir = temp_dir("batch-retry");
   fs::copy_file(shared_data("broken/truncated.off"), dir / "in.off");
-  write(dir / "jobs.txt", "bad: render in.off --size 16\n");
+  write_text_file(dir / "jobs.txt", "bad: render in.off --size 16\n");
   const std::string run = "batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) + " --json-progress";
   auto r = run_surftex(run);
   EXPECT_EQ(r.exit_code, 1) << r.err;
@@ -329,15 +320,15 @@ TEST(BatchCli, TheSnakefileRunsThroughGenericClusterModeWithAStandInSubmitScript
   const fs::path dir = temp_dir("batch-cluster");
   // A stand-in for sbatch/qsub: records the submission, runs Snakemake's job
   // script in the background on this machine, prints a job id.
-  write(dir / "submit.sh",
+  write_text_file(dir / "submit.sh",
         "#!/bin/bash\necho \"$@\" >> " + q((dir / "submitted.txt").string()) +
             "\nbash \"${@: -1}\" > /dev/null 2>&1 &\necho standin-$!\n");
-  write(dir / "jobs.txt", "s: render " + q(shared_data("meshes/knot.off")) + " --size 32\nt: render " +
+  write_text_file(dir / "jobs.txt", "s: render " + q(shared_data("meshes/knot.off")) + " --size 32\nt: render " +
                               q(shared_data("meshes/fish_blub.obj")) + " --size 32\n");
   const auto r = run_surftex("batch " + q((dir / "jobs.txt").string()) + " -o " + q((dir / "out").string()) +
                              " --jobs 2 --engine-args \"--cluster 'bash " + (dir / "submit.sh").string() + "' --latency-wait 30\"");
-  ASSERT_EQ(r.exit_code, 0) << r.err << read_all(dir / "out" / ".surftex" / "snakemake.log");
-  const std::string submitted = read_all(dir / "submitted.txt");
+  ASSERT_EQ(r.exit_code, 0) << r.err << file_bytes(dir / "out" / ".surftex" / "snakemake.log");
+  const std::string submitted = file_bytes(dir / "submitted.txt");
   EXPECT_EQ(count_of(submitted, "snakejob."), 2) << submitted;
   const nlohmann::json s = read_json(dir / "out" / "summary.json");
   EXPECT_EQ(s["counts"]["ok"], 2);
@@ -349,7 +340,7 @@ TEST(BatchCli, TheSnakefileRunsThroughGenericClusterModeWithAStandInSubmitScript
 TEST(BatchCli, SigtermStopsTheBatchWithoutPartialOutputAndTheNextRunCompletesIt) {
   const fs::path dir = temp_dir("batch-sigterm");
   // A synthesis that takes a few seconds.
-  write(dir / "jobs.txt",
+  write_text_file(dir / "jobs.txt",
         "slow: synth " + q(shared_data("textures/leather_64.png")) + " --size 128x128 --window 9\n");
   const fs::path out = dir / "out";
   const pid_t pid = ::fork();
@@ -367,13 +358,13 @@ TEST(BatchCli, SigtermStopsTheBatchWithoutPartialOutputAndTheNextRunCompletesIt)
   const auto t0 = std::chrono::steady_clock::now();
   while (!fs::exists(stage) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120))
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_TRUE(fs::exists(stage)) << read_all(dir / "stderr.txt");
+  ASSERT_TRUE(fs::exists(stage)) << file_bytes(dir / "stderr.txt");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ::kill(pid, SIGTERM);
   int status = 0;
   ::waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << read_all(dir / "stderr.txt");
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << file_bytes(dir / "stderr.txt");
   EXPECT_FALSE(fs::exists(out / "slow"));
   EXPECT_FALSE(fs::exists(stage));
   const nlohmann::json s = read_json(out / "summary.json");
@@ -391,7 +382,7 @@ TEST(BatchCli, TheDemoEndsWithTheSameContactSheet) {
   const fs::path dir = fs::path(temp_dir("batch-demo")) / "demo";
   const auto r = run_surftex("demo -o " + q(dir.string()) + " --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string html = read_all(dir / "index.html");
+  const std::string html = file_bytes(dir / "index.html");
   const nlohmann::json report = read_json(dir / "report.json");
   ASSERT_TRUE(report.contains("steps"));
   for (const auto& [name, step] : report["steps"].items())

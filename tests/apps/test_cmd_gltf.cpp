@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using surftex::test::q;
 
 std::string read_bytes(const std::string& p) {
   std::ifstream f(p, std::ios::binary);

@@ -33,7 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using surftex::test::q;
 
 // Maps of key `png` that are known functions of its colour, written beside it
 // in `dir`: height = 1 - red (16-bit), roughness = green, normal tilted along

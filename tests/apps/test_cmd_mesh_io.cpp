@@ -13,7 +13,7 @@ using namespace surftex;
 namespace fs = std::filesystem;
 
 namespace {
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using surftex::test::q;
 }  // namespace
 
 TEST(CmdInfo, PrintsCountsAndWritesReport) {

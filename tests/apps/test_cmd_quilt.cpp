@@ -17,10 +17,7 @@ using namespace surftex;
 namespace fs = std::filesystem;
 
 namespace {
-nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using surftex::test::read_json;
 // The merge statistics both branches write through one function: the same
 // keys, and the refusal reasons add up to the refusals.
 void expect_stitch_stats(const nlohmann::json& j) {

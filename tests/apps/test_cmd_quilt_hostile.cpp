@@ -37,7 +37,7 @@ namespace {
 // exact self-intersection count.
 const char* const kFast = " --no-render --stretch-iterations 0 --no-check --quiet";
 
-std::string q(const std::string& path) { return "'" + path + "'"; }
+using surftex::test::q;
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream f(path, std::ios::binary);
@@ -49,10 +49,7 @@ std::string read_bytes(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(f)), {});
 }
 
-nlohmann::json read_json(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using surftex::test::read_json;
 
 // The names of the entries of `dir` (files and folders), sorted.
 std::set<std::string> entries(const std::string& dir) {

@@ -16,7 +16,7 @@ using namespace surftex;
 using test::run_surftex;
 
 namespace {
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using surftex::test::q;
 }  // namespace
 
 TEST(CmdRender, RendersARealMeshFramedOnTheBackground) {

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
+using surftex::test::q;
 
 // Runs `args` with --report DIR/COMMAND_report.json and checks the report's schema.
 nlohmann::json run_and_check(const std::string& dir, const std::string& command, const std::string& args,

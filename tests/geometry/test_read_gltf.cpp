@@ -162,7 +162,7 @@ tinygltf::Primitive square(ModelBuilder& b) {
   return p;
 }
 
-double signed_volume(const Mesh& m) {
+double fan_signed_volume(const Mesh& m) {
   double v = 0;
   for (FaceIndex f : m.faces()) {
     std::vector<Point3> p;
@@ -240,7 +240,7 @@ TEST(ReadGltf, VertexColoursRoundTrip) {
     EXPECT_NEAR(c.first[v][0], 0.5 + 0.5 * p.x(), 1e-6);
     EXPECT_NEAR(c.first[v][2], 0.5 + 0.5 * p.z(), 1e-6);
   }
-  EXPECT_GT(signed_volume(back), 0);  // outward, as written
+  EXPECT_GT(fan_signed_volume(back), 0);  // outward, as written
 }
 
 TEST(ReadGltf, StripFanNormalisedColoursAndNodeTransforms) {
@@ -295,7 +295,7 @@ TEST(ReadGltf, NegativeScaleKeepsTheSurfaceOutward) {
   write_bytes(d + "/mirror.glb", join_glb(g));
   Mesh m;
   read_mesh(d + "/mirror.glb", m);
-  EXPECT_GT(signed_volume(m), 0);
+  EXPECT_GT(fan_signed_volume(m), 0);
 }
 
 TEST(ReadGltf, SparseAccessorReplacesListedElements) {

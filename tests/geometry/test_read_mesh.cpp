@@ -158,7 +158,7 @@ std::string expect_throw(F&& f) {
   return "";
 }
 
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 }  // namespace
 

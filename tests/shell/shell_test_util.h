@@ -10,10 +10,9 @@
 #include "shell/shell_space.h"
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
+#include "test_support.h"
 
 namespace surftex::test {
-
-inline bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
 
 /// One chart whose uv is the planar (x, y) position scaled by `s` and shifted by `off`.
 inline void set_planar_uv(Mesh& m, double s, double off) {

@@ -28,7 +28,7 @@
 using namespace surftex;
 
 namespace {
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 Image noise(int w, int h, int c, std::uint64_t seed, float lo = 0.f, float hi = 1.f) {
   std::mt19937_64 rng(seed);

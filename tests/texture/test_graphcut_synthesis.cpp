@@ -12,13 +12,14 @@
 #include "geometry/image_io.h"
 #include "test_support.h"
 #include "texture/graphcut_synthesis.h"
+#include "texture/image_ops.h"
 #include "texture/masked_ssd_fft.h"
 
 using namespace surftex;
 
 namespace {
 
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 Image random_image(std::mt19937_64& rng, int w, int h, int c) {
   std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -32,14 +33,6 @@ std::vector<float> random_mask(std::mt19937_64& rng, int w, int h, double p_one)
   std::vector<float> m(static_cast<std::size_t>(w) * h);
   for (float& v : m) v = b(rng) ? 1.f : 0.f;
   return m;
-}
-
-Image crop(const Image& img, int x0, int y0, int w, int h) {
-  Image out(w, h, img.channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < img.channels; ++c) out.at(x, y, c) = img.at(x0 + x, y0 + y, c);
-  return out;
 }
 
 Image texture(const std::string& name, int size) {

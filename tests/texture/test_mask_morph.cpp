@@ -54,11 +54,7 @@ std::vector<int> components(const Image& m, bool feature) {
   return sizes;
 }
 
-double cv(const std::vector<long long>& c) {
-  double mean = std::accumulate(c.begin(), c.end(), 0.0) / c.size(), var = 0;
-  for (long long v : c) var += (v - mean) * (v - mean);
-  return std::sqrt(var / c.size()) / mean;
-}
+using surftex::test::cv;
 }  // namespace
 
 TEST(MaskMorph, EndsAreTheInputMasksAndStepsAreEven) {

@@ -21,7 +21,7 @@
 using namespace surftex;
 
 namespace {
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 // Chi-square distance between 16-bin luminance histograms.
 double chi_square(const Image& a, const Image& b) {
@@ -38,11 +38,7 @@ double chi_square(const Image& a, const Image& b) {
   return 0.5 * c;
 }
 
-double cv(const std::vector<long long>& c) {
-  double mean = std::accumulate(c.begin(), c.end(), 0.0) / c.size(), var = 0;
-  for (long long v : c) var += (v - mean) * (v - mean);
-  return std::sqrt(var / c.size()) / mean;
-}
+using surftex::test::cv;
 
 MaterialTileOptions small_options() {
   MaterialTileOptions o;

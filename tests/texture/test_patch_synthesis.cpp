@@ -22,7 +22,7 @@
 namespace surftex {
 namespace {
 
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 PatchSynthesisOptions small_options(int res) {
   PatchSynthesisOptions o;

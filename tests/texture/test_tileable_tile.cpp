@@ -20,7 +20,7 @@
 using namespace surftex;
 
 namespace {
-bool sanitized() { return std::getenv("SURFTEX_SANITIZED") != nullptr; }
+using surftex::test::sanitized;
 
 Image crop_corner(const Image& img, int x0, int y0, int w, int h) {
   Image out(w, h, img.channels);
