@@ -9,6 +9,7 @@
 #include "geometry/errors.h"
 #include "texture/feature_mask.h"
 #include "texture/mask_morph.h"
+#include "test_support.h"
 
 using namespace surftex;
 

@@ -18,6 +18,7 @@
 #include "texture/patches/patch_seam_ratio.h"
 #include "texture/patches/patch_synthesis.h"
 #include "texture/procedural_texture.h"
+#include "test_support.h"
 
 namespace surftex {
 namespace {

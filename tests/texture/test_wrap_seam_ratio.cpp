@@ -8,6 +8,7 @@
 #include "geometry/errors.h"
 #include "texture/wrap_seam_ratio.h"
 #include "wrap_test_images.h"
+#include "test_support.h"
 
 using namespace surftex;
 
