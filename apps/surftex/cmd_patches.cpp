@@ -236,11 +236,11 @@ SubcommandRegistrar reg{
                       "and normal texture), render.png, report.json")
            ->required();
        app.add_option("--field", a->field,
-                      "Texture orientation: the exemplar's +x (its rows) follows this field (Gorla 2003: the "
-                      "pattern's dominant direction follows the field), so with up a horizontal grain runs up "
-                      "the surface. up (projected +y), kmax|kmin (greatest/least signed "
-                      "normal curvature), kmax-abs|kmin-abs (greatest/least absolute curvature), "
-                      "none (isotropic) (default up)")
+                      "Texture orientation. up: the exemplar stands upright, its top edge towards +y projected on "
+                      "the surface, its rows horizontal (a photograph of a wall keeps its bricks in rows); "
+                      "kmax|kmin (greatest/least signed normal curvature), kmax-abs|kmin-abs (greatest/least "
+                      "absolute curvature): the exemplar's +x (its rows) follows that principal direction (Gorla "
+                      "2003, Fig. 11); none: no orientation, for isotropic textures (default up)")
            ->check(CLI::IsMember({"up", "kmax", "kmin", "kmax-abs", "kmin-abs", "none"}));
        app.add_option("--patch-res", a->patch_res,
                       "Texels per patch side, 16..1024 (default 128, lowered by eighths when the patches would "

@@ -151,10 +151,12 @@ TEST(PatchSynthesis, StripesFollowTheField) {
     make_cylinder(m, 1.0, 3.0, 32, 12);
     PatchSynthesisOptions o = small_options(res);
     o.field = PatchField::Constant;
-    o.constant_vector = {0, 0, 1};  // along the axis
+    o.constant_vector = {0, 0, 1};  // the exemplar's top along the axis: its rows around it
     const PatchSynthesisResult r = synthesize_patches(m, {ex}, o);
-    const double e = stripe_error_deg(m, r, [](const Vector3&) { return Vector3(0, 0, 1); });
-    EXPECT_LT(e, 12.0) << "axis field";
+    const double e = stripe_error_deg(m, r, [](const Vector3& p) { return Vector3(-p.y(), p.x(), 0); });
+    EXPECT_LT(e, 12.0) << "constant field";
+    const double wrong = stripe_error_deg(m, r, [](const Vector3&) { return Vector3(0, 0, 1); });
+    EXPECT_GT(wrong, 60.0) << "rows must run across the constant vector, not along it";
   }
   {
     Mesh m;
@@ -168,6 +170,54 @@ TEST(PatchSynthesis, StripesFollowTheField) {
     const double wrong = stripe_error_deg(m, r, [](const Vector3&) { return Vector3(0, 0, 1); });
     EXPECT_GT(wrong, 60.0);
   }
+}
+
+// Share of the steps between neighbouring Inside pixels along which the
+// texture gets brighter while going along `axis` (steps weighted by their
+// component along it; steep jumps and flat steps left out).
+double brighter_along(const PatchSynthesisResult& r, const Vector3& axis) {
+  double agree = 0, total = 0;
+  for (std::size_t p = 0; p < r.images.size(); ++p) {
+    const FlatPatch& fp = r.flat.patches[p];
+    const Image& img = r.images[p];
+    const Vector3 e1(fp.e1[0], fp.e1[1], fp.e1[2]), e2(fp.e2[0], fp.e2[1], fp.e2[2]);
+    // pixel x right = +e1, pixel y down = -e2
+    const std::array<std::array<int, 2>, 2> steps{{{1, 0}, {0, -1}}};
+    const std::array<double, 2> along{e1 * axis, e2 * axis};
+    for (int y = 1; y < fp.res; ++y)
+      for (int x = 0; x + 1 < fp.res; ++x)
+        for (int k = 0; k < 2; ++k) {
+          const int x2 = x + steps[k][0], y2 = y + steps[k][1];
+          if (fp.pixel[y * fp.res + x] != PatchPixel::Inside || fp.pixel[y2 * fp.res + x2] != PatchPixel::Inside)
+            continue;
+          const double di = img.at(x2, y2, 0) - img.at(x, y, 0);
+          if (std::abs(di) < 0.02 || std::abs(di) > 0.3) continue;
+          total += std::abs(along[k]);
+          if (di * along[k] > 0) agree += std::abs(along[k]);
+        }
+  }
+  return total > 0 ? agree / total : 0.5;
+}
+
+// A photograph held upright: with the constant field the exemplar's top edge
+// points along the vector (a texture's up side stays up on an upright model),
+// not merely its rows across it. The exemplar: bands bright at their top,
+// fading towards their bottom, so going up inside a band gets brighter.
+TEST(PatchSynthesis, TheConstantFieldStandsTheExemplarUpright) {
+  Image ex(48, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x)
+      for (int c = 0; c < 3; ++c) ex.at(x, y, c) = 1.f - static_cast<float>(y % 8) / 8.f;
+  auto run = [&](double up_z) {
+    Mesh m;
+    make_cylinder(m, 1.0, 3.0, 32, 12);
+    PatchSynthesisOptions o = small_options(sanitized() ? 24 : 40);
+    o.field = PatchField::Constant;
+    o.constant_vector = {0, 0, up_z};
+    return brighter_along(synthesize_patches(m, {ex}, o), Vector3(0, 0, 1));
+  };
+  EXPECT_GT(run(1.0), 0.95) << "up +z: the bands' bright tops must face +z";
+  EXPECT_LT(run(-1.0), 0.05) << "up -z: turned over";
 }
 
 TEST(PatchSynthesis, MultiTexturingByHeight) {

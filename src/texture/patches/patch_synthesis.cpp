@@ -123,6 +123,24 @@ bool principal_field(PatchField f) {
          f == PatchField::KminAbs;
 }
 
+// The constant field names where the exemplar's up (its top edge) goes, so a
+// photograph stands upright on an upright model: bricks lie in horizontal
+// rows on a wall (Gorla's Fig. 11, right). The synthesis orients the
+// exemplar's +x (its rows) along kFaceDirection, so the projected vector d
+// is turned to d x n: the rows run across it and, with rows-down = x x n,
+// the exemplar's top points along d. Principal fields keep +x along the
+// curvature direction (bricks "oriented in the direction of" k, Fig. 11).
+template <class FaceVectorMap>
+void turn_up_field_to_rows(const Mesh& mesh, FaceVectorMap fd) {
+  for (FaceIndex f : mesh.faces()) {
+    const Vector3 d = fd[f];
+    if (d.squared_length() == 0) continue;
+    const Vector3 x = CGAL::cross_product(d, robust_face_normal(mesh, f));
+    const double len = std::sqrt(x.squared_length());
+    if (len > 0) fd[f] = x / len;
+  }
+}
+
 // The face directions: a constant vector projected (3.3.2.1, 1-symmetric) or
 // the principal directions of the most anisotropic faces (3.3.2.2,
 // 2-symmetric), interpolated over the rest; zero where there is no constraint.
@@ -142,6 +160,7 @@ std::vector<Vector3> face_directions(Mesh& mesh, const PatchSynthesisOptions& op
   if (!cons.empty()) {
     interpolate_direction_field(mesh, cons, dfo);
     auto fd = find(mesh, kFaceDirection).first;
+    if (opt.field == PatchField::Constant) turn_up_field_to_rows(mesh, fd);
     for (FaceIndex f : mesh.faces()) fdir[f.idx()] = fd[f];
   }
   return fdir;
