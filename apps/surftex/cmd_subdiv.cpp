@@ -2,8 +2,10 @@
 // `surftex subdiv MESH EXEMPLAR -o OUTDIR`: texture synthesis on a surface by
 // graph matching over a sqrt(2)-subdivision hierarchy (Bangay & Morkel 2006),
 // and its demo step.
-#include <cmath>
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -65,7 +67,6 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
   WriteMeshOptions wo;
   wo.overwrite = force;
   wo.write_uvs = false;
-  std::vector<std::string> files = write_mesh(o.ply, mesh, wo);
   WriteMeshOptions ao;
   ao.overwrite = force;
   ao.write_colors = false;
@@ -74,11 +75,18 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
   ao.height_texture = &asset.height;
   ao.metallic_roughness_texture = &asset.metallic_roughness;
   ao.texture_repeat = false;
-  for (const std::string& f : write_mesh(o.obj, *asset.mesh, ao)) files.push_back(f);
-  ao.height_texture = nullptr;
-  ao.write_colors = true;
-  ao.color_attribute = "_COLOR";
-  for (const std::string& f : write_mesh(o.glb, *asset.mesh, ao)) files.push_back(f);
+  WriteMeshOptions go = ao;
+  go.height_texture = nullptr;
+  go.write_colors = true;
+  go.color_attribute = "_COLOR";
+  // The three files side by side (each mostly one thread's PNG or text encoding).
+  std::vector<std::string> ply_files, obj_files, glb_files;
+  tbb::parallel_invoke([&] { ply_files = write_mesh(o.ply, mesh, wo); },
+                       [&] { obj_files = write_mesh(o.obj, *asset.mesh, ao); },
+                       [&] { glb_files = write_mesh(o.glb, *asset.mesh, go); });
+  std::vector<std::string> files = ply_files;
+  files.insert(files.end(), obj_files.begin(), obj_files.end());
+  files.insert(files.end(), glb_files.begin(), glb_files.end());
   j["seconds_write_mesh"] = t.seconds();
   j["atlas"] = to_json(asset);
   t.reset();
@@ -221,8 +229,12 @@ int run_subdiv(const SubdivArgs& a) {
     const double faces = std::max<double>(1.0, static_cast<double>(mesh.number_of_faces()));
     est_levels = std::max(0, static_cast<int>(std::floor(std::log2(2.0 * static_cast<double>(a.max_vertices) / faces))));
   }
-  // --atlas-size 0 follows the final vertex count, at most max_vertices.
-  const int est_atlas = a.atlas > 0 ? a.atlas : default_subdivision_atlas_size(a.max_vertices);
+  // --atlas-size 0 follows the final vertex count: about half the faces,
+  // which double with each level (at most max_vertices when the levels follow the scale).
+  double est_vertices = 0.5 * static_cast<double>(mesh.number_of_faces()) * std::ldexp(1.0, est_levels);
+  if (a.levels < 0) est_vertices = std::min(est_vertices, static_cast<double>(a.max_vertices));
+  const int est_atlas = a.atlas > 0 ? a.atlas
+                                    : default_subdivision_atlas_size(static_cast<std::size_t>(std::min(est_vertices, 1e12)));
   check_budget(estimate_subdiv(mesh.number_of_faces(), ex.width, ex.height, est_levels, est_atlas), a.common);
   const SubdivisionSynthesisResult r = synthesize_on_subdivision(mesh, ex, o);
   if (!a.common.quiet) print_scale(r);

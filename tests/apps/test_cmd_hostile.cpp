@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -395,4 +396,27 @@ TEST(WorkBudget, EveryTexturingSubcommandRefusesOverTheBudgetBeforeWorking) {
   auto ok = test::run_surftex("synth " + ex + " -o '" + in.out("s.png") + "' --size 16x16 --max-memory 50%");
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_NE(ok.err.find("note: estimate: synth"), std::string::npos) << ok.err;
+}
+
+// subdiv's estimate counts the atlas its run will bake: with --levels given,
+// the atlas follows the vertices those levels make (1024 px for a few
+// thousand), not the largest run --max-vertices allows (2048 px).
+TEST(WorkBudget, SubdivEstimateFollowsTheGivenLevels) {
+  Inputs in("hostile_budget_levels");
+  const std::string m = "'" + in.mesh + "'", ex = "'" + in.exemplar + "'";
+  auto mib = [&](const std::string& extra) {
+    auto r = test::run_surftex("subdiv " + m + " " + ex + " -o '" + in.out("s") + "' --levels 0 --max-memory 1M " + extra);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    const std::size_t at = r.err.find("needs about ");
+    if (at == std::string::npos) return -1.0;
+    std::istringstream is(r.err.substr(at + 12));
+    double v = -1;
+    std::string unit;
+    is >> v >> unit;
+    return unit == "GiB" ? v * 1024 : unit == "KiB" ? v / 1024 : v;
+  };
+  const double chosen = mib(""), given = mib("--atlas-size 1024"), large = mib("--atlas-size 2048");
+  EXPECT_GT(chosen, 0);
+  EXPECT_EQ(chosen, given);
+  EXPECT_LT(chosen, large);
 }
