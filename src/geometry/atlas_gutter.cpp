@@ -2,7 +2,12 @@
 // Atlas gutters filled by dilation (see atlas_gutter.h).
 #include "geometry/atlas_gutter.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -20,7 +25,8 @@ int atlas_gutter_texels(int size, int min_mip_size) {
 }
 
 int next_power_of_two(int n) {
-  if (n < 1 || n > 16384) throw InvalidInputError("next_power_of_two: " + std::to_string(n) + " outside 1..16384");
+  if (n < 1 || n > 16384)
+    throw InvalidInputError("next_power_of_two: " + std::to_string(n) + " outside 1..16384");
   int p = 1;
   while (p < n) p *= 2;
   return p;
@@ -30,8 +36,8 @@ int dilate_charts(Image& img, std::vector<int>& label) {
   const int W = img.width, H = img.height, C = img.channels;
   const std::size_t N = static_cast<std::size_t>(W) * H;
   if (img.empty() || label.size() != N)
-    throw InvalidInputError("dilate_charts: " + std::to_string(label.size()) + " labels for a " + std::to_string(W) +
-                            " x " + std::to_string(H) + " image");
+    throw InvalidInputError("dilate_charts: " + std::to_string(label.size()) + " labels for a " +
+                            std::to_string(W) + " x " + std::to_string(H) + " image");
   std::vector<std::size_t> front;
   std::vector<char> queued(N, 0);
   auto push_neighbours = [&](std::size_t i, std::vector<std::size_t>& out) {
@@ -55,34 +61,41 @@ int dilate_charts(Image& img, std::vector<int>& label) {
     std::sort(front.begin(), front.end());  // deterministic order of the next ring
     new_label.assign(front.size(), -1);
     new_value.assign(front.size() * C, 0.f);
-    for (std::size_t k = 0; k < front.size(); ++k) {
-      const std::size_t i = front[k];
-      const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
-      int labels[8], counts[8], n = 0;
-      std::size_t nb[8];
-      int m = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx, qy = y + dy;
-          if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
-          const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
-          if (label[j] < 0) continue;
-          nb[m++] = j;
-          int s = 0;
-          while (s < n && labels[s] != label[j]) ++s;
-          if (s == n) labels[n] = label[j], counts[n++] = 0;
-          ++counts[s];
-        }
-      int best = 0;
-      for (int s = 1; s < n; ++s)
-        if (counts[s] > counts[best] || (counts[s] == counts[best] && labels[s] < labels[best])) best = s;
-      new_label[k] = labels[best];
-      for (int q = 0; q < m; ++q) {
-        if (label[nb[q]] != labels[best]) continue;
-        for (int c = 0; c < C; ++c) new_value[k * C + c] += img.data[nb[q] * C + c];
-      }
-      for (int c = 0; c < C; ++c) new_value[k * C + c] /= static_cast<float>(counts[best]);
-    }
+    // Each texel of the ring from the ring inside it: independent, in parallel
+    // (each writes its own slot: the same bytes for any thread count).
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, front.size(), 4096),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k < r.end(); ++k) {
+            const std::size_t i = front[k];
+            const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+            int labels[8], counts[8], n = 0;
+            std::size_t nb[8];
+            int m = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = x + dx, qy = y + dy;
+                if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+                const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
+                if (label[j] < 0) continue;
+                nb[m++] = j;
+                int s = 0;
+                while (s < n && labels[s] != label[j]) ++s;
+                if (s == n) labels[n] = label[j], counts[n++] = 0;
+                ++counts[s];
+              }
+            int best = 0;
+            for (int s = 1; s < n; ++s)
+              if (counts[s] > counts[best] || (counts[s] == counts[best] && labels[s] < labels[best]))
+                best = s;
+            new_label[k] = labels[best];
+            for (int q = 0; q < m; ++q) {
+              if (label[nb[q]] != labels[best]) continue;
+              for (int c = 0; c < C; ++c) new_value[k * C + c] += img.data[nb[q] * C + c];
+            }
+            for (int c = 0; c < C; ++c) new_value[k * C + c] /= static_cast<float>(counts[best]);
+          }
+        });
     for (std::size_t k = 0; k < front.size(); ++k) {
       label[front[k]] = new_label[k];
       for (int c = 0; c < C; ++c) img.data[front[k] * C + c] = new_value[k * C + c];
@@ -95,37 +108,80 @@ int dilate_charts(Image& img, std::vector<int>& label) {
   return rings;
 }
 
-std::size_t gutter_violations(const std::vector<int>& chart, const std::vector<int>& fin, int W, int H, int g) {
+namespace {
+
+// Minimum and maximum of in[q] over q in [x - g, x + g] (clipped to the
+// line) for every x, in O(n) whatever g (van Herk / Gil-Werman: prefix and
+// suffix extrema within blocks of the window's width on the padded line).
+// Neutral values: lo_none for the minimum, hi_none for the maximum.
+void window_extrema(const std::vector<int>& in_lo, const std::vector<int>& in_hi, int g, int lo_none,
+                    int hi_none, std::vector<int>& out_lo, std::vector<int>& out_hi) {
+  const int n = static_cast<int>(in_lo.size()), w = 2 * g + 1, m = n + 2 * g;
+  std::vector<int> pl(m, lo_none), ph(m, hi_none);
+  std::copy(in_lo.begin(), in_lo.end(), pl.begin() + g);
+  std::copy(in_hi.begin(), in_hi.end(), ph.begin() + g);
+  std::vector<int> rl(m), rh(m), ll(m), lh(m);  // prefix (r) and suffix (l) extrema per block
+  for (int i = 0; i < m; ++i) {
+    const bool start = i % w == 0;
+    rl[i] = start ? pl[i] : std::min(rl[i - 1], pl[i]);
+    rh[i] = start ? ph[i] : std::max(rh[i - 1], ph[i]);
+  }
+  for (int i = m - 1; i >= 0; --i) {
+    const bool end = i == m - 1 || (i + 1) % w == 0;
+    ll[i] = end ? pl[i] : std::min(ll[i + 1], pl[i]);
+    lh[i] = end ? ph[i] : std::max(lh[i + 1], ph[i]);
+  }
+  out_lo.resize(n);
+  out_hi.resize(n);
+  for (int x = 0; x < n; ++x) {
+    out_lo[x] = std::min(ll[x], rl[x + w - 1]);
+    out_hi[x] = std::max(lh[x], rh[x + w - 1]);
+  }
+}
+
+}  // namespace
+
+std::size_t gutter_violations(const std::vector<int>& chart, const std::vector<int>& fin, int W, int H,
+                              int g) {
   const std::size_t N = static_cast<std::size_t>(W) * H;
-  if (chart.size() != N || fin.size() != N) throw InvalidInputError("gutter_violations: label sizes do not match");
+  if (chart.size() != N || fin.size() != N)
+    throw InvalidInputError("gutter_violations: label sizes do not match");
+  if (g < 0) throw InvalidInputError("gutter_violations: gutter " + std::to_string(g) + " < 0");
   // Smallest and largest chart label within Chebyshev distance g of every
   // texel (separable: rows, then columns); a texel near one chart only must
   // carry that chart's label, a texel near two charts is a violation anyway.
   const int none_lo = std::numeric_limits<int>::max(), none_hi = -1;
-  std::vector<int> lo(N, none_lo), hi(N, none_hi);
-  for (int y = 0; y < H; ++y)
+  std::vector<int> lo(N), hi(N);
+  tbb::parallel_for(0, H, [&](int y) {
+    std::vector<int> a(W), b(W), ra, rb;
     for (int x = 0; x < W; ++x) {
-      int a = none_lo, b = none_hi;
-      for (int q = std::max(0, x - g); q <= std::min(W - 1, x + g); ++q) {
-        const int c = chart[static_cast<std::size_t>(y) * W + q];
-        if (c >= 0) a = std::min(a, c), b = std::max(b, c);
-      }
-      lo[static_cast<std::size_t>(y) * W + x] = a;
-      hi[static_cast<std::size_t>(y) * W + x] = b;
+      const int c = chart[static_cast<std::size_t>(y) * W + x];
+      a[x] = c >= 0 ? c : none_lo;
+      b[x] = c >= 0 ? c : none_hi;
     }
-  std::size_t bad = 0;
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      int a = none_lo, b = none_hi;
-      for (int q = std::max(0, y - g); q <= std::min(H - 1, y + g); ++q) {
-        a = std::min(a, lo[static_cast<std::size_t>(q) * W + x]);
-        b = std::max(b, hi[static_cast<std::size_t>(q) * W + x]);
-      }
-      if (b < 0) continue;  // no chart within g
-      const int f = fin[static_cast<std::size_t>(y) * W + x];
-      bad += a != b || f != a;
-    }
-  return bad;
+    window_extrema(a, b, g, none_lo, none_hi, ra, rb);
+    std::copy(ra.begin(), ra.end(), lo.begin() + static_cast<std::ptrdiff_t>(y) * W);
+    std::copy(rb.begin(), rb.end(), hi.begin() + static_cast<std::ptrdiff_t>(y) * W);
+  });
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, W), std::size_t(0),
+      [&](const tbb::blocked_range<int>& r, std::size_t bad) {
+        std::vector<int> a(H), b(H), ra, rb;
+        for (int x = r.begin(); x < r.end(); ++x) {
+          for (int y = 0; y < H; ++y) {
+            a[y] = lo[static_cast<std::size_t>(y) * W + x];
+            b[y] = hi[static_cast<std::size_t>(y) * W + x];
+          }
+          window_extrema(a, b, g, none_lo, none_hi, ra, rb);
+          for (int y = 0; y < H; ++y) {
+            if (rb[y] < 0) continue;  // no chart within g
+            const int f = fin[static_cast<std::size_t>(y) * W + x];
+            bad += ra[y] != rb[y] || f != ra[y];
+          }
+        }
+        return bad;
+      },
+      std::plus<std::size_t>());
 }
 
 }  // namespace surftex

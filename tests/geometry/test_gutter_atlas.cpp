@@ -4,6 +4,10 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <random>
+#include <vector>
+
 #include "atlas_checks.h"
 #include "geometry/atlas_gutter.h"
 #include "geometry/gutter_atlas.h"
@@ -53,3 +57,51 @@ TEST(GutterAtlas, SameAtlasOnOneAndTwoThreads) {
   EXPECT_TRUE(one.first == two.first);
   EXPECT_TRUE(one.second == two.second);
 }
+
+namespace surftex {
+namespace {
+
+// The count by its definition: a texel with a chart within Chebyshev
+// distance g is a violation unless exactly one chart is that near and the
+// texel carries its label.
+std::size_t gutter_violations_by_definition(const std::vector<int>& chart, const std::vector<int>& fin, int W, int H,
+                                            int g) {
+  std::size_t bad = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      int lo = -1, hi = -1;
+      for (int qy = std::max(0, y - g); qy <= std::min(H - 1, y + g); ++qy)
+        for (int qx = std::max(0, x - g); qx <= std::min(W - 1, x + g); ++qx) {
+          const int c = chart[static_cast<std::size_t>(qy) * W + qx];
+          if (c < 0) continue;
+          lo = lo < 0 ? c : std::min(lo, c);
+          hi = std::max(hi, c);
+        }
+      if (hi < 0) continue;
+      bad += lo != hi || fin[static_cast<std::size_t>(y) * W + x] != lo;
+    }
+  return bad;
+}
+
+TEST(AtlasGutter, ViolationsMatchTheirDefinitionForEveryGutterWidth) {
+  const int W = 37, H = 23;
+  std::mt19937 rng(5);
+  std::vector<int> chart(static_cast<std::size_t>(W) * H, -1), fin(chart.size());
+  // A few rectangles of charts on empty ground, then labels dilated with some wrong.
+  for (int k = 0; k < 6; ++k) {
+    const int x0 = static_cast<int>(rng() % W), y0 = static_cast<int>(rng() % H);
+    for (int y = y0; y < std::min(H, y0 + 4); ++y)
+      for (int x = x0; x < std::min(W, x0 + 5); ++x) chart[static_cast<std::size_t>(y) * W + x] = k % 4;
+  }
+  for (std::size_t i = 0; i < fin.size(); ++i) fin[i] = rng() % 5 == 0 ? static_cast<int>(rng() % 4) : chart[i];
+  std::size_t nonzero = 0;
+  for (int g : {0, 1, 2, 3, 5, 8, 30, 100}) {
+    const std::size_t want = gutter_violations_by_definition(chart, fin, W, H, g);
+    EXPECT_EQ(gutter_violations(chart, fin, W, H, g), want) << "g " << g;
+    nonzero += want > 0;
+  }
+  EXPECT_GE(nonzero, 6u);
+}
+
+}  // namespace
+}  // namespace surftex
