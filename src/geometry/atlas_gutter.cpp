@@ -25,8 +25,7 @@ int atlas_gutter_texels(int size, int min_mip_size) {
 }
 
 int next_power_of_two(int n) {
-  if (n < 1 || n > 16384)
-    throw InvalidInputError("next_power_of_two: " + std::to_string(n) + " outside 1..16384");
+  if (n < 1 || n > 16384) throw InvalidInputError("next_power_of_two: " + std::to_string(n) + " outside 1..16384");
   int p = 1;
   while (p < n) p *= 2;
   return p;
@@ -36,8 +35,8 @@ int dilate_charts(Image& img, std::vector<int>& label) {
   const int W = img.width, H = img.height, C = img.channels;
   const std::size_t N = static_cast<std::size_t>(W) * H;
   if (img.empty() || label.size() != N)
-    throw InvalidInputError("dilate_charts: " + std::to_string(label.size()) + " labels for a " +
-                            std::to_string(W) + " x " + std::to_string(H) + " image");
+    throw InvalidInputError("dilate_charts: " + std::to_string(label.size()) + " labels for a " + std::to_string(W) +
+                            " x " + std::to_string(H) + " image");
   std::vector<std::size_t> front;
   std::vector<char> queued(N, 0);
   auto push_neighbours = [&](std::size_t i, std::vector<std::size_t>& out) {
@@ -141,11 +140,9 @@ void window_extrema(const std::vector<int>& in_lo, const std::vector<int>& in_hi
 
 }  // namespace
 
-std::size_t gutter_violations(const std::vector<int>& chart, const std::vector<int>& fin, int W, int H,
-                              int g) {
+std::size_t gutter_violations(const std::vector<int>& chart, const std::vector<int>& fin, int W, int H, int g) {
   const std::size_t N = static_cast<std::size_t>(W) * H;
-  if (chart.size() != N || fin.size() != N)
-    throw InvalidInputError("gutter_violations: label sizes do not match");
+  if (chart.size() != N || fin.size() != N) throw InvalidInputError("gutter_violations: label sizes do not match");
   if (g < 0) throw InvalidInputError("gutter_violations: gutter " + std::to_string(g) + " < 0");
   // Smallest and largest chart label within Chebyshev distance g of every
   // texel (separable: rows, then columns); a texel near one chart only must

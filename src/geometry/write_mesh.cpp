@@ -431,7 +431,7 @@ void write_off(const std::string& path, const Mesh& mesh, const WriteMeshOptions
 }
 
 // ------------------------------------------------------------------ glTF
-std::string png_bytes(const std::string& beside, const Image& img, std::size_t slot = 0) {
+std::string png_bytes(const std::string& beside, const Image& img, std::size_t slot) {
   // Encoded through OpenImageIO into a temporary that is never committed
   // (one name per slot: a run refuses two staged outputs of the same name).
   AtomicOutputFile tmp(beside + ".texture_" + std::to_string(slot) + ".png", true);
@@ -511,9 +511,9 @@ struct GlbBuilder {
     const int view = add_view(data, bytes, TINYGLTF_TARGET_ARRAY_BUFFER);
     return add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, type, count);
   }
-  // One embedded PNG per map (written beside `path` while encoded), all
-  // through one sampler.
-  int add_texture(const std::string& path, const Image& img, const char* name, bool repeat) {
+  // One embedded PNG per map (its bytes from `encoded`), all through one
+  // sampler.
+  int add_texture(const Image& img, const char* name, bool repeat) {
     if (model.samplers.empty()) {
       tinygltf::Sampler smp;
       smp.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
@@ -521,8 +521,7 @@ struct GlbBuilder {
       smp.wrapS = smp.wrapT = repeat ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       model.samplers.push_back(smp);
     }
-    const auto pre = encoded.find(&img);
-    const std::string png = pre != encoded.end() ? pre->second : png_bytes(path, img);
+    const std::string& png = encoded.at(&img);
     int view = add_view(png.data(), png.size(), 0);
     model.bufferViews[view].target = 0;
     tinygltf::Image im;
@@ -598,8 +597,6 @@ tinygltf::Primitive vertex_attributes(GlbBuilder& b, const Gathered& g, const Gl
   return prim;
 }
 
-// One glTF material per material (metallic 0, roughness 1, double-sided),
-// its texture embedded as PNG. The PBR maps go with WriteMeshOptions::texture.
 // The PNG bytes of every map add_materials embeds, encoded side by side
 // (the same images, in the same conditions, as add_materials takes them).
 std::map<const Image*, std::string> encode_textures(const std::string& path, const MaterialGroups& groups,
@@ -621,6 +618,8 @@ std::map<const Image*, std::string> encode_textures(const std::string& path, con
   return r;
 }
 
+// One glTF material per material (metallic 0, roughness 1, double-sided),
+// its texture embedded as PNG. The PBR maps go with WriteMeshOptions::texture.
 void add_materials(GlbBuilder& b, const std::string& path, const MaterialGroups& groups,
                    const WriteMeshOptions& opt) {
   b.encoded = encode_textures(path, groups, opt);
@@ -636,14 +635,14 @@ void add_materials(GlbBuilder& b, const std::string& path, const MaterialGroups&
       const std::string name =
           b.model.images.empty() ? "texture" : "texture_" + std::to_string(b.model.images.size());
       mat.pbrMetallicRoughness.baseColorTexture.index =
-          b.add_texture(path, *om.texture, name.c_str(), opt.texture_repeat);
+          b.add_texture(*om.texture, name.c_str(), opt.texture_repeat);
     }
     if (om.texture != nullptr && om.texture == opt.texture) {
       if (opt.normal_texture != nullptr && !opt.normal_texture->empty())
-        mat.normalTexture.index = b.add_texture(path, *opt.normal_texture, "normal", opt.texture_repeat);
+        mat.normalTexture.index = b.add_texture(*opt.normal_texture, "normal", opt.texture_repeat);
       if (opt.metallic_roughness_texture != nullptr && !opt.metallic_roughness_texture->empty())
         mat.pbrMetallicRoughness.metallicRoughnessTexture.index =
-            b.add_texture(path, *opt.metallic_roughness_texture, "metallic_roughness", opt.texture_repeat);
+            b.add_texture(*opt.metallic_roughness_texture, "metallic_roughness", opt.texture_repeat);
     }
     b.model.materials.push_back(mat);
   }
