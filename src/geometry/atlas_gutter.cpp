@@ -7,6 +7,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>
@@ -31,78 +32,111 @@ int next_power_of_two(int n) {
   return p;
 }
 
+namespace {
+
+// Chessboard distance of every texel to the nearest labelled one (0 on
+// them), by the two-pass chamfer with unit 8-neighbour steps (exact for this
+// metric): the ring each empty texel is filled in.
+std::vector<int> chessboard_distance(const std::vector<int>& label, int W, int H) {
+  const int far = W + H;
+  std::vector<int> d(label.size());
+  for (std::size_t i = 0; i < label.size(); ++i) d[i] = label[i] >= 0 ? 0 : far;
+  auto at = [&](int x, int y) -> int& { return d[static_cast<std::size_t>(y) * W + x]; };
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      int& v = at(x, y);
+      if (x > 0) v = std::min(v, at(x - 1, y) + 1);
+      if (y > 0) {
+        v = std::min(v, at(x, y - 1) + 1);
+        if (x > 0) v = std::min(v, at(x - 1, y - 1) + 1);
+        if (x + 1 < W) v = std::min(v, at(x + 1, y - 1) + 1);
+      }
+    }
+  for (int y = H - 1; y >= 0; --y)
+    for (int x = W - 1; x >= 0; --x) {
+      int& v = at(x, y);
+      if (x + 1 < W) v = std::min(v, at(x + 1, y) + 1);
+      if (y + 1 < H) {
+        v = std::min(v, at(x, y + 1) + 1);
+        if (x + 1 < W) v = std::min(v, at(x + 1, y + 1) + 1);
+        if (x > 0) v = std::min(v, at(x - 1, y + 1) + 1);
+      }
+    }
+  return d;
+}
+
+// One ring's texel i: the majority label of its labelled 8-neighbours (ties:
+// the lower) and their mean value, written to label_out / value_out.
+void fill_from_inner_ring(const Image& img, const std::vector<int>& label, std::size_t i, int& label_out,
+                          float* value_out) {
+  const int W = img.width, H = img.height, C = img.channels;
+  const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
+  int labels[8], counts[8], n = 0;
+  std::size_t nb[8];
+  int m = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int qx = x + dx, qy = y + dy;
+      if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+      const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
+      if (label[j] < 0) continue;
+      nb[m++] = j;
+      int s = 0;
+      while (s < n && labels[s] != label[j]) ++s;
+      if (s == n) labels[n] = label[j], counts[n++] = 0;
+      ++counts[s];
+    }
+  int best = 0;
+  for (int s = 1; s < n; ++s)
+    if (counts[s] > counts[best] || (counts[s] == counts[best] && labels[s] < labels[best])) best = s;
+  label_out = labels[best];
+  for (int c = 0; c < C; ++c) value_out[c] = 0.f;
+  for (int q = 0; q < m; ++q) {
+    if (label[nb[q]] != labels[best]) continue;
+    for (int c = 0; c < C; ++c) value_out[c] += img.data[nb[q] * C + c];
+  }
+  for (int c = 0; c < C; ++c) value_out[c] /= static_cast<float>(counts[best]);
+}
+
+}  // namespace
+
 int dilate_charts(Image& img, std::vector<int>& label) {
   const int W = img.width, H = img.height, C = img.channels;
   const std::size_t N = static_cast<std::size_t>(W) * H;
   if (img.empty() || label.size() != N)
     throw InvalidInputError("dilate_charts: " + std::to_string(label.size()) + " labels for a " + std::to_string(W) +
                             " x " + std::to_string(H) + " image");
-  std::vector<std::size_t> front;
-  std::vector<char> queued(N, 0);
-  auto push_neighbours = [&](std::size_t i, std::vector<std::size_t>& out) {
-    const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int qx = x + dx, qy = y + dy;
-        if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
-        const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
-        if (label[j] < 0 && !queued[j]) queued[j] = 1, out.push_back(j);
-      }
-  };
-  bool any = false;
-  for (std::size_t i = 0; i < N; ++i)
-    if (label[i] >= 0) any = true, push_neighbours(i, front);
-  if (!any) throw InvalidInputError("dilate_charts: no texel belongs to a chart");
-  int rings = 0;
+  if (std::none_of(label.begin(), label.end(), [](int l) { return l >= 0; }))
+    throw InvalidInputError("dilate_charts: no texel belongs to a chart");
+  // Ring r = the empty texels at chessboard distance r, in row-major order.
+  const std::vector<int> dist = chessboard_distance(label, W, H);
+  const int rings = *std::max_element(dist.begin(), dist.end());
+  std::vector<std::size_t> first(static_cast<std::size_t>(rings) + 2, 0);
+  for (int v : dist) ++first[static_cast<std::size_t>(v) + 1];
+  for (std::size_t r = 1; r < first.size(); ++r) first[r] += first[r - 1];
+  if (N > 0xffffffffu) throw InvalidInputError("dilate_charts: " + std::to_string(N) + " texels (at most 2^32 - 1)");
+  std::vector<std::uint32_t> order(N);
+  std::vector<std::size_t> fill = first;
+  for (std::size_t i = 0; i < N; ++i) order[fill[dist[i]]++] = static_cast<std::uint32_t>(i);
   std::vector<int> new_label;
   std::vector<float> new_value;
-  while (!front.empty()) {
-    std::sort(front.begin(), front.end());  // deterministic order of the next ring
-    new_label.assign(front.size(), -1);
-    new_value.assign(front.size() * C, 0.f);
+  for (int r = 1; r <= rings; ++r) {
+    const std::uint32_t* front = order.data() + first[r];
+    const std::size_t n = first[r + 1] - first[r];
+    new_label.assign(n, -1);
+    new_value.assign(n * C, 0.f);
     // Each texel of the ring from the ring inside it: independent, in parallel
     // (each writes its own slot: the same bytes for any thread count).
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, front.size(), 4096),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t k = r.begin(); k < r.end(); ++k) {
-            const std::size_t i = front[k];
-            const int x = static_cast<int>(i % W), y = static_cast<int>(i / W);
-            int labels[8], counts[8], n = 0;
-            std::size_t nb[8];
-            int m = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dx = -1; dx <= 1; ++dx) {
-                const int qx = x + dx, qy = y + dy;
-                if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
-                const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
-                if (label[j] < 0) continue;
-                nb[m++] = j;
-                int s = 0;
-                while (s < n && labels[s] != label[j]) ++s;
-                if (s == n) labels[n] = label[j], counts[n++] = 0;
-                ++counts[s];
-              }
-            int best = 0;
-            for (int s = 1; s < n; ++s)
-              if (counts[s] > counts[best] || (counts[s] == counts[best] && labels[s] < labels[best]))
-                best = s;
-            new_label[k] = labels[best];
-            for (int q = 0; q < m; ++q) {
-              if (label[nb[q]] != labels[best]) continue;
-              for (int c = 0; c < C; ++c) new_value[k * C + c] += img.data[nb[q] * C + c];
-            }
-            for (int c = 0; c < C; ++c) new_value[k * C + c] /= static_cast<float>(counts[best]);
-          }
-        });
-    for (std::size_t k = 0; k < front.size(); ++k) {
-      label[front[k]] = new_label[k];
-      for (int c = 0; c < C; ++c) img.data[front[k] * C + c] = new_value[k * C + c];
-    }
-    std::vector<std::size_t> next;
-    for (std::size_t i : front) push_neighbours(i, next);
-    front.swap(next);
-    ++rings;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& b) {
+      for (std::size_t k = b.begin(); k < b.end(); ++k)
+        fill_from_inner_ring(img, label, front[k], new_label[k], new_value.data() + k * C);
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& b) {
+      for (std::size_t k = b.begin(); k < b.end(); ++k) {
+        label[front[k]] = new_label[k];
+        for (int c = 0; c < C; ++c) img.data[front[k] * C + c] = new_value[k * C + c];
+      }
+    });
   }
   return rings;
 }

@@ -10,6 +10,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -17,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <unordered_map>
 
 #include "geometry/errors.h"
 #include "geometry/file_extension.h"
@@ -237,69 +239,109 @@ ObjPbrMaps obj_pbr_maps(const fs::path& dir, const std::string& stem, const Writ
 
 // The OBJ's text: vertices (with colours), distinct UVs, normals, faces
 // grouped by material.
+// Lines 0..n-1 written by line(i, out) in chunks side by side, joined in order.
+std::string parallel_lines(std::size_t n, const std::function<void(std::size_t, std::string&)>& line) {
+  constexpr std::size_t kChunk = 8192;
+  std::vector<std::string> part((n + kChunk - 1) / kChunk);
+  tbb::parallel_for(std::size_t(0), part.size(), [&](std::size_t k) {
+    for (std::size_t i = k * kChunk; i < std::min(n, (k + 1) * kChunk); ++i) line(i, part[k]);
+  });
+  std::size_t total = 0;
+  for (const auto& t : part) total += t.size();
+  std::string s;
+  s.reserve(total);
+  for (const auto& t : part) s += t;
+  return s;
+}
+
+void append_index(std::string& out, std::size_t v) {
+  char buf[24];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+// Distinct UV values numbered in first-use order (corner by corner, face by
+// face): the "vt" lines and each face's vt numbers.
+std::string obj_uv_lines(const Gathered& g, std::vector<std::vector<std::size_t>>& face_vt) {
+  struct Key {
+    std::size_t operator()(const std::array<double, 2>& k) const {
+      std::uint64_t a, b;
+      std::memcpy(&a, &k[0], 8);
+      std::memcpy(&b, &k[1], 8);
+      return std::hash<std::uint64_t>()(a * 0x9E3779B97F4A7C15ull ^ b);
+    }
+  };
+  std::unordered_map<std::array<double, 2>, std::size_t, Key> vt_id;
+  vt_id.reserve(g.faces.size() * 2);
+  std::string s;
+  face_vt.resize(g.faces.size());
+  for (std::size_t f = 0; f < g.faces.size(); ++f)
+    for (HalfedgeIndex h : g.corners[f]) {
+      const UV& uv = g.uv[h];
+      // + 0.0 makes -0 and +0 one key, as they compare equal
+      auto [it, inserted] = vt_id.emplace(std::array<double, 2>{uv[0] + 0.0, uv[1] + 0.0}, vt_id.size());
+      if (inserted) {
+        s += "vt ";
+        append_num(s, uv[0]);
+        s += ' ';
+        append_num(s, uv[1]);
+        s += '\n';
+      }
+      face_vt[f].push_back(it->second);
+    }
+  return s;
+}
+
 std::string obj_text(const Gathered& g, const MaterialGroups& groups, const std::string& mtl_name) {
   const bool with_mtl = !groups.materials.empty();
-  std::string s;
-  s.reserve(g.pos.size() * 60 + g.faces.size() * 40);
-  s += "# written by surftex\n";
+  std::string s = "# written by surftex\n";
   if (with_mtl) s += "mtllib " + mtl_name + "\n";
-  for (std::size_t i = 0; i < g.pos.size(); ++i) {
-    s += "v ";
-    append_num(s, g.pos[i][0]);
-    s += ' ';
-    append_num(s, g.pos[i][1]);
-    s += ' ';
-    append_num(s, g.pos[i][2]);
+  s += parallel_lines(g.pos.size(), [&](std::size_t i, std::string& o) {
+    o += "v ";
+    append_num(o, g.pos[i][0]);
+    o += ' ';
+    append_num(o, g.pos[i][1]);
+    o += ' ';
+    append_num(o, g.pos[i][2]);
     if (!g.colors.empty())
       for (int c = 0; c < 3; ++c) {
-        s += ' ';
-        append_num(s, g.colors[i][c]);
+        o += ' ';
+        append_num(o, g.colors[i][c]);
       }
-    s += '\n';
-  }
-  // Distinct UV values, numbered in first-use order.
+    o += '\n';
+  });
   std::vector<std::vector<std::size_t>> face_vt;
-  if (g.has_uv) {
-    std::map<std::array<double, 2>, std::size_t> vt_id;
-    face_vt.resize(g.faces.size());
-    for (std::size_t f = 0; f < g.faces.size(); ++f)
-      for (HalfedgeIndex h : g.corners[f]) {
-        const UV& uv = g.uv[h];
-        auto [it, inserted] = vt_id.emplace(std::array<double, 2>{uv[0], uv[1]}, vt_id.size());
-        if (inserted) {
-          s += "vt ";
-          append_num(s, uv[0]);
-          s += ' ';
-          append_num(s, uv[1]);
-          s += '\n';
-        }
-        face_vt[f].push_back(it->second);
-      }
-  }
-  for (const auto& n : g.normals) {
-    s += "vn ";
-    append_num(s, n[0]);
-    s += ' ';
-    append_num(s, n[1]);
-    s += ' ';
-    append_num(s, n[2]);
-    s += '\n';
-  }
+  if (g.has_uv) s += obj_uv_lines(g, face_vt);
+  s += parallel_lines(g.normals.size(), [&](std::size_t i, std::string& o) {
+    const auto& n = g.normals[i];
+    o += "vn ";
+    append_num(o, n[0]);
+    o += ' ';
+    append_num(o, n[1]);
+    o += ' ';
+    append_num(o, n[2]);
+    o += '\n';
+  });
   // Faces grouped by material (file order within a group).
   for (std::size_t k = 0; k < std::max<std::size_t>(groups.materials.size(), 1); ++k) {
     if (with_mtl) s += "usemtl " + groups.materials[k].name + "\n";
-    for (std::size_t f = 0; f < g.faces.size(); ++f) {
-      if (with_mtl && groups.face[f] != k) continue;
-      s += 'f';
+    s += parallel_lines(g.faces.size(), [&](std::size_t f, std::string& o) {
+      if (with_mtl && groups.face[f] != k) return;
+      o += 'f';
       for (std::size_t c = 0; c < g.faces[f].size(); ++c) {
-        const std::string v = std::to_string(g.faces[f][c] + 1);
-        s += ' ';
-        s += v;
-        if (g.has_uv) s += "/" + std::to_string(face_vt[f][c] + 1);
-        if (!g.normals.empty()) s += (g.has_uv ? "/" : "//") + v;
+        o += ' ';
+        append_index(o, g.faces[f][c] + 1);
+        if (g.has_uv) {
+          o += '/';
+          append_index(o, face_vt[f][c] + 1);
+        }
+        if (!g.normals.empty()) {
+          o += g.has_uv ? "/" : "//";
+          append_index(o, g.faces[f][c] + 1);
+        }
       }
-      s += '\n';
-    }
+      o += '\n';
+    });
   }
   return s;
 }

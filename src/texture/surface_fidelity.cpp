@@ -3,6 +3,7 @@
 #include "texture/surface_fidelity.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,27 +48,31 @@ struct FanTriangle {
 };
 
 std::vector<FanTriangle> fan_triangles(const Mesh& mesh) {
-  std::vector<FanTriangle> tris;
-  tris.reserve(mesh.number_of_faces() * 2);
-  for (FaceIndex f : mesh.faces()) {
-    std::vector<HalfedgeIndex> hs;
-    for (HalfedgeIndex h : mesh.halfedges_around_face(mesh.halfedge(f))) hs.push_back(h);
-    for (std::size_t i = 1; i + 1 < hs.size(); ++i) {
-      FanTriangle t;
-      t.face = f.idx();
-      const HalfedgeIndex c[3] = {hs[0], hs[i], hs[i + 1]};
-      for (int k = 0; k < 3; ++k) {
-        t.corner[k] = c[k].idx();
-        t.vertex[k] = mesh.target(c[k]).idx();
-        t.p[k] = point(mesh, mesh.target(c[k]));
+  // Triangles before each face (its degree - 2 each), then every face's fan in parallel.
+  std::vector<std::size_t> first(mesh.number_of_faces() + 1, 0);
+  for (FaceIndex f : mesh.faces()) first[f.idx() + 1] = std::max<std::size_t>(mesh.degree(f), 2) - 2;
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<FanTriangle> tris(first.back());
+  tbb::parallel_for(std::size_t(0), std::size_t(mesh.number_of_faces()), [&](std::size_t fi) {
+    const FaceIndex f(static_cast<std::uint32_t>(fi));
+    if (first[fi + 1] == first[fi]) return;
+    const HalfedgeIndex h0 = mesh.halfedge(f);
+    HalfedgeIndex hi = mesh.next(h0);
+    for (std::size_t k = first[fi]; k < first[fi + 1]; ++k, hi = mesh.next(hi)) {
+      FanTriangle& t = tris[k];
+      t.face = fi;
+      const HalfedgeIndex c[3] = {h0, hi, mesh.next(hi)};
+      for (int j = 0; j < 3; ++j) {
+        t.corner[j] = c[j].idx();
+        t.vertex[j] = mesh.target(c[j]).idx();
+        t.p[j] = point(mesh, mesh.target(c[j]));
       }
       const V3 nn = cross(sub(t.p[1], t.p[0]), sub(t.p[2], t.p[0]));
       const double l = norm(nn);
       t.area = 0.5 * l;
       if (l > 0 && std::isfinite(l)) t.n = mul(nn, 1.0 / l);
-      tris.push_back(t);
     }
-  }
+  });
   return tris;
 }
 
@@ -77,25 +82,35 @@ struct Adjacency {
 };
 
 Adjacency triangle_adjacency(const std::vector<FanTriangle>& tris) {
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> by_edge;
-  by_edge.reserve(tris.size() * 2);
-  for (std::size_t t = 0; t < tris.size(); ++t)
+  // (edge key, triangle) for every side, sorted: the triangles of an edge are one run.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sides(3 * tris.size());
+  tbb::parallel_for(std::size_t(0), tris.size(), [&](std::size_t t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint64_t a = tris[t].vertex[k], b = tris[t].vertex[(k + 1) % 3];
-      by_edge[(std::min(a, b) << 32) | std::max(a, b)].push_back(static_cast<std::uint32_t>(t));
+      sides[3 * t + k] = {(std::min(a, b) << 32) | std::max(a, b), static_cast<std::uint32_t>(t)};
     }
-  std::vector<std::vector<std::uint32_t>> nb(tris.size());
-  for (const auto& e : by_edge)
-    for (std::uint32_t a : e.second)
-      for (std::uint32_t b : e.second)
-        if (a != b) nb[a].push_back(b);
+  });
+  tbb::parallel_sort(sides.begin(), sides.end());
+  // Every ordered pair of distinct triangles of a run, sorted by (from, to).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  pairs.reserve(sides.size());
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i;
+    while (j < sides.size() && sides[j].first == sides[i].first) ++j;
+    for (std::size_t a = i; a < j; ++a)
+      for (std::size_t b = i; b < j; ++b)
+        if (sides[a].second != sides[b].second) pairs.push_back({sides[a].second, sides[b].second});
+    i = j;
+  }
+  tbb::parallel_sort(pairs.begin(), pairs.end());
   Adjacency adj;
   adj.offset.assign(tris.size() + 1, 0);
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    std::sort(nb[t].begin(), nb[t].end());  // deterministic order
-    adj.offset[t + 1] = adj.offset[t] + static_cast<std::uint32_t>(nb[t].size());
-    adj.next.insert(adj.next.end(), nb[t].begin(), nb[t].end());
+  adj.next.resize(pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    ++adj.offset[pairs[k].first + 1];
+    adj.next[k] = pairs[k].second;
   }
+  std::partial_sum(adj.offset.begin(), adj.offset.end(), adj.offset.begin());
   return adj;
 }
 
@@ -190,9 +205,8 @@ void rasterize_chart(const std::vector<FanTriangle>& tris, const Adjacency& adj,
 
 // Seeded chart placement: area-weighted random points at least one chart
 // side apart (3D), each rasterised; charts with too few valid pixels dropped.
-std::vector<Chart> place_charts(const std::vector<FanTriangle>& tris, const TextureFrames& fr,
+std::vector<Chart> place_charts(const std::vector<FanTriangle>& tris, const Adjacency& adj, const TextureFrames& fr,
                                 const SurfaceFidelityOptions& o) {
-  const Adjacency adj = triangle_adjacency(tris);
   std::vector<double> cum(tris.size());
   double total = 0;
   for (std::size_t t = 0; t < tris.size(); ++t) cum[t] = total += tris[t].area;
@@ -232,10 +246,11 @@ std::vector<Chart> place_charts(const std::vector<FanTriangle>& tris, const Text
 // is left at the side used.
 std::vector<Chart> place_fitting_charts(const std::vector<FanTriangle>& tris, const TextureFrames& fr,
                                         SurfaceFidelityOptions& o) {
-  std::vector<Chart> charts = place_charts(tris, fr, o);
+  const Adjacency adj = triangle_adjacency(tris);
+  std::vector<Chart> charts = place_charts(tris, adj, fr, o);
   while (charts.empty() && o.chart_texels / 2 >= std::max(16, o.patch)) {
     o.chart_texels /= 2;
-    charts = place_charts(tris, fr, o);
+    charts = place_charts(tris, adj, fr, o);
   }
   return charts;
 }

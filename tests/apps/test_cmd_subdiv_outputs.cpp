@@ -51,6 +51,36 @@ TEST(CmdSubdivOutputs, GlbCarriesTheAtlasAndItsNormalMap) {
   EXPECT_EQ(j["export"]["atlas"]["gutter_violations"], 0);
 }
 
+// Every stage after the synthesis runs side by side (the fidelity beside the
+// bake, the render beside the writing, the atlas raster, dilation and OBJ text
+// in parallel): one and two threads write the same bytes, report aside.
+TEST(CmdSubdivOutputs, OneAndTwoThreadsWriteTheSameFiles) {
+  const std::string dir = test::temp_dir("subdiv_threads");
+  std::string outs[2];
+  for (int t = 0; t < 2; ++t) {
+    outs[t] = dir + "/out" + std::to_string(t + 1);
+    auto r = test::run_surftex("subdiv '" + test::shared_data("meshes/fish_blub.obj") + "' '" +
+                               test::shared_data("textures/leather_64.png") + "' -o '" + outs[t] +
+                               "' --levels 2 --atlas-size 512 -q --threads " + std::to_string(t + 1));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::size_t compared = 0;
+  for (const auto& e : fs::directory_iterator(outs[0])) {
+    const std::string name = e.path().filename().string();
+    if (name == "report.json") continue;
+    std::ifstream a(e.path(), std::ios::binary), b(outs[1] + "/" + name, std::ios::binary);
+    const std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_FALSE(sa.empty()) << name;
+    EXPECT_TRUE(sa == sb) << name << " differs between 1 and 2 threads";
+    ++compared;
+  }
+  EXPECT_GE(compared, 7u);  // ply, glb, obj, mtl, three maps, render
+  const auto j1 = nlohmann::json::parse(std::ifstream(outs[0] + "/report.json"));
+  const auto j2 = nlohmann::json::parse(std::ifstream(outs[1] + "/report.json"));
+  EXPECT_EQ(j1["fidelity"]["ratio"], j2["fidelity"]["ratio"]);
+  EXPECT_EQ(j1["export"]["atlas"]["seam"]["ratio"], j2["export"]["atlas"]["seam"]["ratio"]);
+}
+
 namespace {
 
 // A small periodic stochastic exemplar.

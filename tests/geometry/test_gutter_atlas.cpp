@@ -5,6 +5,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -101,6 +102,81 @@ TEST(AtlasGutter, ViolationsMatchTheirDefinitionForEveryGutterWidth) {
     nonzero += want > 0;
   }
   EXPECT_GE(nonzero, 6u);
+}
+
+
+// dilate_charts by its header's words, ring by ring: the empty texels with a
+// labelled 8-neighbour take the majority label (ties: lower) of their labelled
+// neighbours and those neighbours' mean; then the next ring.
+int dilate_by_definition(Image& img, std::vector<int>& label) {
+  const int W = img.width, H = img.height, C = img.channels;
+  int rings = 0;
+  for (;;) {
+    std::vector<int> lab = label;
+    std::vector<float> val = img.data;
+    bool any = false;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * W + x;
+        if (label[i] >= 0) continue;
+        std::map<int, int> count;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = x + dx, qy = y + dy;
+            if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+            const int l = label[static_cast<std::size_t>(qy) * W + qx];
+            if (l >= 0) ++count[l];
+          }
+        if (count.empty()) continue;
+        int best = count.begin()->first;
+        for (const auto& [l, c] : count)
+          if (c > count[best]) best = l;
+        lab[i] = best;
+        for (int c = 0; c < C; ++c) {
+          float sum = 0.f;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int qx = x + dx, qy = y + dy;
+              if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+              const std::size_t j = static_cast<std::size_t>(qy) * W + qx;
+              if (label[j] == best) sum += img.data[j * C + c];
+            }
+          val[i * C + c] = sum / static_cast<float>(count[best]);
+        }
+        any = true;
+      }
+    if (!any) return rings;
+    label.swap(lab);
+    img.data.swap(val);
+    ++rings;
+  }
+}
+
+TEST(AtlasGutter, DilationMatchesItsDefinitionForAnyThreadCount) {
+  const int W = 61, H = 44, C = 3;
+  std::mt19937 rng(9);
+  std::vector<int> label(static_cast<std::size_t>(W) * H, -1);
+  Image img(W, H, C, 0.f);
+  for (int k = 0; k < 7; ++k) {  // scattered charts with random values
+    const int x0 = static_cast<int>(rng() % W), y0 = static_cast<int>(rng() % H);
+    for (int y = y0; y < std::min(H, y0 + 1 + static_cast<int>(rng() % 6)); ++y)
+      for (int x = x0; x < std::min(W, x0 + 1 + static_cast<int>(rng() % 9)); ++x) {
+        label[static_cast<std::size_t>(y) * W + x] = k % 5;
+        for (int c = 0; c < C; ++c) img.at(x, y, c) = static_cast<float>(rng() % 1000) / 1000.f;
+      }
+  }
+  Image want = img;
+  std::vector<int> want_label = label;
+  const int want_rings = dilate_by_definition(want, want_label);
+  EXPECT_GT(want_rings, 3);
+  for (int threads : {1, 2}) {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, threads);
+    Image got = img;
+    std::vector<int> got_label = label;
+    EXPECT_EQ(dilate_charts(got, got_label), want_rings);
+    EXPECT_EQ(got_label, want_label) << threads << " threads";
+    EXPECT_EQ(got.data, want.data) << threads << " threads";
+  }
 }
 
 }  // namespace
