@@ -4,6 +4,8 @@
 // and its demo step.
 #include <tbb/parallel_invoke.h>
 
+#include <exception>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -79,12 +81,18 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
   go.height_texture = nullptr;
   go.write_colors = true;
   go.color_attribute = "_COLOR";
-  // The three files side by side (each mostly one thread's PNG or text encoding).
-  // The render beside them (it reads the mesh only).
+  // The maps both the OBJ and the GLB carry are encoded once, then the three
+  // files side by side (each mostly one thread's PNG or text encoding); the
+  // render beside them (it reads the mesh only).
+  std::vector<const Image*> shared{&asset.color.image, &asset.normal};
+  if (!asset.metallic_roughness.empty()) shared.push_back(&asset.metallic_roughness);
+  std::map<const Image*, std::string> pngs;
+  ao.encoded_png = go.encoded_png = &pngs;
   std::vector<std::string> ply_files, obj_files, glb_files;
   double seconds_write = 0, seconds_render = 0;
   tbb::parallel_invoke(
       [&] {
+        pngs = encode_png(o.glb, shared);
         tbb::parallel_invoke([&] { ply_files = write_mesh(o.ply, mesh, wo); },
                              [&] { obj_files = write_mesh(o.obj, *asset.mesh, ao); },
                              [&] { glb_files = write_mesh(o.glb, *asset.mesh, go); });
@@ -205,10 +213,30 @@ int run_subdiv(const SubdivArgs& a) {
   auto limit = apply_thread_limit(a.common.threads);
   Timer total, t;
   Mesh mesh;
-  // sqrt(2)-subdivision takes any polygons: they are kept when they need no repair.
-  const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common, true);
-  const Image ex = read_image(a.exemplar);
-  const SubdivisionExemplarMaps maps = read_exemplar_maps(a, ex);
+  LoadInputReport loaded;
+  Image ex;
+  SubdivisionExemplarMaps maps;
+  // The mesh and the images side by side (the first image read also loads
+  // the image library); a broken mesh is reported before a broken image.
+  std::exception_ptr mesh_error, image_error;
+  tbb::parallel_invoke(
+      [&] {
+        try {  // sqrt(2)-subdivision takes any polygons: they are kept when they need no repair.
+          loaded = load_method_mesh(a.mesh, mesh, a.common, true);
+        } catch (...) {
+          mesh_error = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          ex = read_image(a.exemplar);
+          maps = read_exemplar_maps(a, ex);
+        } catch (...) {
+          image_error = std::current_exception();
+        }
+      });
+  if (mesh_error) std::rethrow_exception(mesh_error);
+  if (image_error) std::rethrow_exception(image_error);
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;

@@ -239,6 +239,19 @@ ObjPbrMaps obj_pbr_maps(const fs::path& dir, const std::string& stem, const Writ
 
 // The OBJ's text: vertices (with colours), distinct UVs, normals, faces
 // grouped by material.
+// Writes the bytes opt.encoded_png holds for `img` to `path`; false when it
+// holds none.
+bool write_encoded(const std::string& path, const Image* img, const WriteMeshOptions& opt) {
+  if (opt.encoded_png == nullptr || img == nullptr) return false;
+  const auto it = opt.encoded_png->find(img);
+  if (it == opt.encoded_png->end()) return false;
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw IOError("cannot open '" + path + "' for writing");
+  f.write(it->second.data(), static_cast<std::streamsize>(it->second.size()));
+  write_bytes(f, path);
+  return true;
+}
+
 // Lines 0..n-1 written by line(i, out) in chunks side by side, joined in order.
 std::string parallel_lines(std::size_t n, const std::function<void(std::size_t, std::string&)>& line) {
   constexpr std::size_t kChunk = 8192;
@@ -372,8 +385,15 @@ std::vector<std::string> write_obj(const std::string& path, const Mesh& mesh, co
   // and beside the text.
   std::vector<std::function<void()>> encodes;
   for (std::size_t k = 0; k < png_out.size(); ++k)
-    if (png_out[k]) encodes.emplace_back([&, k] { write_image(png_out[k]->temp_path(), *groups.materials[k].texture); });
-  for (const ObjPbrMap& m : pbr.maps) encodes.emplace_back([&m] { m.write(); });
+    if (png_out[k])
+      encodes.emplace_back([&, k] {
+        if (!write_encoded(png_out[k]->temp_path(), groups.materials[k].texture, opt))
+          write_image(png_out[k]->temp_path(), *groups.materials[k].texture);
+      });
+  for (const ObjPbrMap& m : pbr.maps)
+    encodes.emplace_back([&] {
+      if (m.sixteen_bit || !write_encoded(m.file->temp_path(), m.image, opt)) m.write();
+    });
   std::string s;
   tbb::parallel_invoke([&] { s = obj_text(g, groups, mtl_name); },
                        [&] { tbb::parallel_for(std::size_t(0), encodes.size(), [&](std::size_t i) { encodes[i](); }); });
@@ -654,7 +674,11 @@ std::map<const Image*, std::string> encode_textures(const std::string& path, con
       if (im != nullptr && !im->empty()) want(im);
   }
   std::vector<std::string> bytes(images.size());
-  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) { bytes[i] = png_bytes(path, *images[i], i); });
+  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) {
+    const auto ahead = opt.encoded_png ? opt.encoded_png->find(images[i]) : std::map<const Image*, std::string>::const_iterator{};
+    const bool known = opt.encoded_png && ahead != opt.encoded_png->end();
+    bytes[i] = known ? ahead->second : png_bytes(path, *images[i], i);
+  });
   std::map<const Image*, std::string> r;
   for (std::size_t i = 0; i < images.size(); ++i) r.emplace(images[i], std::move(bytes[i]));
   return r;
@@ -740,6 +764,17 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
 }
 
 }  // namespace
+
+std::map<const Image*, std::string> encode_png(const std::string& beside, const std::vector<const Image*>& images) {
+  std::vector<std::string> bytes(images.size());
+  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) {
+    if (images[i] == nullptr || images[i]->empty()) throw InvalidInputError("encode_png: an empty image");
+    bytes[i] = png_bytes(beside + ".ahead", *images[i], i);
+  });
+  std::map<const Image*, std::string> r;
+  for (std::size_t i = 0; i < images.size(); ++i) r.emplace(images[i], std::move(bytes[i]));
+  return r;
+}
 
 std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {
   const std::string ext = lower_extension(path);

@@ -5,6 +5,7 @@
 // glTF 2.0 binary (.glb: positions, normals, UVs, vertex colours, embedded
 // PNG texture). Every writer is atomic (temporary + rename).
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -47,7 +48,17 @@ struct WriteMeshOptions {
   /// "_<name>" (e.g. the material coordinate m). Empty = none.
   std::string vertex_scalar_property;
   bool overwrite = true;
+  /// PNG bytes of some of the images above, encoded ahead (encode_png): an
+  /// OBJ's texture file or a GLB's embedded image of such an image takes
+  /// these bytes instead of encoding it again (an OBJ and a GLB of one asset
+  /// share their maps). Not owned; null = encode every image.
+  const std::map<const Image*, std::string>* encoded_png = nullptr;
 };
+
+/// The 8-bit PNG file bytes of each image (side by side), keyed by image, for
+/// WriteMeshOptions::encoded_png. `beside` names the temporaries the encoder
+/// needs (never committed). Throws like write_mesh.
+std::map<const Image*, std::string> encode_png(const std::string& beside, const std::vector<const Image*>& images);
 
 /// Format by extension (case-insensitive): .obj (+ .mtl and textures, renamed
 /// into place together), .ply (binary little-endian), .off, .glb (glTF 2.0,

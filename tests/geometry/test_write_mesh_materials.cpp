@@ -7,6 +7,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <string>
 
 #include "geometry/errors.h"
 #include "geometry/face_material.h"
@@ -117,4 +119,67 @@ TEST(WriteMeshMaterials, TextureWithoutUvsIsRefused) {
   wo.texture = &tex;
   EXPECT_THROW(write_mesh(d + "/s.glb", m, wo), InvalidInputError);
   EXPECT_FALSE(fs::exists(d + "/s.glb"));
+}
+
+namespace {
+
+std::string file_bytes(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(f)), {});
+}
+
+}  // namespace
+
+// Maps encoded ahead (an OBJ and a GLB of one asset sharing them) give the
+// files encoding them in each writer gives; an image with no bytes ahead is
+// still encoded (the 16-bit height map here).
+TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
+  Mesh m;
+  make_torus(m, 1.0, 0.4, 12, 6);
+  assign_torus_uvs(m, 1.0, 1.0, 1.0);
+  Image color(32, 16, 3), normal(32, 16, 3), height(32, 16, 1);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x) {
+      for (int c = 0; c < 3; ++c) color.at(x, y, c) = static_cast<float>((x * 7 + y * 3 + c * 11) % 32) / 31.f;
+      normal.at(x, y, 0) = 0.5f, normal.at(x, y, 1) = static_cast<float>(y) / 15.f, normal.at(x, y, 2) = 1.f;
+      height.at(x, y, 0) = static_cast<float>(x) / 31.f;
+    }
+  WriteMeshOptions o;
+  o.texture = &color;
+  o.normal_texture = &normal;
+  o.height_texture = &height;
+  const std::string dir = test::temp_dir("encoded_ahead");
+  fs::create_directories(dir + "/a");
+  fs::create_directories(dir + "/b");
+  for (const char* ext : {".obj", ".glb"}) write_mesh(dir + "/a/m" + ext, m, o);
+  const std::map<const Image*, std::string> ahead = encode_png(dir + "/b/m.glb", {&color, &normal});
+  ASSERT_EQ(ahead.size(), 2u);
+  EXPECT_EQ(ahead.at(&color).substr(1, 3), "PNG");
+  o.encoded_png = &ahead;
+  for (const char* ext : {".obj", ".glb"}) write_mesh(dir + "/b/m" + ext, m, o);
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/a")) {
+    const std::string name = e.path().filename().string();
+    EXPECT_EQ(file_bytes(e.path().string()), file_bytes(dir + "/b/" + name)) << name;
+    ++files;
+  }
+  EXPECT_GE(files, 5u);  // obj, mtl, colour, normal, height, glb
+  for (const auto& e : fs::directory_iterator(dir + "/b"))
+    EXPECT_TRUE(fs::exists(dir + "/a/" + e.path().filename().string())) << e.path();  // no temporary left
+  // The bytes ahead are what the OBJ's texture file holds.
+  std::size_t matched = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/b"))
+    matched += file_bytes(e.path().string()) == ahead.at(&color);
+  EXPECT_EQ(matched, 1u);
+  // The writers take the bytes given: other bytes for the colour map land in
+  // the OBJ's texture file and the GLB.
+  fs::create_directories(dir + "/c");
+  const std::map<const Image*, std::string> swapped{{&color, ahead.at(&normal)}};
+  o.encoded_png = &swapped;
+  for (const char* ext : {".obj", ".glb"}) write_mesh(dir + "/c/m" + ext, m, o);
+  std::size_t taken = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/c"))
+    taken += file_bytes(e.path().string()) == ahead.at(&normal);
+  EXPECT_EQ(taken, 2u);  // the colour file and the normal file
+  EXPECT_NE(file_bytes(dir + "/c/m.glb"), file_bytes(dir + "/a/m.glb"));
 }

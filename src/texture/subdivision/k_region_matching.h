@@ -222,6 +222,9 @@ std::array<float, 3> texel_bilinear(const ExemplarLevels& ex, int level, double 
 
 /// x wrapped into [0, n).
 inline int wrap_coordinate(int x, int n) {
+  if (x >= 0 && x < n) return x;  // within one period of the level: no division
+  if (x < 0 && x >= -n) return x + n;
+  if (x >= n && x < 2 * n) return x - n;
   x %= n;
   return x < 0 ? x + n : x;
 }
