@@ -258,7 +258,9 @@ SubcommandRegistrar reg{
            ->check(CLI::Range(1.0, 1000.0));
        app.add_option("--field", a->field,
                       "Orientation without strokes: curvature (principal directions of the 10% most anisotropic "
-                      "faces, smoothed) or constant (world +Y projected); default curvature")
+                      "faces, smoothed) or constant (world +Y projected: the tile's axes run level and upright, but the cross "
+                      "field is 4-symmetric, so which axis points up is not fixed, unlike patches --field up); "
+                      "default curvature")
            ->check(CLI::IsMember({"curvature", "constant"}));
        app.add_option("--render-size", a->render_size, "Side of the renders in pixels (16..4096, default 768)")
            ->check(CLI::Range(16, 4096));
