@@ -323,7 +323,16 @@ class RepetitionGrid {
   std::unordered_map<std::uint64_t, std::vector<int>> cells_;
 };
 
+// Direct texel addresses of a job's groups (group_footprint).
+struct GroupFootprint {
+  bool direct = false;
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  std::vector<const float*> data;
+  std::vector<std::ptrdiff_t> offset;
+};
+
 struct JobScratch {
+  GroupFootprint footprint;
   RegionScratch region;
   GroupScratch group;
   std::vector<RegionSample> samples;
@@ -353,6 +362,33 @@ struct PassContext {
   bool coherent;                        ///< coherence search (SubdivisionSynthesisOptions::exhaustive_levels)
 };
 
+// The texel of level l at (x, y) as texel() finds it (wrapped or clamped).
+inline const float* texel_pointer(const ExemplarLevels& ex, int level, int x, int y) {
+  const Image& im = ex.levels[level];
+  return ex.wraps(level) ? im.pixel(wrap_coordinate(x, im.width), wrap_coordinate(y, im.height))
+                         : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
+}
+
+// The groups' offsets as addresses: when every group's level has the size of
+// the centre's level, a candidate whose footprint [x0, x1] x [y0, y1] lies
+// inside it reads group k's texel at data[k] + offset[k] + 3 (qy W + qx).
+void group_footprint(const ExemplarLevels& ex, int lp, const std::vector<SampleGroup>& groups, GroupFootprint& fp) {
+  const int W = ex.width(lp), H = ex.height(lp);
+  fp.direct = true;
+  fp.x0 = fp.y0 = 0, fp.x1 = fp.y1 = 0;
+  fp.data.resize(groups.size());
+  fp.offset.resize(groups.size());
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    const SampleGroup& g = groups[k];
+    const Image& im = ex.levels[g.level];
+    if (im.width != W || im.height != H || im.channels != 3) fp.direct = false;
+    fp.x0 = std::min(fp.x0, g.dx), fp.x1 = std::max(fp.x1, g.dx);
+    fp.y0 = std::min(fp.y0, g.dy), fp.y1 = std::max(fp.y1, g.dy);
+    fp.data[k] = im.data.data();
+    fp.offset[k] = (static_cast<std::ptrdiff_t>(g.dy) * W + g.dx) * 3;
+  }
+}
+
 // Coherence search (SubdivisionSynthesisOptions::exhaustive_levels): the best
 // of the centres implied by the region's sources. found = false when no
 // region vertex has a source implying a centre inside the box.
@@ -363,6 +399,8 @@ MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, con
   std::array<std::array<int, 2>, 32> seen;
   int nseen = 0;
   double bd = std::numeric_limits<double>::infinity();
+  GroupFootprint& fp = s.footprint;
+  group_footprint(c.ex, lp, s.groups, fp);
   for (std::size_t i = 0; i < reg.vertices.size() && nseen < 32; ++i) {
     const std::size_t v = reg.vertices[i];
     const auto& src = c.source[v];
@@ -378,9 +416,13 @@ MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, con
     if (dup) continue;
     seen[nseen++] = {qx, qy};
     double d = box.bin_penalty ? box.bin_penalty[((qy * sc) / box.bin) * box.bins_x + (qx * sc) / box.bin] : 0.0;
-    for (const SampleGroup& g : s.groups) {
-      const auto t = texel(c.ex, g.level, qx + g.dx, qy + g.dy);
-      for (int k = 0; k < 3; ++k) d += g.weight * (double(t[k]) - g.color[k]) * (double(t[k]) - g.color[k]);
+    const bool inside = fp.direct && qx + fp.x0 >= 0 && qx + fp.x1 < W && qy + fp.y0 >= 0 && qy + fp.y1 < H;
+    const std::ptrdiff_t at = (static_cast<std::ptrdiff_t>(qy) * W + qx) * 3;
+    for (std::size_t k = 0; k < s.groups.size(); ++k) {
+      const SampleGroup& g = s.groups[k];
+      // The footprint inside the level: the texel by address (as texel() reads it).
+      const float* t = inside ? fp.data[k] + at + fp.offset[k] : texel_pointer(c.ex, g.level, qx + g.dx, qy + g.dy);
+      for (int j = 0; j < 3; ++j) d += g.weight * (double(t[j]) - g.color[j]) * (double(t[j]) - g.color[j]);
       if (d >= bd) break;
     }
     if (d < bd || (d == bd && qy * W + qx < best.qy * W + best.qx)) {
