@@ -4,11 +4,10 @@
 // and its demo step.
 #include <tbb/parallel_invoke.h>
 
-#include <exception>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <string>
 #include <utility>

@@ -2,14 +2,14 @@
 // Texture-space triangle rasterisation (see uv_raster.h).
 #include "geometry/uv_raster.h"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <cstdint>
-#include <string>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
 
 #include "geometry/errors.h"
 

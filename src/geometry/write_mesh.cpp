@@ -237,8 +237,6 @@ ObjPbrMaps obj_pbr_maps(const fs::path& dir, const std::string& stem, const Writ
   return r;
 }
 
-// The OBJ's text: vertices (with colours), distinct UVs, normals, faces
-// grouped by material.
 // Writes the bytes opt.encoded_png holds for `img` to `path`; false when it
 // holds none.
 bool write_encoded(const std::string& path, const Image* img, const WriteMeshOptions& opt) {
@@ -305,6 +303,8 @@ std::string obj_uv_lines(const Gathered& g, std::vector<std::vector<std::size_t>
   return s;
 }
 
+// The OBJ's text: vertices (with colours), distinct UVs, normals, faces
+// grouped by material.
 std::string obj_text(const Gathered& g, const MaterialGroups& groups, const std::string& mtl_name) {
   const bool with_mtl = !groups.materials.empty();
   std::string s = "# written by surftex\n";
@@ -659,6 +659,16 @@ tinygltf::Primitive vertex_attributes(GlbBuilder& b, const Gathered& g, const Gl
   return prim;
 }
 
+// The PNG bytes of each image, encoded side by side (temporaries named
+// after `beside` and the image's slot).
+std::map<const Image*, std::string> encode_each(const std::string& beside, const std::vector<const Image*>& images) {
+  std::vector<std::string> bytes(images.size());
+  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) { bytes[i] = png_bytes(beside, *images[i], i); });
+  std::map<const Image*, std::string> r;
+  for (std::size_t i = 0; i < images.size(); ++i) r.emplace(images[i], std::move(bytes[i]));
+  return r;
+}
+
 // The PNG bytes of every map add_materials embeds, encoded side by side
 // (the same images, in the same conditions, as add_materials takes them).
 std::map<const Image*, std::string> encode_textures(const std::string& path, const MaterialGroups& groups,
@@ -673,14 +683,12 @@ std::map<const Image*, std::string> encode_textures(const std::string& path, con
     for (const Image* im : {opt.normal_texture, opt.metallic_roughness_texture})
       if (im != nullptr && !im->empty()) want(im);
   }
-  std::vector<std::string> bytes(images.size());
-  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) {
-    const auto ahead = opt.encoded_png ? opt.encoded_png->find(images[i]) : std::map<const Image*, std::string>::const_iterator{};
-    const bool known = opt.encoded_png && ahead != opt.encoded_png->end();
-    bytes[i] = known ? ahead->second : png_bytes(path, *images[i], i);
-  });
-  std::map<const Image*, std::string> r;
-  for (std::size_t i = 0; i < images.size(); ++i) r.emplace(images[i], std::move(bytes[i]));
+  std::vector<const Image*> missing;
+  for (const Image* im : images)
+    if (opt.encoded_png == nullptr || opt.encoded_png->count(im) == 0) missing.push_back(im);
+  std::map<const Image*, std::string> r = encode_each(path, missing);
+  for (const Image* im : images)
+    if (r.count(im) == 0) r.emplace(im, opt.encoded_png->at(im));
   return r;
 }
 
@@ -766,14 +774,9 @@ void write_glb(const std::string& path, const Mesh& mesh, const WriteMeshOptions
 }  // namespace
 
 std::map<const Image*, std::string> encode_png(const std::string& beside, const std::vector<const Image*>& images) {
-  std::vector<std::string> bytes(images.size());
-  tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) {
-    if (images[i] == nullptr || images[i]->empty()) throw InvalidInputError("encode_png: an empty image");
-    bytes[i] = png_bytes(beside + ".ahead", *images[i], i);
-  });
-  std::map<const Image*, std::string> r;
-  for (std::size_t i = 0; i < images.size(); ++i) r.emplace(images[i], std::move(bytes[i]));
-  return r;
+  for (const Image* im : images)
+    if (im == nullptr || im->empty()) throw InvalidInputError("encode_png: an empty image");
+  return encode_each(beside + ".ahead", images);
 }
 
 std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt) {

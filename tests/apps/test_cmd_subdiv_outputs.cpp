@@ -68,15 +68,13 @@ TEST(CmdSubdivOutputs, OneAndTwoThreadsWriteTheSameFiles) {
   for (const auto& e : fs::directory_iterator(outs[0])) {
     const std::string name = e.path().filename().string();
     if (name == "report.json") continue;
-    std::ifstream a(e.path(), std::ios::binary), b(outs[1] + "/" + name, std::ios::binary);
-    const std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
+    const std::string sa = test::file_bytes(e.path().string()), sb = test::file_bytes(outs[1] + "/" + name);
     EXPECT_FALSE(sa.empty()) << name;
     EXPECT_TRUE(sa == sb) << name << " differs between 1 and 2 threads";
     ++compared;
   }
   EXPECT_GE(compared, 7u);  // ply, glb, obj, mtl, three maps, render
-  const auto j1 = nlohmann::json::parse(std::ifstream(outs[0] + "/report.json"));
-  const auto j2 = nlohmann::json::parse(std::ifstream(outs[1] + "/report.json"));
+  const auto j1 = test::read_json(outs[0] + "/report.json"), j2 = test::read_json(outs[1] + "/report.json");
   EXPECT_EQ(j1["fidelity"]["ratio"], j2["fidelity"]["ratio"]);
   EXPECT_EQ(j1["export"]["atlas"]["seam"]["ratio"], j2["export"]["atlas"]["seam"]["ratio"]);
 }

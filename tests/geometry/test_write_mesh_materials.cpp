@@ -121,15 +121,6 @@ TEST(WriteMeshMaterials, TextureWithoutUvsIsRefused) {
   EXPECT_FALSE(fs::exists(d + "/s.glb"));
 }
 
-namespace {
-
-std::string file_bytes(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(f)), {});
-}
-
-}  // namespace
-
 // Maps encoded ahead (an OBJ and a GLB of one asset sharing them) give the
 // files encoding them in each writer gives; an image with no bytes ahead is
 // still encoded (the 16-bit height map here).
@@ -160,7 +151,7 @@ TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
   std::size_t files = 0;
   for (const auto& e : fs::directory_iterator(dir + "/a")) {
     const std::string name = e.path().filename().string();
-    EXPECT_EQ(file_bytes(e.path().string()), file_bytes(dir + "/b/" + name)) << name;
+    EXPECT_EQ(test::file_bytes(e.path().string()), test::file_bytes(dir + "/b/" + name)) << name;
     ++files;
   }
   EXPECT_GE(files, 5u);  // obj, mtl, colour, normal, height, glb
@@ -169,7 +160,7 @@ TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
   // The bytes ahead are what the OBJ's texture file holds.
   std::size_t matched = 0;
   for (const auto& e : fs::directory_iterator(dir + "/b"))
-    matched += file_bytes(e.path().string()) == ahead.at(&color);
+    matched += test::file_bytes(e.path().string()) == ahead.at(&color);
   EXPECT_EQ(matched, 1u);
   // The writers take the bytes given: other bytes for the colour map land in
   // the OBJ's texture file and the GLB.
@@ -179,7 +170,7 @@ TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
   for (const char* ext : {".obj", ".glb"}) write_mesh(dir + "/c/m" + ext, m, o);
   std::size_t taken = 0;
   for (const auto& e : fs::directory_iterator(dir + "/c"))
-    taken += file_bytes(e.path().string()) == ahead.at(&normal);
+    taken += test::file_bytes(e.path().string()) == ahead.at(&normal);
   EXPECT_EQ(taken, 2u);  // the colour file and the normal file
-  EXPECT_NE(file_bytes(dir + "/c/m.glb"), file_bytes(dir + "/a/m.glb"));
+  EXPECT_NE(test::file_bytes(dir + "/c/m.glb"), test::file_bytes(dir + "/a/m.glb"));
 }

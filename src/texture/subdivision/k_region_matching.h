@@ -229,12 +229,17 @@ inline int wrap_coordinate(int x, int n) {
   return x < 0 ? x + n : x;
 }
 
-/// Texel colour of level l at (x, y), wrapping, or clamped at a bounded level
+/// The texel of level l at (x, y), wrapping, or clamped at a bounded level
 /// (inline: the coherence search's inner loop).
-inline std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
+inline const float* texel_pointer(const ExemplarLevels& ex, int level, int x, int y) {
   const Image& im = ex.levels[level];
-  const float* p = ex.wraps(level) ? im.pixel(wrap_coordinate(x, im.width), wrap_coordinate(y, im.height))
-                                   : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
+  return ex.wraps(level) ? im.pixel(wrap_coordinate(x, im.width), wrap_coordinate(y, im.height))
+                         : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
+}
+
+/// Texel colour of level l at (x, y), as texel_pointer finds it.
+inline std::array<float, 3> texel(const ExemplarLevels& ex, int level, int x, int y) {
+  const float* p = texel_pointer(ex, level, x, y);
   return {p[0], p[1], p[2]};
 }
 

@@ -362,13 +362,6 @@ struct PassContext {
   bool coherent;                        ///< coherence search (SubdivisionSynthesisOptions::exhaustive_levels)
 };
 
-// The texel of level l at (x, y) as texel() finds it (wrapped or clamped).
-inline const float* texel_pointer(const ExemplarLevels& ex, int level, int x, int y) {
-  const Image& im = ex.levels[level];
-  return ex.wraps(level) ? im.pixel(wrap_coordinate(x, im.width), wrap_coordinate(y, im.height))
-                         : im.pixel(std::clamp(x, 0, im.width - 1), std::clamp(y, 0, im.height - 1));
-}
-
 // The groups' offsets as addresses: when every group's level has the size of
 // the centre's level, a candidate whose footprint [x0, x1] x [y0, y1] lies
 // inside it reads group k's texel at data[k] + offset[k] + 3 (qy W + qx).
