@@ -14,6 +14,13 @@ for a in "$@"; do
   esac
 done
 if [[ "${CI:-}" == "true" ]]; then sanitize=1; fi
+# The tests read real meshes and textures (tests/test_support.cpp): say where
+# they are missing before installing and building for twenty minutes.
+data="${SURFTEX_SHARED_DATA:-$root/../shared/data}"
+if [[ ! -d "$data/meshes" || ! -d "$data/textures" ]]; then
+  echo "error: the test data is not at '$data' (clone surftex beside shared/, or set SURFTEX_SHARED_DATA to the shared/data folder)" >&2
+  exit 2
+fi
 
 bash "$root/scripts/setup.sh" --tests
 SURFTEX_BUILD_DIR="$root/build" bash "$root/scripts/build.sh"
