@@ -15,12 +15,11 @@
 #include "texture/graphcut_synthesis.h"
 #include "texture/surface_fidelity.h"
 #include "texture/wrap_seam_ratio.h"
+#include "test_support.h"
 
 using namespace surftex;
 
 namespace {
-
-const std::string kTextures = std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/";
 
 Image rgb(const Image& in) {
   Image out(in.width, in.height, 3);
@@ -72,7 +71,7 @@ TextureFrames uv_frames(const Mesh& mesh, int w, int h) {
 // copy shows every exemplar patch, so its completeness is near 0; the seam
 // ratio and, where sources are known, long_run_fraction catch it.)
 TEST(SurfaceFidelity, RanksAVerbatimTilingWithSeamsBelowASeamlessSynthesis) {
-  const Image ex = rgb(read_image(kTextures + "brick_small_96.png"));
+  const Image ex = rgb(read_image(test::shared_data("textures/brick_small_96.png")));
   ASSERT_EQ(ex.width, 96);
   EXPECT_GT(wrap_seam_ratio(ex), 1.3) << "the exemplar would tile";
   const int tiles = 3;
@@ -108,7 +107,7 @@ TEST(SurfaceFidelity, RanksAVerbatimTilingWithSeamsBelowASeamlessSynthesis) {
 // match the exemplar far better than the same surface read in a frame turned
 // by a quarter turn (the exemplar's stripes would then run the other way).
 TEST(SurfaceFidelity, ChartsAreReadInTheTexturesOwnFrame) {
-  const Image ex = rgb(read_image(kTextures + "stripes_blue_white_256.png"));
+  const Image ex = rgb(read_image(test::shared_data("textures/stripes_blue_white_256.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 1, 32, false, ids);
@@ -129,7 +128,7 @@ TEST(SurfaceFidelity, ChartsAreReadInTheTexturesOwnFrame) {
 // The same figures for 1 and 2 threads; every pixel of a chart fully inside
 // a flat square is valid.
 TEST(SurfaceFidelity, SameFiguresForAnyThreadCount) {
-  const Image ex = rgb(read_image(kTextures + "leather_64.png"));
+  const Image ex = rgb(read_image(test::shared_data("textures/leather_64.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 2, 16, true, ids);
@@ -153,7 +152,7 @@ TEST(SurfaceFidelity, SameFiguresForAnyThreadCount) {
 }
 
 TEST(SurfaceFidelity, BadInputIsRefusedNamingTheProblem) {
-  const Image ex = rgb(read_image(kTextures + "pebbles_256.png"));
+  const Image ex = rgb(read_image(test::shared_data("textures/pebbles_256.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 1, 8, false, ids);
