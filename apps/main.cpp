@@ -7,12 +7,14 @@
 #include <exception>
 #include <new>
 
+#include "geometry/allocator_settings.h"
 #include "geometry/cancellation.h"
 #include "geometry/errors.h"
 #include "geometry/output_file.h"
 #include "surftex/command.h"
 
 int main(int argc, char** argv) {
+  surftex::keep_freed_memory_for_reuse();  // before any thread starts
   surftex::cli::record_command_line(argc, argv);  // for the reports (surftex/report.h)
   CLI::App app{
       "surftex: decorate 3D surface meshes with textures grown from examples.\n"

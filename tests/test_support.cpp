@@ -34,6 +34,12 @@ void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
 
+std::string write_file(const std::string& dir, const std::string& name, const std::string& bytes) {
+  const std::string p = dir + "/" + name;
+  write_text_file(p, bytes);
+  return p;
+}
+
 nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);

@@ -20,6 +20,8 @@ std::string temp_dir(const std::string& tag);
 std::string file_bytes(const std::string& path);
 /// Writes `text` to `path`, creating its folders.
 void write_text_file(const std::string& path, const std::string& text);
+/// Writes `bytes` to dir/name (as they are) and returns that path.
+std::string write_file(const std::string& dir, const std::string& name, const std::string& bytes);
 /// The JSON document in `path` (throws if it cannot be parsed).
 nlohmann::json read_json(const std::string& path);
 /// `s` in single quotes, for a shell command line (paths without quotes).

@@ -32,12 +32,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string write_file(const std::string& dir, const std::string& name, const std::string& bytes) {
-  std::string p = dir + "/" + name;
-  std::ofstream f(p, std::ios::binary);
-  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return p;
-}
+using surftex::test::write_file;
 
 const std::string kBom = "\xEF\xBB\xBF";
 
