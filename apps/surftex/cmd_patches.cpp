@@ -165,18 +165,22 @@ int run(const PatchArgs& a) {
   auto limit = apply_thread_limit(a.common.threads);
   Mesh mesh;
   const LoadInputReport loaded = load_method_mesh(a.mesh, mesh, a.common);
-  const Image colour = read_image(a.exemplar);
-  // Exemplar maps: the colour exemplar's size, resized with it.
+  Image colour = read_image(a.exemplar);
+  // Exemplar maps: the colour exemplar's size, cropped to its opaque part and
+  // resized with it.
   PatchExemplarMaps maps;
-  auto read_map = [&](const std::string& path, const char* what) -> Image {
-    Image m = read_exemplar_map(path, what, a.exemplar, colour);
-    return m.empty() ? m : as_rgb(m, a.exemplar_size);
-  };
-  maps.normal = read_map(a.exemplar_normal, "--exemplar-normal");
-  maps.height = read_map(a.exemplar_height, "--exemplar-height");
-  maps.roughness = read_map(a.exemplar_roughness, "--exemplar-roughness");
+  maps.normal = read_exemplar_map(a.exemplar_normal, "--exemplar-normal", a.exemplar, colour);
+  maps.height = read_exemplar_map(a.exemplar_height, "--exemplar-height", a.exemplar, colour);
+  maps.roughness = read_exemplar_map(a.exemplar_roughness, "--exemplar-roughness", a.exemplar, colour);
+  const nlohmann::json opaque = use_opaque_part(colour, {&maps.normal, &maps.height, &maps.roughness}, a.common);
+  for (Image* m : {&maps.normal, &maps.height, &maps.roughness})
+    if (!m->empty()) *m = as_rgb(*m, a.exemplar_size);
   std::vector<Image> ex{as_rgb(colour, a.exemplar_size)};
-  if (!a.exemplar2.empty()) ex.push_back(as_rgb(read_image(a.exemplar2), a.exemplar_size));
+  if (!a.exemplar2.empty()) {
+    Image second = read_image(a.exemplar2);
+    use_opaque_part(second, {}, a.common);
+    ex.push_back(as_rgb(second, a.exemplar_size));
+  }
   po.partition.max_angle_deg = a.max_angle;
   po.partition.max_faces = a.max_faces;
   po.flatten.resolution = a.patch_res;
@@ -202,6 +206,7 @@ int run(const PatchArgs& a) {
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
+  if (!opaque.is_null()) rep["exemplar_transparency"] = opaque;
   rep["field"] = a.field;
   rep["order"] = a.order;
   rep["fill"] = a.fill;
@@ -229,7 +234,8 @@ SubcommandRegistrar reg{
      [](CLI::App& app) -> std::function<int()> {
        auto a = std::make_shared<PatchArgs>();
        app.add_option("MESH", a->mesh, "Input mesh (OFF/OBJ/PLY/STL)")->required();
-       app.add_option("EXEMPLAR", a->exemplar, "Exemplar image (grey or RGB; alpha ignored)")->required();
+       app.add_option("EXEMPLAR", a->exemplar, "Exemplar image (grey or colour). With transparent pixels (a hole, "
+                      "a cut-out) its largest opaque block is used when that holds a quarter of it (the atlas has no alpha)")->required();
        app.add_option("-o,--output", a->outdir,
                       "Output folder: mesh.obj/.mtl with mesh.png (the atlas: power of two, mip gutters), "
                       "mesh_normal.png (tangent-space, +Y up), mesh_height.png (16-bit), mesh.glb (base colour "

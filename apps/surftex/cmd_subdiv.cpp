@@ -236,6 +236,7 @@ int run_subdiv(const SubdivArgs& a) {
       });
   if (mesh_error) std::rethrow_exception(mesh_error);
   if (image_error) std::rethrow_exception(image_error);
+  const nlohmann::json opaque = use_opaque_part(ex, {&maps.normal, &maps.height, &maps.roughness}, a.common);
   const double seconds_read = t.seconds();
   SubdivisionSynthesisOptions o;
   o.r_scale = a.rscale;
@@ -303,6 +304,7 @@ int run_subdiv(const SubdivArgs& a) {
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
+  if (!opaque.is_null()) rep["exemplar_transparency"] = opaque;
   rep["displace"] = a.displace;
   if (!a.exemplar_normal.empty() || !a.exemplar_height.empty() || !a.exemplar_roughness.empty())
     rep["exemplar_maps"] = {{"normal", a.exemplar_normal}, {"height", a.exemplar_height},
@@ -348,7 +350,9 @@ SubcommandRegistrar reg_subdiv{
        auto a = std::make_shared<SubdivArgs>();
        app.add_option("mesh", a->mesh, "Input mesh (OFF/OBJ/PLY/STL; polygons kept, any genus)")->required();
        app.add_option("exemplar", a->exemplar,
-                      "Exemplar image (any format OpenImageIO reads); wrapped around only if it tiles (see --wrap)")
+                      "Exemplar image (any format OpenImageIO reads); wrapped around only if it tiles (see --wrap). "
+                      "With transparent pixels (a hole, a cut-out) its largest opaque block is used when that holds "
+                      "a quarter of it (the output has no alpha)")
            ->required();
        app.add_option("-o,--output", a->outdir,
                       "Output folder: surface.ply (vertex colours), surface.glb (baked atlas as base colour, "

@@ -20,6 +20,7 @@
 #include "geometry/image_io.h"
 #include "geometry/output_file.h"
 #include "geometry/work_budget.h"
+#include "texture/image_ops.h"
 
 namespace surftex::cli {
 
@@ -149,6 +150,34 @@ LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const Comm
 void check_budget(const WorkEstimate& estimate, const CommonOptions& opt) {
   const std::string note = check_work_budget(estimate);
   if (!opt.quiet) std::fprintf(stderr, "note: %s\n", note.c_str());
+}
+
+nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt) {
+  long long transparent = 0;
+  for (int y = 0; y < exemplar.height; ++y)
+    for (int x = 0; x < exemplar.width; ++x) transparent += is_transparent(exemplar, x, y);
+  if (transparent == 0) return nullptr;
+  const double share = static_cast<double>(transparent) / (static_cast<double>(exemplar.width) * exemplar.height);
+  const PixelRect r = largest_opaque_rectangle(exemplar);
+  const bool crop_it = 4 * r.area() >= static_cast<long long>(exemplar.width) * exemplar.height &&
+                       std::min(r.width, r.height) >= 16;
+  char msg[256];
+  if (crop_it) {
+    std::snprintf(msg, sizeof msg,
+                  "the exemplar has %.1f%% transparent pixels: its largest opaque block is used, %dx%d at (%d, %d) "
+                  "(the output has no alpha)", 100 * share, r.width, r.height, r.x, r.y);
+    exemplar = crop(exemplar, r.x, r.y, r.width, r.height);
+    for (Image* m : maps)
+      if (m && !m->empty()) *m = crop(*m, r.x, r.y, r.width, r.height);
+  } else {
+    std::snprintf(msg, sizeof msg,
+                  "the exemplar has %.1f%% transparent pixels and no opaque block of a quarter of it: the colours "
+                  "stored under them are used (the output has no alpha)", 100 * share);
+  }
+  if (!opt.quiet) std::fprintf(stderr, "note: %s\n", msg);
+  nlohmann::json j{{"transparent_share", share}, {"cropped", crop_it}};
+  if (crop_it) j["opaque_block"] = {r.x, r.y, r.width, r.height};
+  return j;
 }
 
 namespace {

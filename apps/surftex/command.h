@@ -88,6 +88,15 @@ LoadInputReport load_method_mesh(const std::string& path, Mesh& mesh, const Comm
 /// the estimate in one "note:" line on stderr unless opt.quiet.
 void check_budget(const WorkEstimate& estimate, const CommonOptions& opt);
 
+/// An exemplar for a method whose outputs have no alpha (subdiv, patches). With
+/// transparent pixels (alpha < 0.5: a hole, a cut-out) it is cropped to its
+/// largest opaque block when that holds at least a quarter of it and 16 pixels
+/// a side, as the colours stored under the transparent pixels (often black)
+/// would otherwise be copied onto the surface; `maps` (each the exemplar's
+/// size, or empty) are cropped with it. Says what it did in a "note:" line
+/// unless opt.quiet; returns the report's record (null when all is opaque).
+nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt);
+
 /// An exemplar map given beside the colour exemplar (--exemplar-normal, ...):
 /// empty when `path` is empty; refused (InvalidInputError naming `option`
 /// and both sizes) unless it has the colour exemplar's size.

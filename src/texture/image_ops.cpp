@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
 
@@ -49,6 +50,37 @@ Image crop(const Image& img, int x, int y, int w, int h, bool wrap) {
       std::copy_n(img.pixel(sx, sy), img.channels, out.pixel(i, j));
     }
   return out;
+}
+
+bool is_transparent(const Image& img, int x, int y) {
+  return (img.channels == 2 || img.channels == 4) && img.at(x, y, img.channels - 1) < 0.5f;
+}
+
+// Row by row, the opaque run above each column is a histogram; its largest
+// rectangle comes from a stack of increasing heights (each bar popped when a
+// lower one ends it: its rectangle spans from the bar below it in the stack).
+PixelRect largest_opaque_rectangle(const Image& img) {
+  require_image(img, "largest_opaque_rectangle: image");
+  const int W = img.width, H = img.height;
+  std::vector<int> run(static_cast<std::size_t>(W) + 1, 0), stack;  // run[W] = 0 closes every row
+  stack.reserve(static_cast<std::size_t>(W) + 1);
+  PixelRect best;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) run[x] = is_transparent(img, x, y) ? 0 : run[x] + 1;
+    stack.clear();
+    for (int x = 0; x <= W; ++x) {
+      while (!stack.empty() && run[stack.back()] >= run[x]) {
+        const int h = run[stack.back()];
+        stack.pop_back();
+        const int left = stack.empty() ? 0 : stack.back() + 1;
+        const PixelRect r{left, y - h + 1, x - left, h};
+        const bool same_row_left = r.area() == best.area() && r.y + r.height == best.y + best.height && r.x < best.x;
+        if (h > 0 && (r.area() > best.area() || same_row_left)) best = r;
+      }
+      stack.push_back(x);
+    }
+  }
+  return best;
 }
 
 void sample_bilinear(const Image& img, double x, double y, bool wrap, float* out) {

@@ -19,6 +19,21 @@ Image luminance(const Image& img);
 /// `wrap`, else the block must lie inside `img`.
 Image crop(const Image& img, int x, int y, int w, int h, bool wrap = false);
 
+/// A block of pixels: top-left corner and size.
+struct PixelRect {
+  int x = 0, y = 0, width = 0, height = 0;
+  long long area() const { return static_cast<long long>(width) * height; }
+};
+
+/// Whether pixel (x, y) is transparent: alpha (the last channel of a 2- or
+/// 4-channel image) below 0.5. Images of 1 or 3 channels have none.
+bool is_transparent(const Image& img, int x, int y);
+
+/// The largest axis-aligned block of `img` holding no transparent pixel (ties:
+/// the one whose bottom row is highest, then leftmost); the whole image when
+/// none is transparent; width 0 when all are. O(width x height).
+PixelRect largest_opaque_rectangle(const Image& img);
+
 /// Bilinear resize to w x h (pixel centres aligned: sample (i+0.5)*W/w-0.5,
 /// clamped to the border, or read around it with `wrap`: a tile stays a
 /// tile). Suitable for moderate scale changes; for strong minification build

@@ -107,6 +107,41 @@ TEST(ImageOps, CropWrapResizeAndRotate) {
   EXPECT_NEAR(lum.at(1, 1), 1.f, 1e-6);
 }
 
+// The largest opaque block against every block of small random masks (each
+// pixel transparent with probability 1/4, 1/2 or 3/4; RGBA and grey + alpha).
+TEST(ImageOps, LargestOpaqueRectangleIsTheLargestBlockWithoutTransparentPixels) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 60; ++trial) {
+    const int w = 1 + static_cast<int>(rng() % 9), h = 1 + static_cast<int>(rng() % 9), channels = trial % 2 ? 4 : 2;
+    const unsigned holes = 1 + trial % 3;
+    Image img(w, h, channels, 0.3f);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) img.at(x, y, channels - 1) = rng() % 4 < holes ? 0.2f : 0.9f;
+    auto opaque = [&](int x0, int y0, int bw, int bh) {
+      for (int y = y0; y < y0 + bh; ++y)
+        for (int x = x0; x < x0 + bw; ++x)
+          if (is_transparent(img, x, y)) return false;
+      return true;
+    };
+    long long largest = 0;
+    for (int y0 = 0; y0 < h; ++y0)
+      for (int x0 = 0; x0 < w; ++x0)
+        for (int bh = 1; y0 + bh <= h; ++bh)
+          for (int bw = 1; x0 + bw <= w; ++bw)
+            if (opaque(x0, y0, bw, bh)) largest = std::max(largest, static_cast<long long>(bw) * bh);
+    const PixelRect r = largest_opaque_rectangle(img);
+    EXPECT_EQ(r.area(), largest) << "trial " << trial;
+    if (r.area() > 0) {
+      EXPECT_TRUE(r.x >= 0 && r.y >= 0 && r.x + r.width <= w && r.y + r.height <= h);
+      EXPECT_TRUE(opaque(r.x, r.y, r.width, r.height)) << "trial " << trial;
+    }
+  }
+  const PixelRect whole = largest_opaque_rectangle(Image(5, 3, 3, 0.f));  // no alpha: all of it
+  EXPECT_EQ(whole.width, 5);
+  EXPECT_EQ(whole.height, 3);
+  EXPECT_EQ(largest_opaque_rectangle(Image(4, 4, 4, 0.f)).area(), 0);  // all transparent
+}
+
 TEST(RotatedExemplars, IndexWrapsAndRotationZeroIsExact) {
   EXPECT_EQ(rotation_index(0.0, 64), 0);
   EXPECT_EQ(rotation_index(2 * M_PI, 64), 0);
