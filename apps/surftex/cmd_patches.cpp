@@ -176,9 +176,10 @@ int run(const PatchArgs& a) {
   for (Image* m : {&maps.normal, &maps.height, &maps.roughness})
     if (!m->empty()) *m = as_rgb(*m, a.exemplar_size);
   std::vector<Image> ex{as_rgb(colour, a.exemplar_size)};
+  nlohmann::json opaque2;
   if (!a.exemplar2.empty()) {
     Image second = read_image(a.exemplar2);
-    use_opaque_part(second, {}, a.common);
+    opaque2 = use_opaque_part(second, {}, a.common, "the second exemplar (--exemplar2)");
     ex.push_back(as_rgb(second, a.exemplar_size));
   }
   po.partition.max_angle_deg = a.max_angle;
@@ -207,6 +208,7 @@ int run(const PatchArgs& a) {
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
   if (!opaque.is_null()) rep["exemplar_transparency"] = opaque;
+  if (!opaque2.is_null()) rep["exemplar2_transparency"] = opaque2;
   rep["field"] = a.field;
   rep["order"] = a.order;
   rep["fill"] = a.fill;

@@ -152,7 +152,8 @@ void check_budget(const WorkEstimate& estimate, const CommonOptions& opt) {
   if (!opt.quiet) std::fprintf(stderr, "note: %s\n", note.c_str());
 }
 
-nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt) {
+nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt,
+                               const std::string& which) {
   long long transparent = 0;
   for (int y = 0; y < exemplar.height; ++y)
     for (int x = 0; x < exemplar.width; ++x) transparent += is_transparent(exemplar, x, y);
@@ -161,18 +162,18 @@ nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps,
   const PixelRect r = largest_opaque_rectangle(exemplar);
   const bool crop_it = 4 * r.area() >= static_cast<long long>(exemplar.width) * exemplar.height &&
                        std::min(r.width, r.height) >= 16;
-  char msg[256];
+  char msg[512];
   if (crop_it) {
     std::snprintf(msg, sizeof msg,
-                  "the exemplar has %.1f%% transparent pixels: its largest opaque block is used, %dx%d at (%d, %d) "
-                  "(the output has no alpha)", 100 * share, r.width, r.height, r.x, r.y);
+                  "%s has %.1f%% transparent pixels: its largest opaque block is used, %dx%d at (%d, %d) "
+                  "(the output has no alpha)", which.c_str(), 100 * share, r.width, r.height, r.x, r.y);
     exemplar = crop(exemplar, r.x, r.y, r.width, r.height);
     for (Image* m : maps)
       if (m && !m->empty()) *m = crop(*m, r.x, r.y, r.width, r.height);
   } else {
     std::snprintf(msg, sizeof msg,
-                  "the exemplar has %.1f%% transparent pixels and no opaque block of a quarter of it: the colours "
-                  "stored under them are used (the output has no alpha)", 100 * share);
+                  "%s has %.1f%% transparent pixels and no opaque block of a quarter of it: the colours "
+                  "stored under them are used (the output has no alpha)", which.c_str(), 100 * share);
   }
   if (!opt.quiet) std::fprintf(stderr, "note: %s\n", msg);
   nlohmann::json j{{"transparent_share", share}, {"cropped", crop_it}};

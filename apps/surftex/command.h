@@ -94,8 +94,10 @@ void check_budget(const WorkEstimate& estimate, const CommonOptions& opt);
 /// a side, as the colours stored under the transparent pixels (often black)
 /// would otherwise be copied onto the surface; `maps` (each the exemplar's
 /// size, or empty) are cropped with it. Says what it did in a "note:" line
-/// unless opt.quiet; returns the report's record (null when all is opaque).
-nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt);
+/// naming the image (`which`) unless opt.quiet; returns the report's record
+/// (null when all is opaque).
+nlohmann::json use_opaque_part(Image& exemplar, const std::vector<Image*>& maps, const CommonOptions& opt,
+                               const std::string& which = "the exemplar");
 
 /// An exemplar map given beside the colour exemplar (--exemplar-normal, ...):
 /// empty when `path` is empty; refused (InvalidInputError naming `option`

@@ -88,3 +88,31 @@ TEST(TransparentExemplar, PatchesDoNotCopyTheHolesColour) {
   EXPECT_EQ(test::read_json(out + "/report.json")["exemplar_transparency"]["opaque_block"],
             nlohmann::json({0, 0, 64, 22}));
 }
+
+// The second exemplar of multi-texturing goes through the same crop, named in
+// its note and reported on its own (before: "the exemplar" and no record).
+TEST(TransparentExemplar, PatchesSecondExemplarIsCroppedNamedAndReported) {
+  const std::string dir = test::temp_dir("transparent_patches2");
+  const std::string out = dir + "/out";
+  const std::string inputs = sphere_and_exemplar(dir);
+  Image opaque = noise_with_black_hole();
+  for (int y = 0; y < opaque.height; ++y)
+    for (int x = 0; x < opaque.width; ++x) {
+      opaque.at(x, y, 3) = 1.f;
+      if (opaque.at(x, y, 1) < 0.3f) opaque.at(x, y, 1) = opaque.at(x, y, 2) = 0.5f;
+    }
+  write_image(dir + "/opaque.png", opaque);
+  auto r = test::run_surftex("patches '" + dir + "/sphere.obj' '" + dir + "/opaque.png' --exemplar2 '" + dir +
+                             "/holed.png' --multi height --patch-res 48 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the second exemplar (--exemplar2) has 9.8% transparent pixels: its largest opaque block is "
+                       "used, 64x22"),
+            std::string::npos)
+      << r.err;
+  std::size_t texels = 0;
+  EXPECT_EQ(dark_texels(out + "/mesh.png", out + "/mesh.obj", texels), 0u);
+  EXPECT_GT(texels, 5000u);
+  const auto j = test::read_json(out + "/report.json");
+  EXPECT_FALSE(j.contains("exemplar_transparency"));
+  EXPECT_EQ(j["exemplar2_transparency"]["opaque_block"], nlohmann::json({0, 0, 64, 22}));
+}
