@@ -283,7 +283,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   }
   // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SHAPE,
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
-  // BENCH_CLEARANCE (swatch units; negative = automatic).
+  // BENCH_CLEARANCE (swatch units; negative = automatic), BENCH_SEED (the run's seed, default 1: the spread of a figure over seeds).
   if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
@@ -293,6 +293,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
+  if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
@@ -379,6 +380,7 @@ int main(int argc, char** argv) {
     else if (a == "--old-defaults") g_old_defaults = true;
     else cases.push_back(a);
   }
+  if (!outdir.empty()) std::filesystem::create_directories(outdir);  // before the first case, not after its quilt
   if (cases.empty())
     for (const char* m : {"bunny", "koala", "knot"})
       for (const char* sw : {"weave", "chainmail", "tori", "rock"}) cases.push_back(std::string(m) + ":" + sw);

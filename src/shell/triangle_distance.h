@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
 // Closest-point queries against the triangles of an ElementMesh, accelerated
-// with CGAL's AABB tree (Zhou et al. 2006, section 2.4: "we obtained a
-// significant speed-up ... by building an octree data structure for the input
-// texture"; an AABB tree over the triangles plays that role here).
+// with a bounding-volume hierarchy (Zhou et al. 2006, section 2.4: "we
+// obtained a significant speed-up ... by building an octree data structure
+// for the input texture"; the hierarchy over the triangles plays that role).
 // Queries are const and thread-safe once built (the tree is built eagerly).
+// Exact up to floating-point rounding; among triangles at the same distance
+// the one first in the mesh wins.
 #include <memory>
 
 #include "shell/element_mesh.h"

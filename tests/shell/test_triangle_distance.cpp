@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// TriangleDistance (the closest-point queries of mesh quilting) against a
+// brute force over every triangle, on a generated swatch and on random
+// triangle soups with degenerate (collinear, point-like) triangles.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "geometry/mesh.h"
+#include "shell/swatch.h"
+#include "shell/swatch_generators.h"
+#include "shell/triangle_distance.h"
+
+using namespace surftex;
+
+namespace {
+
+// The squared distance from q to segment se and to triangle abc: the minimum
+// over the projection on the face's plane (when inside) and the three edges,
+// written independently of the library's Voronoi-region code.
+double segment_d2(const P3& q, const P3& s, const P3& e) {
+  P3 d{e[0] - s[0], e[1] - s[1], e[2] - s[2]};
+  const double l = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  double t = l > 0 ? ((q[0] - s[0]) * d[0] + (q[1] - s[1]) * d[1] + (q[2] - s[2]) * d[2]) / l : 0;
+  t = std::clamp(t, 0.0, 1.0);
+  double r = 0;
+  for (int k = 0; k < 3; ++k) r += (q[k] - s[k] - t * d[k]) * (q[k] - s[k] - t * d[k]);
+  return r;
+}
+
+double triangle_d2(const P3& q, const P3& a, const P3& b, const P3& c) {
+  double best = std::min({segment_d2(q, a, b), segment_d2(q, b, c), segment_d2(q, c, a)});
+  const P3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const P3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  if (nn > 1e-20) {
+    const double h = ((q[0] - a[0]) * n[0] + (q[1] - a[1]) * n[1] + (q[2] - a[2]) * n[2]) / nn;
+    const P3 p{q[0] - h * n[0], q[1] - h * n[1], q[2] - h * n[2]};
+    // Inside test by the signs of the three sub-areas along n.
+    auto side = [&](const P3& s, const P3& e) {
+      const P3 x{e[0] - s[0], e[1] - s[1], e[2] - s[2]}, y{p[0] - s[0], p[1] - s[1], p[2] - s[2]};
+      const P3 cr{x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
+      return cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2];
+    };
+    if (side(a, b) >= 0 && side(b, c) >= 0 && side(c, a) >= 0) best = std::min(best, h * h * nn);
+  }
+  return best;
+}
+
+void expect_matches_brute_force(const ElementMesh& m, const std::vector<P3>& queries) {
+  const TriangleDistance td(m);
+  for (const P3& q : queries) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Tri& t : m.tris) best = std::min(best, triangle_d2(q, m.points[t[0]], m.points[t[1]], m.points[t[2]]));
+    const auto h = td.closest(q);
+    ASSERT_GE(h.tri, 0);
+    const double scale = 1e-9 * (1 + best);
+    EXPECT_NEAR(h.distance * h.distance, best, scale);
+    // The reported point lies on the reported triangle at the reported barycentrics, at that distance.
+    const Tri& t = m.tris[h.tri];
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = h.bary[0] * m.points[t[0]][k] + h.bary[1] * m.points[t[1]][k] + h.bary[2] * m.points[t[2]][k];
+      EXPECT_NEAR(x, h.point[k], 1e-9);
+      d2 += (q[k] - x) * (q[k] - x);
+    }
+    EXPECT_NEAR(d2, best, scale);
+    EXPECT_NEAR(h.bary[0] + h.bary[1] + h.bary[2], 1.0, 1e-12);
+    for (int k = 0; k < 3; ++k) EXPECT_GE(h.bary[k], -1e-12);
+  }
+}
+
+}  // namespace
+
+TEST(TriangleDistance, MatchesBruteForceOnAWeaveSwatch) {
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  std::mt19937_64 rng(3);
+  std::vector<P3> q;
+  std::uniform_real_distribution<double> u(-0.3, 1.3);
+  for (int i = 0; i < 400; ++i) {
+    P3 p;
+    for (int k = 0; k < 3; ++k) p[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
+    q.push_back(p);
+  }
+  for (int i = 0; i < 100; ++i) q.push_back(s.mesh.points[(i * 97) % s.mesh.points.size()]);  // on the surface
+  expect_matches_brute_force(s.mesh, q);
+}
+
+TEST(TriangleDistance, MatchesBruteForceOnSoupsWithDegenerateTriangles) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0, 1);
+  for (int round = 0; round < 5; ++round) {
+    ElementMesh m;
+    for (int t = 0; t < 300; ++t) {
+      const P3 c{g(rng), g(rng), g(rng)};
+      const int base = static_cast<int>(m.points.size());
+      for (int k = 0; k < 3; ++k) m.points.push_back({c[0] + 0.2 * g(rng), c[1] + 0.2 * g(rng), c[2] + 0.2 * g(rng)});
+      if (t % 10 == 0) m.points[base + 2] = {(m.points[base][0] + m.points[base + 1][0]) / 2,  // collinear
+                                             (m.points[base][1] + m.points[base + 1][1]) / 2,
+                                             (m.points[base][2] + m.points[base + 1][2]) / 2};
+      if (t % 25 == 0) m.points[base + 1] = m.points[base + 2] = m.points[base];  // a point
+      m.tris.push_back({base, base + 1, base + 2});
+    }
+    std::vector<P3> q;
+    for (int i = 0; i < 300; ++i) q.push_back({1.5 * g(rng), 1.5 * g(rng), 1.5 * g(rng)});
+    expect_matches_brute_force(m, q);
+  }
+}
+
+TEST(TriangleDistance, EmptyMeshAndTiesAreDefined) {
+  const TriangleDistance none(ElementMesh{});
+  EXPECT_TRUE(none.empty());
+  EXPECT_EQ(none.closest({0, 0, 0}).tri, -1);
+  // Two copies of one triangle: the first in the mesh is reported, whichever the tree visits first.
+  ElementMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (int i = 0; i < 20; ++i) m.tris.push_back({0, 1, 2});
+  const TriangleDistance td(m);
+  const auto h = td.closest({0.2, 0.2, 1.0});
+  EXPECT_EQ(h.tri, 0);
+  EXPECT_NEAR(h.distance, 1.0, 1e-15);
+}
+
+// A non-finite query point gives a NaN distance, not an index out of range.
+TEST(TriangleDistance, NonFiniteQueryGivesNaN) {
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  const TriangleDistance td(s.mesh);
+  const auto h = td.closest({std::nan(""), 0, 0});
+  EXPECT_TRUE(std::isnan(h.distance));
+  EXPECT_GE(h.tri, 0);
+  EXPECT_LT(h.tri, static_cast<int>(s.mesh.tris.size()));
+}
