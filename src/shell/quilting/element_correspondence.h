@@ -3,7 +3,7 @@
 // Element correspondences between the output elements and the placed input
 // elements (Zhou et al. 2006, section 2.5).
 //
-// 1. Per output vertex in the overlap, the input face of smallest Dist (AABB
+// 1. Per output vertex in the overlap, the input face of smallest Dist (BVH
 //    closest point; D of eq. 1 reported for it, the minimiser unless the normal
 //    term dominates). 2. Pruned for opposite normals or Dist > prune_factor
 //    local edges. 3. Surviving pairs relate elements. 4. Relations whose xy
