@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <limits>
+#include <atomic>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -289,7 +291,10 @@ QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& 
     return P3{grid.x0 + oi * c - swatch.bbox_min[0], grid.y0 + oj * c - swatch.bbox_min[1], 0.0};
   };
   // E(t) (eq. 3): eq. 1 with the closest face (see element_correspondence.h), eq. 2, summed.
-  auto match_cost = [&](const P3& t) {
+  // Every term is >= 1, so the partial sum only grows: once it passes `bound`
+  // the candidate cannot be chosen and the partial sum is returned (a value
+  // above the bound; the chosen candidates' costs are exact, the same bytes).
+  auto match_cost = [&](const P3& t, double bound) {
     double e = 0;
     for (std::size_t v = 0; v < mv.size(); ++v) {
       const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]});
@@ -297,18 +302,30 @@ QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& 
       const double dn = std::sqrt((mn[v][0] - nf[0]) * (mn[v][0] - nf[0]) + (mn[v][1] - nf[1]) * (mn[v][1] - nf[1]) +
                                   (mn[v][2] - nf[2]) * (mn[v][2] - nf[2]));
       e += (1 + opt.lambda * h.distance) * (1 + dn);
+      if (e > bound) return e;
     }
     return e;
   };
+  // A candidate is eligible when within choice_tolerance of the best; the best
+  // cost seen so far (any thread) bounds that from above, so a candidate past
+  // it is dropped early whatever order the threads run in.
   std::vector<double> cost(cand.size(), 0.0);
+  std::atomic<double> best_seen{std::numeric_limits<double>::infinity()};
+  auto eligible_bound = [&](double b) { return b * (1 + opt.choice_tolerance) + 1e-12; };
   if (!mv.empty())
     tbb::parallel_for(std::size_t(0), cand.size(), [&](std::size_t k) {
-      cost[k] = match_cost(translation(cand[k].first, cand[k].second));
+      const double bound = eligible_bound(best_seen.load(std::memory_order_relaxed));
+      const double c = match_cost(translation(cand[k].first, cand[k].second), bound);
+      cost[k] = c;
+      if (c > bound) return;  // dropped early: above the final bound too
+      double prev = best_seen.load(std::memory_order_relaxed);
+      while (c < prev && !best_seen.compare_exchange_weak(prev, c, std::memory_order_relaxed)) {
+      }
     });
   const double best = *std::min_element(cost.begin(), cost.end());
   std::vector<std::size_t> eligible;
   for (std::size_t k = 0; k < cand.size(); ++k)
-    if (cost[k] <= best * (1 + opt.choice_tolerance) + 1e-12) eligible.push_back(k);
+    if (cost[k] <= eligible_bound(best)) eligible.push_back(k);
   const std::size_t pick = near ? 0 : eligible[static_cast<std::size_t>(rng() % eligible.size())];
   const int oi = cand[pick].first, oj = cand[pick].second;
   const P3 t = translation(oi, oj);
@@ -329,7 +346,7 @@ QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& 
         }
       std::vector<double> oc(offs.size());
       tbb::parallel_for(std::size_t(0), offs.size(), [&](std::size_t k) {
-        oc[k] = match_cost({t[0] + offs[k][0], t[1] + offs[k][1], t[2]});
+        oc[k] = match_cost({t[0] + offs[k][0], t[1] + offs[k][1], t[2]}, picked_cost);  // only a lower one wins
       });
       res.candidates += offs.size();
       double bx = dx, by = dy;
