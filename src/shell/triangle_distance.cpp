@@ -14,6 +14,8 @@
 #include <numeric>
 #include <vector>
 
+#include "geometry/vec3.h"
+
 namespace surftex {
 namespace triangle_distance_detail {  // named: TriangleDistance::Impl holds these
 
@@ -49,25 +51,23 @@ using triangle_distance_detail::Box;
 using triangle_distance_detail::Node;
 constexpr int kLeafSize = 4;
 
-// (Named apart: the unity build puts other files' sub/dot helpers beside these.)
-P3 td_sub(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double td_dot(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 // Closest point of triangle abc to p as barycentrics (u, v, w) on (a, b, c).
+// (vec3's helpers are called qualified: a using-declaration could meet another
+// file's sub/dot in the same unity batch.)
 P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c) {
-  const P3 ab = td_sub(b, a), ac = td_sub(c, a), ap = td_sub(p, a);
-  const double d1 = td_dot(ab, ap), d2 = td_dot(ac, ap);
+  const P3 ab = vec3::sub(b, a), ac = vec3::sub(c, a), ap = vec3::sub(p, a);
+  const double d1 = vec3::dot(ab, ap), d2 = vec3::dot(ac, ap);
   if (d1 <= 0 && d2 <= 0) return {1, 0, 0};  // vertex a
-  const P3 bp = td_sub(p, b);
-  const double d3 = td_dot(ab, bp), d4 = td_dot(ac, bp);
+  const P3 bp = vec3::sub(p, b);
+  const double d3 = vec3::dot(ab, bp), d4 = vec3::dot(ac, bp);
   if (d3 >= 0 && d4 <= d3) return {0, 1, 0};  // vertex b
   const double vc = d1 * d4 - d3 * d2;
   if (vc <= 0 && d1 >= 0 && d3 <= 0) {  // edge ab
     const double t = d1 / (d1 - d3);
     return {1 - t, t, 0};
   }
-  const P3 cp = td_sub(p, c);
-  const double d5 = td_dot(ab, cp), d6 = td_dot(ac, cp);
+  const P3 cp = vec3::sub(p, c);
+  const double d5 = vec3::dot(ab, cp), d6 = vec3::dot(ac, cp);
   if (d6 >= 0 && d5 <= d6) return {0, 0, 1};  // vertex c
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) {  // edge ac
@@ -82,12 +82,12 @@ P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c) {
   const double den = va + vb + vc;
   if (!(den > 0)) {  // degenerate (collinear) triangle: the nearest of its three edges
     auto on_edge = [&](const P3& s, const P3& e, double& t) {
-      const P3 d = td_sub(e, s);
-      const double l = td_dot(d, d);
-      t = l > 0 ? std::clamp(td_dot(td_sub(p, s), d) / l, 0.0, 1.0) : 0.0;
+      const P3 d = vec3::sub(e, s);
+      const double l = vec3::dot(d, d);
+      t = l > 0 ? std::clamp(vec3::dot(vec3::sub(p, s), d) / l, 0.0, 1.0) : 0.0;
       const P3 x{s[0] + t * d[0], s[1] + t * d[1], s[2] + t * d[2]};
-      const P3 r = td_sub(p, x);
-      return td_dot(r, r);
+      const P3 r = vec3::sub(p, x);
+      return vec3::dot(r, r);
     };
     double t0, t1, t2;
     const double e0 = on_edge(a, b, t0), e1 = on_edge(a, c, t1), e2 = on_edge(b, c, t2);
@@ -176,8 +176,8 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
     const P3 b = closest_barycentric(q, t[0], t[1], t[2]);
     P3 x;
     for (int k = 0; k < 3; ++k) x[k] = b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k];
-    const P3 r = td_sub(q, x);
-    const double d = td_dot(r, r);
+    const P3 r = vec3::sub(q, x);
+    const double d = vec3::dot(r, r);
     // Ties: the triangle first in the mesh (independent of the traversal).
     if (d < best || (d == best && I.original[i] < I.original[best_i])) {
       best = d;

@@ -94,7 +94,7 @@ TEST(TransparentExemplar, PatchesDoNotCopyTheHolesColour) {
 TEST(TransparentExemplar, PatchesSecondExemplarIsCroppedNamedAndReported) {
   const std::string dir = test::temp_dir("transparent_patches2");
   const std::string out = dir + "/out";
-  const std::string inputs = sphere_and_exemplar(dir);
+  sphere_and_exemplar(dir);  // writes sphere.obj and holed.png (the second exemplar)
   Image opaque = noise_with_black_hole();
   for (int y = 0; y < opaque.height; ++y)
     for (int x = 0; x < opaque.width; ++x) {
