@@ -54,6 +54,30 @@ struct Batch {
     }
   }
 };
+
+// Traversal of a batch's tree that stops at the first triangle of a counted
+// element meeting the query; the element's tag is read before the exact
+// triangle test, so the triangles of the query's own element (which touch it
+// at shared corners, where the filtered predicates fall back to exact
+// arithmetic) are never tested. Same answer as listing every intersected
+// triangle and filtering the list.
+template <class Counts>
+struct CountedHit {
+  using Node = CGAL::AABB_node<Tree::AABB_traits>;
+  const Tree::AABB_traits& traits;
+  const Batch& batch;
+  const Counts& counts;
+  bool found = false;
+  CountedHit(const Tree::AABB_traits& tr, const Batch& b, const Counts& c) : traits(tr), batch(b), counts(c) {}
+  bool go_further() const { return !found; }
+  void intersection(const Triangle3& query, const Primitive& primitive) {
+    if (!counts(batch.element[static_cast<std::size_t>(primitive.id() - batch.tris.cbegin())])) return;
+    if (traits.do_intersect_object()(query, primitive)) found = true;
+  }
+  bool do_intersect(const Triangle3& query, const Node& node) const {
+    return traits.do_intersect_object()(query, node.bbox());
+  }
+};
 }  // namespace
 
 struct ElementCollider::Impl {
@@ -112,7 +136,6 @@ std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double c
           break;
         }
       }
-  std::vector<Tree::Primitive_id> ids;
   for (std::size_t t = 0; t < m.tris.size(); ++t) {
     const Tri& tr = m.tris[t];
     for (int v : tr)
@@ -135,14 +158,12 @@ std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double c
         }
         continue;
       }
-      ids.clear();
-      bt->tree.all_intersected_primitives(q, std::back_inserter(ids));
-      for (const auto& id : ids)
-        if (counts(bt->element[static_cast<std::size_t>(id - bt->tris.cbegin())])) {
-          hit[t] = 1;
-          break;
-        }
-      if (hit[t]) break;
+      CountedHit<decltype(counts)> traits(bt->tree.traits(), *bt, counts);
+      bt->tree.traversal(q, traits);
+      if (traits.found) {
+        hit[t] = 1;
+        break;
+      }
     }
   }
   return hit;
