@@ -54,8 +54,9 @@ constexpr int kLeafSize = 4;
 // Closest point of triangle abc to p as barycentrics (u, v, w) on (a, b, c).
 // (vec3's helpers are called qualified: a using-declaration could meet another
 // file's sub/dot in the same unity batch.)
-P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c) {
-  const P3 ab = vec3::sub(b, a), ac = vec3::sub(c, a), ap = vec3::sub(p, a);
+// ab = b - a and ac = c - a are precomputed per triangle (the same values).
+P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c, const P3& ab, const P3& ac) {
+  const P3 ap = vec3::sub(p, a);
   const double d1 = vec3::dot(ab, ap), d2 = vec3::dot(ac, ap);
   if (d1 <= 0 && d2 <= 0) return {1, 0, 0};  // vertex a
   const P3 bp = vec3::sub(p, b);
@@ -103,6 +104,8 @@ P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c) {
 
 struct TriangleDistance::Impl {
   std::vector<std::array<P3, 3>> tris;  // in leaf order
+  std::vector<std::array<P3, 2>> edges;  // per triangle in leaf order: b - a, c - a
+  std::vector<triangle_distance_detail::Box> boxes;  // per triangle in leaf order
   std::vector<int> original;            // leaf order -> index into mesh.tris
   std::vector<triangle_distance_detail::Node> nodes;
 
@@ -157,6 +160,13 @@ TriangleDistance::TriangleDistance(const ElementMesh& m) : impl_(std::make_uniqu
   std::vector<std::array<P3, 3>> ordered(n);
   for (int i = 0; i < n; ++i) ordered[i] = impl_->tris[impl_->original[i]];
   impl_->tris = std::move(ordered);
+  impl_->edges.resize(n);
+  impl_->boxes.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const auto& t = impl_->tris[i];
+    impl_->edges[i] = {vec3::sub(t[1], t[0]), vec3::sub(t[2], t[0])};
+    for (const P3& p : t) impl_->boxes[i].add(p);
+  }
 }
 TriangleDistance::~TriangleDistance() = default;
 TriangleDistance::TriangleDistance(TriangleDistance&&) noexcept = default;
@@ -172,8 +182,10 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
   int best_i = -1;
   P3 best_bary{1, 0, 0};
   auto try_triangle = [&](int i) {
+    // A triangle whose box is farther than the best hit can neither win nor tie.
+    if (I.boxes[i].squared_distance(q) > best) return;
     const auto& t = I.tris[i];
-    const P3 b = closest_barycentric(q, t[0], t[1], t[2]);
+    const P3 b = closest_barycentric(q, t[0], t[1], t[2], I.edges[i][0], I.edges[i][1]);
     P3 x;
     for (int k = 0; k < 3; ++k) x[k] = b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k];
     const P3 r = vec3::sub(q, x);
@@ -186,12 +198,16 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
       h.point = x;
     }
   };
+  // Each stack entry carries its box's squared distance, computed once when pushed.
   int stack[128];
+  double stack_d[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top] = 0;
+  stack_d[top++] = I.nodes[0].box.squared_distance(q);
   while (top > 0) {
-    const Node& nd = I.nodes[stack[--top]];
-    if (nd.box.squared_distance(q) > best) continue;  // (equal: a tie may still win, see below)
+    --top;
+    if (stack_d[top] > best) continue;  // (equal: a tie may still win, see below)
+    const Node& nd = I.nodes[stack[top]];
     if (nd.count > 0) {
       for (int i = nd.first; i < nd.first + nd.count; ++i) try_triangle(i);
       continue;
@@ -200,11 +216,11 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
     const double dl = I.nodes[l].box.squared_distance(q), dr = I.nodes[r].box.squared_distance(q);
     // Nearer child on top of the stack (visited first); the depth is below 2 log2(n) + 2.
     if (dl <= dr) {
-      stack[top++] = r;
-      stack[top++] = l;
+      stack[top] = r, stack_d[top++] = dr;
+      stack[top] = l, stack_d[top++] = dl;
     } else {
-      stack[top++] = l;
-      stack[top++] = r;
+      stack[top] = l, stack_d[top++] = dl;
+      stack[top] = r, stack_d[top++] = dr;
     }
   }
   if (best_i < 0) {  // a non-finite query point: no distance compares
