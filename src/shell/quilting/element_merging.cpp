@@ -84,8 +84,32 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   ElementCut res;
   const double match = auto_match(a, b, opt);
   const int nt = static_cast<int>(a.tris.size());
+  // A's closest points on B, queried where a rule or a weight reads them (a
+  // long element's far part needs none; see the edge loop below).
   std::vector<TriangleDistance::Hit> hit(a.points.size());
-  for (std::size_t i = 0; i < a.points.size(); ++i) hit[i] = tb.closest(a.points[i]);
+  std::vector<char> have_hit(a.points.size(), 0);
+  auto hit_of = [&](int v) -> const TriangleDistance::Hit& {
+    if (!have_hit[v]) hit[v] = tb.closest(a.points[v]), have_hit[v] = 1;
+    return hit[v];
+  };
+  std::vector<char> force_keep(nt, 0), force_del(nt, 0);
+  for (int t = 0; t < nt; ++t)
+    if (owns(side_a, region(centroid(a, a.tris[t])))) force_keep[t] = 1;
+  // B's faces farther from A's bounding box than `match` are not covered
+  // (the closest point of A is farther still); a margin of 1e-9 relative
+  // keeps rounding from deciding a face the query would call covered.
+  P3 alo = a.points.empty() ? P3{0, 0, 0} : a.points[0], ahi = alo;
+  for (const P3& p : a.points)
+    for (int k = 0; k < 3; ++k) alo[k] = std::min(alo[k], p[k]), ahi[k] = std::max(ahi[k], p[k]);
+  const double far2 = match * (1 + 1e-9) * match * (1 + 1e-9) + 1e-300;
+  auto far_from_a = [&](const P3& c) {
+    double d = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double e = c[k] < alo[k] ? alo[k] - c[k] : (c[k] > ahi[k] ? c[k] - ahi[k] : 0.0);
+      d += e * e;
+    }
+    return d > far2;
+  };
   // Faces of B "with a corresponding vertex in A" (see the header): the point
   // q of A closest to the face's centroid c must be within `match` and must
   // itself have its closest point of B at c (within opt.round_trip_edges mean
@@ -99,9 +123,10 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   std::vector<char> b_in(b.tris.size());
   for (std::size_t g = 0; g < b.tris.size(); ++g) {
     const P3 c = centroid(b, b.tris[g]);
+    b_in[g] = !owns(side_b, region(c));  // not in B's own outside
+    if (!ta.empty() && far_from_a(c)) continue;
     const auto q = ta.closest(c);
     covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
-    b_in[g] = !owns(side_b, region(c));  // not in B's own outside
   }
   // Edge-neighbours of B's faces.
   std::vector<std::vector<int>> b_nb(b.tris.size());
@@ -133,26 +158,30 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
 
   GraphCut gc(nt);
   const auto edges = dual_edges(a);
+  auto weight = [&](const DualEdge& e) {
+    return (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit_of(e.vi).distance + hit_of(e.vj).distance);
+  };
   double wmax = 0;
   for (const DualEdge& e : edges) {
-    const double w = (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
+    // An edge between two kept-by-force triangles is never cut: GraphCut
+    // drops it, so its weight (and its queries) are needed only for the
+    // guide's scale, wmax, when there is a guide.
+    if (!b_keep && force_keep[e.t1] && force_keep[e.t2]) continue;
+    const double w = weight(e);
     wmax = std::max(wmax, w);
     gc.add_edge(e.t1, e.t2, w, w);
   }
-  std::vector<char> force_keep(nt, 0), force_del(nt, 0);
-  for (int t = 0; t < nt; ++t)
-    if (owns(side_a, region(centroid(a, a.tris[t])))) force_keep[t] = 1;
   std::vector<std::vector<int>> vtris(a.points.size());
   for (int t = 0; t < nt; ++t)
     for (int v : a.tris[t]) vtris[v].push_back(t);
   for (std::size_t v = 0; v < a.points.size(); ++v) {
-    const auto& h = hit[v];
-    if (h.tri < 0 || h.distance > match) continue;
     // The paper applies the SINK rule in the overlap region; with
     // MergeOptions::delete_past_overlap also where A pokes past it into the
     // other side (not A's own outside, not off the grid).
     const Region rv = region(a.points[v]);
     if (opt.delete_past_overlap ? owns(side_a, rv) || rv == Region::kNone : rv != Region::kOverlap) continue;
+    const auto& h = hit_of(static_cast<int>(v));
+    if (h.tri < 0 || h.distance > match) continue;
     bool del = !b_in[h.tri];
     for (int g : b_nb[h.tri]) del = del || (!covered[g] && escapes[g]);
     // Keep wins over delete where both rules hit one triangle (at the rim of
@@ -175,7 +204,10 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
       if (h.tri < 0 || h.distance > match) continue;
       bool behind = (*b_keep)[h.tri];
       if (opt.guide_by_vertices)
-        for (int v : a.tris[t]) behind = behind || (hit[v].tri >= 0 && hit[v].distance <= match && (*b_keep)[hit[v].tri]);
+        for (int v : a.tris[t]) {
+          const auto& hv = hit_of(v);
+          behind = behind || (hv.tri >= 0 && hv.distance <= match && (*b_keep)[hv.tri]);
+        }
       if (behind)
         gc.add_terminal(t, 0, g);
       else
@@ -188,8 +220,7 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   for (int t = 0; t < nt; ++t) res.keep[t] = gc.is_source_side(t) ? 1 : 0;
   res.cost = 0;
   for (const DualEdge& e : edges)
-    if (res.keep[e.t1] != res.keep[e.t2])
-      res.cost += (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
+    if (res.keep[e.t1] != res.keep[e.t2]) res.cost += weight(e);
   return res;
 }
 }  // namespace
