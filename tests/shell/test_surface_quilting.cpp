@@ -532,7 +532,8 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
 }
 
 // The refused inputs' cut parts and the z fitting (issue #8, session 5) keep
-// the quilt deterministic: same seed, same output on 1 and 2 threads.
+// the quilt deterministic: same seed, same output on 1 and 2 threads; so do
+// the groups of a step deformed and merged in parallel (issue 19 item 2).
 TEST(SurfaceQuilting, WeaveCylinderWithCutPartsSameOutputOnOneAndTwoThreads) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, 16, 6);
@@ -548,6 +549,8 @@ TEST(SurfaceQuilting, WeaveCylinderWithCutPartsSameOutputOnOneAndTwoThreads) {
     r[k] = quilt_surface(base, sw, q[k], o);
   }
   EXPECT_GT(r[0].stats.in_cut_added, 0u);  // the new path is taken
+  EXPECT_GT(r[0].stats.stitched, 10u);      // groups are merged (in parallel on 2 threads)
+  EXPECT_EQ(r[0].stats.stitched, r[1].stats.stitched);
   EXPECT_EQ(r[0].stats.in_cut_added, r[1].stats.in_cut_added);
   EXPECT_EQ(r[0].z_fitted_elements, r[1].z_fitted_elements);
   ASSERT_EQ(q[0].tris, q[1].tris);

@@ -389,6 +389,7 @@ struct QuiltStepState {
   std::vector<std::pair<int, int>> related;  // (output, input) element pairs
   int no = 0, ni = 0;                        // output and input elements
   UnionFind<int> sets;                       // over outputs, then inputs
+  std::vector<int> root_of;                  // per output element: its set's root (-1: unrelated)
   std::map<int, std::pair<std::vector<int>, std::vector<int>>> groups;  // root -> (outs, ins)
   std::vector<char> add_in;                                            // per input: added as is
   std::vector<std::pair<int, ElementMesh>> replacements;               // output elements replaced
@@ -472,8 +473,9 @@ void group_related(QuiltStepState& s) {
   for (auto& r : s.related) s.sets.unite(r.first, no + r.second);
   std::vector<char> in_related(ni, 0), out_related(no, 0);
   for (auto& r : s.related) out_related[r.first] = 1, in_related[r.second] = 1;
+  s.root_of.assign(no, -1);
   for (int e = 0; e < no; ++e)
-    if (out_related[e]) s.groups[s.sets.find(e)].first.push_back(e);
+    if (out_related[e]) s.groups[s.root_of[e] = s.sets.find(e)].first.push_back(e);
   for (int e = 0; e < ni; ++e)
     if (in_related[e]) s.groups[s.sets.find(no + e)].second.push_back(e);
 }
@@ -482,10 +484,10 @@ void group_related(QuiltStepState& s) {
 /// (equations 5 and 6): each pair pulls its output vertex and input face
 /// point to their midpoint; output vertices outside the overlap stay put.
 /// Returns the deformed output elements; the inputs are deformed in place.
-std::map<int, ElementMesh> deform_group(QuiltStepState& s, int root) {
+std::map<int, ElementMesh> deform_group(QuiltStepState& s, int root) {  // (writes s.placed of its inputs only)
   std::map<int, std::vector<DeformConstraint>> cout_, cin_;
   for (const VertexFacePair& p : s.corr.pairs) {
-    if (s.sets.find(p.out_element) != root) continue;
+    if (s.root_of[p.out_element] != root) continue;
     const P3& v = s.elements[p.out_element].points[p.vertex];
     const P3 cpt{(v[0] + p.closest[0]) / 2, (v[1] + p.closest[1]) / 2, (v[2] + p.closest[2]) / 2};
     cout_[p.out_element].push_back({{p.vertex, p.vertex, p.vertex}, {1, 0, 0}, cpt});
@@ -514,15 +516,25 @@ std::map<int, ElementMesh> deform_group(QuiltStepState& s, int root) {
   return deformed_out;
 }
 
+/// What merging one group produces, kept apart so that groups can be merged
+/// in parallel and their results taken in group order (the same bytes for
+/// any thread count).
+struct GroupOutcome {
+  QuiltStepStats stats;
+  std::vector<std::pair<int, ElementMesh>> replacements;  // output elements replaced
+  std::vector<ElementMesh> cut_inputs;                    // refused inputs' closed kept parts
+  double t_deform = 0, t_merge = 0;                       // thread seconds
+};
+
 /// An input element not merged: its closed kept parts are added (counted in
 /// `kept`) when asked for and there are any, else it is dropped.
-void keep_capped_or_drop(QuiltStepState& s, MergeResult& r, std::size_t& kept) {
+void keep_capped_or_drop(const QuiltStepState& s, MergeResult& r, std::size_t& kept, GroupOutcome& out) {
   if (s.opt.keep_cut_refused_inputs && !r.capped_b.empty()) {
     ++kept;
-    s.stats.in_cut_components += r.capped_b.size();
-    for (ElementMesh& part : r.capped_b) s.cut_inputs.push_back(std::move(part));
+    out.stats.in_cut_components += r.capped_b.size();
+    for (ElementMesh& part : r.capped_b) out.cut_inputs.push_back(std::move(part));
   } else {
-    ++s.stats.in_dropped;
+    ++out.stats.in_dropped;
   }
 }
 
@@ -543,10 +555,12 @@ void count_refusal(QuiltStepStats& stats, const std::string& reason) {
 /// Zhou et al. 2006 s.2.7, merging one group: the first output element
 /// absorbs the group's inputs, then its other outputs, one by one (graph-cut
 /// stitching); what could not be stitched is kept, replaced or dropped.
+/// Writes s.alive of its outputs and s.add_in of its inputs only, the rest
+/// into `out`.
 void merge_group(QuiltStepState& s, const std::vector<int>& outs, const std::vector<int>& ins,
-                 std::map<int, ElementMesh>& deformed_out) {
+                 std::map<int, ElementMesh>& deformed_out, GroupOutcome& out) {
   const QuiltStepOptions& opt = s.opt;
-  QuiltStepStats& stats = s.stats;
+  QuiltStepStats& stats = out.stats;
   const int first = outs.front();
   ElementMesh acc = deformed_out.count(first) ? deformed_out[first] : s.elements[first];
   Side acc_side = Region::kOld;
@@ -574,29 +588,32 @@ void merge_group(QuiltStepState& s, const std::vector<int>& outs, const std::vec
         s.add_in[e] = 0;
     } else if (r.coincident) {  // nothing to stitch: keep the output element whole
       ++stats.coincident;
-      if (is_out && deformed_out.count(e)) s.replacements.emplace_back(e, deformed_out[e]);
+      if (is_out && deformed_out.count(e)) out.replacements.emplace_back(e, deformed_out[e]);
       if (!is_out && s.add_in[e]) {
         s.add_in[e] = 0;
-        keep_capped_or_drop(s, r, stats.coincident_cut_added);
+        keep_capped_or_drop(s, r, stats.coincident_cut_added, out);
       }
     } else {
       count_refusal(stats, r.reason);
-      if (is_out && deformed_out.count(e)) s.replacements.emplace_back(e, deformed_out[e]);
+      if (is_out && deformed_out.count(e)) out.replacements.emplace_back(e, deformed_out[e]);
       if (!is_out && opt.drop_refused_inputs && s.add_in[e]) {  // keep C_out rather than overlap it
         s.add_in[e] = 0;
-        keep_capped_or_drop(s, r, stats.in_cut_added);
+        keep_capped_or_drop(s, r, stats.in_cut_added, out);
       }
     }
   }
-  s.replacements.emplace_back(first, std::move(acc));
+  out.replacements.emplace_back(first, std::move(acc));
 }
 
-/// Each group of related elements in turn (s.2.7): a group whose output side
-/// lies entirely within the overlap is replaced by its inputs, one whose
-/// input side does keeps its outputs; the others are deformed (s.2.6) and
-/// merged.
+/// Each group of related elements (s.2.7): a group whose output side lies
+/// entirely within the overlap is replaced by its inputs, one whose input
+/// side does keeps its outputs; the others are deformed (s.2.6) and merged.
+/// Groups share no element (they are the union-find's sets), so the deformed
+/// and merged ones run in parallel, each into its own GroupOutcome, taken in
+/// the groups' order.
 void merge_groups(QuiltStepState& s) {
   s.add_in.assign(s.ni, 1);
+  std::vector<int> work;  // roots to deform and merge
   for (auto& [root, g] : s.groups) {
     auto& [outs, ins] = g;
     bool outs_inside = true, ins_inside = true;
@@ -612,13 +629,30 @@ void merge_groups(QuiltStepState& s) {
       s.stats.in_dropped += ins.size();
       continue;
     }
-    Timer td;
-    std::map<int, ElementMesh> deformed_out = deform_group(s, root);
-    s.t_deform += td.seconds();
-    Timer tm;
-    merge_group(s, outs, ins, deformed_out);
-    s.t_merge += tm.seconds();
+    work.push_back(root);
   }
+  std::vector<GroupOutcome> outcome(work.size());
+  Timer wall;
+  tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t k) {
+    const auto& [outs, ins] = s.groups.at(work[k]);
+    Timer td;
+    std::map<int, ElementMesh> deformed_out = deform_group(s, work[k]);
+    outcome[k].t_deform = td.seconds();
+    Timer tm;
+    merge_group(s, outs, ins, deformed_out, outcome[k]);
+    outcome[k].t_merge = tm.seconds();
+  });
+  // Stage seconds: the section's wall time, shared as the thread seconds were.
+  double td = 0, tm = 0;
+  for (GroupOutcome& o : outcome) {
+    s.stats.add(o.stats);
+    for (auto& r : o.replacements) s.replacements.push_back(std::move(r));
+    for (ElementMesh& m : o.cut_inputs) s.cut_inputs.push_back(std::move(m));
+    td += o.t_deform, tm += o.t_merge;
+  }
+  const double w = wall.seconds();
+  s.t_deform += td + tm > 0 ? w * td / (td + tm) : 0.0;
+  s.t_merge += td + tm > 0 ? w * tm / (td + tm) : 0.0;
 }
 
 /// Commits the step: the replaced output elements, the added inputs (and
