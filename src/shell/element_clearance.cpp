@@ -4,12 +4,15 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "geometry/errors.h"
@@ -120,52 +123,60 @@ bool ElementCollider::empty() const {
   return true;
 }
 
+namespace {
+// One triangle of hits(): near a collider triangle (clearance), or meeting
+// one of a counted element.
+template <class Counts>
+bool triangle_hits(const ElementMesh& m, const Tri& tr, const std::vector<char>& near, int skip,
+                   const std::vector<char>* dead, const Counts& counts,
+                   const std::vector<std::unique_ptr<Batch>>& batches) {
+  if (near[static_cast<std::size_t>(tr[0])] || near[static_cast<std::size_t>(tr[1])] || near[static_cast<std::size_t>(tr[2])])
+    return true;
+  const Point3 a = pt(m.points[static_cast<std::size_t>(tr[0])]), b = pt(m.points[static_cast<std::size_t>(tr[1])]),
+               c = pt(m.points[static_cast<std::size_t>(tr[2])]);
+  if (CGAL::collinear(a, b, c)) return false;
+  const Triangle3 q(a, b, c);
+  for (const auto& bt : batches) {
+    if (bt->tris.empty()) continue;
+    if (skip < 0 && !dead) {
+      if (bt->tree.do_intersect(q)) return true;
+      continue;
+    }
+    CountedHit<Counts> traits(bt->tree.traits(), *bt, counts);
+    bt->tree.traversal(q, traits);
+    if (traits.found) return true;
+  }
+  return false;
+}
+}  // namespace
+
 std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead) const {
   auto counts = [&](int tag) {
     if (tag == skip && skip >= 0) return false;
     return !(dead && tag >= 0 && static_cast<std::size_t>(tag) < dead->size() && (*dead)[static_cast<std::size_t>(tag)]);
   };
-  std::vector<char> hit(m.tris.size(), 0);
-  std::vector<char> near(m.points.size(), 0);
-  if (clearance > 0 && skip < 0 && !dead)
-    for (std::size_t v = 0; v < m.points.size(); ++v)
-      for (const auto& b : impl_->batches) {
-        if (b->tris.empty()) continue;
-        if (b->near2(pt(m.points[v]), clearance, clearance * clearance) < clearance * clearance) {
-          near[v] = 1;
-          break;
-        }
-      }
-  for (std::size_t t = 0; t < m.tris.size(); ++t) {
-    const Tri& tr = m.tris[t];
+  for (const Tri& tr : m.tris)
     for (int v : tr)
       if (v < 0 || static_cast<std::size_t>(v) >= m.points.size())
         throw InvalidInputError("ElementCollider::hits: vertex index " + std::to_string(v) + " out of range");
-    if (near[static_cast<std::size_t>(tr[0])] || near[static_cast<std::size_t>(tr[1])] || near[static_cast<std::size_t>(tr[2])]) {
-      hit[t] = 1;
-      continue;
-    }
-    const Point3 a = pt(m.points[static_cast<std::size_t>(tr[0])]), b = pt(m.points[static_cast<std::size_t>(tr[1])]),
-                 c = pt(m.points[static_cast<std::size_t>(tr[2])]);
-    if (CGAL::collinear(a, b, c)) continue;
-    const Triangle3 q(a, b, c);
-    for (const auto& bt : impl_->batches) {
-      if (bt->tris.empty()) continue;
-      if (skip < 0 && !dead) {
-        if (bt->tree.do_intersect(q)) {
-          hit[t] = 1;
-          break;
+  // Each vertex and each triangle is tested on its own (the trees are only
+  // read), in parallel; the answer does not depend on the thread count.
+  std::vector<char> hit(m.tris.size(), 0);
+  std::vector<char> near(m.points.size(), 0);
+  if (clearance > 0 && skip < 0 && !dead)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.points.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v < r.end(); ++v)
+        for (const auto& b : impl_->batches) {
+          if (b->tris.empty()) continue;
+          if (b->near2(pt(m.points[v]), clearance, clearance * clearance) < clearance * clearance) {
+            near[v] = 1;
+            break;
+          }
         }
-        continue;
-      }
-      CountedHit<decltype(counts)> traits(bt->tree.traits(), *bt, counts);
-      bt->tree.traversal(q, traits);
-      if (traits.found) {
-        hit[t] = 1;
-        break;
-      }
-    }
-  }
+    });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.tris.size(), 32), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t < r.end(); ++t) hit[t] = triangle_hits(m, m.tris[t], near, skip, dead, counts, impl_->batches) ? 1 : 0;
+  });
   return hit;
 }
 

@@ -2,11 +2,15 @@
 #include "shell/quilting/element_correspondence.h"
 
 #include <CGAL/intersections.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "geometry/mesh.h"
 #include "shell/triangle_distance.h"
@@ -79,49 +83,69 @@ ElementCorrespondences find_element_correspondences(const std::vector<ElementMes
   if (all.tris.empty()) return res;
   TriangleDistance tree(all);
   const auto fn = face_normals(all);
-  std::vector<VertexFacePair> pairs;
+  // The output vertices in the overlap, then their closest input faces (in
+  // parallel: each query is independent), then the pairs in vertex order.
+  struct Query {
+    int oe, v;
+    P3 n;
+  };
+  std::vector<Query> queries;
   for (int oe : out_ids) {
     const ElementMesh& m = out[oe];
     const auto vn = vertex_normals(m);
-    for (std::size_t v = 0; v < m.points.size(); ++v) {
-      if (!in_overlap(m.points[v])) continue;
-      ++res.candidates;
-      const auto hit = tree.closest(m.points[v]);
-      const P3& nf = fn[hit.tri];
-      const double dot = vn[v][0] * nf[0] + vn[v][1] * nf[1] + vn[v][2] * nf[2];
-      if (dot < 0) {
-        ++res.pruned_normal;
-        continue;
-      }
-      const Tri& t = all.tris[hit.tri];
-      const double local =
-          (len(all.points[t[0]], all.points[t[1]]) + len(all.points[t[1]], all.points[t[2]]) +
-           len(all.points[t[2]], all.points[t[0]])) / 3.0;
-      if (hit.distance > opt.prune_factor * local) {
-        ++res.pruned_distance;
-        continue;
-      }
-      VertexFacePair p;
-      p.out_element = oe;
-      p.vertex = static_cast<int>(v);
-      p.in_element = tri_elem[hit.tri];
-      p.face = tri_local[hit.tri];
-      p.bary = hit.bary;
-      p.closest = hit.point;
-      p.distance = hit.distance;
-      const double dn = std::sqrt((vn[v][0] - nf[0]) * (vn[v][0] - nf[0]) + (vn[v][1] - nf[1]) * (vn[v][1] - nf[1]) +
-                                  (vn[v][2] - nf[2]) * (vn[v][2] - nf[2]));
-      p.cost = (1 + opt.lambda * hit.distance) * (1 + dn);
-      pairs.push_back(p);
+    for (std::size_t v = 0; v < m.points.size(); ++v)
+      if (in_overlap(m.points[v])) queries.push_back({oe, static_cast<int>(v), vn[v]});
+  }
+  std::vector<TriangleDistance::Hit> hits(queries.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k < r.end(); ++k)
+      hits[k] = tree.closest(out[queries[k].oe].points[static_cast<std::size_t>(queries[k].v)]);
+  });
+  std::vector<VertexFacePair> pairs;
+  for (std::size_t k = 0; k < queries.size(); ++k) {
+    const int oe = queries[k].oe;
+    const std::size_t v = static_cast<std::size_t>(queries[k].v);
+    const P3& vnv = queries[k].n;
+    ++res.candidates;
+    const auto& hit = hits[k];
+    const P3& nf = fn[hit.tri];
+    const double dot = vnv[0] * nf[0] + vnv[1] * nf[1] + vnv[2] * nf[2];
+    if (dot < 0) {
+      ++res.pruned_normal;
+      continue;
     }
+    const Tri& t = all.tris[hit.tri];
+    const double local =
+        (len(all.points[t[0]], all.points[t[1]]) + len(all.points[t[1]], all.points[t[2]]) +
+         len(all.points[t[2]], all.points[t[0]])) / 3.0;
+    if (hit.distance > opt.prune_factor * local) {
+      ++res.pruned_distance;
+      continue;
+    }
+    VertexFacePair p;
+    p.out_element = oe;
+    p.vertex = static_cast<int>(v);
+    p.in_element = tri_elem[hit.tri];
+    p.face = tri_local[hit.tri];
+    p.bary = hit.bary;
+    p.closest = hit.point;
+    p.distance = hit.distance;
+    const double dn = std::sqrt((vnv[0] - nf[0]) * (vnv[0] - nf[0]) + (vnv[1] - nf[1]) * (vnv[1] - nf[1]) +
+                                (vnv[2] - nf[2]) * (vnv[2] - nf[2]));
+    p.cost = (1 + opt.lambda * hit.distance) * (1 + dn);
+    pairs.push_back(p);
   }
   std::set<std::pair<int, int>> rel;
   for (const auto& p : pairs) rel.insert({p.out_element, p.in_element});
+  // The projection test of each related pair (section 2.5), in parallel.
+  const std::vector<std::pair<int, int>> rel_list(rel.begin(), rel.end());
+  std::vector<char> overlaps(rel_list.size(), 0);
+  tbb::parallel_for(std::size_t(0), rel_list.size(), [&](std::size_t k) {
+    overlaps[k] = projections_overlap(out[rel_list[k].first], in[rel_list[k].second]) ? 1 : 0;
+  });
   std::set<std::pair<int, int>> keep;
-  for (const auto& r : rel) {
-    if (projections_overlap(out[r.first], in[r.second]))
-      keep.insert(r);
-  }
+  for (std::size_t k = 0; k < rel_list.size(); ++k)
+    if (overlaps[k]) keep.insert(rel_list[k]);
   for (const auto& p : pairs) {
     if (keep.count({p.out_element, p.in_element}))
       res.pairs.push_back(p);
