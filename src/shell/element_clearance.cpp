@@ -27,6 +27,16 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
 Point3 pt(const P3& p) { return Point3(p[0], p[1], p[2]); }
 
+// Whether the bounding box of triangle t meets the box [lo, hi] (closed).
+bool meets_box(const ElementMesh& m, const Tri& t, const P3& lo, const P3& hi) {
+  for (int k = 0; k < 3; ++k) {
+    const double a = m.points[static_cast<std::size_t>(t[0])][k], b = m.points[static_cast<std::size_t>(t[1])][k],
+                 c = m.points[static_cast<std::size_t>(t[2])][k];
+    if (std::max({a, b, c}) < lo[k] || std::min({a, b, c}) > hi[k]) return false;
+  }
+  return true;
+}
+
 // One batch of triangles (a tree is built once; later additions get their own).
 struct Batch {
   std::vector<Triangle3> tris;
@@ -47,8 +57,9 @@ struct Batch {
     if (!hit) return c2;
     return std::min(c2, CGAL::squared_distance(p, tree.closest_point(p, (*hit)->vertex(0))));
   }
-  void push(const ElementMesh& m, int id) {
+  void push(const ElementMesh& m, int id, const P3* lo = nullptr, const P3* hi = nullptr) {
     for (const Tri& t : m.tris) {
+      if (lo && !meets_box(m, t, *lo, *hi)) continue;
       const Point3 a = pt(m.points[static_cast<std::size_t>(t[0])]), b = pt(m.points[static_cast<std::size_t>(t[1])]),
                    c = pt(m.points[static_cast<std::size_t>(t[2])]);
       if (CGAL::collinear(a, b, c)) continue;
@@ -95,6 +106,18 @@ ElementCollider::ElementCollider(const std::vector<ElementMesh>& elements, const
   auto b = std::make_unique<Batch>();
   for (std::size_t e = 0; e < elements.size(); ++e)
     if (use.empty() || use[e]) b->push(elements[e], static_cast<int>(e));
+  b->build();
+  impl_->batches.push_back(std::move(b));
+}
+ElementCollider::ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use, const P3& lo,
+                                 const P3& hi)
+    : impl_(std::make_unique<Impl>()) {
+  if (!use.empty() && use.size() != elements.size())
+    throw InvalidInputError("ElementCollider: use has " + std::to_string(use.size()) + " entries for " +
+                            std::to_string(elements.size()) + " elements");
+  auto b = std::make_unique<Batch>();
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (use.empty() || use[e]) b->push(elements[e], static_cast<int>(e), &lo, &hi);
   b->build();
   impl_->batches.push_back(std::move(b));
 }

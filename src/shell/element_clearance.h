@@ -19,6 +19,9 @@ class ElementCollider {
   /// The triangles of elements[e] with use[e] != 0 (use empty: all), tagged
   /// with e. Degenerate triangles (collinear corners) are left out.
   ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use);
+  /// The same, keeping only the triangles whose bounding box meets the box
+  /// [lo, hi]: exact for queries (with their clearance) inside that box.
+  ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use, const P3& lo, const P3& hi);
   ~ElementCollider();
   ElementCollider(ElementCollider&&) noexcept;
   ElementCollider& operator=(ElementCollider&&) noexcept;

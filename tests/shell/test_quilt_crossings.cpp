@@ -68,6 +68,30 @@ TEST(ElementClearance, CrossingTubesHitDisjointOnesDoNotClearanceCounts) {
   EXPECT_EQ(smallest_element_gap({a, d}, 10.0), 0.0);
 }
 
+// The collider restricted to a box (quilt_step's resolve_crossings: the new
+// elements' box grown by the clearance) answers queries inside it as the
+// whole collider does, and leaves out what lies outside.
+TEST(ElementClearance, ColliderRestrictedToABoxAnswersQueriesInsideItTheSame) {
+  Mesh tor;
+  make_torus(tor, 1.0, 0.3, 24, 12);
+  const ElementMesh a = element_mesh_from(tor);
+  ElementMesh far = a, d = a, c = a;
+  for (P3& p : far.points) p = {p[0] + 10.0, p[1], p[2]};
+  for (P3& p : d.points) p = {p[0] + 1.5, p[1], p[2]};  // overlaps a
+  for (P3& p : c.points) p = {p[0] + 3.0, p[1], p[2]};  // 0.4 beside a
+  const ElementCollider whole({a, far}, {});
+  const P3 lo{-1.5, -1.5, -1.0}, hi{4.5, 1.5, 1.0};  // holds d and c grown by 0.45, not far
+  const ElementCollider boxed({a, far}, {}, lo, hi);
+  EXPECT_EQ(boxed.hits(d, -1, 0.0), whole.hits(d, -1, 0.0));
+  EXPECT_EQ(boxed.hits(c, -1, 0.45), whole.hits(c, -1, 0.45));
+  EXPECT_EQ(boxed.hits(c, -1, 0.35), whole.hits(c, -1, 0.35));
+  ElementMesh g = far;  // overlaps `far`, outside the box: the boxed collider does not hold it
+  for (P3& p : g.points) p = {p[0] + 0.5, p[1], p[2]};
+  auto any = [](const std::vector<char>& h) { return std::find(h.begin(), h.end(), 1) != h.end(); };
+  EXPECT_TRUE(any(whole.hits(g, -1, 0.0)));
+  EXPECT_FALSE(any(boxed.hits(g, -1, 0.0)));
+}
+
 TEST(ElementClearance, TrimAndCapLeavesClosedPiecesAwayFromTheHits) {
   Mesh tor;
   make_torus(tor, 2.0, 0.3, 48, 8);
