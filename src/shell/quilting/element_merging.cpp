@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/quilting/element_merging.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <tuple>
 #include <cmath>
@@ -84,17 +87,31 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   ElementCut res;
   const double match = auto_match(a, b, opt);
   const int nt = static_cast<int>(a.tris.size());
-  // A's closest points on B, queried where a rule or a weight reads them (a
-  // long element's far part needs none; see the edge loop below).
-  std::vector<TriangleDistance::Hit> hit(a.points.size());
-  std::vector<char> have_hit(a.points.size(), 0);
-  auto hit_of = [&](int v) -> const TriangleDistance::Hit& {
-    if (!have_hit[v]) hit[v] = tb.closest(a.points[v]), have_hit[v] = 1;
-    return hit[v];
-  };
   std::vector<char> force_keep(nt, 0), force_del(nt, 0);
   for (int t = 0; t < nt; ++t)
     if (owns(side_a, region(centroid(a, a.tris[t])))) force_keep[t] = 1;
+  // The SINK rule's vertices (see below): the paper applies it in the overlap
+  // region; with MergeOptions::delete_past_overlap also where A pokes past it
+  // into the other side (not A's own outside, not off the grid).
+  std::vector<char> sink_rule(a.points.size(), 0);
+  for (std::size_t v = 0; v < a.points.size(); ++v) {
+    const Region rv = region(a.points[v]);
+    sink_rule[v] = !(opt.delete_past_overlap ? owns(side_a, rv) || rv == Region::kNone : rv != Region::kOverlap);
+  }
+  // A's closest points on B, queried (in parallel) where a rule or a weight
+  // reads them: an edge between two kept-by-force triangles is never cut
+  // (GraphCut drops it), so without a guide (whose scale, wmax, reads every
+  // weight) a long element's far part needs no query.
+  const auto edges = dual_edges(a);
+  std::vector<char> need(a.points.size(), b_keep ? 1 : 0);
+  for (const DualEdge& e : edges)
+    if (b_keep || !(force_keep[e.t1] && force_keep[e.t2])) need[e.vi] = need[e.vj] = 1;
+  for (std::size_t v = 0; v < a.points.size(); ++v) need[v] = need[v] || sink_rule[v];
+  std::vector<TriangleDistance::Hit> hit(a.points.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.points.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v < r.end(); ++v)
+      if (need[v]) hit[v] = tb.closest(a.points[v]);
+  });
   // B's faces farther from A's bounding box than `match` are not covered
   // (the closest point of A is farther still); a margin of 1e-9 relative
   // keeps rounding from deciding a face the query would call covered.
@@ -121,13 +138,15 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   const double round_trip = opt.round_trip_edges * mean_edge(b);
   std::vector<char> covered(b.tris.size());
   std::vector<char> b_in(b.tris.size());
-  for (std::size_t g = 0; g < b.tris.size(); ++g) {
-    const P3 c = centroid(b, b.tris[g]);
-    b_in[g] = !owns(side_b, region(c));  // not in B's own outside
-    if (!ta.empty() && far_from_a(c)) continue;
-    const auto q = ta.closest(c);
-    covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
-  }
+  for (std::size_t g = 0; g < b.tris.size(); ++g) b_in[g] = !owns(side_b, region(centroid(b, b.tris[g])));  // not in B's own outside
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b.tris.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t g = r.begin(); g < r.end(); ++g) {
+      const P3 c = centroid(b, b.tris[g]);
+      if (!ta.empty() && far_from_a(c)) continue;
+      const auto q = ta.closest(c);
+      covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
+    }
+  });
   // Edge-neighbours of B's faces.
   std::vector<std::vector<int>> b_nb(b.tris.size());
   for (const DualEdge& e : dual_edges(b)) b_nb[e.t1].push_back(e.t2), b_nb[e.t2].push_back(e.t1);
@@ -157,16 +176,12 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   }
 
   GraphCut gc(nt);
-  const auto edges = dual_edges(a);
   auto weight = [&](const DualEdge& e) {
-    return (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit_of(e.vi).distance + hit_of(e.vj).distance);
+    return (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + hit[e.vi].distance + hit[e.vj].distance);
   };
   double wmax = 0;
   for (const DualEdge& e : edges) {
-    // An edge between two kept-by-force triangles is never cut: GraphCut
-    // drops it, so its weight (and its queries) are needed only for the
-    // guide's scale, wmax, when there is a guide.
-    if (!b_keep && force_keep[e.t1] && force_keep[e.t2]) continue;
+    if (!b_keep && force_keep[e.t1] && force_keep[e.t2]) continue;  // never cut (above)
     const double w = weight(e);
     wmax = std::max(wmax, w);
     gc.add_edge(e.t1, e.t2, w, w);
@@ -175,12 +190,8 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   for (int t = 0; t < nt; ++t)
     for (int v : a.tris[t]) vtris[v].push_back(t);
   for (std::size_t v = 0; v < a.points.size(); ++v) {
-    // The paper applies the SINK rule in the overlap region; with
-    // MergeOptions::delete_past_overlap also where A pokes past it into the
-    // other side (not A's own outside, not off the grid).
-    const Region rv = region(a.points[v]);
-    if (opt.delete_past_overlap ? owns(side_a, rv) || rv == Region::kNone : rv != Region::kOverlap) continue;
-    const auto& h = hit_of(static_cast<int>(v));
+    if (!sink_rule[v]) continue;
+    const auto& h = hit[v];
     if (h.tri < 0 || h.distance > match) continue;
     bool del = !b_in[h.tri];
     for (int g : b_nb[h.tri]) del = del || (!covered[g] && escapes[g]);
@@ -198,14 +209,19 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   }
   if (b_keep) {
     const double g = opt.guide_factor * std::max(wmax, 1.0);
+    std::vector<TriangleDistance::Hit> ch(static_cast<std::size_t>(nt));
+    tbb::parallel_for(tbb::blocked_range<int>(0, nt, 64), [&](const tbb::blocked_range<int>& r) {
+      for (int t = r.begin(); t < r.end(); ++t)
+        if (!force_keep[t] && !force_del[t]) ch[static_cast<std::size_t>(t)] = tb.closest(centroid(a, a.tris[t]));
+    });
     for (int t = 0; t < nt; ++t) {
       if (force_keep[t] || force_del[t]) continue;
-      const auto h = tb.closest(centroid(a, a.tris[t]));
+      const auto& h = ch[static_cast<std::size_t>(t)];
       if (h.tri < 0 || h.distance > match) continue;
       bool behind = (*b_keep)[h.tri];
       if (opt.guide_by_vertices)
         for (int v : a.tris[t]) {
-          const auto& hv = hit_of(v);
+          const auto& hv = hit[v];
           behind = behind || (hv.tri >= 0 && hv.distance <= match && (*b_keep)[hv.tri]);
         }
       if (behind)
