@@ -27,6 +27,12 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
 Point3 pt(const P3& p) { return Point3(p[0], p[1], p[2]); }
 
+// (sign * infinity) in each coordinate: the corners of a box holding everything.
+P3 collider_corner(double sign) {
+  const double i = sign * std::numeric_limits<double>::infinity();
+  return {i, i, i};
+}
+
 // Whether the bounding box of triangle t meets the box [lo, hi] (closed).
 bool meets_box(const ElementMesh& m, const Tri& t, const P3& lo, const P3& hi) {
   for (int k = 0; k < 3; ++k) {
@@ -99,16 +105,7 @@ struct ElementCollider::Impl {
 };
 
 ElementCollider::ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use)
-    : impl_(std::make_unique<Impl>()) {
-  if (!use.empty() && use.size() != elements.size())
-    throw InvalidInputError("ElementCollider: use has " + std::to_string(use.size()) + " entries for " +
-                            std::to_string(elements.size()) + " elements");
-  auto b = std::make_unique<Batch>();
-  for (std::size_t e = 0; e < elements.size(); ++e)
-    if (use.empty() || use[e]) b->push(elements[e], static_cast<int>(e));
-  b->build();
-  impl_->batches.push_back(std::move(b));
-}
+    : ElementCollider(elements, use, collider_corner(-1.0), collider_corner(1.0)) {}
 ElementCollider::ElementCollider(const std::vector<ElementMesh>& elements, const std::vector<char>& use, const P3& lo,
                                  const P3& hi)
     : impl_(std::make_unique<Impl>()) {
