@@ -174,6 +174,10 @@ TriangleDistance& TriangleDistance::operator=(TriangleDistance&&) noexcept = def
 
 bool TriangleDistance::empty() const { return impl_->tris.empty(); }
 
+double TriangleDistance::box_squared_distance(const P3& q) const {
+  return impl_->nodes.empty() ? 0.0 : impl_->nodes[0].box.squared_distance(q);
+}
+
 TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
   Hit h;
   const Impl& I = *impl_;

@@ -29,6 +29,9 @@ class TriangleDistance {
     P3 bary{0, 0, 0};      ///< its barycentric coordinates in tri (alpha, beta, gamma)
   };
   Hit closest(const P3& q) const;
+  /// Squared distance from q to the bounding box of the triangles, a lower
+  /// bound of closest(q).distance squared (0 for an empty mesh).
+  double box_squared_distance(const P3& q) const;
   bool empty() const;
 
  private:

@@ -67,6 +67,7 @@ void expect_matches_brute_force(const ElementMesh& m, const std::vector<P3>& que
       d2 += (q[k] - x) * (q[k] - x);
     }
     EXPECT_NEAR(d2, best, scale);
+    EXPECT_LE(td.box_squared_distance(q), best);  // the box bound never exceeds the distance
     EXPECT_NEAR(h.bary[0] + h.bary[1] + h.bary[2], 1.0, 1e-12);
     for (int k = 0; k < 3; ++k) EXPECT_GE(h.bary[k], -1e-12);
   }
@@ -115,12 +116,15 @@ TEST(TriangleDistance, EmptyMeshAndTiesAreDefined) {
   const TriangleDistance none(ElementMesh{});
   EXPECT_TRUE(none.empty());
   EXPECT_EQ(none.closest({0, 0, 0}).tri, -1);
+  EXPECT_EQ(none.box_squared_distance({5, 0, 0}), 0.0);
   // Two copies of one triangle: the first in the mesh is reported, whichever the tree visits first.
   ElementMesh m;
   m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   for (int i = 0; i < 20; ++i) m.tris.push_back({0, 1, 2});
   const TriangleDistance td(m);
   const auto h = td.closest({0.2, 0.2, 1.0});
+  EXPECT_EQ(td.box_squared_distance({3, 0.5, 0}), 4.0);  // 2 beyond the box along x
+  EXPECT_EQ(td.box_squared_distance({0.2, 0.2, 0}), 0.0);  // inside it
   EXPECT_EQ(h.tri, 0);
   EXPECT_NEAR(h.distance, 1.0, 1e-15);
 }

@@ -105,7 +105,7 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   const auto edges = dual_edges(a);
   std::vector<char> need(a.points.size(), b_keep ? 1 : 0);
   for (const DualEdge& e : edges)
-    if (b_keep || !(force_keep[e.t1] && force_keep[e.t2])) need[e.vi] = need[e.vj] = 1;
+    if (!(force_keep[e.t1] && force_keep[e.t2])) need[e.vi] = need[e.vj] = 1;
   for (std::size_t v = 0; v < a.points.size(); ++v) need[v] = need[v] || sink_rule[v];
   std::vector<TriangleDistance::Hit> hit(a.points.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.points.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -115,18 +115,7 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   // B's faces farther from A's bounding box than `match` are not covered
   // (the closest point of A is farther still); a margin of 1e-9 relative
   // keeps rounding from deciding a face the query would call covered.
-  P3 alo = a.points.empty() ? P3{0, 0, 0} : a.points[0], ahi = alo;
-  for (const P3& p : a.points)
-    for (int k = 0; k < 3; ++k) alo[k] = std::min(alo[k], p[k]), ahi[k] = std::max(ahi[k], p[k]);
   const double far2 = match * (1 + 1e-9) * match * (1 + 1e-9) + 1e-300;
-  auto far_from_a = [&](const P3& c) {
-    double d = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double e = c[k] < alo[k] ? alo[k] - c[k] : (c[k] > ahi[k] ? c[k] - ahi[k] : 0.0);
-      d += e * e;
-    }
-    return d > far2;
-  };
   // Faces of B "with a corresponding vertex in A" (see the header): the point
   // q of A closest to the face's centroid c must be within `match` and must
   // itself have its closest point of B at c (within opt.round_trip_edges mean
@@ -142,7 +131,7 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b.tris.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t g = r.begin(); g < r.end(); ++g) {
       const P3 c = centroid(b, b.tris[g]);
-      if (!ta.empty() && far_from_a(c)) continue;
+      if (ta.box_squared_distance(c) > far2) continue;
       const auto q = ta.closest(c);
       covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
     }

@@ -187,13 +187,13 @@ std::vector<ElementMesh> resolve_crossings(const std::vector<ElementMesh>& eleme
   // Only the old triangles near the new elements can be hit: the collider
   // holds those meeting the new elements' xy box grown by the clearance
   // (unbounded in z: push_over_under moves a thread in z only).
-  P3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  const double inf = std::numeric_limits<double>::infinity();
+  P3 lo{inf, inf, -inf}, hi{-inf, -inf, inf};
   for (const ElementMesh& m : adds)
     for (const P3& p : m.points)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
   const double grow = std::max(0.0, opt.clearance) * (1 + 1e-9) + 1e-12;
   for (int k = 0; k < 2; ++k) lo[k] -= grow, hi[k] += grow;
-  lo[2] = -std::numeric_limits<double>::infinity(), hi[2] = std::numeric_limits<double>::infinity();
   ElementCollider old(elements, alive, lo, hi);
   std::vector<ElementMesh> keep;
   for (ElementMesh& m : adds) {
