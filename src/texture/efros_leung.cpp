@@ -112,6 +112,28 @@ SURFTEX_SIMD_CLONES void span_ssd_c4(const float* p, std::size_t ps, const int* 
                                      int nk, int len, std::size_t row, float* out) {
   span_ssd_impl<4>(p, ps, d, t, nk, len, row, out);
 }
+// Short-list kernel: the unweighted SSD of one candidate `id` over the nk
+// known first-pass neighbours, summed in the order (neighbour, channel) one
+// term at a time (the value is the same float whichever C path runs). When
+// the partial sum passes `stop` the candidate is abandoned and the partial
+// sum, already > stop, is returned: partial sums of squares never decrease,
+// so its full error would exceed stop too.
+template <int C>
+inline float short_list_ssd(const float* P, std::size_t ps, int Cr, const int* delta, const float* tv, int nk,
+                            int id, float stop) {
+  const int ch = C > 0 ? C : Cr;
+  float e = 0;
+  for (int k = 0; k < nk; ++k) {
+    const float* base = P + id + delta[k];
+    for (int c = 0; c < ch; ++c) {
+      const float d = base[c * ps] - tv[k * ch + c];
+      e += d * d;
+    }
+    if (e > stop) return e;
+  }
+  return e;
+}
+
 // Pass-2 kernel: Gaussian-weighted SSD of the candidates ids[0..count),
 // into out. The window is stored per active row as nv groups of 8 offsets
 // starting at buffer offset roff[r]; weights are 0 at unknown offsets (and
@@ -414,7 +436,10 @@ class Synthesizer {
   int search_key(int p) const { return key_[p]; }
   void gather_known(int p, const SearchImage& s);
   int pass1(const SearchImage& s, std::size_t n);
-  void pass1_short_list(const SearchImage& s, std::size_t n, int p);
+  void short_list_passes(const SearchImage& s, std::size_t n, int p);
+  bool short_list_ties(const SearchImage& s);
+  void rank_short_list(const SearchImage& s, std::size_t n, int p, bool widen);
+  float first_pass_ssd(const SearchImage& s, int nk, int id, float stop) const;
   void select_smallest(const SearchImage& s, std::size_t n);
   void score_full(const SearchImage& s, const std::vector<int>& ids, std::vector<Scored>& out);
   void synthesize_pixel(int p);
@@ -457,6 +482,12 @@ class Synthesizer {
   std::vector<float> err_, sample_, p2_err_;
   std::vector<int> pre_;
   std::vector<Scored> scored_, collect_;
+  // The short list's first-pass errors, their tie bound, and whether any
+  // was abandoned past it (short_list_ties).
+  std::vector<Scored> p1_scored_;
+  float p1_tie_ = 0;
+  bool p1_abandoned_ = false;
+  bool last_widened_ = false;  // the previous short list was widened
   std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0, widened_ = 0;
   std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
   std::vector<ElSource> source_;         // per pixel: where its value came from
@@ -701,7 +732,7 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // Approximate pass 1 (ElSearch::Approximate): the short list -- the coherent
 // candidates gathered with the known neighbours and the kd-tree's nearest
 // first-pass neighbourhoods -- deduplicated and ranked exactly by the
-// first-pass SSD; the n best (by (error, position)) go to pre_.
+// first-pass SSD; the n best (by (error, position)) go to pre_, then pass 2.
 //
 // Ties: when at least ann_candidates of the short list are within the
 // pick tolerance of its best (a flat or repeated region: many candidates
@@ -714,36 +745,72 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // candidates, drawn from a hash of the seed and the pixel, so the
 // synthesis's random stream is untouched), as the exhaustive pass would
 // see them. Pixels without such ties are unchanged.
-void Synthesizer::pass1_short_list(const SearchImage& s, std::size_t n, int p) {
+//
+// Order of work: when the short list fits the preselect (the usual case, no
+// ranking needed) pass 2 scores it first, and the first-pass errors of the
+// tie rule are then read from the cache lines pass 2 has just loaded (read
+// first, they were scattered misses: a third slower synthesis with a 512 px
+// exemplar). Only a widened list is ranked and scored again. Pass 2 scores
+// each candidate on its own, so the result is the same as ranking first
+// (checked byte for byte on patches and synth outputs, decision 501).
+void Synthesizer::short_list_passes(const SearchImage& s, std::size_t n, int p) {
   const int nk = static_cast<int>(p1_slot_.size());
   s.ann->query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
                static_cast<float>(opt_.ann_eps), short_, ann_scratch_);
   std::sort(short_.begin(), short_.end());
   short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
-  pre_.clear();
-  const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
-  const float* P = s.planes.data();
-  auto ssd = [&](int id) {
-    float e = 0;
-    for (int k = 0; k < nk; ++k)
-      for (int c = 0; c < C; ++c) {
-        const float d = P[c * ps + id + p1_delta_[k]] - p1_value_[k * C + c];
-        e += d * d;
-      }
-    return e;
-  };
-  scored_.clear();
-  float best = std::numeric_limits<float>::infinity();
-  for (int id : short_) {
-    scored_.push_back({ssd(id), id});
-    best = std::min(best, scored_.back().first);
+  // Scored first unless the previous pixel widened (ties come in regions:
+  // there the speculative pass 2 would mostly be thrown away).
+  const bool first = short_.size() <= n && !last_widened_;
+  if (first) {
+    pre_ = short_;
+    add_coherent_to_preselect();
+    score_full(s, pre_, scored_);
   }
+  const bool widen = short_list_ties(s);
+  last_widened_ = widen;
+  if (first && !widen) {
+    pass1_candidates_ += short_.size();
+    return;
+  }
+  rank_short_list(s, n, p, widen);
+  add_coherent_to_preselect();
+  score_full(s, pre_, scored_);
+}
+
+// The short list's first-pass errors into p1_scored_ (short_'s order) and
+// the tie rule's verdict. Exact errors only where they decide something: a
+// candidate whose partial error passes the tie bound of the best so far
+// (which only falls) is no tie and not the best, and is abandoned there
+// (its entry holds that partial error, above p1_tie_).
+bool Synthesizer::short_list_ties(const SearchImage& s) {
+  const int nk = static_cast<int>(p1_slot_.size());
   const float tol = static_cast<float>(std::max(opt_.error_tolerance, 0.0));
-  const float tie = best * (1.f + tol) + 1e-6f * static_cast<float>(nk * C);
+  float best = std::numeric_limits<float>::infinity();
+  p1_tie_ = best;
+  p1_abandoned_ = false;
+  p1_scored_.clear();
+  for (int id : short_) {
+    const float e = first_pass_ssd(s, nk, id, p1_tie_);
+    p1_scored_.push_back({e, id});
+    p1_abandoned_ = p1_abandoned_ || e > p1_tie_;
+    if (e < best) best = e, p1_tie_ = best * (1.f + tol) + 1e-6f * static_cast<float>(nk * C);
+  }
   std::size_t ties = 0;
-  for (const auto& v : scored_) ties += v.first <= tie;
+  for (const auto& v : p1_scored_) ties += v.first <= p1_tie_;
+  return ties >= static_cast<std::size_t>(opt_.ann_candidates) && s.ids.size() > short_.size();
+}
+
+// The short list (widened by the stratified sample when `widen`) ranked by
+// exact first-pass errors; its n best into pre_.
+void Synthesizer::rank_short_list(const SearchImage& s, std::size_t n, int p, bool widen) {
+  const int nk = static_cast<int>(p1_slot_.size());
+  const float inf = std::numeric_limits<float>::infinity();
+  if (p1_abandoned_)
+    for (auto& v : p1_scored_)
+      if (v.first > p1_tie_) v.first = first_pass_ssd(s, nk, v.second, inf);
   const std::size_t N = s.ids.size();
-  if (ties >= static_cast<std::size_t>(opt_.ann_candidates) && N > short_.size()) {
+  if (widen) {
     const std::size_t m = std::min(n, N);
     const std::size_t step = N / m;
     std::uint64_t h = opt_.seed ^ (0x9e3779b97f4a7c15ull * (static_cast<std::uint64_t>(p) + 1));
@@ -754,16 +821,32 @@ void Synthesizer::pass1_short_list(const SearchImage& s, std::size_t n, int p) {
       h = h * 6364136223846793005ull + 1442695040888963407ull;  // one draw per stratum
       const int id = s.ids[j * step + static_cast<std::size_t>((h >> 33) % step)];
       if (std::binary_search(short_.begin(), short_.end(), id)) continue;
-      scored_.push_back({ssd(id), id});
+      p1_scored_.push_back({first_pass_ssd(s, nk, id, inf), id});
     }
     ++widened_;
   }
-  pass1_candidates_ += scored_.size();
-  if (scored_.size() > n) {
-    std::nth_element(scored_.begin(), scored_.begin() + n, scored_.end());
-    scored_.resize(n);
+  pass1_candidates_ += p1_scored_.size();
+  if (p1_scored_.size() > n) {
+    std::nth_element(p1_scored_.begin(), p1_scored_.begin() + n, p1_scored_.end());
+    p1_scored_.resize(n);
   }
-  for (const auto& v : scored_) pre_.push_back(v.second);
+  pre_.clear();
+  for (const auto& v : p1_scored_) pre_.push_back(v.second);
+}
+
+// Unweighted SSD of candidate id over the known first-pass neighbours
+// (short_list_ssd), abandoned past `stop`.
+float Synthesizer::first_pass_ssd(const SearchImage& s, int nk, int id, float stop) const {
+  const std::size_t ps = static_cast<std::size_t>(s.pw) * s.ph;
+  const float* P = s.planes.data();
+  const int* d = p1_delta_.data();
+  const float* t = p1_value_.data();
+  switch (C) {
+    case 1: return short_list_ssd<1>(P, ps, C, d, t, nk, id, stop);
+    case 3: return short_list_ssd<3>(P, ps, C, d, t, nk, id, stop);
+    case 4: return short_list_ssd<4>(P, ps, C, d, t, nk, id, stop);
+    default: return short_list_ssd<0>(P, ps, C, d, t, nk, id, stop);
+  }
 }
 
 // The n smallest (err_[i], ids[i]) into scored_ (in no particular order:
@@ -890,12 +973,13 @@ void Synthesizer::synthesize_pixel(int p) {
     if (!in_.exemplar_index.empty())
       n = opt_.preselect > 0 ? n : static_cast<std::size_t>(ex[in_.exemplar_index[p]].width);
     n = std::min(n, total);
-    if (s.ann && !p1_slot_.empty())
-      pass1_short_list(s, n, p);
-    else
+    if (s.ann && !p1_slot_.empty()) {
+      short_list_passes(s, n, p);
+    } else {
       pass1(s, n);
-    add_coherent_to_preselect();
-    score_full(s, pre_, scored_);
+      add_coherent_to_preselect();
+      score_full(s, pre_, scored_);
+    }
   }
   const std::size_t m = scored_.size();
   std::size_t k = std::max<std::size_t>(static_cast<std::size_t>(opt_.pick_min),

@@ -40,7 +40,7 @@ TEST(PatchTexture, AtlasMapsAndReport) {
   for (const char* k : {"patches", "greedy_patches", "split_patches", "merged_patches", "reassigned_faces",
                         "max_normal_deviation_deg", "patch_resolution", "texel_size", "dropped_boundary_triangles",
                         "texels_synthesized", "texels_seeded", "known_boundary_pixels", "texels_per_second",
-                        "seconds", "synthesis_share", "seam", "atlas", "fidelity"})
+                        "seconds", "synthesis_share", "seam", "atlas", "fidelity", "pass1"})
     EXPECT_TRUE(j.contains(k)) << k;
   EXPECT_EQ(j["patch_resolution"], 16);
   EXPECT_EQ(j["patches"], r.synthesis.flat.patches.size());
@@ -48,6 +48,11 @@ TEST(PatchTexture, AtlasMapsAndReport) {
   EXPECT_EQ(j["atlas"]["normal_source"], "height");
   EXPECT_EQ(j["atlas"]["roughness"], false);
   EXPECT_EQ(j["seam"]["ratio"], r.seam.ratio);
+  // The approximate first pass's work, summed over the patches: every
+  // synthesised texel ranked at least one candidate.
+  EXPECT_GE(j["pass1"]["candidates"].get<std::size_t>(), r.synthesis.texels - r.synthesis.seeded);
+  EXPECT_EQ(j["pass1"]["candidates"], r.synthesis.pass1_candidates);
+  EXPECT_EQ(j["pass1"]["widened_pixels"], r.synthesis.pass1_widened);
   for (const char* k : {"partition", "field", "flatten", "synthesis", "atlas", "seam_metric", "total"})
     EXPECT_TRUE(j["seconds"].contains(k)) << k;
 }

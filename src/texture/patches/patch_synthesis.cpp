@@ -389,6 +389,8 @@ class PatchSynthesizer {
         texels_(patches_.size(), 0),
         seeded_(patches_.size(), 0),
         known_(patches_.size(), 0),
+        candidates_(patches_.size(), 0),
+        widened_(patches_.size(), 0),
         steps_(patches_.size() + opt.resynthesize.size()) {
     const int P = static_cast<int>(patches_.size());
     res_.images.assign(P, Image(R_, R_, C_, 0.f));
@@ -431,6 +433,8 @@ class PatchSynthesizer {
     const ElResult r = efros_leung_synthesize(in, el_options(p, pass, pixel_parallel, mean_c, mean_s));
     texels_[p] += r.synthesized + r.seeded;
     seeded_[p] += r.seeded;
+    candidates_[p] += r.pass1_candidates;
+    widened_[p] += r.pass1_widened;
     store_inside(p, box, r);
     if (opt_.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex_);
@@ -444,6 +448,8 @@ class PatchSynthesizer {
       res_.texels += texels_[p];
       res_.seeded += seeded_[p];
       res_.known_boundary += known_[p];
+      res_.pass1_candidates += candidates_[p];
+      res_.pass1_widened += widened_[p];
     }
   }
 
@@ -532,7 +538,7 @@ class PatchSynthesizer {
   const Vector3 light_;
   const std::shared_ptr<const ElPreparedExemplars> prepared_;
   // Per patch: texels filled, of which seeded, Known boundary pixels.
-  std::vector<std::size_t> texels_, seeded_, known_;
+  std::vector<std::size_t> texels_, seeded_, known_, candidates_, widened_;
   std::mutex progress_mutex_;
   std::size_t step_ = 0;
   const std::size_t steps_;

@@ -85,6 +85,9 @@ struct PatchSynthesisResult {
   std::size_t texels = 0;        ///< pixels synthesised (main pass + resynthesis)
   std::size_t seeded = 0;        ///< of which seeded by random patches
   std::size_t known_boundary = 0;  ///< Known boundary pixels given to the synthesis
+  /// First-pass candidates ranked, and pixels whose approximate short list was
+  /// widened for ties (ElResult::pass1_candidates, pass1_widened), summed.
+  std::size_t pass1_candidates = 0, pass1_widened = 0;
   double seconds_partition = 0, seconds_field = 0, seconds_flatten = 0,
          seconds_synthesis = 0, seconds_total = 0;
 };

@@ -85,6 +85,7 @@ nlohmann::json to_json(const PatchTextureResult& t) {
   j["texels_synthesized"] = r.texels;
   j["texels_seeded"] = r.seeded;
   j["known_boundary_pixels"] = r.known_boundary;
+  j["pass1"] = {{"candidates", r.pass1_candidates}, {"widened_pixels", r.pass1_widened}};
   j["texels_per_second"] = r.texels / std::max(r.seconds_synthesis, 1e-9);
   j["seconds"] = {{"partition", r.seconds_partition}, {"field", r.seconds_field},
                   {"flatten", r.seconds_flatten},     {"synthesis", r.seconds_synthesis},
