@@ -4,8 +4,8 @@
 // and limbs; knot: genus 1) x 4 swatches (the generated weave, chain mail and
 // 16 tilted tori, disjoint elements; the real pebble swatches/rock_1.obj), each
 // quilted and embedded by the CLI's driver (quilt_swatch_on_surface) at the
-// CLI's defaults (relative size default_surface_quilt_size: 0.25, the single
-// rock 0.0625; up +Y, shell height 1, 20 stretch sweeps, seed 1; the swatch's
+// CLI's defaults (relative size default_surface_quilt_size: 0.25, the weave
+// 0.125, the single rock 0.0468; up +Y, shell height 1, 20 stretch sweeps, seed 1; the swatch's
 // thin axis detected).
 // Prints one JSON line per case:
 //   faces, elements (the output's connected components) and quilt_elements

@@ -261,7 +261,8 @@ SubcommandRegistrar reg_quilt{
                       "The paper's s. On a mesh: the swatch's larger side as a fraction of the base mesh's "
                       "bounding-box diagonal, (0, 10]; 0 = 0.25, or less for a swatch of few large compact "
                       "elements (a single pebble) so that one element is at most 1/16 of the diagonal wide and "
-                      "1/32 of it tall (a tall element splays over curved ground). On a "
+                      "1/32 of it tall (a tall element splays over curved ground), and for threads (a weave) so that the "
+                      "longest is at most 1/8 of the diagonal long (a longer one is cut where the surface curves). On a "
                       "plane: factor applied to the swatch, 0 = 1 (default 0)")
            ->check(number_above(0, false));
        app.add_option("--field", a->field,

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <string>
 
@@ -208,17 +209,33 @@ TEST(QuiltDriver, SurfaceDriverRefusesAScaleAbove10AndOversizedRunsBeforeQuiltin
 // base's diagonal every placement on a small sphere is stretched or crosses
 // and nothing is left ("no element was placed"); the default size gives one
 // element 1/16 of the diagonal, and the sphere gets covered with pebbles.
-// Swatches of several elements (tori) or of threads (weave) keep 0.25.
-TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOnly) {
+// Swatches of several small elements (tori, chain mail) keep 0.25; threads
+// (the weave's, which span the swatch) are capped at 1/8 of the diagonal in
+// length, so the weave gets about half of 0.25.
+TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOrOfLongThreads) {
   Mesh pebble;
   make_ellipsoid(pebble, 1.0, 0.8, 0.35, 2);
   const Swatch one = make_swatch(pebble);
   EXPECT_DOUBLE_EQ(default_surface_quilt_size(one), 0.0625);
-  Mesh tori, weave;
+  Mesh tori, chain, weave;
   make_tori_swatch(tori, ToriOptions{});
+  make_chainmail_swatch(chain, ChainmailOptions{});
   make_weave_swatch(weave, WeaveOptions{});
   EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(tori)), 0.25);
-  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(weave)), 0.25);
+  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(chain)), 0.25);
+  const Swatch ws = make_swatch(weave);
+  double longest = 0;  // the longest thread's larger xy side (swatch units)
+  for (std::size_t e = 0; e < ws.elements.size(); ++e) {
+    const ElementMesh m = swatch_element(ws, static_cast<int>(e));
+    double lo[2] = {m.points[0][0], m.points[0][1]}, hi[2] = {lo[0], lo[1]};
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    longest = std::max({longest, hi[0] - lo[0], hi[1] - lo[1]});
+  }
+  const double size = default_surface_quilt_size(ws);
+  EXPECT_LT(size, 0.13);
+  // relative size x (thread / swatch side) = the thread's share of the diagonal.
+  EXPECT_NEAR(size * longest / std::max(ws.length(), ws.width()), 1.0 / 8, 1e-12);
 
   Mesh base;
   make_icosphere(base, 3);

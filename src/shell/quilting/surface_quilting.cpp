@@ -1794,8 +1794,36 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
   return relative_size * diag / std::max(swatch.length(), swatch.width());
 }
 
+namespace {
+// The larger xy side of every element that is not compact (a thread).
+std::vector<double> thread_sides(const Swatch& s) {
+  std::vector<std::vector<int>> tris_of(s.elements.size());
+  for (std::size_t t = 0; t < s.mesh.tris.size(); ++t) tris_of[static_cast<std::size_t>(s.face_element[t])].push_back(static_cast<int>(t));
+  std::vector<double> out;
+  for (const std::vector<int>& tris : tris_of) {
+    const ElementMesh m = extract_triangles(s.mesh, tris);
+    if (m.points.empty() || is_compact_element(m)) continue;
+    double lo[2] = {m.points[0][0], m.points[0][1]}, hi[2] = {lo[0], lo[1]};
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    out.push_back(std::max(hi[0] - lo[0], hi[1] - lo[1]));
+  }
+  return out;
+}
+}  // namespace
+
 double default_surface_quilt_size(const Swatch& swatch) {
-  constexpr double kSize = 0.25, kElementSize = 1.0 / 16, kElementHeight = 1.0 / 32;
+  constexpr double kSize = 0.25, kElementSize = 1.0 / 16, kElementHeight = 1.0 / 32, kThreadLength = 1.0 / 8;
+  const double whole = std::max(swatch.length(), swatch.width());
+  if (!(whole > 0)) return kSize;
+  double size = kSize;
+  // Threads: the longest at most 1/8 of the diagonal, so that it follows a
+  // patch it can be expressed in (decision 102, session 24).
+  const std::vector<double> threads = thread_sides(swatch);
+  if (!threads.empty()) {
+    const double longest = *std::max_element(threads.begin(), threads.end());
+    if (longest > 0) size = std::min(size, kThreadLength * whole / longest);
+  }
   std::vector<double> sides, heights;  // larger xy side and z extent of each compact element
   for (const ElementMesh& m : compact_swatch_elements(swatch)) {
     double lo[3], hi[3];
@@ -1805,13 +1833,12 @@ double default_surface_quilt_size(const Swatch& swatch) {
     const double side = std::max(hi[0] - lo[0], hi[1] - lo[1]);
     if (side > 0) sides.push_back(side), heights.push_back(std::max(0.0, hi[2] - lo[2]));
   }
-  const double whole = std::max(swatch.length(), swatch.width());
-  if (sides.empty() || !(whole > 0)) return kSize;
+  if (sides.empty()) return size;
   auto median = [](std::vector<double>& v) {
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
     return v[v.size() / 2];
   };
-  double size = std::min(kSize, kElementSize * whole / median(sides));
+  size = std::min(size, kElementSize * whole / median(sides));
   const double h = median(heights);
   if (h > 0) size = std::min(size, kElementHeight * whole / h);
   return size;

@@ -214,7 +214,9 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 /// height (z, along the normal) at most 1/32: lifted along the normals over
 /// curved ground an element splays in proportion to its height, so a pebble
 /// as tall as it is wide gets smaller than a flat ring of the same width.
-/// Swatches of threads only (weaves) keep 0.25.
+/// Threads (elements that are not compact: a weave's) are capped at 1/8 of
+/// the diagonal in length: on curved ground a longer thread runs past the
+/// patch that can express it and is cut into pieces (decision 102).
 double default_surface_quilt_size(const Swatch& swatch);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
