@@ -247,13 +247,14 @@ std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<ch
   return out;
 }
 
+bool is_compact_extent(double a, double b, double ratio) { return std::max(a, b) <= ratio * std::min(a, b); }
+
 bool is_compact_element(const ElementMesh& m, double ratio) {
   if (m.points.empty()) return true;
   double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
   for (const P3& p : m.points)
     for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
-  const double a = hi[0] - lo[0], b = hi[1] - lo[1];
-  return std::max(a, b) <= ratio * std::min(a, b);
+  return is_compact_extent(hi[0] - lo[0], hi[1] - lo[1], ratio);
 }
 
 double smallest_element_gap(const std::vector<ElementMesh>& elements, double limit) {

@@ -49,6 +49,8 @@ std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<ch
 /// An element is compact if the larger side of its xy bounding box is at
 /// most `ratio` times the smaller one (a ring, a pebble; not a thread).
 bool is_compact_element(const ElementMesh& m, double ratio = 2.5);
+/// The same rule for an xy bounding box of sides a and b.
+bool is_compact_extent(double a, double b, double ratio = 2.5);
 
 /// The smallest distance between two different elements of `elements`
 /// (vertex to triangle); 0 if there are fewer than two or two intersect;

@@ -1795,20 +1795,15 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 }
 
 namespace {
-// The larger xy side of every element that is not compact (a thread).
-std::vector<double> thread_sides(const Swatch& s) {
-  std::vector<std::vector<int>> tris_of(s.elements.size());
-  for (std::size_t t = 0; t < s.mesh.tris.size(); ++t) tris_of[static_cast<std::size_t>(s.face_element[t])].push_back(static_cast<int>(t));
-  std::vector<double> out;
-  for (const std::vector<int>& tris : tris_of) {
-    const ElementMesh m = extract_triangles(s.mesh, tris);
-    if (m.points.empty() || is_compact_element(m)) continue;
-    double lo[2] = {m.points[0][0], m.points[0][1]}, hi[2] = {lo[0], lo[1]};
-    for (const P3& q : m.points)
-      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
-    out.push_back(std::max(hi[0] - lo[0], hi[1] - lo[1]));
+// The larger xy side of the swatch's longest thread (an element that is not
+// compact), from the element boxes make_swatch keeps; 0 when there is none.
+double longest_thread(const Swatch& s) {
+  double longest = 0;
+  for (const SwatchElement& el : s.elements) {
+    const double a = el.bbox_max[0] - el.bbox_min[0], b = el.bbox_max[1] - el.bbox_min[1];
+    if (!is_compact_extent(a, b)) longest = std::max({longest, a, b});
   }
-  return out;
+  return longest;
 }
 }  // namespace
 
@@ -1819,11 +1814,8 @@ double default_surface_quilt_size(const Swatch& swatch) {
   double size = kSize;
   // Threads: the longest at most 1/8 of the diagonal, so that it follows a
   // patch it can be expressed in (decision 102, session 24).
-  const std::vector<double> threads = thread_sides(swatch);
-  if (!threads.empty()) {
-    const double longest = *std::max_element(threads.begin(), threads.end());
-    if (longest > 0) size = std::min(size, kThreadLength * whole / longest);
-  }
+  const double longest = longest_thread(swatch);
+  if (longest > 0) size = std::min(size, kThreadLength * whole / longest);
   std::vector<double> sides, heights;  // larger xy side and z extent of each compact element
   for (const ElementMesh& m : compact_swatch_elements(swatch)) {
     double lo[3], hi[3];
