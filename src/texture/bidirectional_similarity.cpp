@@ -112,17 +112,24 @@ std::vector<double> project(const Patches& p, const PcaBasis& pca) {
 // bound reaches the best full SSD found so far is pruned, and each point the
 // tree offers is re-ranked with the full SSD. The result is the exact minimum
 // (the visiting order only changes the speed). With max_candidates > 0 the
-// search stops after that many full evaluations (approximate, an upper bound).
+// search stops after that many full evaluations (approximate, an upper
+// bound); so does a search with eps > 0, which skips the tree nodes whose
+// bound is within a factor 1 + eps of the best (nanoflann's eps).
+// `visits` counts the looks at the bound: one per tree node or offered point.
 struct NearestByBound : KdIndex<double>::Visitor {
   const float* query;
   const Patches* base;
   std::size_t max_candidates;
   double best = std::numeric_limits<double>::infinity();
   std::size_t evaluated = 0;
+  mutable std::size_t visits = 0;
   NearestByBound(const float* q, const Patches* b, std::size_t m) : query(q), base(b), max_candidates(m) {}
   // Slack for the rounding of the projection (the bound is exact in exact
   // arithmetic).
-  double bound() const override { return best * (1.0 + 1e-9); }
+  double bound() const override {
+    ++visits;
+    return best * (1.0 + 1e-9);
+  }
   bool add(double, std::uint32_t index) override {
     best = std::min(best, ssd_bounded(query, base->row(index), base->dim, best));
     ++evaluated;
@@ -130,11 +137,16 @@ struct NearestByBound : KdIndex<double>::Visitor {
   }
 };
 
-// Mean over `queries` of the distance to the nearest patch of `base`.
-// `subset`: the query indices to average over (empty = all).
+struct SearchCost {
+  std::size_t evaluations = 0, visits = 0;
+};
+
+// Mean over `queries` of the distance to the nearest patch of `base`; adds the
+// search's work to `cost`. `subset`: the query indices to average over (empty = all).
 double mean_nearest(const Patches& queries, const Patches& base, const PcaBasis* pca,
                     const std::vector<double>& qproj, const std::vector<double>& bproj,
-                    std::size_t max_candidates, const std::vector<std::size_t>& subset = {}) {
+                    std::size_t max_candidates, float eps, SearchCost& cost,
+                    const std::vector<std::size_t>& subset = {}) {
   std::vector<std::size_t> all;
   if (subset.empty()) {
     all.resize(queries.count);
@@ -142,6 +154,7 @@ double mean_nearest(const Patches& queries, const Patches& base, const PcaBasis*
   }
   const std::vector<std::size_t>& qs = subset.empty() ? all : subset;
   std::vector<double> best(qs.size());
+  std::vector<std::size_t> evaluated(qs.size(), base.count), visits(qs.size(), 0);
   if (!pca) {
     tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
       const std::size_t i = qs[k];
@@ -155,9 +168,15 @@ double mean_nearest(const Patches& queries, const Patches& base, const PcaBasis*
     tbb::parallel_for(std::size_t(0), qs.size(), [&](std::size_t k) {
       const std::size_t i = qs[k];
       NearestByBound r(queries.row(i), &base, max_candidates);
-      tree.search(qproj.data() + i * d, r);
+      tree.search(qproj.data() + i * d, r, eps);
       best[k] = r.best;
+      evaluated[k] = r.evaluated;
+      visits[k] = r.visits;
     });
+  }
+  for (std::size_t k = 0; k < qs.size(); ++k) {
+    cost.evaluations += evaluated[k];
+    cost.visits += visits[k];
   }
   double sum = 0;
   for (double v : best) sum += v;
@@ -178,6 +197,7 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
   if (opt.stride < 1) bad("stride " + std::to_string(opt.stride) + " < 1");
   if (opt.exemplar_stride < 1) bad("exemplar_stride " + std::to_string(opt.exemplar_stride) + " < 1");
   if (opt.max_candidates < 0) bad("max_candidates " + std::to_string(opt.max_candidates) + " < 0");
+  if (!(opt.search_eps >= 0.f)) bad("search_eps " + std::to_string(opt.search_eps) + " < 0");
   if (opt.pca_dims < 1) bad("pca_dims " + std::to_string(opt.pca_dims) + " < 1");
   if (output.width < opt.patch || output.height < opt.patch)
     bad("patch " + std::to_string(opt.patch) + " larger than the output (" +
@@ -200,17 +220,21 @@ BidirectionalResult bidirectional_similarity(const Image& output, const Image& e
   const Patches exq = opt.exemplar_stride > 1 ? extract(exemplar, opt.patch, opt.periodic_exemplar, opt.exemplar_stride)
                                               : Patches{};
   const Patches& queries = opt.exemplar_stride > 1 ? exq : ex;
+  SearchCost cost;
   if (opt.brute_force) {
     std::vector<double> none;
-    r.coherence = mean_nearest(out, ex, nullptr, none, none, 0);
-    r.completeness = mean_nearest(queries, out, nullptr, none, none, 0);
+    r.coherence = mean_nearest(out, ex, nullptr, none, none, 0, 0.f, cost);
+    r.completeness = mean_nearest(queries, out, nullptr, none, none, 0, 0.f, cost);
   } else {
     const PcaBasis pca = fit_patch_pca(ex, out, std::min(opt.pca_dims, ex.dim));
     const std::vector<double> pout = project(out, pca), pex = project(ex, pca);
-    r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates);
+    r.coherence = mean_nearest(out, ex, &pca, pout, pex, opt.max_candidates, opt.search_eps, cost);
     const std::vector<double> pq = opt.exemplar_stride > 1 ? project(queries, pca) : std::vector<double>();
-    r.completeness = mean_nearest(queries, out, &pca, opt.exemplar_stride > 1 ? pq : pex, pout, opt.max_candidates);
+    r.completeness = mean_nearest(queries, out, &pca, opt.exemplar_stride > 1 ? pq : pex, pout, opt.max_candidates,
+                                  opt.search_eps, cost);
   }
+  r.evaluations = cost.evaluations;
+  r.visits = cost.visits;
   r.total = r.coherence + r.completeness;
   return r;
 }

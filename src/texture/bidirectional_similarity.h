@@ -48,6 +48,10 @@ struct BidirectionalOptions {
   /// 0 (default) = exact. > 0 = approximate: at most this many full distances per
   /// query, the best seen kept (figures can only be too high).
   int max_candidates = 0;
+  /// 0 (default) = exact. > 0 = approximate: the kd-tree skips a node
+  /// unless (1 + search_eps) times its PCA bound stays within the best full
+  /// distance so far (nanoflann's eps); figures can only be too high.
+  float search_eps = 0.f;
   /// Brute-force search instead of the kd-tree (reference; slow).
   bool brute_force = false;
   /// Optional validity mask of the output (width*height; empty = all valid):
@@ -62,6 +66,10 @@ struct BidirectionalResult {
   double total = 0.0;
   std::size_t output_patches = 0;
   std::size_t exemplar_patches = 0;
+  /// The search's work, both ways (deterministic): full patch distances
+  /// computed, and kd-tree nodes plus offered points looked at.
+  std::size_t evaluations = 0;
+  std::size_t visits = 0;
 };
 
 BidirectionalResult bidirectional_similarity(const Image& output, const Image& exemplar,

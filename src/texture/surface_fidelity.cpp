@@ -574,6 +574,7 @@ SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, 
   if (o.patch < 1 || o.patch > o.chart_texels) fail("patch must be in 1..chart_texels");
   if (o.stride < 1) fail("stride must be >= 1");
   if (o.max_candidates < 0) fail("max_candidates must be >= 0");
+  if (!(o.search_eps >= 0.f)) fail("search_eps must be >= 0");
   if (o.exemplar_stride < 0) fail("exemplar_stride must be >= 0");
   if (frames.x_axis.size() != mesh.number_of_faces() || frames.y_axis.size() != mesh.number_of_faces())
     fail("texture frames have " + std::to_string(frames.x_axis.size()) + " entries for " +
@@ -628,6 +629,7 @@ SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, 
   bo.stride = o.stride;
   bo.periodic_exemplar = o.periodic_exemplar;
   bo.max_candidates = o.max_candidates;
+  bo.search_eps = o.search_eps;
   bo.exemplar_stride = o.exemplar_stride;
   if (bo.exemplar_stride == 0) {
     const double patches = double(std::max(1, ex.width - o.patch + 1)) * std::max(1, ex.height - o.patch + 1);

@@ -140,8 +140,13 @@ struct SurfaceFidelityOptions {
   int patch = 7;
   int stride = 2;
   bool periodic_exemplar = false;
-  /// Full distances per nearest-neighbour query (0 = exact). Default 64.
-  int max_candidates = 64;
+  /// Nearest-neighbour search: at most this many full distances per query
+  /// (0 = unbounded), kd-tree nodes skipped unless within a factor 1 +
+  /// search_eps of the best (0 = exact pruning). Defaults 256 and 3: near
+  /// the exact figure for about a quarter of the work of 64 / 0
+  /// (BidirectionalOptions; decision 201). Both 0 = exact.
+  int max_candidates = 256;
+  float search_eps = 3.f;
   /// Every exemplar_stride-th exemplar patch queries the charts for
   /// completeness (BidirectionalOptions::exemplar_stride), >= 0; 0 (default)
   /// = the smallest step >= 2 that keeps the queries at most 20000.

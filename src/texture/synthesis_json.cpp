@@ -17,6 +17,7 @@ nlohmann::json to_json(const BidirectionalResult& r, const BidirectionalOptions&
           {"stride", opt.stride},
           {"exemplar_stride", opt.exemplar_stride},
           {"approximate_max_candidates", opt.max_candidates},
+          {"approximate_search_eps", opt.search_eps},
           {"coherence", r.coherence},
           {"completeness", r.completeness},
           {"total", r.total}};

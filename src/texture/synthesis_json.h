@@ -20,7 +20,7 @@ nlohmann::json to_json(const ElResult& result);
 
 /// Bidirectional similarity (Simakov et al. 2008) with the settings that
 /// measured it: "patch", "stride", "exemplar_stride",
-/// "approximate_max_candidates" (0 = exact) and the distances "coherence",
+/// "approximate_max_candidates" (0 = exact), "approximate_search_eps" (0 = exact) and the distances "coherence",
 /// "completeness", "total" (mean squared difference per value, squared image
 /// units).
 nlohmann::json to_json(const BidirectionalResult& result, const BidirectionalOptions& opt);

@@ -45,9 +45,11 @@ TEST(SynthesisJson, BidirectionalSimilarityCarriesItsSettings) {
   o.stride = 2;
   o.exemplar_stride = 3;
   o.max_candidates = 256;
+  o.search_eps = 3.f;
   const nlohmann::json j = to_json(r, o);
   EXPECT_EQ(keys(j), (std::set<std::string>{"patch", "stride", "exemplar_stride", "approximate_max_candidates",
-                                            "coherence", "completeness", "total"}));
+                                            "approximate_search_eps", "coherence", "completeness", "total"}));
+  EXPECT_EQ(j["approximate_search_eps"], 3.0);
   EXPECT_EQ(j["patch"], 5);
   EXPECT_EQ(j["stride"], 2);
   EXPECT_EQ(j["exemplar_stride"], 3);

@@ -199,6 +199,9 @@ TEST(BidirectionalSimilarity, VerbatimCopyIsCoherentAndKdTreeMatchesBruteForce) 
     EXPECT_NEAR(a.completeness, b.completeness, 1e-9 * b.completeness);
   }
   EXPECT_THROW(bidirectional_similarity(copy, ex, {0}), InvalidInputError);
+  BidirectionalOptions negative = o;
+  negative.search_eps = -1.f;
+  EXPECT_THROW(bidirectional_similarity(copy, ex, negative), InvalidInputError);
   EXPECT_THROW(bidirectional_similarity(Image(), ex), InvalidInputError);
   EXPECT_THROW(bidirectional_similarity(Image(8, 8, 1), ex), InvalidInputError);
 }

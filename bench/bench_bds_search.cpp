@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The surface-fidelity figure's nearest-neighbour search (surface_fidelity.h,
+// texture/bidirectional_similarity): its cost and how far its bounded
+// settings move the figures, on the charts of a real textured surface.
+//
+// Reads a textured mesh as the CLI writes it (OBJ with corner UVs and its
+// atlas PNG, e.g. `surftex patches ... -o DIR`: DIR/mesh.obj, DIR/mesh.png),
+// the exemplar and the texel size (the report's fidelity.texel_size), builds
+// the charts once (surface_fidelity at its defaults, frames along the atlas's
+// u axis) and then runs bidirectional_similarity on the charts and on the
+// graph-cut reference with each setting MAX_CANDIDATES/SEARCH_EPS ("0/0" is
+// the exact nearest neighbour, slow on big exemplars). The first line is
+// surface_fidelity at its defaults (which builds the charts). One JSON line
+// per setting: bds, bds_2d, ratio, the search's work (full distances and
+// tree visits, surface + reference) and seconds.
+//
+// Usage: bench_bds_search MESH.obj ATLAS.png EXEMPLAR TEXEL_SIZE [threads]
+//          [SETTINGS, e.g. "64/0;256/3;0/0"]
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "geometry/image_io.h"
+#include "geometry/mesh.h"
+#include "geometry/properties.h"
+#include "geometry/read_mesh.h"
+#include "geometry/timer.h"
+#include "texture/bidirectional_similarity.h"
+#include "texture/surface_fidelity.h"
+
+using namespace surftex;
+
+int main(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: bench_bds_search MESH.obj ATLAS.png EXEMPLAR TEXEL_SIZE [threads] [SETTINGS]\n");
+    return 2;
+  }
+  const int threads = argc > 5 ? std::atoi(argv[5]) : 2;
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+  Mesh mesh;
+  read_mesh(argv[1], mesh);
+  const Image atlas = read_image(argv[2]);
+  const Image exemplar = read_image(argv[3]);
+  SurfaceFidelityOptions so;
+  so.texel_size = std::atof(argv[4]);
+  const int w = atlas.width, h = atlas.height;
+  auto uv = find(mesh, kCornerUV);
+  if (!uv.second) {
+    std::fprintf(stderr, "bench_bds_search: %s has no corner UVs\n", argv[1]);
+    return 2;
+  }
+  const TextureFrames frames = frames_from_corner_coordinates(mesh, [&](std::size_t he) {
+    const UV t = uv.first[HalfedgeIndex(static_cast<Mesh::size_type>(he))];
+    return std::array<double, 2>{t[0] * w, (1.0 - t[1]) * h};
+  });
+  Timer t;
+  const SurfaceFidelityResult base = surface_fidelity(mesh, exemplar, atlas_color_source(mesh, atlas), frames, so);
+  std::printf("%s\n", nlohmann::json({{"setting", "surface_fidelity defaults"},
+                                      {"bds", base.bds},
+                                      {"bds_2d", base.bds_2d},
+                                      {"ratio", base.ratio},
+                                      {"evaluations", base.surface.evaluations + base.reference.evaluations},
+                                      {"visits", base.surface.visits + base.reference.visits},
+                                      {"seconds_bds", base.seconds_bds},
+                                      {"seconds_reference", base.seconds_reference},
+                                      {"seconds_total", t.seconds()},
+                                      {"charts", base.charts},
+                                      {"valid_texels", base.valid_texels}})
+                          .dump()
+                          .c_str());
+  std::fflush(stdout);
+  Image ex3(exemplar.width, exemplar.height, 3, 0.f);
+  for (int y = 0; y < exemplar.height; ++y)
+    for (int x = 0; x < exemplar.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        ex3.pixel(x, y)[c] = exemplar.pixel(x, y)[exemplar.channels >= 3 ? c : 0];
+  std::string settings = argc > 6 ? argv[6] : "";
+  std::stringstream ss(settings);
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    BidirectionalOptions bo;
+    bo.patch = so.patch;
+    bo.stride = so.stride;
+    const double patches = double(exemplar.width - so.patch + 1) * (exemplar.height - so.patch + 1);
+    bo.exemplar_stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(patches / 20000.0))));
+    bo.output_valid = base.mosaic_valid;
+    if (std::sscanf(item.c_str(), "%d/%f", &bo.max_candidates, &bo.search_eps) != 2) {
+      std::fprintf(stderr, "bench_bds_search: setting '%s' is not MAX_CANDIDATES/SEARCH_EPS\n", item.c_str());
+      return 2;
+    }
+    Timer ts;
+    const BidirectionalResult s = bidirectional_similarity(base.mosaic, ex3, bo);
+    const double t1 = ts.seconds();
+    ts.reset();
+    const BidirectionalResult r = bidirectional_similarity(base.reference_image, ex3, bo);
+    const double t2 = ts.seconds();
+    std::printf("%s\n", nlohmann::json({{"setting", item},
+                                        {"bds", s.total},
+                                        {"coherence", s.coherence},
+                                        {"bds_2d", r.total},
+                                        {"ratio", r.total > 0 ? s.total / r.total : 0.0},
+                                        {"evaluations", s.evaluations + r.evaluations},
+                                        {"visits", s.visits + r.visits},
+                                        {"seconds_bds", t1},
+                                        {"seconds_reference", t2}})
+                            .dump()
+                            .c_str());
+    std::fflush(stdout);
+  }
+  return 0;
+}
