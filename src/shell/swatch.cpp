@@ -32,14 +32,13 @@ Swatch make_swatch(const Mesh& mesh) {
   s.mesh = element_mesh_from(mesh);
   const int n = triangle_components(s.mesh, s.face_element);
   s.elements.assign(static_cast<std::size_t>(n), SwatchElement{});
-  std::vector<std::vector<int>> tris(static_cast<std::size_t>(n));
-  for (std::size_t t = 0; t < s.mesh.tris.size(); ++t) tris[s.face_element[t]].push_back(static_cast<int>(t));
+  const std::vector<ElementMesh> els = swatch_element_meshes(s);
   s.bbox_min = {1e300, 1e300, 1e300};
   s.bbox_max = {-1e300, -1e300, -1e300};
   double edge_sum = 0;
   std::size_t edges = 0;
   for (int e = 0; e < n; ++e) {
-    ElementMesh em = extract_triangles(s.mesh, tris[e]);
+    const ElementMesh& em = els[static_cast<std::size_t>(e)];
     SwatchElement& el = s.elements[e];
     el.faces = em.tris.size();
     el.closed = count_border_edges(em) == 0;
@@ -67,11 +66,7 @@ Swatch make_swatch(const Mesh& mesh) {
   if (!(s.length() > 0) || !(s.width() > 0))
     throw InvalidInputError("swatch: zero extent in x or y (" + std::to_string(s.length()) + " x " +
                             std::to_string(s.width()) + ")");
-  if (n > 1) {
-    std::vector<ElementMesh> els;
-    for (int e = 0; e < n; ++e) els.push_back(extract_triangles(s.mesh, tris[e]));
-    s.min_gap = smallest_element_gap(els, std::max(s.length(), s.width()));
-  }
+  if (n > 1) s.min_gap = smallest_element_gap(els, std::max(s.length(), s.width()));
   return s;
 }
 
@@ -147,6 +142,17 @@ Swatch load_swatch(const std::string& path) {
   Mesh m;
   read_mesh(path, m);
   return make_swatch(m);
+}
+
+std::vector<ElementMesh> swatch_element_meshes(const Swatch& s) {
+  std::size_t n = 0;
+  for (int e : s.face_element) n = std::max(n, static_cast<std::size_t>(e) + 1);
+  std::vector<std::vector<int>> tris(n);
+  for (std::size_t t = 0; t < s.face_element.size(); ++t) tris[static_cast<std::size_t>(s.face_element[t])].push_back(static_cast<int>(t));
+  std::vector<ElementMesh> out;
+  out.reserve(n);
+  for (const std::vector<int>& t : tris) out.push_back(extract_triangles(s.mesh, t));
+  return out;
 }
 
 ElementMesh swatch_element(const Swatch& s, int e) {

@@ -69,6 +69,9 @@ double swatch_element_spacing(const Swatch& swatch);
 const char* axis_name(int axis);
 /// read_mesh + make_swatch (any format read_mesh reads). Throws as both.
 Swatch load_swatch(const std::string& path);
+/// Every element's triangles as its own ElementMesh, in element order (one
+/// pass over the triangles; element e of face_element is entry e).
+std::vector<ElementMesh> swatch_element_meshes(const Swatch& swatch);
 /// The triangles of element `e` as their own ElementMesh.
 ElementMesh swatch_element(const Swatch& swatch, int e);
 

@@ -495,11 +495,8 @@ double spread13(const std::vector<P3>& pts) {
 // moved so that its xy centroid is the origin (swatch units, z kept): what
 // the scatter fill places one at a time.
 std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
-  std::vector<std::vector<int>> tris_of(s.elements.size());
-  for (std::size_t t = 0; t < s.mesh.tris.size(); ++t) tris_of[static_cast<std::size_t>(s.face_element[t])].push_back(static_cast<int>(t));
   std::vector<ElementMesh> out;
-  for (const std::vector<int>& tris : tris_of) {
-    ElementMesh m = extract_triangles(s.mesh, tris);
+  for (ElementMesh& m : swatch_element_meshes(s)) {
     if (m.points.empty() || !is_compact_element(m)) continue;
     double cx = 0, cy = 0;
     for (const P3& q : m.points) cx += q[0], cy += q[1];
