@@ -18,7 +18,6 @@
 //          [SETTINGS, e.g. "64/0;256/3;0/0"]
 #include <tbb/global_control.h>
 
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -28,10 +27,10 @@
 
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
-#include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/timer.h"
 #include "texture/bidirectional_similarity.h"
+#include "texture/image_ops.h"
 #include "texture/surface_fidelity.h"
 
 using namespace surftex;
@@ -49,16 +48,7 @@ int main(int argc, char** argv) {
   const Image exemplar = read_image(argv[3]);
   SurfaceFidelityOptions so;
   so.texel_size = std::atof(argv[4]);
-  const int w = atlas.width, h = atlas.height;
-  auto uv = find(mesh, kCornerUV);
-  if (!uv.second) {
-    std::fprintf(stderr, "bench_bds_search: %s has no corner UVs\n", argv[1]);
-    return 2;
-  }
-  const TextureFrames frames = frames_from_corner_coordinates(mesh, [&](std::size_t he) {
-    const UV t = uv.first[HalfedgeIndex(static_cast<Mesh::size_type>(he))];
-    return std::array<double, 2>{t[0] * w, (1.0 - t[1]) * h};
-  });
+  const TextureFrames frames = frames_from_atlas_uv(mesh, atlas.width, atlas.height);
   Timer t;
   const SurfaceFidelityResult base = surface_fidelity(mesh, exemplar, atlas_color_source(mesh, atlas), frames, so);
   std::printf("%s\n", nlohmann::json({{"setting", "surface_fidelity defaults"},
@@ -75,20 +65,12 @@ int main(int argc, char** argv) {
                           .dump()
                           .c_str());
   std::fflush(stdout);
-  Image ex3(exemplar.width, exemplar.height, 3, 0.f);
-  for (int y = 0; y < exemplar.height; ++y)
-    for (int x = 0; x < exemplar.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        ex3.pixel(x, y)[c] = exemplar.pixel(x, y)[exemplar.channels >= 3 ? c : 0];
+  const Image ex3 = as_rgb(exemplar);
   std::string settings = argc > 6 ? argv[6] : "";
   std::stringstream ss(settings);
   std::string item;
   while (std::getline(ss, item, ';')) {
-    BidirectionalOptions bo;
-    bo.patch = so.patch;
-    bo.stride = so.stride;
-    const double patches = double(exemplar.width - so.patch + 1) * (exemplar.height - so.patch + 1);
-    bo.exemplar_stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(patches / 20000.0))));
+    BidirectionalOptions bo = fidelity_similarity_options(so, ex3);
     bo.output_valid = base.mosaic_valid;
     if (std::sscanf(item.c_str(), "%d/%f", &bo.max_candidates, &bo.search_eps) != 2) {
       std::fprintf(stderr, "bench_bds_search: setting '%s' is not MAX_CANDIDATES/SEARCH_EPS\n", item.c_str());

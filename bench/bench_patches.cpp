@@ -37,6 +37,7 @@
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
 #include "geometry/timer.h"
+#include "texture/image_ops.h"
 #include "texture/patches/patch_texture.h"
 
 using namespace surftex;
@@ -57,19 +58,10 @@ Mesh cgal_mesh(const std::string& name) {
   return mesh;
 }
 
-Image rgb(const Image& ex) {  // as the CLI: grey replicated, alpha dropped
-  if (ex.channels == 3) return ex;
-  Image out(ex.width, ex.height, 3);
-  for (int y = 0; y < ex.height; ++y)
-    for (int x = 0; x < ex.width; ++x)
-      for (int c = 0; c < 3; ++c) out.at(x, y, c) = ex.at(x, y, ex.channels >= 3 ? c : 0);
-  return out;
-}
-
 void run_case(const std::string& name, const std::string& mesh_file, const std::string& texture,
               const std::string& out) {
   Mesh mesh = cgal_mesh(mesh_file);
-  const Image ex = rgb(read_image(std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/" + texture));
+  const Image ex = as_rgb(read_image(std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/" + texture));
   PatchTextureOptions to;  // the CLI's synthesis defaults; no PBR maps, no fidelity (not measured here)
   to.pbr_maps = false;
   to.fidelity = false;

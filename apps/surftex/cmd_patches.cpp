@@ -47,20 +47,14 @@ struct PatchArgs {
 
 // Exemplars as RGB (grey replicated, alpha dropped), optionally resized so
 // that the longer side is `size`.
-Image as_rgb(const Image& in, int size) {
+Image sized_rgb(const Image& in, int size) {
   Image img = in;
   if (size > 0 && std::max(img.width, img.height) != size) {
     const double s = static_cast<double>(size) / std::max(img.width, img.height);
     img = resize_bilinear(img, std::max(1, static_cast<int>(std::lround(img.width * s))),
                           std::max(1, static_cast<int>(std::lround(img.height * s))));
   }
-  if (img.channels == 3) return img;
-  Image out(img.width, img.height, 3);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        out.at(x, y, c) = img.at(x, y, img.channels >= 3 ? c : 0);
-  return out;
+  return as_rgb(img);
 }
 
 std::vector<int> parse_ids(const std::string& s) {
@@ -174,13 +168,13 @@ int run(const PatchArgs& a) {
   maps.roughness = read_exemplar_map(a.exemplar_roughness, "--exemplar-roughness", a.exemplar, colour);
   const nlohmann::json opaque = use_opaque_part(colour, {&maps.normal, &maps.height, &maps.roughness}, a.common);
   for (Image* m : {&maps.normal, &maps.height, &maps.roughness})
-    if (!m->empty()) *m = as_rgb(*m, a.exemplar_size);
-  std::vector<Image> ex{as_rgb(colour, a.exemplar_size)};
+    if (!m->empty()) *m = sized_rgb(*m, a.exemplar_size);
+  std::vector<Image> ex{sized_rgb(colour, a.exemplar_size)};
   nlohmann::json opaque2;
   if (!a.exemplar2.empty()) {
     Image second = read_image(a.exemplar2);
     opaque2 = use_opaque_part(second, {}, a.common, "the second exemplar (--exemplar2)");
-    ex.push_back(as_rgb(second, a.exemplar_size));
+    ex.push_back(sized_rgb(second, a.exemplar_size));
   }
   po.partition.max_angle_deg = a.max_angle;
   po.partition.max_faces = a.max_faces;

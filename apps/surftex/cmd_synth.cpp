@@ -118,8 +118,8 @@ int run(const SynthArgs& a) {
   BidirectionalOptions bo;
   bo.periodic_exemplar = a.periodic;
   bo.stride = std::max(1, std::min(w, h) / 128);  // subsample big outputs
-  bo.max_candidates = 256;                         // approximate (upper bound), bounded time
-  bo.search_eps = 3.f;                             // as the surface fidelity (decision 201)
+  bo.max_candidates = kReportMaxCandidates;  // approximate (an upper bound), as the surface fidelity
+  bo.search_eps = kReportSearchEps;
   // Completeness from at most ~16K exemplar positions (a regular subsample).
   const double ex_patches = double(exemplar.width) * exemplar.height;
   bo.exemplar_stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(ex_patches / 16384.0))));

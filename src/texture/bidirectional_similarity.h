@@ -29,6 +29,12 @@
 
 namespace surftex {
 
+/// The approximate search of the reports' figures (surface fidelity,
+/// `surftex synth`): BidirectionalOptions::max_candidates and search_eps
+/// (docs/decisions/201-surface-fidelity.md).
+inline constexpr int kReportMaxCandidates = 256;
+inline constexpr float kReportSearchEps = 3.f;
+
 struct BidirectionalOptions {
   /// Patch side k, 1..31. Default 7.
   int patch = 7;

@@ -33,6 +33,15 @@ Image luminance(const Image& img) {
   return out;
 }
 
+Image as_rgb(const Image& img) {
+  if (img.channels == 3) return img;
+  Image out(img.width, img.height, 3);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) out.at(x, y, c) = img.at(x, y, img.channels >= 3 ? c : 0);
+  return out;
+}
+
 Image crop(const Image& img, int x, int y, int w, int h, bool wrap) {
   require_image(img, "crop: image");
   if (w <= 0 || h <= 0)

@@ -15,6 +15,11 @@ namespace surftex {
 /// image returns its first channel. Output: 1 channel, same size.
 Image luminance(const Image& img);
 
+/// Three channels: the first three of an RGB(A) image (alpha dropped), a
+/// grey (or grey + alpha) image's first channel replicated; an RGB image is
+/// returned as it is.
+Image as_rgb(const Image& img);
+
 /// The w x h block starting at (x, y); coordinates wrap toroidally when
 /// `wrap`, else the block must lie inside `img`.
 Image crop(const Image& img, int x, int y, int w, int h, bool wrap = false);

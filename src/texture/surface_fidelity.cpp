@@ -255,15 +255,6 @@ std::vector<Chart> place_fitting_charts(const std::vector<FanTriangle>& tris, co
   return charts;
 }
 
-Image as_rgb(const Image& in) {
-  if (in.channels == 3) return in;
-  Image out(in.width, in.height, 3);
-  for (int y = 0; y < in.height; ++y)
-    for (int x = 0; x < in.width; ++x)
-      for (int c = 0; c < 3; ++c) out.at(x, y, c) = in.at(x, y, in.channels >= 3 ? c : 0);
-  return out;
-}
-
 SurfacePoint surface_point(const FanTriangle& t, const std::array<float, 3>& b) {
   SurfacePoint s;
   s.face = t.face;
@@ -624,17 +615,7 @@ SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, 
   }
   r.seconds_charts = timer.seconds();
   timer.reset();
-  BidirectionalOptions bo;
-  bo.patch = o.patch;
-  bo.stride = o.stride;
-  bo.periodic_exemplar = o.periodic_exemplar;
-  bo.max_candidates = o.max_candidates;
-  bo.search_eps = o.search_eps;
-  bo.exemplar_stride = o.exemplar_stride;
-  if (bo.exemplar_stride == 0) {
-    const double patches = double(std::max(1, ex.width - o.patch + 1)) * std::max(1, ex.height - o.patch + 1);
-    bo.exemplar_stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(patches / 20000.0))));
-  }
+  BidirectionalOptions bo = fidelity_similarity_options(o, ex);
   bo.output_valid = r.mosaic_valid;
   r.surface = bidirectional_similarity(r.mosaic, ex, bo);
   r.bds = r.surface.total;
@@ -667,6 +648,31 @@ SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, 
   return r;
 }
 
+BidirectionalOptions fidelity_similarity_options(const SurfaceFidelityOptions& o, const Image& exemplar) {
+  BidirectionalOptions bo;
+  bo.patch = o.patch;
+  bo.stride = o.stride;
+  bo.periodic_exemplar = o.periodic_exemplar;
+  bo.max_candidates = o.max_candidates;
+  bo.search_eps = o.search_eps;
+  bo.exemplar_stride = o.exemplar_stride;
+  if (bo.exemplar_stride == 0) {
+    const double patches =
+        double(std::max(1, exemplar.width - o.patch + 1)) * std::max(1, exemplar.height - o.patch + 1);
+    bo.exemplar_stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(patches / 20000.0))));
+  }
+  return bo;
+}
+
+TextureFrames frames_from_atlas_uv(const Mesh& mesh, int width, int height) {
+  auto uv = find(mesh, kCornerUV);
+  if (!uv.second) fail("the mesh has no corner UVs (kCornerUV)");
+  return frames_from_corner_coordinates(mesh, [&](std::size_t he) {
+    const UV t = uv.first[HalfedgeIndex(static_cast<Mesh::size_type>(he))];
+    return std::array<double, 2>{t[0] * width, (1.0 - t[1]) * height};
+  });
+}
+
 nlohmann::json fidelity_report(const Mesh& mesh, const Image& exemplar, const SurfaceColorFn& color,
                                const TextureFrames& frames, const std::vector<char>& seam_edges,
                                const SurfaceFidelityOptions& o) {
@@ -691,14 +697,9 @@ nlohmann::json fidelity_report(const Mesh& mesh, const Image& exemplar, const Su
 
 nlohmann::json atlas_fidelity_report(const Mesh& mesh, const Image& exemplar, const Image& atlas, double texel_size,
                                      bool face_directions, std::uint64_t seed) {
-  auto uv = find(mesh, kCornerUV);
-  if (!uv.second) fail("the mesh has no corner UVs (kCornerUV)");
-  const int w = atlas.width, h = atlas.height;
-  const TextureFrames frames = face_directions ? frames_from_face_directions(mesh)
-                                               : frames_from_corner_coordinates(mesh, [&](std::size_t he) {
-                                                   const UV t = uv.first[HalfedgeIndex(static_cast<Mesh::size_type>(he))];
-                                                   return std::array<double, 2>{t[0] * w, (1.0 - t[1]) * h};
-                                                 });
+  if (!find(mesh, kCornerUV).second) fail("the mesh has no corner UVs (kCornerUV)");
+  const TextureFrames frames =
+      face_directions ? frames_from_face_directions(mesh) : frames_from_atlas_uv(mesh, atlas.width, atlas.height);
   auto patch = find(mesh, kFacePatch);
   std::vector<char> seams;
   if (patch.second) {

@@ -90,6 +90,9 @@ TextureFrames frames_from_face_directions(const Mesh& mesh);
 /// and y over each face's first fan triangle.
 TextureFrames frames_from_corner_coordinates(const Mesh& mesh,
                                              const std::function<std::array<double, 2>(std::size_t halfedge)>& xy);
+/// frames_from_corner_coordinates of an atlas of width x height texels read
+/// through kCornerUV (u right, v up). Throws InvalidInputError without corner UVs.
+TextureFrames frames_from_atlas_uv(const Mesh& mesh, int width, int height);
 
 /// The texel size (mesh units per texel) a mapping's frames imply: the
 /// area-weighted median over faces of sqrt(|x_axis| |y_axis|) (for frames
@@ -145,8 +148,8 @@ struct SurfaceFidelityOptions {
   /// search_eps of the best (0 = exact pruning). Defaults 256 and 3: near
   /// the exact figure for about a quarter of the work of 64 / 0
   /// (BidirectionalOptions; decision 201). Both 0 = exact.
-  int max_candidates = 256;
-  float search_eps = 3.f;
+  int max_candidates = kReportMaxCandidates;
+  float search_eps = kReportSearchEps;
   /// Every exemplar_stride-th exemplar patch queries the charts for
   /// completeness (BidirectionalOptions::exemplar_stride), >= 0; 0 (default)
   /// = the smallest step >= 2 that keeps the queries at most 20000.
@@ -180,6 +183,11 @@ struct SurfaceFidelityResult {
 /// three are compared) or grey (replicated).
 SurfaceFidelityResult surface_fidelity(const Mesh& mesh, const Image& exemplar, const SurfaceColorFn& color,
                                        const TextureFrames& frames, const SurfaceFidelityOptions& options);
+
+/// The bidirectional-similarity settings surface_fidelity compares its
+/// charts and the reference with (patch, stride, periodic, search; the
+/// exemplar stride from the exemplar's size when 0), output_valid left empty.
+BidirectionalOptions fidelity_similarity_options(const SurfaceFidelityOptions& options, const Image& exemplar);
 
 /// The CLI's report block: to_json(surface_fidelity) plus "seam" (when
 /// seam_edges is non-empty); {"error": reason} when no chart fits.

@@ -13,6 +13,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "texture/graphcut_synthesis.h"
+#include "texture/image_ops.h"
 #include "texture/surface_fidelity.h"
 #include "texture/wrap_seam_ratio.h"
 #include "test_support.h"
@@ -20,14 +21,6 @@
 using namespace surftex;
 
 namespace {
-
-Image rgb(const Image& in) {
-  Image out(in.width, in.height, 3);
-  for (int y = 0; y < in.height; ++y)
-    for (int x = 0; x < in.width; ++x)
-      for (int c = 0; c < 3; ++c) out.at(x, y, c) = in.at(x, y, in.channels >= 3 ? c : 0);
-  return out;
-}
 
 // A flat square [0, tiles]^2 (z = 0) of cells x cells grid squares per tile.
 // Corner UVs: per tile [0,1]^2 (each tile a verbatim copy of the atlas) when
@@ -51,14 +44,6 @@ void tiled_square(Mesh& mesh, int tiles, int cells, bool per_tile, std::vector<i
   }
 }
 
-// Frames from the corner UVs of an atlas of w x h pixels (v up).
-TextureFrames uv_frames(const Mesh& mesh, int w, int h) {
-  auto uv = find(mesh, kCornerUV).first;
-  return frames_from_corner_coordinates(mesh, [&](std::size_t he) {
-    const UV t = uv[HalfedgeIndex(static_cast<Mesh::size_type>(he))];
-    return std::array<double, 2>{t[0] * w, (1.0 - t[1]) * h};
-  });
-}
 
 }  // namespace
 
@@ -71,7 +56,7 @@ TextureFrames uv_frames(const Mesh& mesh, int w, int h) {
 // copy shows every exemplar patch, so its completeness is near 0; the seam
 // ratio and, where sources are known, long_run_fraction catch it.)
 TEST(SurfaceFidelity, RanksAVerbatimTilingWithSeamsBelowASeamlessSynthesis) {
-  const Image ex = rgb(read_image(test::shared_data("textures/brick_small_96.png")));
+  const Image ex = as_rgb(read_image(test::shared_data("textures/brick_small_96.png")));
   ASSERT_EQ(ex.width, 96);
   EXPECT_GT(wrap_seam_ratio(ex), 1.3) << "the exemplar would tile";
   const int tiles = 3;
@@ -83,9 +68,9 @@ TEST(SurfaceFidelity, RanksAVerbatimTilingWithSeamsBelowASeamlessSynthesis) {
   const Image synth = graphcut_synthesize(ex, tiles * ex.width, tiles * ex.height, GraphcutOptions{});
   SurfaceFidelityOptions o;
   o.texel_size = 1.0 / ex.width;
-  const auto f_tiled = surface_fidelity(tiled, ex, atlas_color_source(tiled, ex), uv_frames(tiled, ex.width, ex.height), o);
+  const auto f_tiled = surface_fidelity(tiled, ex, atlas_color_source(tiled, ex), frames_from_atlas_uv(tiled, ex.width, ex.height), o);
   const auto f_smooth = surface_fidelity(smooth, ex, atlas_color_source(smooth, synth),
-                                         uv_frames(smooth, synth.width, synth.height), o);
+                                         frames_from_atlas_uv(smooth, synth.width, synth.height), o);
   ASSERT_GE(f_tiled.charts, 4);
   EXPECT_EQ(f_tiled.charts, f_smooth.charts);  // same geometry, same seed: the same charts
   EXPECT_EQ(f_tiled.bds_2d, f_smooth.bds_2d);
@@ -107,11 +92,11 @@ TEST(SurfaceFidelity, RanksAVerbatimTilingWithSeamsBelowASeamlessSynthesis) {
 // match the exemplar far better than the same surface read in a frame turned
 // by a quarter turn (the exemplar's stripes would then run the other way).
 TEST(SurfaceFidelity, ChartsAreReadInTheTexturesOwnFrame) {
-  const Image ex = rgb(read_image(test::shared_data("textures/stripes_blue_white_256.png")));
+  const Image ex = as_rgb(read_image(test::shared_data("textures/stripes_blue_white_256.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 1, 32, false, ids);
-  const TextureFrames right = uv_frames(m, ex.width, ex.height);
+  const TextureFrames right = frames_from_atlas_uv(m, ex.width, ex.height);
   TextureFrames turned;
   turned.x_axis = right.y_axis;
   for (auto x : right.x_axis) turned.y_axis.push_back({-x[0], -x[1], -x[2]});
@@ -128,7 +113,7 @@ TEST(SurfaceFidelity, ChartsAreReadInTheTexturesOwnFrame) {
 // The same figures for 1 and 2 threads; every pixel of a chart fully inside
 // a flat square is valid.
 TEST(SurfaceFidelity, SameFiguresForAnyThreadCount) {
-  const Image ex = rgb(read_image(test::shared_data("textures/leather_64.png")));
+  const Image ex = as_rgb(read_image(test::shared_data("textures/leather_64.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 2, 16, true, ids);
@@ -138,11 +123,11 @@ TEST(SurfaceFidelity, SameFiguresForAnyThreadCount) {
   SurfaceFidelityResult a, b;
   {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
-    a = surface_fidelity(m, ex, atlas_color_source(m, ex), uv_frames(m, ex.width, ex.height), o);
+    a = surface_fidelity(m, ex, atlas_color_source(m, ex), frames_from_atlas_uv(m, ex.width, ex.height), o);
   }
   {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 2);
-    b = surface_fidelity(m, ex, atlas_color_source(m, ex), uv_frames(m, ex.width, ex.height), o);
+    b = surface_fidelity(m, ex, atlas_color_source(m, ex), frames_from_atlas_uv(m, ex.width, ex.height), o);
   }
   EXPECT_EQ(a.bds, b.bds);
   EXPECT_EQ(a.bds_2d, b.bds_2d);
@@ -157,14 +142,14 @@ TEST(SurfaceFidelity, SameFiguresForAnyThreadCount) {
 // slack), which walked most of the tree in 16 PCA dimensions: the report's
 // figure cost more than the synthesis with a 512 px exemplar (decision 201).
 TEST(SurfaceFidelity, DefaultSearchIsNearTheExactFigureForAFractionOfTheWork) {
-  const Image ex = rgb(read_image(test::shared_data("textures/pebbles_256.png")));
+  const Image ex = as_rgb(read_image(test::shared_data("textures/pebbles_256.png")));
   GraphcutOptions go;
   go.seed = 3;
   const Image synth = graphcut_synthesize(ex, 2 * ex.width, 2 * ex.height, go);
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 1, 24, false, ids);
-  const TextureFrames frames = uv_frames(m, synth.width, synth.height);
+  const TextureFrames frames = frames_from_atlas_uv(m, synth.width, synth.height);
   auto run = [&](int candidates, float eps) {
     SurfaceFidelityOptions o;
     o.texel_size = 1.0 / synth.width;
@@ -184,12 +169,12 @@ TEST(SurfaceFidelity, DefaultSearchIsNearTheExactFigureForAFractionOfTheWork) {
 }
 
 TEST(SurfaceFidelity, BadInputIsRefusedNamingTheProblem) {
-  const Image ex = rgb(read_image(test::shared_data("textures/pebbles_256.png")));
+  const Image ex = as_rgb(read_image(test::shared_data("textures/pebbles_256.png")));
   Mesh m;
   std::vector<int> ids;
   tiled_square(m, 1, 8, false, ids);
   const auto src = atlas_color_source(m, ex);
-  const TextureFrames fr = uv_frames(m, ex.width, ex.height);
+  const TextureFrames fr = frames_from_atlas_uv(m, ex.width, ex.height);
   SurfaceFidelityOptions o;
   EXPECT_THROW(surface_fidelity(m, ex, src, fr, o), InvalidInputError);  // texel size 0
   o.texel_size = 1.0 / 256;

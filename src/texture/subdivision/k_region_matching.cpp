@@ -16,6 +16,7 @@
 #include "geometry/polygon_util.h"
 #include "geometry/properties.h"
 #include "texture/gaussian_pyramid.h"
+#include "texture/image_ops.h"
 
 namespace surftex {
 namespace {
@@ -200,11 +201,7 @@ int region_k(double region_texels, int level, bool pyramid, double r_scale, doub
 ExemplarLevels make_exemplar_levels(const Image& exemplar, bool pyramid, int levels, int bounded_levels) {
   if (exemplar.empty()) throw InvalidInputError("make_exemplar_levels: the exemplar image is empty");
   if (bounded_levels < 0) throw InvalidInputError("make_exemplar_levels: bounded_levels must be >= 0");
-  Image rgb(exemplar.width, exemplar.height, 3);
-  for (int y = 0; y < exemplar.height; ++y)
-    for (int x = 0; x < exemplar.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        rgb.at(x, y, c) = exemplar.at(x, y, exemplar.channels >= 3 ? c : 0);
+  const Image rgb = as_rgb(exemplar);
   ExemplarLevels ex;
   ex.pyramid = pyramid;
   auto build = [&](bool toroidal) {

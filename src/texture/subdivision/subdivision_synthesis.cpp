@@ -100,15 +100,6 @@ Image reduce_exemplar(const Image& img, int w, int h, bool periodic) {
   return resize_bilinear(cur, w, h, periodic);
 }
 
-Image to_rgb(const Image& in) {
-  if (in.channels == 3) return in;
-  Image out(in.width, in.height, 3);
-  for (int y = 0; y < in.height; ++y)
-    for (int x = 0; x < in.width; ++x)
-      for (int c = 0; c < 3; ++c) out.at(x, y, c) = in.at(x, y, in.channels >= 3 ? c : 0);
-  return out;
-}
-
 // detail_kept of an image's luminance (one channel).
 double luminance_detail_kept(const Image& lum, double scale) {
   const int w = lum.width, h = lum.height;
@@ -874,7 +865,7 @@ namespace {
 // and whether it wraps (issue 18 item 2): decided on the input exemplar, at
 // its own resolution (decision 207), and a periodic one is reduced wrapping.
 void prepare_exemplar(const Image& exemplar, const SubdivisionSynthesisOptions& opt, SubdivisionSynthesisResult& res) {
-  const Image rgb = to_rgb(exemplar);
+  const Image rgb = as_rgb(exemplar);
   if (rgb.width >= 2 && rgb.height >= 2) {
     // Windows of the matching neighbourhood's side (region_texels, odd).
     const int window = 2 * static_cast<int>(opt.region_texels / 2) + 1;
