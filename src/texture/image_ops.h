@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Small image utilities shared by the synthesis code: luminance, crop,
-// bilinear resize and rotation (with or without toroidal wrap).
+// Small image utilities shared by the synthesis code: luminance, RGB
+// conversion, crop, bilinear resize and rotation (with or without toroidal
+// wrap).
 //
 // Inputs and outputs are surftex::Image (float, interleaved channels, (0,0)
-// top-left). Every function throws InvalidInputError (naming the argument)
-// on an empty image or an out-of-range parameter.
+// top-left). Every function but as_rgb throws InvalidInputError (naming the
+// argument) on an empty image or an out-of-range parameter.
 
 #include "geometry/image.h"
 
@@ -17,7 +18,7 @@ Image luminance(const Image& img);
 
 /// Three channels: the first three of an RGB(A) image (alpha dropped), a
 /// grey (or grey + alpha) image's first channel replicated; an RGB image is
-/// returned as it is.
+/// returned as it is, an empty image as an empty one.
 Image as_rgb(const Image& img);
 
 /// The w x h block starting at (x, y); coordinates wrap toroidally when
