@@ -20,11 +20,13 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "geometry/errors.h"
 #include "geometry/image_io.h"
 #include "geometry/mesh.h"
 #include "geometry/read_mesh.h"
@@ -35,12 +37,32 @@
 
 using namespace surftex;
 
-int main(int argc, char** argv) {
-  if (argc < 5) {
-    std::fprintf(stderr, "usage: bench_bds_search MESH.obj ATLAS.png EXEMPLAR TEXEL_SIZE [threads] [SETTINGS]\n");
-    return 2;
+namespace {
+
+struct Setting {
+  std::string text;
+  int max_candidates = 0;
+  float search_eps = 0;
+};
+
+// "C/EPS;C/EPS;...", checked before any work.
+std::vector<Setting> parse_settings(const std::string& list) {
+  std::vector<Setting> out;
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, ';');) {
+    Setting st{item};
+    if (std::sscanf(item.c_str(), "%d/%f", &st.max_candidates, &st.search_eps) != 2 || st.max_candidates < 0 ||
+        !(st.search_eps >= 0))
+      throw InvalidInputError("setting '" + item + "' is not MAX_CANDIDATES/SEARCH_EPS (both >= 0)");
+    out.push_back(st);
   }
+  return out;
+}
+
+int run(int argc, char** argv) {
   const int threads = argc > 5 ? std::atoi(argv[5]) : 2;
+  if (threads < 1) throw InvalidInputError("threads must be >= 1 (got '" + std::string(argv[5]) + "')");
+  const std::vector<Setting> settings = parse_settings(argc > 6 ? argv[6] : "");
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
   Mesh mesh;
   read_mesh(argv[1], mesh);
@@ -66,16 +88,12 @@ int main(int argc, char** argv) {
                           .c_str());
   std::fflush(stdout);
   const Image ex3 = as_rgb(exemplar);
-  std::string settings = argc > 6 ? argv[6] : "";
-  std::stringstream ss(settings);
-  std::string item;
-  while (std::getline(ss, item, ';')) {
+  for (const Setting& st : settings) {
+    const std::string& item = st.text;
     BidirectionalOptions bo = fidelity_similarity_options(so, ex3);
     bo.output_valid = base.mosaic_valid;
-    if (std::sscanf(item.c_str(), "%d/%f", &bo.max_candidates, &bo.search_eps) != 2) {
-      std::fprintf(stderr, "bench_bds_search: setting '%s' is not MAX_CANDIDATES/SEARCH_EPS\n", item.c_str());
-      return 2;
-    }
+    bo.max_candidates = st.max_candidates;
+    bo.search_eps = st.search_eps;
     Timer ts;
     const BidirectionalResult s = bidirectional_similarity(base.mosaic, ex3, bo);
     const double t1 = ts.seconds();
@@ -96,4 +114,19 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: bench_bds_search MESH.obj ATLAS.png EXEMPLAR TEXEL_SIZE [threads] [SETTINGS]\n");
+    return 2;
+  }
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
 }
