@@ -619,13 +619,18 @@ void Synthesizer::prepare_search_images() {
     pair_of[p] = e * K + k;
     needed[pair_of[p]] = 1;
   }
-  std::vector<int> slot(needed.size(), -1);
-  for (int e = 0; e < E; ++e)
-    for (int k = 0; k < K; ++k) {
-      if (!needed[e * K + k]) continue;
-      slot[e * K + k] = static_cast<int>(search_.size());
-      search_.push_back(&prep_->get(e, k));
-    }
+  // The needed rotations not built yet are built side by side (each build's
+  // own parallel part is small; isolated, see ElPreparedExemplars::get).
+  std::vector<int> slot(needed.size(), -1), pairs;
+  for (int i = 0; i < E * K; ++i)
+    if (needed[i]) pairs.push_back(i);
+  search_.resize(pairs.size());
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(0, static_cast<int>(pairs.size()), [&](int j) {
+      search_[j] = &prep_->get(pairs[j] / K, pairs[j] % K);
+    });
+  });
+  for (std::size_t j = 0; j < pairs.size(); ++j) slot[pairs[j]] = static_cast<int>(j);
   key_.assign(n, -1);
   for (std::size_t p = 0; p < n; ++p)
     if (pair_of[p] >= 0) key_[p] = slot[pair_of[p]];

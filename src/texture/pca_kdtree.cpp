@@ -105,6 +105,7 @@ struct Cloud {
 template <class T>
 struct VisitorSet {
   typename KdIndex<T>::Visitor* v;
+  const std::uint32_t* order;  // tree slot -> point index
   std::size_t n = 0;
   std::size_t size() const { return n; }
   bool full() const { return true; }
@@ -112,7 +113,7 @@ struct VisitorSet {
   bool addPoint(T d, std::uint32_t i) {
     if (d > v->bound()) return true;
     ++n;
-    return v->add(d, i);
+    return v->add(d, order[i]);
   }
 };
 
@@ -134,6 +135,29 @@ KdIndex<T>::KdIndex(std::vector<T> points, int dims) : points_(std::move(points)
     throw InvalidInputError("KdIndex: " + std::to_string(points_.size()) + " coordinates are not a multiple of " +
                             std::to_string(dims));
   tree_ = std::make_unique<Tree>(&points_, dims);
+  store_in_tree_order();
+}
+
+// The points rearranged in the tree's leaf order (each leaf's points then lie
+// together in memory instead of scattered over the cloud) and the tree's
+// accessor made the identity; order_ maps back. The tree, its visiting order
+// and hence every result are unchanged.
+template <class T>
+void KdIndex<T>::store_in_tree_order() {
+  auto& acc = tree_->index.vAcc;
+  const std::size_t n = acc.size();
+  const std::size_t d = static_cast<std::size_t>(dims_);
+  std::vector<T> moved(points_.size());
+  order_.resize(n);
+  slot_.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::size_t i = acc[j];
+    std::copy_n(points_.data() + i * d, d, moved.data() + j * d);
+    order_[j] = static_cast<std::uint32_t>(i);
+    slot_[i] = static_cast<std::uint32_t>(j);
+    acc[j] = j;
+  }
+  points_.swap(moved);
 }
 
 template <class T>
@@ -150,13 +174,15 @@ std::size_t KdIndex<T>::knn(const T* q, std::size_t k, float eps, std::uint32_t*
   nanoflann::KNNResultSet<T, std::uint32_t> rs(k);
   rs.init(index, d2);
   tree_->index.findNeighbors(rs, q, nanoflann::SearchParams(32, eps));
-  return rs.size();
+  const std::size_t r = rs.size();
+  for (std::size_t i = 0; i < r; ++i) index[i] = order_[index[i]];
+  return r;
 }
 
 template <class T>
 void KdIndex<T>::search(const T* q, Visitor& v, float eps) const {
   if (size() == 0) return;
-  VisitorSet<T> rs{&v};
+  VisitorSet<T> rs{&v, order_.data()};
   tree_->index.findNeighbors(rs, q, nanoflann::SearchParams(32, eps));
 }
 
@@ -164,7 +190,7 @@ template <class T>
 std::size_t KdIndex<T>::bytes() const {
   // Points, the permutation and about 2 n / 16 nodes of ~ (2 dims + 4) words.
   const std::size_t n = size();
-  return points_.size() * sizeof(T) + n * sizeof(std::uint32_t) +
+  return points_.size() * sizeof(T) + 3 * n * sizeof(std::uint32_t) +
          (2 * n / 16 + 1) * (2 * dims_ * sizeof(T) + 32);
 }
 

@@ -73,7 +73,7 @@ class KdIndex {
   KdIndex& operator=(const KdIndex&) = delete;
   std::size_t size() const;
   int dims() const { return dims_; }
-  const T* point(std::size_t i) const { return points_.data() + i * static_cast<std::size_t>(dims_); }
+  const T* point(std::size_t i) const { return points_.data() + slot_[i] * static_cast<std::size_t>(dims_); }
   /// The (up to) k nearest points to q, nearest first, (1+eps)-approximate
   /// (eps >= 0); writes index[0..r) and squared distance[0..r), returns r.
   std::size_t knn(const T* q, std::size_t k, float eps, std::uint32_t* index, T* squared_distance) const;
@@ -84,7 +84,9 @@ class KdIndex {
 
  private:
   struct Tree;
-  std::vector<T> points_;
+  void store_in_tree_order();
+  std::vector<T> points_;  // in the tree's leaf order
+  std::vector<std::uint32_t> order_, slot_;  // leaf slot -> point index, and back
   int dims_;
   std::unique_ptr<Tree> tree_;
 };

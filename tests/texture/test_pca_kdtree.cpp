@@ -27,6 +27,9 @@ TEST(PcaKdTree, KnnWithoutApproximationIsTheBruteForceNearest) {
   for (float& v : pts) v = g(rng);
   const KdIndex<float> tree(pts, dims);
   ASSERT_EQ(tree.size(), std::size_t(n));
+  // The index stores the points in its own order; point(i) is still the i-th given.
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < dims; ++k) ASSERT_EQ(tree.point(i)[k], pts[i * dims + k]) << "point " << i;
   for (int t = 0; t < 50; ++t) {
     float q[dims];
     for (float& v : q) v = g(rng);
