@@ -134,6 +134,13 @@ inline float short_list_ssd(const float* P, std::size_t ps, int Cr, const int* d
   return e;
 }
 
+// The lanes of a summed in lane order.
+__attribute__((always_inline)) inline float lane_sum(const V8& a) {
+  float e = 0.f;
+  for (int l = 0; l < kLanes; ++l) e += a[l];
+  return e;
+}
+
 // Pass-2 kernel: Gaussian-weighted SSD of the candidates ids[0..count),
 // into out. The window is stored per active row as nv groups of 8 offsets
 // starting at buffer offset roff[r]; weights are 0 at unknown offsets (and
@@ -147,7 +154,36 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
                                                              const int* ids, std::size_t count,
                                                              float* out) {
   const int ch = C > 0 ? C : Cr;
-  for (std::size_t j = 0; j < count; ++j) {
+  // Two candidates at a time share the loads of the weights and the window;
+  // each candidate's arithmetic is the same, in the same order, as alone.
+  std::size_t j = 0;
+  for (; j + 2 <= count; j += 2) {
+    const int ia = ids[j], ib = ids[j + 1];
+    V8 acc_a[2] = {{}, {}}, acc_b[2] = {{}, {}};
+    for (int r = 0; r < nrows; ++r)
+      for (int g = 0; g < nv; ++g) {
+        const std::size_t o = static_cast<std::size_t>(r) * nv + g;
+        V8 wv;
+        std::memcpy(&wv, w + o * kLanes, sizeof(V8));
+        V8 sa = {}, sb = {};
+        for (int c = 0; c < ch; ++c) {
+          V8 va, vb, tv;
+          const float* plane = planes + c * plane_size;
+          std::memcpy(&va, plane + ia + roff[r] + g * kLanes, sizeof(V8));
+          std::memcpy(&vb, plane + ib + roff[r] + g * kLanes, sizeof(V8));
+          std::memcpy(&tv, t + ((static_cast<std::size_t>(r) * ch + c) * nv + g) * kLanes,
+                      sizeof(V8));
+          const V8 da = va - tv, db = vb - tv;
+          sa += da * da;
+          sb += db * db;
+        }
+        acc_a[r & 1] += wv * sa;
+        acc_b[r & 1] += wv * sb;
+      }
+    out[j] = lane_sum(acc_a[0] + acc_a[1]);
+    out[j + 1] = lane_sum(acc_b[0] + acc_b[1]);
+  }
+  for (; j < count; ++j) {
     const int id = ids[j];
     V8 acc[2] = {{}, {}};
     for (int r = 0; r < nrows; ++r)
@@ -166,10 +202,7 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
         }
         acc[r & 1] += wv * sq;
       }
-    const V8 a = acc[0] + acc[1];
-    float e = 0.f;
-    for (int l = 0; l < kLanes; ++l) e += a[l];
-    out[j] = e;
+    out[j] = lane_sum(acc[0] + acc[1]);
   }
 }
 #define SURFTEX_WEIGHTED_ARGS                                                                 \
@@ -991,7 +1024,8 @@ void Synthesizer::synthesize_pixel(int p) {
                                         static_cast<std::size_t>(std::ceil(opt_.pick_fraction * m)));
   k = std::min(k, m);
   // Only the k best, in the total order (error, id), are needed.
-  std::partial_sort(scored_.begin(), scored_.begin() + k, scored_.end());
+  if (k < m) std::nth_element(scored_.begin(), scored_.begin() + k, scored_.end());
+  std::sort(scored_.begin(), scored_.begin() + k);
   if (opt_.error_tolerance >= 0) {
     const double limit = scored_[0].first * (1.0 + opt_.error_tolerance);
     std::size_t within = 1;
@@ -1014,7 +1048,7 @@ void Synthesizer::add_coherent_to_preselect() {
   std::sort(coh_.begin(), coh_.end());
   coh_.erase(std::unique(coh_.begin(), coh_.end()), coh_.end());
   const std::size_t n0 = pre_.size();
-  std::sort(pre_.begin(), pre_.end());
+  if (!std::is_sorted(pre_.begin(), pre_.end())) std::sort(pre_.begin(), pre_.end());
   for (int c : coh_)
     if (!std::binary_search(pre_.begin(), pre_.begin() + static_cast<std::ptrdiff_t>(n0), c)) pre_.push_back(c);
 }
