@@ -392,9 +392,10 @@ class PatchSynthesizer {
         candidates_(patches_.size(), 0),
         widened_(patches_.size(), 0),
         steps_(patches_.size() + opt.resynthesize.size()) {
-    const int P = static_cast<int>(patches_.size());
-    res_.images.assign(P, Image(R_, R_, C_, 0.f));
-    res_.sources.assign(P, std::vector<ElSource>(static_cast<std::size_t>(R_) * R_));
+    // Each patch's image and sources are allocated by its own task
+    // (store_inside), in parallel, not here.
+    res_.images.resize(patches_.size());
+    res_.sources.resize(patches_.size());
   }
 
   // Synthesises patch p (pass 0: main, 1: re-synthesis). available(q) says
@@ -518,6 +519,8 @@ class PatchSynthesizer {
   void store_inside(int p, const PixelBox& box, const ElResult& r) {
     const FlatPatch& fp = patches_[p];
     Image& img = res_.images[p];
+    if (img.empty()) img = Image(R_, R_, C_, 0.f);
+    if (res_.sources[p].empty()) res_.sources[p].resize(static_cast<std::size_t>(R_) * R_);
     for (std::size_t j = 0; j < box.size(); ++j) {
       const std::size_t i = box.raster(j, R_);
       if (fp.pixel[i] == PatchPixel::Inside) {
