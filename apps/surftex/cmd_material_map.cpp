@@ -82,10 +82,10 @@ std::vector<std::string> write_meshes(Mesh& mesh, const MaterialAsset& a, const 
   wo.height_texture = &a.bake.height;
   wo.metallic_roughness_texture = &a.metallic_roughness;
   wo.texture_repeat = false;
-  std::vector<std::string> files = write_mesh(obj, mesh, wo);
-  wo.height_texture = nullptr;
-  wo.vertex_scalar_property = "material";
-  for (const std::string& f : write_mesh(glb, mesh, wo)) files.push_back(f);
+  WriteMeshOptions go = wo;
+  go.height_texture = nullptr;
+  go.vertex_scalar_property = "material";
+  std::vector<std::string> files = write_obj_and_glb(obj, glb, mesh, wo, go);
   WriteMeshOptions po;
   po.overwrite = force;
   po.write_uvs = false;

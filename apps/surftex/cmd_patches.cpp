@@ -4,6 +4,7 @@
 // patch following a direction field; writes an atlas, OBJ+MTL, GLB, a render
 // and a report with timings and the on-surface seam figure.
 #include <CLI/CLI.hpp>
+#include <tbb/parallel_invoke.h>
 
 #include <array>
 #include <cstdio>
@@ -112,12 +113,16 @@ nlohmann::json run_pipeline(Mesh& mesh, const std::vector<Image>& exemplars, con
   wo.metallic_roughness_texture = &r.metallic_roughness;
   wo.texture_repeat = false;
   wo.write_colors = false;
-  write_mesh((fs::path(dir) / "mesh.obj").string(), mesh, wo);
-  wo.height_texture = nullptr;
-  write_mesh((fs::path(dir) / "mesh.glb").string(), mesh, wo);
-  ViewOptions view;
-  view.texture = &r.atlas.image;
-  write_image((fs::path(dir) / "render.png").string(), render_view(mesh, view));
+  WriteMeshOptions go = wo;
+  go.height_texture = nullptr;
+  // The OBJ and the GLB share their encoded maps; the render beside them.
+  tbb::parallel_invoke(
+      [&] { write_obj_and_glb((fs::path(dir) / "mesh.obj").string(), (fs::path(dir) / "mesh.glb").string(), mesh, wo, go); },
+      [&] {
+        ViewOptions view;
+        view.texture = &r.atlas.image;
+        write_image((fs::path(dir) / "render.png").string(), render_view(mesh, view));
+      });
   const double s_write = tout.seconds();
   nlohmann::json j = to_json(r);
   j["seconds"]["write"] = s_write;

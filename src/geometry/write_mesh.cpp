@@ -791,4 +791,21 @@ std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, c
   return {path};
 }
 
+std::vector<std::string> write_obj_and_glb(const std::string& obj, const std::string& glb, const Mesh& mesh,
+                                           const WriteMeshOptions& obj_opt, const WriteMeshOptions& glb_opt) {
+  std::vector<const Image*> shared;
+  for (const Image* im : {obj_opt.texture, obj_opt.normal_texture, obj_opt.metallic_roughness_texture})
+    if (im != nullptr && !im->empty() && (obj_opt.encoded_png == nullptr || obj_opt.encoded_png->count(im) == 0))
+      shared.push_back(im);
+  std::map<const Image*, std::string> pngs = obj_opt.encoded_png ? *obj_opt.encoded_png
+                                                                  : std::map<const Image*, std::string>{};
+  if (!shared.empty()) pngs.merge(encode_png(glb, shared));
+  WriteMeshOptions oo = obj_opt, go = glb_opt;
+  oo.encoded_png = go.encoded_png = &pngs;
+  std::vector<std::string> obj_files, glb_files;
+  tbb::parallel_invoke([&] { obj_files = write_mesh(obj, mesh, oo); }, [&] { glb_files = write_mesh(glb, mesh, go); });
+  obj_files.insert(obj_files.end(), glb_files.begin(), glb_files.end());
+  return obj_files;
+}
+
 }  // namespace surftex

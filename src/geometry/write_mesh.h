@@ -72,4 +72,12 @@ std::map<const Image*, std::string> encode_png(const std::string& beside, const 
 /// first, then an OBJ's .mtl and texture images), for the run's report.
 std::vector<std::string> write_mesh(const std::string& path, const Mesh& mesh, const WriteMeshOptions& opt = {});
 
+/// An OBJ and a GLB of one textured asset side by side: the maps both carry
+/// (obj_opt's texture, normal and metallic-roughness maps, when given and not
+/// already in obj_opt.encoded_png) encoded once, then the two files written in
+/// parallel; glb_opt's texture pointers must be the same images. Returns the
+/// OBJ's files, then the GLB. Throws like write_mesh.
+std::vector<std::string> write_obj_and_glb(const std::string& obj, const std::string& glb, const Mesh& mesh,
+                                           const WriteMeshOptions& obj_opt, const WriteMeshOptions& glb_opt);
+
 }  // namespace surftex

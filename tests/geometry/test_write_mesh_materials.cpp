@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -173,4 +174,47 @@ TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
     taken += test::file_bytes(e.path().string()) == ahead.at(&normal);
   EXPECT_EQ(taken, 2u);  // the colour file and the normal file
   EXPECT_NE(test::file_bytes(dir + "/c/m.glb"), test::file_bytes(dir + "/a/m.glb"));
+}
+
+// write_obj_and_glb: the two files of one asset written side by side, as
+// write_mesh writes each alone (the GLB without the 16-bit height map it does
+// not carry), every file listed, the OBJ's first, no temporary left behind.
+TEST(WriteMeshMaterials, ObjAndGlbSideBySideAreTheFilesEachWriterGives) {
+  Mesh m;
+  make_torus(m, 1.0, 0.4, 12, 6);
+  assign_torus_uvs(m, 1.0, 1.0, 1.0);
+  Image color(32, 16, 3), normal(32, 16, 3), height(32, 16, 1);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x) {
+      for (int c = 0; c < 3; ++c) color.at(x, y, c) = static_cast<float>((x * 5 + y * 9 + c * 7) % 32) / 31.f;
+      normal.at(x, y, 0) = static_cast<float>(x) / 31.f, normal.at(x, y, 1) = 0.5f, normal.at(x, y, 2) = 1.f;
+      height.at(x, y, 0) = static_cast<float>(y) / 15.f;
+    }
+  WriteMeshOptions o;
+  o.texture = &color;
+  o.normal_texture = &normal;
+  o.height_texture = &height;
+  WriteMeshOptions g = o;
+  g.height_texture = nullptr;
+  const std::string dir = test::temp_dir("obj_and_glb");
+  fs::create_directories(dir + "/a");
+  fs::create_directories(dir + "/b");
+  write_mesh(dir + "/a/m.obj", m, o);
+  write_mesh(dir + "/a/m.glb", m, g);
+  const std::vector<std::string> files = write_obj_and_glb(dir + "/b/m.obj", dir + "/b/m.glb", m, o, g);
+  ASSERT_GE(files.size(), 6u);  // obj, mtl, colour, normal, height, glb
+  EXPECT_EQ(files.front(), dir + "/b/m.obj");
+  EXPECT_EQ(files.back(), dir + "/b/m.glb");
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir + "/b")) {
+    const std::string name = e.path().filename().string();
+    EXPECT_EQ(test::file_bytes(e.path().string()), test::file_bytes(dir + "/a/" + name)) << name;
+    EXPECT_NE(std::find(files.begin(), files.end(), e.path().string()), files.end()) << name;
+    ++n;
+  }
+  EXPECT_EQ(n, files.size());
+  // The GLB embeds the very bytes of the OBJ's colour map (encoded once).
+  const std::string glb = test::file_bytes(dir + "/b/m.glb"), png = test::file_bytes(dir + "/b/m.png");
+  ASSERT_FALSE(png.empty());
+  EXPECT_NE(glb.find(png), std::string::npos);
 }
