@@ -80,21 +80,15 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
   go.height_texture = nullptr;
   go.write_colors = true;
   go.color_attribute = "_COLOR";
-  // The maps both the OBJ and the GLB carry are encoded once, then the three
-  // files side by side (each mostly one thread's PNG or text encoding); the
-  // render beside them (it reads the mesh only).
-  std::vector<const Image*> shared{&asset.color.image, &asset.normal};
-  if (!asset.metallic_roughness.empty()) shared.push_back(&asset.metallic_roughness);
-  std::map<const Image*, std::string> pngs;
-  ao.encoded_png = go.encoded_png = &pngs;
-  std::vector<std::string> ply_files, obj_files, glb_files;
+  // The PLY, and the OBJ and GLB sharing their encoded maps (each file mostly
+  // one thread's PNG or text encoding); the render beside them (it reads the
+  // mesh only).
+  std::vector<std::string> ply_files, obj_glb_files;
   double seconds_write = 0, seconds_render = 0;
   tbb::parallel_invoke(
       [&] {
-        pngs = encode_png(o.glb, shared);
         tbb::parallel_invoke([&] { ply_files = write_mesh(o.ply, mesh, wo); },
-                             [&] { obj_files = write_mesh(o.obj, *asset.mesh, ao); },
-                             [&] { glb_files = write_mesh(o.glb, *asset.mesh, go); });
+                             [&] { obj_glb_files = write_obj_and_glb(o.obj, o.glb, *asset.mesh, ao, go); });
         seconds_write = t.seconds();
       },
       [&] {
@@ -107,8 +101,7 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
         seconds_render = tr.seconds();
       });
   std::vector<std::string> files = ply_files;
-  files.insert(files.end(), obj_files.begin(), obj_files.end());
-  files.insert(files.end(), glb_files.begin(), glb_files.end());
+  files.insert(files.end(), obj_glb_files.begin(), obj_glb_files.end());
   j["seconds_write_mesh"] = seconds_write;
   j["atlas"] = to_json(asset);
   j["seconds_render"] = seconds_render;
