@@ -1024,8 +1024,7 @@ void Synthesizer::synthesize_pixel(int p) {
                                         static_cast<std::size_t>(std::ceil(opt_.pick_fraction * m)));
   k = std::min(k, m);
   // Only the k best, in the total order (error, id), are needed.
-  if (k < m) std::nth_element(scored_.begin(), scored_.begin() + k, scored_.end());
-  std::sort(scored_.begin(), scored_.begin() + k);
+  std::partial_sort(scored_.begin(), scored_.begin() + k, scored_.end());
   if (opt_.error_tolerance >= 0) {
     const double limit = scored_[0].first * (1.0 + opt_.error_tolerance);
     std::size_t within = 1;

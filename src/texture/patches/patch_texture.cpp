@@ -91,6 +91,7 @@ nlohmann::json to_json(const PatchTextureResult& t) {
                   {"flatten", r.seconds_flatten},     {"synthesis", r.seconds_synthesis},
                   {"atlas", t.seconds_atlas},         {"seam_metric", t.seconds_seam},
                   {"total", t.seconds_total}};
+  j["cpu_seconds_synthesis"] = t.cpu_seconds_synthesis;  // all threads: steadier than wall on a shared machine
   j["synthesis_share"] = r.seconds_synthesis / std::max(r.seconds_total, 1e-9);
   j["seam"] = {{"ratio", t.seam.ratio},
                {"mean_jump_across", t.seam.mean_across},
