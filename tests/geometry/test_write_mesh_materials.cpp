@@ -33,6 +33,21 @@ Image flat(float r, float g, float b) {
   return img;
 }
 
+// A colour, a normal and a 16-bit height map of 32 x 16 with distinct patterns.
+struct Maps {
+  Image color{32, 16, 3}, normal{32, 16, 3}, height{32, 16, 1};
+};
+Maps patterned_maps() {
+  Maps m;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x) {
+      for (int c = 0; c < 3; ++c) m.color.at(x, y, c) = static_cast<float>((x * 7 + y * 3 + c * 11) % 32) / 31.f;
+      m.normal.at(x, y, 0) = 0.5f, m.normal.at(x, y, 1) = static_cast<float>(y) / 15.f, m.normal.at(x, y, 2) = 1.f;
+      m.height.at(x, y, 0) = static_cast<float>(x) / 31.f;
+    }
+  return m;
+}
+
 // A torus with UVs whose faces use three materials by their index mod 3:
 // red texture, blue texture, and a plain green colour.
 Mesh three_material_torus(std::vector<MeshMaterial>& mats) {
@@ -129,13 +144,8 @@ TEST(WriteMeshMaterials, MapsEncodedAheadGiveTheSameFiles) {
   Mesh m;
   make_torus(m, 1.0, 0.4, 12, 6);
   assign_torus_uvs(m, 1.0, 1.0, 1.0);
-  Image color(32, 16, 3), normal(32, 16, 3), height(32, 16, 1);
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 32; ++x) {
-      for (int c = 0; c < 3; ++c) color.at(x, y, c) = static_cast<float>((x * 7 + y * 3 + c * 11) % 32) / 31.f;
-      normal.at(x, y, 0) = 0.5f, normal.at(x, y, 1) = static_cast<float>(y) / 15.f, normal.at(x, y, 2) = 1.f;
-      height.at(x, y, 0) = static_cast<float>(x) / 31.f;
-    }
+  const Maps maps = patterned_maps();
+  const Image &color = maps.color, &normal = maps.normal, &height = maps.height;
   WriteMeshOptions o;
   o.texture = &color;
   o.normal_texture = &normal;
@@ -183,17 +193,11 @@ TEST(WriteMeshMaterials, ObjAndGlbSideBySideAreTheFilesEachWriterGives) {
   Mesh m;
   make_torus(m, 1.0, 0.4, 12, 6);
   assign_torus_uvs(m, 1.0, 1.0, 1.0);
-  Image color(32, 16, 3), normal(32, 16, 3), height(32, 16, 1);
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 32; ++x) {
-      for (int c = 0; c < 3; ++c) color.at(x, y, c) = static_cast<float>((x * 5 + y * 9 + c * 7) % 32) / 31.f;
-      normal.at(x, y, 0) = static_cast<float>(x) / 31.f, normal.at(x, y, 1) = 0.5f, normal.at(x, y, 2) = 1.f;
-      height.at(x, y, 0) = static_cast<float>(y) / 15.f;
-    }
+  const Maps maps = patterned_maps();
   WriteMeshOptions o;
-  o.texture = &color;
-  o.normal_texture = &normal;
-  o.height_texture = &height;
+  o.texture = &maps.color;
+  o.normal_texture = &maps.normal;
+  o.height_texture = &maps.height;
   WriteMeshOptions g = o;
   g.height_texture = nullptr;
   const std::string dir = test::temp_dir("obj_and_glb");
