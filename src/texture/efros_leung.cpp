@@ -155,10 +155,11 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
                                                              float* out) {
   const int ch = C > 0 ? C : Cr;
   // Two candidates at a time share the loads of the weights and the window;
-  // each candidate's arithmetic is the same, in the same order, as alone.
-  std::size_t j = 0;
-  for (; j + 2 <= count; j += 2) {
-    const int ia = ids[j], ib = ids[j + 1];
+  // each candidate's arithmetic is the same, in the same order, as alone (an
+  // odd last one is scored as both of a pair, its copy's result dropped).
+  for (std::size_t j = 0; j < count; j += 2) {
+    const bool pair = j + 1 < count;
+    const int ia = ids[j], ib = pair ? ids[j + 1] : ia;
     V8 acc_a[2] = {{}, {}}, acc_b[2] = {{}, {}};
     for (int r = 0; r < nrows; ++r)
       for (int g = 0; g < nv; ++g) {
@@ -181,28 +182,7 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
         acc_b[r & 1] += wv * sb;
       }
     out[j] = lane_sum(acc_a[0] + acc_a[1]);
-    out[j + 1] = lane_sum(acc_b[0] + acc_b[1]);
-  }
-  for (; j < count; ++j) {
-    const int id = ids[j];
-    V8 acc[2] = {{}, {}};
-    for (int r = 0; r < nrows; ++r)
-      for (int g = 0; g < nv; ++g) {
-        const std::size_t o = static_cast<std::size_t>(r) * nv + g;
-        V8 wv;
-        std::memcpy(&wv, w + o * kLanes, sizeof(V8));
-        V8 sq = {};
-        for (int c = 0; c < ch; ++c) {
-          V8 v, tv;
-          std::memcpy(&v, planes + c * plane_size + id + roff[r] + g * kLanes, sizeof(V8));
-          std::memcpy(&tv, t + ((static_cast<std::size_t>(r) * ch + c) * nv + g) * kLanes,
-                      sizeof(V8));
-          const V8 d = v - tv;
-          sq += d * d;
-        }
-        acc[r & 1] += wv * sq;
-      }
-    out[j] = lane_sum(acc[0] + acc[1]);
+    if (pair) out[j + 1] = lane_sum(acc_b[0] + acc_b[1]);
   }
 }
 #define SURFTEX_WEIGHTED_ARGS                                                                 \

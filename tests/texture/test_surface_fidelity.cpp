@@ -44,7 +44,6 @@ void tiled_square(Mesh& mesh, int tiles, int cells, bool per_tile, std::vector<i
   }
 }
 
-
 }  // namespace
 
 // The done-when test of item 3: a verbatim 3x3 tiling of a non-periodic
