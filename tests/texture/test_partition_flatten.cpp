@@ -120,6 +120,61 @@ TEST(TrianglesOverlap2d, ExactCases) {
   EXPECT_FALSE(triangles_overlap_2d(a, T{{{0, 0}, {1, 0}, {2, 0}}}));  // degenerate
 }
 
+// Each patch stores only the window of its raster holding its Inside and
+// Boundary pixels: tight (every edge row and column has one), covering every
+// patch triangle, and much smaller than the raster for small patches.
+TEST(FlattenPatches, WindowIsTheBoxOfTheChartedPixels) {
+  // A unit sphere and one of radius 0.2 beside it: the small sphere's patches
+  // cover about a fifth of the raster's side.
+  Mesh m, small;
+  make_icosphere(m, 3);
+  make_icosphere(small, 3);
+  const int big_faces = static_cast<int>(m.number_of_faces());
+  std::vector<VertexIndex> vmap(small.number_of_vertices());
+  for (VertexIndex v : small.vertices()) {
+    const Point3& p = small.point(v);
+    vmap[v.idx()] = m.add_vertex(Point3(3 + 0.2 * p.x(), 0.2 * p.y(), 0.2 * p.z()));
+  }
+  for (FaceIndex f : small.faces()) {
+    const auto v = face_vertices(small, f);
+    m.add_face(vmap[v[0].idx()], vmap[v[1].idx()], vmap[v[2].idx()]);
+  }
+  PartitionOptions po;
+  po.max_faces = 30;
+  const PartitionResult pr = partition_near_planar(m, po);
+  std::vector<int> seeds = pr.seed_face;
+  split_overlapping_patches(m, seeds, 30.0);
+  FlattenOptions fo;
+  fo.resolution = 64;
+  const FlattenResult fr = flatten_patches(m, seeds, fo);
+  std::size_t stored_small = 0, small_patches = 0;
+  for (const FlatPatch& fp : fr.patches) {
+    ASSERT_EQ(fp.pixel.size(), static_cast<std::size_t>(fp.bw) * fp.bh);
+    ASSERT_EQ(fp.pixel_face.size(), fp.pixel.size());
+    ASSERT_EQ(fp.pixel_bary.size(), fp.pixel.size());
+    ASSERT_TRUE(fp.bx >= 0 && fp.by >= 0 && fp.bx + fp.bw <= fp.res && fp.by + fp.bh <= fp.res);
+    auto charted = [&](int x, int y) { return fp.state(x, y) != PatchPixel::Outside; };
+    bool top = false, bottom = false, left = false, right = false;
+    for (int x = fp.bx; x < fp.bx + fp.bw; ++x) top |= charted(x, fp.by), bottom |= charted(x, fp.by + fp.bh - 1);
+    for (int y = fp.by; y < fp.by + fp.bh; ++y) left |= charted(fp.bx, y), right |= charted(fp.bx + fp.bw - 1, y);
+    EXPECT_TRUE(top && bottom && left && right) << "patch " << fp.id << ": window not tight";
+    for (const FlatTriangle& t : fp.triangles) {
+      double cx = 0, cy = 0;
+      for (const Uv2& c : t.corner) {
+        const auto px = fp.to_pixel(c[0], c[1]);
+        cx += px[0] / 3, cy += px[1] / 3;
+      }
+      EXPECT_EQ(fp.state(static_cast<int>(cx), static_cast<int>(cy)), PatchPixel::Inside)
+          << "patch " << fp.id << " face " << t.face;
+    }
+    EXPECT_EQ(fp.state(-1, 0), PatchPixel::Outside);
+    EXPECT_EQ(fp.state(fp.res, fp.res - 1), PatchPixel::Outside);
+    if (fp.triangles.front().face >= big_faces) stored_small += fp.pixel.size(), ++small_patches;
+  }
+  ASSERT_GT(small_patches, 10u);
+  EXPECT_LT(stored_small, small_patches * 64u * 64u / 8) << "the small sphere's patches keep large windows";
+}
+
 TEST(FlattenPatches, NoOverlapsAndRasterStates) {
   for (int shape = 0; shape < 2; ++shape) {
     Mesh m;

@@ -109,15 +109,18 @@ double stripe_error_deg(const Mesh& m, const PatchSynthesisResult& r, F expected
         bool ok = true;
         for (int dy = -1; dy <= 1 && ok; ++dy)
           for (int dx = -1; dx <= 1 && ok; ++dx)
-            ok = fp.pixel[(y + dy) * fp.res + x + dx] == PatchPixel::Inside;
+            ok = fp.state(x + dx, y + dy) == PatchPixel::Inside;
         if (!ok) continue;
-        auto lum = [&](int xx, int yy) { return img.at(xx, yy, 0) + img.at(xx, yy, 1) + img.at(xx, yy, 2); };
+        auto lum = [&](int xx, int yy) {
+          const float* v = img.data.data() + fp.index(xx, yy) * 3;
+          return v[0] + v[1] + v[2];
+        };
         const double gx = lum(x + 1, y) - lum(x - 1, y), gy = lum(x, y + 1) - lum(x, y - 1);
         jxx += gx * gx;
         jxy += gx * gy;
         jyy += gy * gy;
         // expected direction at the pixel's 3D point, in the plane
-        const std::size_t i = static_cast<std::size_t>(y) * fp.res + x;
+        const std::size_t i = fp.index(x, y);
         const auto v = face_vertices(m, FaceIndex(fp.pixel_face[i]));
         const auto& b = fp.pixel_bary[i];
         Vector3 pt = b[0] * (m.point(v[0]) - CGAL::ORIGIN) + b[1] * (m.point(v[1]) - CGAL::ORIGIN) +
@@ -188,9 +191,8 @@ double brighter_along(const PatchSynthesisResult& r, const Vector3& axis) {
       for (int x = 0; x + 1 < fp.res; ++x)
         for (int k = 0; k < 2; ++k) {
           const int x2 = x + steps[k][0], y2 = y + steps[k][1];
-          if (fp.pixel[y * fp.res + x] != PatchPixel::Inside || fp.pixel[y2 * fp.res + x2] != PatchPixel::Inside)
-            continue;
-          const double di = img.at(x2, y2, 0) - img.at(x, y, 0);
+          if (fp.state(x, y) != PatchPixel::Inside || fp.state(x2, y2) != PatchPixel::Inside) continue;
+          const double di = img.data[fp.index(x2, y2) * 3] - img.data[fp.index(x, y) * 3];
           if (std::abs(di) < 0.02 || std::abs(di) > 0.3) continue;
           total += std::abs(along[k]);
           if (di * along[k] > 0) agree += std::abs(along[k]);

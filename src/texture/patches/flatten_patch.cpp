@@ -284,6 +284,119 @@ int split_overlapping_patches(Mesh& mesh, std::vector<int>& seeds, double max_an
   return split;
 }
 
+namespace {
+
+// A triangle's pixel range in the raster (inclusive, clipped to 0..res-1) and
+// its corners in pixel units; false when degenerate or off the raster.
+struct TriangleSpan {
+  std::array<std::array<double, 2>, 3> q;
+  double det = 0;
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+};
+
+bool triangle_span(const FlatPatch& fp, const FlatTriangle& t, TriangleSpan& s) {
+  for (int k = 0; k < 3; ++k) s.q[k] = fp.to_pixel(t.corner[k][0], t.corner[k][1]);
+  const auto& q = s.q;
+  s.det = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+  if (!(std::abs(s.det) > 1e-18)) return false;
+  const int R = fp.res;
+  s.x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0][0], q[1][0], q[2][0]}) - 0.5)));
+  s.x1 = std::min(R - 1, static_cast<int>(std::ceil(std::max({q[0][0], q[1][0], q[2][0]}))));
+  s.y0 = std::max(0, static_cast<int>(std::floor(std::min({q[0][1], q[1][1], q[2][1]}) - 0.5)));
+  s.y1 = std::min(R - 1, static_cast<int>(std::ceil(std::max({q[0][1], q[1][1], q[2][1]}))));
+  return s.x0 <= s.x1 && s.y0 <= s.y1;
+}
+
+// Window (bx, by, bw, bh) and arrays of fp set to the given box, all Outside.
+void reset_window(FlatPatch& fp, int x0, int y0, int x1, int y1) {
+  fp.bx = x0;
+  fp.by = y0;
+  fp.bw = x1 - x0 + 1;
+  fp.bh = y1 - y0 + 1;
+  const std::size_t N = static_cast<std::size_t>(fp.bw) * fp.bh;
+  fp.pixel.assign(N, PatchPixel::Outside);
+  fp.pixel_face.assign(N, -1);
+  fp.pixel_bary.assign(N, {0.f, 0.f, 0.f});
+}
+
+// Pixels whose centre lies in t (and not yet claimed) take kind, face and
+// barycentrics; the window must cover t's span.
+void rasterise_triangle(FlatPatch& fp, const FlatTriangle& t, const TriangleSpan& s, PatchPixel kind) {
+  const auto& q = s.q;
+  for (int y = s.y0; y <= s.y1; ++y)
+    for (int x = s.x0; x <= s.x1; ++x) {
+      const std::size_t i = fp.index(x, y);
+      if (fp.pixel[i] != PatchPixel::Outside) continue;
+      const double px = x + 0.5, py = y + 0.5;
+      const double b1 = ((px - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (py - q[0][1])) / s.det;
+      const double b2 = ((q[1][0] - q[0][0]) * (py - q[0][1]) - (px - q[0][0]) * (q[1][1] - q[0][1])) / s.det;
+      const double b0 = 1.0 - b1 - b2;
+      const double eps = -1e-9;
+      if (b0 < eps || b1 < eps || b2 < eps) continue;
+      fp.pixel[i] = kind;
+      fp.pixel_face[i] = t.face;
+      fp.pixel_bary[i] = {static_cast<float>(b0), static_cast<float>(b1), static_cast<float>(b2)};
+    }
+}
+
+// The window shrunk to the box of its Inside and Boundary pixels.
+void crop_window(FlatPatch& fp) {
+  int x0 = fp.bx + fp.bw, y0 = fp.by + fp.bh, x1 = -1, y1 = -1;
+  for (std::size_t i = 0; i < fp.pixel.size(); ++i)
+    if (fp.pixel[i] != PatchPixel::Outside) {
+      x0 = std::min(x0, fp.raster_x(i));
+      x1 = std::max(x1, fp.raster_x(i));
+      y0 = std::min(y0, fp.raster_y(i));
+      y1 = std::max(y1, fp.raster_y(i));
+    }
+  if (x1 < 0) {
+    reset_window(fp, 0, 0, 0, 0);
+    return;
+  }
+  if (x0 == fp.bx && y0 == fp.by && x1 == fp.bx + fp.bw - 1 && y1 == fp.by + fp.bh - 1) return;
+  FlatPatch old;
+  old.bx = fp.bx, old.by = fp.by, old.bw = fp.bw, old.bh = fp.bh;
+  old.pixel.swap(fp.pixel);
+  old.pixel_face.swap(fp.pixel_face);
+  old.pixel_bary.swap(fp.pixel_bary);
+  reset_window(fp, x0, y0, x1, y1);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const std::size_t i = fp.index(x, y), j = old.index(x, y);
+      fp.pixel[i] = old.pixel[j];
+      fp.pixel_face[i] = old.pixel_face[j];
+      fp.pixel_bary[i] = old.pixel_bary[j];
+    }
+}
+
+// The patch's pixels (3.2): Inside where a patch triangle covers the centre,
+// else Boundary where a kept neighbour triangle does; stored in the window of
+// those pixels.
+void rasterise_patch(FlatPatch& fp) {
+  std::vector<TriangleSpan> in(fp.triangles.size()), out(fp.boundary.size());
+  std::vector<char> in_ok(in.size()), out_ok(out.size());
+  int x0 = fp.res, y0 = fp.res, x1 = -1, y1 = -1;
+  auto grow = [&](const TriangleSpan& s) {
+    x0 = std::min(x0, s.x0), y0 = std::min(y0, s.y0), x1 = std::max(x1, s.x1), y1 = std::max(y1, s.y1);
+  };
+  for (std::size_t k = 0; k < in.size(); ++k)
+    if ((in_ok[k] = triangle_span(fp, fp.triangles[k], in[k]))) grow(in[k]);
+  for (std::size_t k = 0; k < out.size(); ++k)
+    if ((out_ok[k] = triangle_span(fp, fp.boundary[k], out[k]))) grow(out[k]);
+  if (x1 < 0) {
+    reset_window(fp, 0, 0, 0, 0);
+    return;
+  }
+  reset_window(fp, x0, y0, x1, y1);
+  for (std::size_t k = 0; k < in.size(); ++k)
+    if (in_ok[k]) rasterise_triangle(fp, fp.triangles[k], in[k], PatchPixel::Inside);
+  for (std::size_t k = 0; k < out.size(); ++k)
+    if (out_ok[k]) rasterise_triangle(fp, fp.boundary[k], out[k], PatchPixel::Boundary);
+  crop_window(fp);
+}
+
+}  // namespace
+
 FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seeds,
                               const FlattenOptions& opt) {
   if (opt.resolution < 8 || opt.resolution > 4096)
@@ -328,36 +441,7 @@ FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seeds,
     fp.texel = texel;
     fp.u0 = 0.5 * (pbox[p].x0 + pbox[p].x1) - 0.5 * R * texel;
     fp.v0 = 0.5 * (pbox[p].y0 + pbox[p].y1) + 0.5 * R * texel;
-    const std::size_t N = static_cast<std::size_t>(R) * R;
-    fp.pixel.assign(N, PatchPixel::Outside);
-    fp.pixel_face.assign(N, -1);
-    fp.pixel_bary.assign(N, {0.f, 0.f, 0.f});
-    auto raster = [&](const FlatTriangle& t, PatchPixel kind) {
-      std::array<std::array<double, 2>, 3> q;
-      for (int k = 0; k < 3; ++k) q[k] = fp.to_pixel(t.corner[k][0], t.corner[k][1]);
-      const double det = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-      if (!(std::abs(det) > 1e-18)) return;
-      const int x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0][0], q[1][0], q[2][0]}) - 0.5)));
-      const int x1 = std::min(R - 1, static_cast<int>(std::ceil(std::max({q[0][0], q[1][0], q[2][0]}))));
-      const int y0 = std::max(0, static_cast<int>(std::floor(std::min({q[0][1], q[1][1], q[2][1]}) - 0.5)));
-      const int y1 = std::min(R - 1, static_cast<int>(std::ceil(std::max({q[0][1], q[1][1], q[2][1]}))));
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * R + x;
-          if (fp.pixel[i] != PatchPixel::Outside) continue;
-          const double px = x + 0.5, py = y + 0.5;
-          const double b1 = ((px - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (py - q[0][1])) / det;
-          const double b2 = ((q[1][0] - q[0][0]) * (py - q[0][1]) - (px - q[0][0]) * (q[1][1] - q[0][1])) / det;
-          const double b0 = 1.0 - b1 - b2;
-          const double eps = -1e-9;
-          if (b0 < eps || b1 < eps || b2 < eps) continue;
-          fp.pixel[i] = kind;
-          fp.pixel_face[i] = t.face;
-          fp.pixel_bary[i] = {static_cast<float>(b0), static_cast<float>(b1), static_cast<float>(b2)};
-        }
-    };
-    for (const FlatTriangle& t : fp.triangles) raster(t, PatchPixel::Inside);
-    for (const FlatTriangle& t : fp.boundary) raster(t, PatchPixel::Boundary);
+    rasterise_patch(fp);
   });
   for (const FlatPatch& fp : res.patches) {
     res.dropped_boundary += fp.dropped_boundary;
@@ -382,10 +466,9 @@ bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, 
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
       const int x = x0 + i, y = y0 + j;
-      if (x < 0 || y < 0 || x >= fp.res || y >= fp.res) continue;
-      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Inside) continue;
+      if (fp.state(x, y) != PatchPixel::Inside) continue;
       const double w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay) + 1e-6;
-      for (int c = 0; c < C; ++c) acc[c] += w * img.at(x, y, c);
+      for (int c = 0; c < C; ++c) acc[c] += w * img.at(x - fp.bx, y - fp.by, c);
       wsum += w;
     }
   if (wsum <= 0) return false;

@@ -50,9 +50,25 @@ struct FlatPatch {
   // Raster: pixel (x, y) centre is at (u0 + (x + 0.5) * texel, v0 - (y + 0.5) * texel).
   int res = 0;
   double texel = 0, u0 = 0, v0 = 0;
-  std::vector<PatchPixel> pixel;                  ///< res*res, row-major
+  // Stored window of the res x res raster: the bounding box of its Inside and
+  // Boundary pixels (1 x 1 at the origin when there are none); every pixel
+  // outside it is Outside. The arrays below, and every image laid over the
+  // patch, hold the window only (bw * bh, row-major): a small patch's raster
+  // is mostly Outside, and thousands of full rasters cost gigabytes.
+  int bx = 0, by = 0, bw = 1, bh = 1;
+  std::vector<PatchPixel> pixel;                  ///< bw*bh, row-major
   std::vector<int> pixel_face;                    ///< mesh face, -1 for Outside
   std::vector<std::array<float, 3>> pixel_bary;   ///< barycentrics in that face
+  bool in_window(int x, int y) const { return x >= bx && y >= by && x < bx + bw && y < by + bh; }
+  /// Window index of raster pixel (x, y), which must be in the window.
+  std::size_t index(int x, int y) const {
+    return static_cast<std::size_t>(y - by) * bw + static_cast<std::size_t>(x - bx);
+  }
+  /// State of raster pixel (x, y) (Outside beyond the window).
+  PatchPixel state(int x, int y) const { return in_window(x, y) ? pixel[index(x, y)] : PatchPixel::Outside; }
+  /// Raster position of window index i.
+  int raster_x(std::size_t i) const { return bx + static_cast<int>(i % static_cast<std::size_t>(bw)); }
+  int raster_y(std::size_t i) const { return by + static_cast<int>(i / static_cast<std::size_t>(bw)); }
   /// Image position (pixel units, continuous: texel centres at +0.5) of plane point (u, v).
   std::array<double, 2> to_pixel(double u, double v) const {
     return {(u - u0) / texel, (v0 - v) / texel};
@@ -92,8 +108,8 @@ FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seed_fac
 
 struct Image;
 
-/// Bilinear lookup at pixel position (px, py) of an image laid over patch
-/// `fp`, restricted to its Inside pixels (weights renormalised); writes
+/// Bilinear lookup at raster position (px, py) of an image laid over patch
+/// `fp` (window-sized, see FlatPatch), restricted to its Inside pixels (weights renormalised); writes
 /// img.channels values to `out`; false if none of the four texels is Inside.
 bool sample_inside(const FlatPatch& fp, const Image& img, double px, double py, float* out);
 

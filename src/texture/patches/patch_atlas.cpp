@@ -22,15 +22,8 @@ struct Box {
   int h() const { return y1 - y0 + 1; }
 };
 
-Box chart_box(const FlatPatch& fp) {
-  Box b{fp.res, fp.res, -1, -1};
-  for (int y = 0; y < fp.res; ++y)
-    for (int x = 0; x < fp.res; ++x)
-      if (fp.pixel[static_cast<std::size_t>(y) * fp.res + x] != PatchPixel::Outside)
-        b = {std::min(b.x0, x), std::min(b.y0, y), std::max(b.x1, x), std::max(b.y1, y)};
-  if (b.x1 < 0) b = {0, 0, 0, 0};  // an empty raster still gets a texel
-  return b;
-}
+// The patch's stored window (an empty raster's is one texel).
+Box chart_box(const FlatPatch& fp) { return {fp.bx, fp.by, fp.bx + fp.bw - 1, fp.by + fp.bh - 1}; }
 
 // Shelf packing (tallest first) of the boxes into a `side` square, `gap`
 // texels between boxes and g = gap / 2 from the border; top-left corner of
@@ -99,12 +92,14 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
   if (P == 0 || static_cast<int>(images.size()) != P)
     throw InvalidInputError("pack_patch_atlas: " + std::to_string(images.size()) + " images for " +
                             std::to_string(P) + " patches");
-  const int R = flat.patches[0].res, C = images[0].channels;
-  for (int p = 0; p < P; ++p)
-    if (images[p].width != R || images[p].height != R || images[p].channels != C ||
-        flat.patches[p].res != R)
-      throw InvalidInputError("pack_patch_atlas: patch " + std::to_string(p) +
-                              " image does not match the raster size " + std::to_string(R));
+  const int C = images[0].channels;
+  for (int p = 0; p < P; ++p) {
+    const FlatPatch& fp = flat.patches[p];
+    if (images[p].width != fp.bw || images[p].height != fp.bh || images[p].channels != C)
+      throw InvalidInputError("pack_patch_atlas: patch " + std::to_string(p) + " image is " +
+                              std::to_string(images[p].width) + " x " + std::to_string(images[p].height) +
+                              ", its raster window " + std::to_string(fp.bw) + " x " + std::to_string(fp.bh));
+  }
   std::vector<Box> box;
   const std::vector<int> order = packing_order(flat, box);
   std::vector<std::array<int, 2>> corner(P);
@@ -120,14 +115,16 @@ PatchAtlas pack_patch_atlas(Mesh& mesh, const FlattenResult& flat, const std::ve
     const FlatPatch& fp = flat.patches[p];
     for (int y = box[p].y0; y <= box[p].y1; ++y)
       for (int x = box[p].x0; x <= box[p].x1; ++x) {
-        const PatchPixel state = fp.pixel[static_cast<std::size_t>(y) * R + x];
+        const std::size_t i = fp.index(x, y);
+        const PatchPixel state = fp.pixel[i];
         if (state == PatchPixel::Outside) continue;
         // A Boundary pixel whose neighbour lookup found no Inside texel stays
         // all zero in the patch image: the dilation fills it instead.
+        const float* v = images[p].data.data() + i * C;
         bool zero = true;
-        for (int c = 0; c < C && zero; ++c) zero = images[p].at(x, y, c) == 0.f;
+        for (int c = 0; c < C && zero; ++c) zero = v[c] == 0.f;
         if (state == PatchPixel::Boundary && zero) continue;
-        for (int c = 0; c < C; ++c) at.image.at(ox + x, oy + y, c) = images[p].at(x, y, c);
+        for (int c = 0; c < C; ++c) at.image.at(ox + x, oy + y, c) = v[c];
         at.chart[static_cast<std::size_t>(oy + y) * W + ox + x] = p;
       }
   }

@@ -63,7 +63,7 @@ std::vector<Image> resample_patch_map(const PatchSynthesisResult& res, const Ima
   std::vector<Image> out(P);
   tbb::parallel_for(0, P, [&](int p) {
     const FlatPatch& fp = res.flat.patches[p];
-    Image img(fp.res, fp.res, C);
+    Image img(fp.bw, fp.bh, C);
     for (std::size_t i = 0; i < fp.pixel.size(); ++i) {
       float* v = img.data.data() + i * C;
       const ElSource& s = res.sources[p][i];

@@ -21,7 +21,7 @@
 
 namespace surftex {
 
-/// Per patch, res x res images of `map` (exemplar 0's map; its channels).
+/// Per patch, window-sized (FlatPatch::bw x bh) images of `map` (exemplar 0's map; its channels).
 /// `el` = the synthesis's ElOptions (rotations, window, periodic_exemplar).
 std::vector<Image> resample_patch_map(const PatchSynthesisResult& result, const Image& map,
                                       std::array<int, 2> exemplar_size, const ElOptions& el,

@@ -78,8 +78,8 @@ SeamRatioResult patch_seam_ratio(const Mesh& mesh, const FlattenResult& flat, co
     const FlatPatch& fp = flat.patches[p];
     const auto px = fp.to_pixel(u, v);
     const int x = static_cast<int>(std::floor(px[0])), y = static_cast<int>(std::floor(px[1]));
-    if (x < 0 || y < 0 || x >= fp.res || y >= fp.res) return {};
-    const int face = fp.pixel_face[static_cast<std::size_t>(y) * fp.res + x];
+    if (!fp.in_window(x, y)) return {};
+    const int face = fp.pixel_face[fp.index(x, y)];
     if (face < 0) return {};
     return {face, bary_in(*tri[p].at(face), u, v)};
   };
@@ -93,7 +93,7 @@ SeamRatioResult patch_seam_ratio(const Mesh& mesh, const FlattenResult& flat, co
     const FlatPatch& fp = flat.patches[p];
     const std::size_t i = inside[p][std::min<std::size_t>(inside[p].size() - 1,
                                                           static_cast<std::size_t>(U(rng) * inside[p].size()))];
-    const double x = static_cast<double>(i % fp.res) + U(rng), y = static_cast<double>(i / fp.res) + U(rng);
+    const double x = static_cast<double>(fp.raster_x(i)) + U(rng), y = static_cast<double>(fp.raster_y(i)) + U(rng);
     const double th = 2 * M_PI * U(rng);
     const double x2 = x + opt.step_texels * std::cos(th), y2 = y + opt.step_texels * std::sin(th);
     const double u1 = fp.u0 + x * fp.texel, v1 = fp.v0 - y * fp.texel;

@@ -341,31 +341,6 @@ bool sample_neighbour(const std::vector<FlatPatch>& patches, const PatchFaces& p
   return sample_inside(fq, images[q], pq[0], pq[1], out);
 }
 
-// The bounding box of a patch's Inside and Boundary pixels (most of the
-// raster is Outside); one Outside pixel when there are none.
-struct PixelBox {
-  int x0, y0, w, h;
-  std::size_t size() const { return static_cast<std::size_t>(w) * h; }
-  // Raster index of box pixel j (row-major in the box).
-  std::size_t raster(std::size_t j, int R) const {
-    return static_cast<std::size_t>(y0 + j / w) * R + x0 + j % w;
-  }
-};
-
-PixelBox patch_box(const FlatPatch& fp, int R) {
-  int x0 = R, y0 = R, x1 = -1, y1 = -1;
-  for (int y = 0; y < R; ++y)
-    for (int x = 0; x < R; ++x)
-      if (fp.pixel[static_cast<std::size_t>(y) * R + x] != PatchPixel::Outside) {
-        x0 = std::min(x0, x);
-        x1 = std::max(x1, x);
-        y0 = std::min(y0, y);
-        y1 = std::max(y1, y);
-      }
-  if (x1 < 0) x0 = y0 = x1 = y1 = 0;
-  return {x0, y0, x1 - x0 + 1, y1 - y0 + 1};
-}
-
 // The synthesis of one patch image (3.3): its Inside pixels are filled by
 // Efros-Leung, steered per pixel by the direction field, from the boundary
 // conditions its available neighbours' images give.
@@ -381,7 +356,6 @@ class PatchSynthesizer {
         patches_(res.flat.patches),
         vnormal_(find(mesh, kVertexNormal).first),
         C_(exemplars[0].channels),
-        R_(res.resolution),
         E_(static_cast<int>(exemplars.size())),
         light_(normalized_or(vec(opt.light), Vector3(0, 0, 1))),
         // Exemplar rotations prepared once for every patch (not once per patch).
@@ -404,39 +378,38 @@ class PatchSynthesizer {
   template <class Available>
   void synthesize(int p, int pass, const Available& available, bool pixel_parallel) {
     const FlatPatch& fp = patches_[p];
-    // Synthesis runs on the bounding box of the patch's Inside and Boundary
-    // pixels; row-major order, relative positions and hence the result are
-    // those of the full raster.
-    const PixelBox box = patch_box(fp, R_);
+    // Synthesis runs on the patch's window (the box of its Inside and
+    // Boundary pixels); row-major order, relative positions and hence the
+    // result are those of the full raster.
+    const std::size_t n = fp.pixel.size();
     ElInput in;
     in.prepared = prepared_;
-    in.target = Image(box.w, box.h, C_, 0.f);
-    in.state.assign(box.size(), PixelState::Outside);
-    if (fields_.oriented) in.angle = Image(box.w, box.h, 1, 0.f);
-    if (opt_.multi != MultiTexture::None) in.exemplar_index.assign(box.size(), 0);
+    in.target = Image(fp.bw, fp.bh, C_, 0.f);
+    in.state.assign(n, PixelState::Outside);
+    if (fields_.oriented) in.angle = Image(fp.bw, fp.bh, 1, 0.f);
+    if (opt_.multi != MultiTexture::None) in.exemplar_index.assign(n, 0);
     double mean_c = 0, mean_s = 0;
-    for (std::size_t j = 0; j < box.size(); ++j) {
-      const std::size_t i = box.raster(j, R_);
+    for (std::size_t i = 0; i < n; ++i) {
       const PatchPixel kind = fp.pixel[i];
       if (kind == PatchPixel::Outside) continue;
       if (kind == PatchPixel::Boundary) {
         if (!available(faces_.patch[fp.pixel_face[i]])) continue;
         if (sample_neighbour(patches_, faces_, res_.images, fp.pixel_face[i], fp.pixel_bary[i],
-                             &in.target.data[j * C_])) {
-          in.state[j] = PixelState::Known;
+                             &in.target.data[i * C_])) {
+          in.state[i] = PixelState::Known;
           ++known_[p];
         }
         continue;
       }
-      in.state[j] = PixelState::Fill;
-      fill_pixel_inputs(fp, i, j, in, mean_c, mean_s);
+      in.state[i] = PixelState::Fill;
+      fill_pixel_inputs(fp, i, in, mean_c, mean_s);
     }
     const ElResult r = efros_leung_synthesize(in, el_options(p, pass, pixel_parallel, mean_c, mean_s));
     texels_[p] += r.synthesized + r.seeded;
     seeded_[p] += r.seeded;
     candidates_[p] += r.pass1_candidates;
     widened_[p] += r.pass1_widened;
-    store_inside(p, box, r);
+    store_inside(p, r);
     if (opt_.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex_);
       report_progress(opt_.progress, "synthesis", static_cast<double>(++step_) / steps_);
@@ -458,7 +431,7 @@ class PatchSynthesizer {
   // A Fill pixel's angle (the vertex directions interpolated in its face and
   // expressed in the patch plane: exemplar +x along it) and exemplar index
   // (multi-texturing); mean_c/mean_s accumulate the angles' mean direction.
-  void fill_pixel_inputs(const FlatPatch& fp, std::size_t i, std::size_t j, ElInput& in, double& mean_c,
+  void fill_pixel_inputs(const FlatPatch& fp, std::size_t i, ElInput& in, double& mean_c,
                          double& mean_s) const {
     const FaceIndex f(static_cast<Mesh::size_type>(fp.pixel_face[i]));
     const auto& b = fp.pixel_bary[i];
@@ -479,7 +452,7 @@ class PatchSynthesizer {
         dv = fd * e2;
       }
       const double a = std::atan2(dv, du);  // exemplar +x along (du, dv) in the plane
-      in.angle.data[j] = static_cast<float>(a);
+      in.angle.data[i] = static_cast<float>(a);
       mean_c += std::cos(line_field ? 2 * a : a);
       mean_s += std::sin(line_field ? 2 * a : a);
     }
@@ -493,7 +466,7 @@ class PatchSynthesizer {
         const std::vector<double>& vt = fields_.vt;
         tt = b[0] * vt[vv[0].idx()] + b[1] * vt[vv[1].idx()] + b[2] * vt[vv[2].idx()];
       }
-      in.exemplar_index[j] = std::clamp(static_cast<int>(std::floor(tt * E_)), 0, E_ - 1);
+      in.exemplar_index[i] = std::clamp(static_cast<int>(std::floor(tt * E_)), 0, E_ - 1);
     }
   }
 
@@ -516,18 +489,16 @@ class PatchSynthesizer {
   }
 
   // Keeps only Inside pixels in the stored image (boundary filled at the end).
-  void store_inside(int p, const PixelBox& box, const ElResult& r) {
+  void store_inside(int p, const ElResult& r) {
     const FlatPatch& fp = patches_[p];
     Image& img = res_.images[p];
-    if (img.empty()) img = Image(R_, R_, C_, 0.f);
-    if (res_.sources[p].empty()) res_.sources[p].resize(static_cast<std::size_t>(R_) * R_);
-    for (std::size_t j = 0; j < box.size(); ++j) {
-      const std::size_t i = box.raster(j, R_);
+    if (img.empty()) img = Image(fp.bw, fp.bh, C_, 0.f);
+    if (res_.sources[p].empty()) res_.sources[p].resize(fp.pixel.size());
+    for (std::size_t i = 0; i < fp.pixel.size(); ++i)
       if (fp.pixel[i] == PatchPixel::Inside) {
-        for (int c = 0; c < C_; ++c) img.data[i * C_ + c] = r.image.data[j * C_ + c];
-        res_.sources[p][i] = r.source[j];
+        for (int c = 0; c < C_; ++c) img.data[i * C_ + c] = r.image.data[i * C_ + c];
+        res_.sources[p][i] = r.source[i];
       }
-    }
   }
 
   const Mesh& mesh_;
@@ -537,7 +508,7 @@ class PatchSynthesizer {
   PatchSynthesisResult& res_;
   const std::vector<FlatPatch>& patches_;
   PropertyMap<VertexIndex, Vector3> vnormal_;
-  const int C_, R_, E_;
+  const int C_, E_;
   const Vector3 light_;
   const std::shared_ptr<const ElPreparedExemplars> prepared_;
   // Per patch: texels filled, of which seeded, Known boundary pixels.
@@ -600,12 +571,11 @@ void resynthesize(PatchSynthesizer& synth, int P, const std::vector<int>& ids) {
 // Boundary pixels of every image from the neighbour's texture. Patch p
 // writes only its own Boundary pixels and reads only Inside pixels of
 // others, so the patches run in parallel.
-void fill_boundary_pixels(PatchSynthesisResult& res, const PatchFaces& pf, int R, int C) {
+void fill_boundary_pixels(PatchSynthesisResult& res, const PatchFaces& pf, int C) {
   const std::vector<FlatPatch>& patches = res.flat.patches;
-  const std::size_t N = static_cast<std::size_t>(R) * R;
   tbb::parallel_for(0, static_cast<int>(patches.size()), [&](int p) {
     const FlatPatch& fp = patches[p];
-    for (std::size_t i = 0; i < N; ++i) {
+    for (std::size_t i = 0; i < fp.pixel.size(); ++i) {
       if (fp.pixel[i] != PatchPixel::Boundary) continue;
       sample_neighbour(patches, pf, res.images, fp.pixel_face[i], fp.pixel_bary[i],
                        &res.images[p].data[i * C]);
@@ -685,7 +655,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   resynthesize(synth, P, opt.resynthesize);
   synth.add_counts();
   res.seconds_synthesis = t.seconds();
-  fill_boundary_pixels(res, faces, res.resolution, exemplars[0].channels);
+  fill_boundary_pixels(res, faces, exemplars[0].channels);
   res.seconds_total = total.seconds();
   return res;
 }

@@ -74,7 +74,7 @@ struct PatchSynthesisOptions {
 struct PatchSynthesisResult {
   PartitionResult partition;
   FlattenResult flat;            ///< rasters per patch (pixel states, faces, barycentrics)
-  std::vector<Image> images;     ///< per patch, res x res, exemplar channels
+  std::vector<Image> images;     ///< per patch, its raster window (FlatPatch::bw x bh), exemplar channels
   /// Per patch and pixel: where an Inside pixel's value came from
   /// (efros_leung.h ElSource; exemplar -1 elsewhere), to resample other maps
   /// of the exemplar through the same synthesis (texture/patches/patch_exemplar_maps.h).
