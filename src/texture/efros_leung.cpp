@@ -278,10 +278,45 @@ struct SearchImage {
     }
     return c >= 0 && c < static_cast<long long>(is_candidate.size()) && is_candidate[c] ? static_cast<int>(c) : -1;
   }
-  std::unique_ptr<PartialNeighbourhoodIndex> ann;  // approximate search only
+  std::vector<std::uint8_t> valid;  // per buffer position: 1 = a usable sample
+  // Approximate search only: the index of this image, or (quarter > 0) of
+  // the image it is `quarter` quarter turns of (ann_pw x ann_ph), whose
+  // first-pass slots ann_slot maps ours to.
+  std::shared_ptr<const PartialNeighbourhoodIndex> ann;
+  int quarter = 0, ann_pw = 0, ann_ph = 0;
+  std::vector<int> ann_slot;
 
   const float* plane(int c) const { return planes.data() + static_cast<std::size_t>(c) * pw * ph; }
+
+  /// The index's hits for a partly known first-pass window (slots in this
+  /// image's frame) appended to out as candidate positions of this image.
+  void ann_query(const int* slot, const float* values, int known, std::size_t k, float eps, std::vector<int>& out,
+                 PartialNeighbourhoodIndex::Scratch& scratch, std::vector<int>& turned) const {
+    if (quarter == 0) {
+      ann->query(slot, values, known, k, eps, out, scratch);
+      return;
+    }
+    turned.resize(static_cast<std::size_t>(known));
+    for (int i = 0; i < known; ++i) turned[i] = ann_slot[slot[i]];
+    const std::size_t first = out.size();
+    ann->query(turned.data(), values, known, k, eps, out, scratch);
+    std::size_t kept = first;
+    for (std::size_t i = first; i < out.size(); ++i) {
+      int x = out[i] % ann_pw, y = out[i] / ann_pw, w = ann_pw, h = ann_ph;
+      for (int t = 0; t < quarter; ++t) {
+        quarter_turn_position(w, x, y);
+        std::swap(w, h);
+      }
+      const int id = y * pw + x;
+      if (is_candidate[id]) out[kept++] = id;
+    }
+    out.resize(kept);
+  }
 };
+
+// Candidate centres, spans and blocks of a search image whose size, planes
+// and validity are set.
+void index_candidates(SearchImage& s, int window, bool periodic, int margin, int core_w, int core_h);
 
 SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodic, int margin,
                               int core_w, int core_h) {
@@ -294,6 +329,73 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
   s.planes.resize(n * s.channels + kPad, 0.f);  // padding: vector loads may overrun a row
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < s.channels; ++c) s.planes[c * n + i] = img.data[i * s.channels + c];
+  s.valid.resize(n);
+  for (std::size_t i = 0; i < n; ++i) s.valid[i] = r.valid.data[i] > 0.5f;
+  index_candidates(s, window, periodic, margin, core_w, core_h);
+  return s;
+}
+
+// `base` turned by q quarter turns (rotated_exemplars.h): its planes and
+// validity permuted, its candidates indexed anew; the approximate index is
+// base's, queried through the turn (SearchImage::ann_query). Windows must be
+// odd (a turned window is then the same window).
+SearchImage turned_search_image(const SearchImage& base, int q, int window, int first_window) {
+  SearchImage s;
+  const bool odd = q % 2 == 1;
+  s.pw = odd ? base.ph : base.pw;
+  s.ph = odd ? base.pw : base.ph;
+  s.channels = base.channels;
+  const std::size_t n = static_cast<std::size_t>(s.pw) * s.ph;
+  s.planes.resize(n * s.channels + kPad, 0.f);
+  s.valid.resize(n);
+  // Our pixel (x, y) is base pixel a + x * sx + y * sy (the turn is affine);
+  // written in our row order.
+  auto source = [&](int x, int y) {
+    int w = s.pw, h = s.ph;
+    for (int t = 0; t < q; ++t) {  // pixel (x, y) of a turned w x h canvas is (h - 1 - y, x) of the h x w one
+      const int bx = h - 1 - y, by = x;
+      x = bx, y = by;
+      std::swap(w, h);
+    }
+    return static_cast<long long>(y) * base.pw + x;
+  };
+  const long long a = source(0, 0), sx = source(1, 0) - a, sy = source(0, 1) - a;
+  for (int y = 0; y < s.ph; ++y) {
+    const long long row = a + y * sy;
+    for (int c = 0; c < s.channels; ++c) {
+      const float* from = base.planes.data() + c * n;
+      float* to = s.planes.data() + c * n + static_cast<std::size_t>(y) * s.pw;
+      for (int x = 0; x < s.pw; ++x) to[x] = from[row + x * sx];
+    }
+    std::uint8_t* v = s.valid.data() + static_cast<std::size_t>(y) * s.pw;
+    for (int x = 0; x < s.pw; ++x) v[x] = base.valid[row + x * sx];
+  }
+  index_candidates(s, window, false, 0, 0, 0);
+  if (base.ann) {
+    s.ann = base.ann;
+    s.quarter = q;
+    s.ann_pw = base.pw;
+    s.ann_ph = base.ph;
+    // One turn sends a base offset (a, b) to (b, -a); so our offset (a, b)
+    // is base offset (-b, a), turned back q times.
+    const int f = first_window, lo = lo_of(f);
+    s.ann_slot.resize(static_cast<std::size_t>(f) * f);
+    for (int dy = lo; dy < lo + f; ++dy)
+      for (int dx = lo; dx < lo + f; ++dx) {
+        int a = dx, b = dy;
+        for (int t = 0; t < q; ++t) {
+          const int na = -b;
+          b = a;
+          a = na;
+        }
+        s.ann_slot[(dy - lo) * f + (dx - lo)] = (b - lo) * f + (a - lo);
+      }
+  }
+  return s;
+}
+
+void index_candidates(SearchImage& s, int window, bool periodic, int margin, int core_w, int core_h) {
+  const std::size_t n = static_cast<std::size_t>(s.pw) * s.ph;
   const int lo = lo_of(window), hi = hi_of(window);
   if (periodic) {
     // One period of centres: every exemplar pixel exactly once.
@@ -304,7 +406,7 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
     std::vector<int> sum(static_cast<std::size_t>(s.pw + 1) * (s.ph + 1), 0);
     for (int y = 0; y < s.ph; ++y)
       for (int x = 0; x < s.pw; ++x)
-        sum[(y + 1) * (s.pw + 1) + x + 1] = (r.valid.at(x, y) > 0.5f ? 0 : 1) +
+        sum[(y + 1) * (s.pw + 1) + x + 1] = (s.valid[static_cast<std::size_t>(y) * s.pw + x] ? 0 : 1) +
                                             sum[y * (s.pw + 1) + x + 1] +
                                             sum[(y + 1) * (s.pw + 1) + x] -
                                             sum[y * (s.pw + 1) + x];
@@ -348,7 +450,6 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
     }
   }
   if (b0 < static_cast<int>(s.spans.size())) s.blocks.emplace_back(b0, static_cast<int>(s.spans.size()));
-  return s;
 }
 
 void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& opt) {
@@ -380,7 +481,8 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
 }  // namespace
 
 // Search images built on first use: slot e * rotations + k holds exemplar e
-// rotated by 2 pi k / rotations. Each slot is built once (its own once_flag,
+// rotated by 2 pi k / rotations (rotate_exemplar_step: k >= K/4 as quarter
+// turns of k mod K/4, sharing its approximate index). Each slot is built once (its own once_flag,
 // so different slots build concurrently); a built slot never changes.
 struct ElPreparedExemplars {
   std::vector<Image> exemplars;
@@ -399,9 +501,20 @@ struct ElPreparedExemplars {
     return *slots[i];
   }
 
+  // Orientations k >= K/4 are quarter turns of k mod K/4 when the exemplar
+  // allows it (rotate_exemplar_step) and both windows are odd.
+  bool turned(int e, int k) const {
+    return k >= rotations / 4 && window % 2 == 1 && first_window % 2 == 1 &&
+           quarter_turns_shared(exemplars[e], rotations, periodic);
+  }
+
   std::unique_ptr<SearchImage> build(int e, int k) const {
     const Image& ex = exemplars[e];
     const int margin = std::max(-lo_of(window), hi_of(window));
+    if (turned(e, k)) {
+      const int quarter = rotations / 4;
+      return std::make_unique<SearchImage>(turned_search_image(get(e, k % quarter), k / quarter, window, first_window));
+    }
     RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
     auto s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));
     if (s->ids.empty())
@@ -411,7 +524,7 @@ struct ElPreparedExemplars {
                               " fits; use a larger exemplar, a smaller window or "
                               "periodic_exemplar");
     if (search == ElSearch::Approximate)
-      s->ann = std::make_unique<PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
+      s->ann = std::make_shared<const PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
                                                            s->pw, s->channels, s->ids, first_window, ann_pca_dims,
                                                            ann_stride);
     return s;
@@ -520,6 +633,7 @@ class Synthesizer {
   void add_coherent_to_preselect();
   bool pick_coherent(int& id) const;
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
+  std::vector<int> ann_turned_;
 };
 
 void Synthesizer::validate() {
@@ -773,8 +887,8 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // (checked byte for byte on patches and synth outputs, decision 501).
 void Synthesizer::short_list_passes(const SearchImage& s, std::size_t n, int p) {
   const int nk = static_cast<int>(p1_slot_.size());
-  s.ann->query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
-               static_cast<float>(opt_.ann_eps), short_, ann_scratch_);
+  s.ann_query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
+              static_cast<float>(opt_.ann_eps), short_, ann_scratch_, ann_turned_);
   std::sort(short_.begin(), short_.end());
   short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
   // Scored first unless the previous pixel widened (ties come in regions:

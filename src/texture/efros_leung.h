@@ -144,7 +144,7 @@ struct ElInput {
 };
 
 /// Where a synthesised pixel took its value: pixel (x, y) of `exemplar` rotated
-/// by `rotation` (rotate_exemplar, margin window / 2); exemplar -1 = not synthesised.
+/// by `rotation` (rotate_exemplar_step with K = rotations, margin window / 2); exemplar -1 = not synthesised.
 struct ElSource {
   int exemplar = -1, rotation = 0, x = 0, y = 0;
 };

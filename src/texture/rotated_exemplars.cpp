@@ -56,6 +56,48 @@ RotatedExemplar rotate_exemplar(const Image& exemplar, double radians, bool peri
   return r;
 }
 
+namespace {
+
+Image turn_image(const Image& img) {
+  Image out(img.height, img.width, img.channels);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      int tx = x, ty = y;
+      quarter_turn_position(img.width, tx, ty);
+      std::copy_n(img.pixel(x, y), img.channels, out.pixel(tx, ty));
+    }
+  return out;
+}
+
+}  // namespace
+
+RotatedExemplar turn_quarters(const RotatedExemplar& r, int q) {
+  RotatedExemplar t = r;
+  for (int i = 0; i < ((q % 4) + 4) % 4; ++i) {
+    t.image = turn_image(t.image);
+    t.valid = turn_image(t.valid);
+    t.angle += M_PI / 2;
+  }
+  return t;
+}
+
+bool quarter_turns_shared(const Image& exemplar, int rotations, bool periodic) {
+  return rotations % 4 == 0 && !periodic && (exemplar.width - exemplar.height) % 2 == 0;
+}
+
+RotatedExemplar rotate_exemplar_step(const Image& exemplar, int k, int rotations, bool periodic, int margin) {
+  if (rotations < 1 || k < 0 || k >= rotations)
+    throw InvalidInputError("rotate_exemplar_step: orientation " + std::to_string(k) + " of " +
+                            std::to_string(rotations));
+  const int quarter = rotations / 4;
+  if (!quarter_turns_shared(exemplar, rotations, periodic) || k < quarter)
+    return rotate_exemplar(exemplar, 2.0 * M_PI * k / rotations, periodic, margin);
+  RotatedExemplar r = turn_quarters(
+      rotate_exemplar(exemplar, 2.0 * M_PI * (k % quarter) / rotations, periodic, margin), k / quarter);
+  r.angle = 2.0 * M_PI * k / rotations;
+  return r;
+}
+
 RotatedExemplarSet rotated_exemplars(const Image& exemplar, const RotatedExemplarOptions& opt) {
   if (exemplar.empty()) throw InvalidInputError("rotated_exemplars: exemplar is empty");
   if (opt.rotations < 1 || opt.rotations > 128)

@@ -55,6 +55,29 @@ int rotation_index(double radians, int rotations);
 RotatedExemplar rotate_exemplar(const Image& exemplar, double radians, bool periodic,
                                 int margin = 0);
 
+/// Position (x, y) of a w-wide image after one exact quarter turn (the
+/// rotation by +pi/2 of the convention above; the turned image is h x w).
+inline void quarter_turn_position(int w, int& x, int& y) {
+  const int nx = y;
+  y = w - 1 - x;
+  x = nx;
+}
+
+/// `r` turned by q exact quarter turns (q = 0..3): the exemplar rotated by
+/// r.angle + q pi/2, its samples permuted, not resampled.
+RotatedExemplar turn_quarters(const RotatedExemplar& r, int q);
+
+/// Whether the orientations of a K-rotation synthesis of `exemplar` are
+/// shared by quarter turns: K a multiple of 4, not periodic, sides of equal
+/// parity (so the turned canvas is the directly rotated one).
+bool quarter_turns_shared(const Image& exemplar, int rotations, bool periodic);
+
+/// Orientation k of K (angle 2 pi k / K) as the synthesis builds it: when
+/// quarter_turns_shared, orientation k >= K/4 is orientation k mod K/4 turned
+/// by k / (K/4) quarter turns (the samples of rotate_exemplar up to rounding,
+/// one resampling for four orientations); else rotate_exemplar.
+RotatedExemplar rotate_exemplar_step(const Image& exemplar, int k, int rotations, bool periodic, int margin);
+
 /// All K rotations (or those in opt.only). Throws InvalidInputError on an
 /// empty exemplar, rotations outside 1..128, margin < 0 or an index outside 0..K-1.
 RotatedExemplarSet rotated_exemplars(const Image& exemplar, const RotatedExemplarOptions& opt = {});

@@ -21,6 +21,7 @@
 #include "test_support.h"
 #include "texture/bidirectional_similarity.h"
 #include "texture/efros_leung.h"
+#include "texture/rotated_exemplars.h"
 #include "texture/gaussian_pyramid.h"
 #include "texture/histogram_distance.h"
 #include "texture/image_ops.h"
@@ -547,6 +548,80 @@ TEST(EfrosLeung, ApproximateSearchKeepsTheQualityOfTheExhaustiveOne) {
       }
     EXPECT_GT(bidirectional_similarity(shuffled, ex, bo).total, 2 * qa) << name;
   }
+}
+
+// Orientations k >= K/4 are quarter turns of k mod K/4 and query its index
+// through the turn (slots and hits mapped): at 90 and 270 degrees the
+// approximate search keeps the exhaustive one's quality against the turned
+// exemplar, as at 0 degrees.
+TEST(EfrosLeung, ApproximateSearchOnQuarterTurnedOrientations) {
+  const int size = sanitized() ? 32 : 48;
+  const Image ex = read_image(test::shared_data("textures/cracked_mud_100.png"));
+  for (int k : {16, 48}) {
+    ElInput in;
+    in.exemplars = {ex};
+    in.target = Image(size, size, ex.channels);
+    in.angle = Image(size, size, 1, static_cast<float>(2.0 * M_PI * k / 64));
+    ElOptions opt;
+    opt.window = 9;
+    opt.seed = 5;
+    const Image a = efros_leung_synthesize(in, opt).image;
+    opt.search = ElSearch::Exhaustive;
+    const Image b = efros_leung_synthesize(in, opt).image;
+    RotatedExemplar id;
+    id.image = ex;
+    id.valid = Image(ex.width, ex.height, 1, 1.f);
+    const Image turned = turn_quarters(id, k / 16).image;
+    BidirectionalOptions bo;
+    bo.patch = 5;
+    const double qa = bidirectional_similarity(a, turned, bo).total, qb = bidirectional_similarity(b, turned, bo).total;
+    EXPECT_LT(qa, 1.10 * qb) << "k " << k << ": approximate " << qa << ", exhaustive " << qb;
+  }
+}
+
+// Orientations k >= K/4 are quarter turns of k mod K/4 and query its index
+// through the turn (slots and hits mapped). A pixel whose whole window is
+// known, cut from the exemplar turned by q quarter turns, has one exact
+// match; searched at orientation 16 q of 64 it is found exactly when the same
+// window searched unturned at orientation 0 finds it (the approximate index
+// alone: no coherent candidates next to Known pixels).
+TEST(EfrosLeung, QuarterTurnedOrientationsFindWhatTheirBaseFinds) {
+  const Image ex = read_image(test::shared_data("textures/cracked_mud_100.png"));
+  RotatedExemplar id;
+  id.image = ex;
+  id.valid = Image(ex.width, ex.height, 1, 1.f);
+  const int r = 7, side = 2 * r + 1;
+  auto exact = [&](const Image& img, int cx, int cy, int k, std::uint64_t seed) {
+    ElInput in;
+    in.exemplars = {ex};
+    in.target = crop(img, cx - r, cy - r, side, side, false);
+    in.state.assign(static_cast<std::size_t>(side) * side, PixelState::Known);
+    in.state[static_cast<std::size_t>(r) * side + r] = PixelState::Fill;
+    in.angle = Image(side, side, 1, static_cast<float>(2.0 * M_PI * k / 64));
+    ElOptions opt;  // window 11, first-pass window 5: both odd, so k >= 16 is turned
+    opt.seed = seed;
+    const ElResult res = efros_leung_synthesize(in, opt);
+    bool same = true;
+    for (int c = 0; c < ex.channels; ++c) same = same && res.image.at(r, r, c) == img.at(cx, cy, c);
+    return same;
+  };
+  std::mt19937_64 rng(3);
+  int base_found = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const int x = r + static_cast<int>(rng() % (ex.width - 2 * r)), y = r + static_cast<int>(rng() % (ex.height - 2 * r));
+    const bool base = exact(ex, x, y, 0, trial + 1);
+    base_found += base;
+    for (int q = 1; q <= 3; ++q) {
+      int tx = x, ty = y, w = ex.width, h = ex.height;
+      for (int t = 0; t < q; ++t) {
+        quarter_turn_position(w, tx, ty);
+        std::swap(w, h);
+      }
+      EXPECT_EQ(exact(turn_quarters(id, q).image, tx, ty, 16 * q, trial + 1), base)
+          << "window at (" << x << ", " << y << ") turned " << q << " times";
+    }
+  }
+  EXPECT_GE(base_found, 5) << "the unturned search finds too few exact matches to compare";
 }
 
 TEST(EfrosLeung, ApproximateSearchSameBytesForOneAndTwoThreadsAndPrepared) {

@@ -2,6 +2,7 @@
 // Gaussian pyramid/stack, image ops, rotated exemplars, quality metrics.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <string>
@@ -172,6 +173,33 @@ TEST(RotatedExemplars, IndexWrapsAndRotationZeroIsExact) {
   EXPECT_THROW(rotated_exemplars(ex, bad), InvalidInputError);
   bad.rotations = 129;
   EXPECT_THROW(rotated_exemplars(ex, bad), InvalidInputError);
+}
+
+// Orientation k >= K/4 built by exact quarter turns of orientation k mod K/4
+// is the direct rotation up to rounding: same canvas, same validity, same
+// samples (a wrong turn direction would put the texture upside down).
+TEST(RotatedExemplars, QuarterTurnsAreTheDirectRotation) {
+  for (const auto& size : {std::array<int, 2>{16, 16}, std::array<int, 2>{20, 12}}) {
+    const Image ex = noise(size[0], size[1], 3, 7);
+    ASSERT_TRUE(quarter_turns_shared(ex, 64, false));
+    for (int k : {16, 19, 32, 37, 48, 63}) {
+      const RotatedExemplar turned = rotate_exemplar_step(ex, k, 64, false, 0);
+      const RotatedExemplar direct = rotate_exemplar(ex, 2.0 * M_PI * k / 64, false, 0);
+      ASSERT_EQ(turned.image.width, direct.image.width) << k;
+      ASSERT_EQ(turned.image.height, direct.image.height) << k;
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < direct.valid.data.size(); ++i) {
+        differ += turned.valid.data[i] != direct.valid.data[i];
+        if (turned.valid.data[i] == 0.f || direct.valid.data[i] == 0.f) continue;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(turned.image.data[i * 3 + c], direct.image.data[i * 3 + c], 1e-4) << k;
+      }
+      EXPECT_LE(differ, direct.valid.data.size() / 100) << k;  // samples exactly on the border may flip
+    }
+    EXPECT_EQ(rotate_exemplar_step(ex, 5, 64, false, 0).image.data, rotate_exemplar(ex, 2.0 * M_PI * 5 / 64, false, 0).image.data);
+  }
+  EXPECT_FALSE(quarter_turns_shared(noise(16, 15, 3, 1), 64, false));  // odd side difference
+  EXPECT_FALSE(quarter_turns_shared(noise(16, 16, 3, 1), 64, true));   // periodic
+  EXPECT_FALSE(quarter_turns_shared(noise(16, 16, 3, 1), 30, false));  // K not a multiple of 4
 }
 
 TEST(BidirectionalSimilarity, VerbatimCopyIsCoherentAndKdTreeMatchesBruteForce) {

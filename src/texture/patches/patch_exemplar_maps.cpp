@@ -54,7 +54,7 @@ std::vector<Image> resample_patch_map(const PatchSynthesisResult& res, const Ima
   std::vector<RotatedExemplar> rot(K);
   const int margin = el.window / 2;  // as efros_leung prepares its search images
   tbb::parallel_for(0, K, [&](int k) {
-    if (used[k]) rot[k] = rotate_exemplar(map, 2.0 * M_PI * k / K, el.periodic_exemplar, margin);
+    if (used[k]) rot[k] = rotate_exemplar_step(map, k, K, el.periodic_exemplar, margin);
   });
   std::vector<float> mean(C, 0.f);
   for (std::size_t i = 0; i < map.data.size(); ++i) mean[i % C] += map.data[i];
