@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cassert>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -144,14 +145,16 @@ __attribute__((always_inline)) inline float lane_sum(const V8& a) {
 // Pass-2 kernel: Gaussian-weighted SSD of the candidates ids[0..count),
 // into out. The window is stored per active row as nv groups of 8 offsets
 // starting at buffer offset roff[r]; weights are 0 at unknown offsets (and
-// past the window), so they contribute exactly 0. Even and odd rows go to
-// two accumulators; lanes are summed in a fixed order at the end.
+// past the window), so they contribute exactly 0, and groups without a known
+// offset (bit g of gmask[r] clear) are skipped: adding +0 changes no sum.
+// Even and odd rows go to two accumulators; lanes are summed in a fixed
+// order at the end.
 template <int C>
 __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes,
                                                              std::size_t plane_size, int Cr,
-                                                             const int* roff, const float* w,
-                                                             const float* t, int nrows, int nv,
-                                                             const int* ids, std::size_t count,
+                                                             const int* roff, const unsigned* gmask,
+                                                             const float* w, const float* t, int nrows,
+                                                             int nv, const int* ids, std::size_t count,
                                                              float* out) {
   const int ch = C > 0 ? C : Cr;
   // Two candidates at a time share the loads of the weights and the window;
@@ -163,6 +166,7 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
     V8 acc_a[2] = {{}, {}}, acc_b[2] = {{}, {}};
     for (int r = 0; r < nrows; ++r)
       for (int g = 0; g < nv; ++g) {
+        if (!((gmask[r] >> g) & 1u)) continue;
         const std::size_t o = static_cast<std::size_t>(r) * nv + g;
         V8 wv;
         std::memcpy(&wv, w + o * kLanes, sizeof(V8));
@@ -186,19 +190,19 @@ __attribute__((always_inline)) inline void weighted_ssd_impl(const float* planes
   }
 }
 #define SURFTEX_WEIGHTED_ARGS                                                                 \
-  const float *p, std::size_t ps, const int *ro, const float *w, const float *t, int nr, int nv, \
+  const float *p, std::size_t ps, const int *ro, const unsigned *gm, const float *w, const float *t, int nr, int nv, \
       const int *ids, std::size_t count, float *out
 SURFTEX_SIMD_CLONES void weighted_ssd_c1(SURFTEX_WEIGHTED_ARGS) {
-  weighted_ssd_impl<1>(p, ps, 1, ro, w, t, nr, nv, ids, count, out);
+  weighted_ssd_impl<1>(p, ps, 1, ro, gm, w, t, nr, nv, ids, count, out);
 }
 SURFTEX_SIMD_CLONES void weighted_ssd_c3(SURFTEX_WEIGHTED_ARGS) {
-  weighted_ssd_impl<3>(p, ps, 3, ro, w, t, nr, nv, ids, count, out);
+  weighted_ssd_impl<3>(p, ps, 3, ro, gm, w, t, nr, nv, ids, count, out);
 }
 SURFTEX_SIMD_CLONES void weighted_ssd_c4(SURFTEX_WEIGHTED_ARGS) {
-  weighted_ssd_impl<4>(p, ps, 4, ro, w, t, nr, nv, ids, count, out);
+  weighted_ssd_impl<4>(p, ps, 4, ro, gm, w, t, nr, nv, ids, count, out);
 }
 void weighted_ssd_any(int C, SURFTEX_WEIGHTED_ARGS) {
-  weighted_ssd_impl<0>(p, ps, C, ro, w, t, nr, nv, ids, count, out);
+  weighted_ssd_impl<0>(p, ps, C, ro, gm, w, t, nr, nv, ids, count, out);
 }
 #undef SURFTEX_WEIGHTED_ARGS
 
@@ -285,6 +289,7 @@ struct SearchImage {
   std::shared_ptr<const PartialNeighbourhoodIndex> ann;
   int quarter = 0, ann_pw = 0, ann_ph = 0;
   std::vector<int> ann_slot;
+  int hit_at = 0, hit_dx = 0, hit_dy = 0;  // base pixel (x, y) is our position hit_at + x hit_dx + y hit_dy
 
   const float* plane(int c) const { return planes.data() + static_cast<std::size_t>(c) * pw * ph; }
 
@@ -300,17 +305,13 @@ struct SearchImage {
     for (int i = 0; i < known; ++i) turned[i] = ann_slot[slot[i]];
     const std::size_t first = out.size();
     ann->query(turned.data(), values, known, k, eps, out, scratch);
-    std::size_t kept = first;
+    // A candidate turned is a candidate (odd windows: the turned window is
+    // the same window), so every hit is kept.
     for (std::size_t i = first; i < out.size(); ++i) {
-      int x = out[i] % ann_pw, y = out[i] / ann_pw, w = ann_pw, h = ann_ph;
-      for (int t = 0; t < quarter; ++t) {
-        quarter_turn_position(w, x, y);
-        std::swap(w, h);
-      }
-      const int id = y * pw + x;
-      if (is_candidate[id]) out[kept++] = id;
+      const int x = out[i] % ann_pw, y = out[i] / ann_pw;
+      out[i] = hit_at + x * hit_dx + y * hit_dy;
+      assert(is_candidate[out[i]]);
     }
-    out.resize(kept);
   }
 };
 
@@ -376,6 +377,17 @@ SearchImage turned_search_image(const SearchImage& base, int q, int window, int 
     s.quarter = q;
     s.ann_pw = base.pw;
     s.ann_ph = base.ph;
+    auto turned_id = [&](int x, int y) {
+      int w = base.pw, h = base.ph;
+      for (int t = 0; t < q; ++t) {
+        quarter_turn_position(w, x, y);
+        std::swap(w, h);
+      }
+      return y * s.pw + x;
+    };
+    s.hit_at = turned_id(0, 0);
+    s.hit_dx = turned_id(1, 0) - s.hit_at;
+    s.hit_dy = turned_id(0, 1) - s.hit_at;
     // One turn sends a base offset (a, b) to (b, -a); so our offset (a, b)
     // is base offset (-b, a), turned back q times.
     const int f = first_window, lo = lo_of(f);
@@ -601,6 +613,7 @@ class Synthesizer {
   std::vector<float> value_;             // known values, [k * C + c]
   std::vector<float> weight_;            // Gaussian weight per known neighbour
   std::vector<int> p2_roff_;
+  std::vector<unsigned> p2_gmask_;  // per row: bit g = group g holds a known offset
   std::vector<float> p2_w_, p2_t_;
   int p2_row_dy_ = 0;
   std::vector<int> p1_delta_;
@@ -780,6 +793,7 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   const int flo = lo_of(first_), fhi = hi_of(first_);
   const int nv = (window_ + kLanes - 1) / kLanes, rowlen = nv * kLanes;
   p2_roff_.clear();
+  p2_gmask_.clear();
   p2_w_.clear();
   p2_t_.clear();
   int g = 0;
@@ -811,10 +825,12 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
       if (p2_roff_.empty() || p2_row_dy_ != dy) {
         p2_row_dy_ = dy;
         p2_roff_.push_back(dy * s.pw + lo);
+        p2_gmask_.push_back(0u);
         p2_w_.resize(p2_w_.size() + rowlen, 0.f);
         p2_t_.resize(p2_t_.size() + static_cast<std::size_t>(rowlen) * C, 0.f);
       }
       const std::size_t r = p2_roff_.size() - 1;
+      p2_gmask_[r] |= 1u << ((dx - lo) / kLanes);
       p2_w_[r * rowlen + (dx - lo)] = gauss_[g];
       for (int c = 0; c < C; ++c) p2_t_[(r * C + c) * rowlen + (dx - lo)] = v[c];
     }
@@ -1038,10 +1054,10 @@ void Synthesizer::score_full(const SearchImage& s, const std::vector<int>& ids,
     float* o = p2_err_.data() + i0;
     const std::size_t m = i1 - i0;
     switch (C) {
-      case 1: weighted_ssd_c1(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
-      case 3: weighted_ssd_c3(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
-      case 4: weighted_ssd_c4(P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
-      default: weighted_ssd_any(C, P, ps, p2_roff_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o);
+      case 1: weighted_ssd_c1(P, ps, p2_roff_.data(), p2_gmask_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      case 3: weighted_ssd_c3(P, ps, p2_roff_.data(), p2_gmask_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      case 4: weighted_ssd_c4(P, ps, p2_roff_.data(), p2_gmask_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o); break;
+      default: weighted_ssd_any(C, P, ps, p2_roff_.data(), p2_gmask_.data(), p2_w_.data(), p2_t_.data(), nr, nv, I, m, o);
     }
   };
   const std::size_t work = ids.size() * nk * static_cast<std::size_t>(C);
