@@ -337,10 +337,10 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
 }
 
 // `base` turned by q quarter turns (rotated_exemplars.h): its planes and
-// validity permuted, its candidates indexed anew; the approximate index is
-// base's, queried through the turn (SearchImage::ann_query). Windows must be
-// odd (a turned window is then the same window).
-SearchImage turned_search_image(const SearchImage& base, int q, int window, int first_window) {
+// validity permuted, its candidates indexed anew; with share_index (odd
+// windows only: a turned window is then the same window) the approximate
+// index is base's, queried through the turn (SearchImage::ann_query).
+SearchImage turned_search_image(const SearchImage& base, int q, int window, int first_window, bool share_index) {
   SearchImage s;
   const bool odd = q % 2 == 1;
   s.pw = odd ? base.ph : base.pw;
@@ -372,7 +372,7 @@ SearchImage turned_search_image(const SearchImage& base, int q, int window, int 
     for (int x = 0; x < s.pw; ++x) v[x] = base.valid[row + x * sx];
   }
   index_candidates(s, window, false, 0, 0, 0);
-  if (base.ann) {
+  if (base.ann && share_index) {
     s.ann = base.ann;
     s.quarter = q;
     s.ann_pw = base.pw;
@@ -513,29 +513,27 @@ struct ElPreparedExemplars {
     return *slots[i];
   }
 
-  // Orientations k >= K/4 are quarter turns of k mod K/4 when the exemplar
-  // allows it (rotate_exemplar_step) and both windows are odd.
-  bool turned(int e, int k) const {
-    return k >= rotations / 4 && window % 2 == 1 && first_window % 2 == 1 &&
-           quarter_turns_shared(exemplars[e], rotations, periodic);
-  }
-
   std::unique_ptr<SearchImage> build(int e, int k) const {
     const Image& ex = exemplars[e];
     const int margin = std::max(-lo_of(window), hi_of(window));
-    if (turned(e, k)) {
-      const int quarter = rotations / 4;
-      return std::make_unique<SearchImage>(turned_search_image(get(e, k % quarter), k / quarter, window, first_window));
+    const int quarter = rotations / 4;
+    std::unique_ptr<SearchImage> s;
+    if (k >= quarter && quarter_turns_shared(ex, rotations, periodic)) {
+      // Orientation k is a quarter turn of k mod K/4 (rotate_exemplar_step);
+      // its approximate index is shared when both windows are odd.
+      const bool share = window % 2 == 1 && first_window % 2 == 1;
+      s = std::make_unique<SearchImage>(turned_search_image(get(e, k % quarter), k / quarter, window, first_window, share));
+    } else {
+      RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
+      s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));
     }
-    RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
-    auto s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));
     if (s->ids.empty())
       throw InvalidInputError("efros_leung: exemplar " + std::to_string(e) + " rotated by " +
                               std::to_string(360.0 * k / rotations) +
                               " degrees has no position where the whole window " + std::to_string(window) +
                               " fits; use a larger exemplar, a smaller window or "
                               "periodic_exemplar");
-    if (search == ElSearch::Approximate)
+    if (search == ElSearch::Approximate && !s->ann)
       s->ann = std::make_shared<const PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
                                                            s->pw, s->channels, s->ids, first_window, ann_pca_dims,
                                                            ann_stride);

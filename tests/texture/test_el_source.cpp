@@ -32,24 +32,27 @@ TEST(EfrosLeungSource, EveryFilledPixelNamesTheTexelItCopied) {
     }
 }
 
-// Also for orientations built by quarter turns (k >= K/4: 2.5 rad is k = 3 of 8).
+// Also for orientations built by quarter turns (k >= K/4: 2.5 rad is k = 3 of
+// 8), with their base's index (odd windows) or their own (an even window).
 TEST(EfrosLeungSource, RotatedSourcesIndexTheRotatedExemplar) {
   const Image ex = make_noise(32, 4, 6);
-  for (float angle : {0.7f, 2.5f}) {
-    ElInput in;
-    in.exemplars = {ex};
-    in.target = Image(16, 16, 3);
-    in.angle = Image(16, 16, 1, angle);
-    ElOptions o;
-    o.window = 5;
-    o.rotations = 8;
-    const ElResult r = efros_leung_synthesize(in, o);
-    const int k = rotation_index(angle, 8);
-    const RotatedExemplar rot = rotate_exemplar_step(ex, k, 8, false, o.window / 2);
-    for (std::size_t p = 0; p < r.source.size(); ++p) {
-      const ElSource& s = r.source[p];
-      ASSERT_EQ(s.rotation, k);
-      for (int c = 0; c < 3; ++c) ASSERT_EQ(r.image.data[p * 3 + c], rot.image.at(s.x, s.y, c)) << p;
+  for (int window : {5, 6}) {
+    for (float angle : {0.7f, 2.5f}) {
+      ElInput in;
+      in.exemplars = {ex};
+      in.target = Image(16, 16, 3);
+      in.angle = Image(16, 16, 1, angle);
+      ElOptions o;
+      o.window = window;
+      o.rotations = 8;
+      const ElResult r = efros_leung_synthesize(in, o);
+      const int k = rotation_index(angle, 8);
+      const RotatedExemplar rot = rotate_exemplar_step(ex, k, 8, false, o.window / 2);
+      for (std::size_t p = 0; p < r.source.size(); ++p) {
+        const ElSource& s = r.source[p];
+        ASSERT_EQ(s.rotation, k);
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(r.image.data[p * 3 + c], rot.image.at(s.x, s.y, c)) << p;
+      }
     }
   }
 }

@@ -51,11 +51,12 @@ struct FlatPatch {
   int res = 0;
   double texel = 0, u0 = 0, v0 = 0;
   // Stored window of the res x res raster: the bounding box of its Inside and
-  // Boundary pixels (1 x 1 at the origin when there are none); every pixel
-  // outside it is Outside. The arrays below, and every image laid over the
-  // patch, hold the window only (bw * bh, row-major): a small patch's raster
-  // is mostly Outside, and thousands of full rasters cost gigabytes.
-  int bx = 0, by = 0, bw = 1, bh = 1;
+  // Boundary pixels (1 x 1 at the origin when there are none; 0 x 0 before
+  // flatten_patches rasterises); every pixel outside it is Outside. The
+  // arrays below, and every image laid over the patch, hold the window only
+  // (bw * bh, row-major): a small patch's raster is mostly Outside, and
+  // thousands of full rasters cost gigabytes.
+  int bx = 0, by = 0, bw = 0, bh = 0;
   std::vector<PatchPixel> pixel;                  ///< bw*bh, row-major
   std::vector<int> pixel_face;                    ///< mesh face, -1 for Outside
   std::vector<std::array<float, 3>> pixel_bary;   ///< barycentrics in that face
