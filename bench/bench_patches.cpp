@@ -9,11 +9,16 @@
 //  - triceratops: CGAL's triceratops.off (5,660 triangles) with leather_64
 //    (the paper's 64 x 64 sample size, Table 1);
 //  - bear: CGAL's bear.off (27.6K triangles) with pebbles_256 (issue 19's
-//    goal: a 256 px exemplar at defaults in <= 60 s on 2 threads).
-// Meshes are extracted with tar from SURFTEX_CGAL_DATA_TARBALL into a
+//    goal: a 256 px exemplar at defaults in <= 60 s on 2 threads);
+//  - bear_512: the same with rock_512 (issue 19: >= 100K texels/s up to 512 px);
+//  - lion: shared/data's guardian_lion_20k.off with woven_tissue_512 (2,475
+//    small patches: the per-texel cost of small patches);
+//  - stripes: shared/data's bunny_6k.obj with stripes_blue_white_256 (flat
+//    stripes wider than the window: most pixels widen their short list).
+// CGAL meshes are extracted with tar from SURFTEX_CGAL_DATA_TARBALL into a
 // temporary folder. Measurement history: docs/decisions/501-*.md.
 //
-// Usage: bench_patches [case|all] [out_dir] [threads]
+// Usage: bench_patches [triceratops|bear|bear_512|lion|stripes|all] [out_dir] [threads]
 // (default all, no file output, all cores). out_dir receives
 // CASE_atlas.png and CASE_render.png. texels_per_second is texels over the
 // synthesis wall time; pipeline_cpu_seconds is the process CPU time (all
@@ -58,9 +63,17 @@ Mesh cgal_mesh(const std::string& name) {
   return mesh;
 }
 
+// "shared:NAME" is shared/data/meshes/NAME, any other name a CGAL mesh.
+Mesh load_mesh(const std::string& name) {
+  if (name.rfind("shared:", 0) != 0) return cgal_mesh(name);
+  Mesh mesh;
+  read_mesh(std::string(SURFTEX_SHARED_DATA_DIR) + "/meshes/" + name.substr(7), mesh);
+  return mesh;
+}
+
 void run_case(const std::string& name, const std::string& mesh_file, const std::string& texture,
               const std::string& out) {
-  Mesh mesh = cgal_mesh(mesh_file);
+  Mesh mesh = load_mesh(mesh_file);
   const Image ex = as_rgb(read_image(std::string(SURFTEX_SHARED_DATA_DIR) + "/textures/" + texture));
   PatchTextureOptions to;  // the CLI's synthesis defaults; no PBR maps, no fidelity (not measured here)
   to.pbr_maps = false;
@@ -121,6 +134,9 @@ int main(int argc, char** argv) {
   try {
     if (which == "all" || which == "triceratops") run_case("triceratops", "triceratops.off", "leather_64.png", out);
     if (which == "all" || which == "bear") run_case("bear", "bear.off", "pebbles_256.png", out);
+    if (which == "all" || which == "bear_512") run_case("bear_512", "bear.off", "rock_512.png", out);
+    if (which == "all" || which == "lion") run_case("lion", "shared:guardian_lion_20k.off", "woven_tissue_512.png", out);
+    if (which == "all" || which == "stripes") run_case("stripes", "shared:bunny_6k.obj", "stripes_blue_white_256.png", out);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
