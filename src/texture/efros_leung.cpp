@@ -284,10 +284,10 @@ struct SearchImage {
   }
   std::vector<std::uint8_t> valid;  // per buffer position: 1 = a usable sample
   // Approximate search only: the index of this image, or (quarter > 0) of
-  // the image it is `quarter` quarter turns of (ann_pw x ann_ph), whose
+  // the image it is `quarter` quarter turns of (ann_pw wide), whose
   // first-pass slots ann_slot maps ours to.
   std::shared_ptr<const PartialNeighbourhoodIndex> ann;
-  int quarter = 0, ann_pw = 0, ann_ph = 0;
+  int quarter = 0, ann_pw = 0;
   std::vector<int> ann_slot;
   int hit_at = 0, hit_dx = 0, hit_dy = 0;  // base pixel (x, y) is our position hit_at + x hit_dx + y hit_dy
 
@@ -349,15 +349,10 @@ SearchImage turned_search_image(const SearchImage& base, int q, int window, int 
   const std::size_t n = static_cast<std::size_t>(s.pw) * s.ph;
   s.planes.resize(n * s.channels + kPad, 0.f);
   s.valid.resize(n);
-  // Our pixel (x, y) is base pixel a + x * sx + y * sy (the turn is affine);
-  // written in our row order.
+  // Our pixel (x, y) is base pixel a + x * sx + y * sy (the turn is affine;
+  // 4 - q more turns bring ours back to base); written in our row order.
   auto source = [&](int x, int y) {
-    int w = s.pw, h = s.ph;
-    for (int t = 0; t < q; ++t) {  // pixel (x, y) of a turned w x h canvas is (h - 1 - y, x) of the h x w one
-      const int bx = h - 1 - y, by = x;
-      x = bx, y = by;
-      std::swap(w, h);
-    }
+    quarter_turns_position(s.pw, s.ph, (4 - q) % 4, x, y);
     return static_cast<long long>(y) * base.pw + x;
   };
   const long long a = source(0, 0), sx = source(1, 0) - a, sy = source(0, 1) - a;
@@ -376,13 +371,8 @@ SearchImage turned_search_image(const SearchImage& base, int q, int window, int 
     s.ann = base.ann;
     s.quarter = q;
     s.ann_pw = base.pw;
-    s.ann_ph = base.ph;
     auto turned_id = [&](int x, int y) {
-      int w = base.pw, h = base.ph;
-      for (int t = 0; t < q; ++t) {
-        quarter_turn_position(w, x, y);
-        std::swap(w, h);
-      }
+      quarter_turns_position(base.pw, base.ph, q, x, y);
       return y * s.pw + x;
     };
     s.hit_at = turned_id(0, 0);
@@ -494,8 +484,9 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
 
 // Search images built on first use: slot e * rotations + k holds exemplar e
 // rotated by 2 pi k / rotations (rotate_exemplar_step: k >= K/4 as quarter
-// turns of k mod K/4, sharing its approximate index). Each slot is built once (its own once_flag,
-// so different slots build concurrently); a built slot never changes.
+// turns of k mod K/4, sharing its approximate index). Each slot is built
+// once (its own once_flag, so different slots build concurrently); a built
+// slot never changes.
 struct ElPreparedExemplars {
   std::vector<Image> exemplars;
   int window = 0, first_window = 0, rotations = 1, ann_pca_dims = 0, ann_stride = 1;
@@ -516,13 +507,13 @@ struct ElPreparedExemplars {
   std::unique_ptr<SearchImage> build(int e, int k) const {
     const Image& ex = exemplars[e];
     const int margin = std::max(-lo_of(window), hi_of(window));
-    const int quarter = rotations / 4;
     std::unique_ptr<SearchImage> s;
-    if (k >= quarter && quarter_turns_shared(ex, rotations, periodic)) {
-      // Orientation k is a quarter turn of k mod K/4 (rotate_exemplar_step);
+    if (const int q = quarter_turns_of(ex, k, rotations, periodic); q > 0) {
+      // Orientation k is q quarter turns of k mod K/4 (rotate_exemplar_step);
       // its approximate index is shared when both windows are odd.
       const bool share = window % 2 == 1 && first_window % 2 == 1;
-      s = std::make_unique<SearchImage>(turned_search_image(get(e, k % quarter), k / quarter, window, first_window, share));
+      s = std::make_unique<SearchImage>(
+          turned_search_image(get(e, k % (rotations / 4)), q, window, first_window, share));
     } else {
       RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
       s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));

@@ -85,15 +85,18 @@ bool quarter_turns_shared(const Image& exemplar, int rotations, bool periodic) {
   return rotations % 4 == 0 && !periodic && (exemplar.width - exemplar.height) % 2 == 0;
 }
 
+int quarter_turns_of(const Image& exemplar, int k, int rotations, bool periodic) {
+  return quarter_turns_shared(exemplar, rotations, periodic) ? k / (rotations / 4) : 0;
+}
+
 RotatedExemplar rotate_exemplar_step(const Image& exemplar, int k, int rotations, bool periodic, int margin) {
   if (rotations < 1 || k < 0 || k >= rotations)
     throw InvalidInputError("rotate_exemplar_step: orientation " + std::to_string(k) + " of " +
                             std::to_string(rotations));
-  const int quarter = rotations / 4;
-  if (!quarter_turns_shared(exemplar, rotations, periodic) || k < quarter)
-    return rotate_exemplar(exemplar, 2.0 * M_PI * k / rotations, periodic, margin);
+  const int q = quarter_turns_of(exemplar, k, rotations, periodic);
+  if (q == 0) return rotate_exemplar(exemplar, 2.0 * M_PI * k / rotations, periodic, margin);
   RotatedExemplar r = turn_quarters(
-      rotate_exemplar(exemplar, 2.0 * M_PI * (k % quarter) / rotations, periodic, margin), k / quarter);
+      rotate_exemplar(exemplar, 2.0 * M_PI * (k % (rotations / 4)) / rotations, periodic, margin), q);
   r.angle = 2.0 * M_PI * k / rotations;
   return r;
 }

@@ -63,6 +63,16 @@ inline void quarter_turn_position(int w, int& x, int& y) {
   x = nx;
 }
 
+/// Position (x, y) of a w x h image after q quarter turns (q = 0..3).
+inline void quarter_turns_position(int w, int h, int q, int& x, int& y) {
+  for (int t = 0; t < q; ++t) {
+    quarter_turn_position(w, x, y);
+    const int nw = h;
+    h = w;
+    w = nw;
+  }
+}
+
 /// `r` turned by q exact quarter turns (q = 0..3): the exemplar rotated by
 /// r.angle + q pi/2, its samples permuted, not resampled.
 RotatedExemplar turn_quarters(const RotatedExemplar& r, int q);
@@ -71,6 +81,10 @@ RotatedExemplar turn_quarters(const RotatedExemplar& r, int q);
 /// shared by quarter turns: K a multiple of 4, not periodic, sides of equal
 /// parity (so the turned canvas is the directly rotated one).
 bool quarter_turns_shared(const Image& exemplar, int rotations, bool periodic);
+
+/// The quarter turns by which orientation k of K is built from orientation
+/// k mod K/4 (0: rotated directly): k / (K/4) when quarter_turns_shared.
+int quarter_turns_of(const Image& exemplar, int k, int rotations, bool periodic);
 
 /// Orientation k of K (angle 2 pi k / K) as the synthesis builds it: when
 /// quarter_turns_shared, orientation k >= K/4 is orientation k mod K/4 turned

@@ -612,11 +612,8 @@ TEST(EfrosLeung, QuarterTurnedOrientationsFindWhatTheirBaseFinds) {
     const bool base = exact(ex, x, y, 0, trial + 1);
     base_found += base;
     for (int q = 1; q <= 3; ++q) {
-      int tx = x, ty = y, w = ex.width, h = ex.height;
-      for (int t = 0; t < q; ++t) {
-        quarter_turn_position(w, tx, ty);
-        std::swap(w, h);
-      }
+      int tx = x, ty = y;
+      quarter_turns_position(ex.width, ex.height, q, tx, ty);
       EXPECT_EQ(exact(turn_quarters(id, q).image, tx, ty, 16 * q, trial + 1), base)
           << "window at (" << x << ", " << y << ") turned " << q << " times";
     }
