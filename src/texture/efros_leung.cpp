@@ -619,9 +619,20 @@ class Synthesizer {
   std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0, widened_ = 0;
   std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
   std::vector<ElSource> source_;         // per pixel: where its value came from
+  // Per search image: its exemplar, that exemplar's size and the cosine and
+  // sine of its rotation (rotated_point / exemplar_point).
+  struct Frame {
+    int e = 0, w = 0, h = 0;
+    double c = 1, s = 0;
+  };
+  std::vector<Frame> frame_;
   void record_source(int q, int p, int id, const SearchImage& s) {
-    source_[q] = {pair_of_[p] / opt_.rotations, pair_of_[p] % opt_.rotations, id % s.pw, id / s.pw};
+    const Frame& f = frame_[key_[p]];
+    const auto u = exemplar_point(f.w, f.h, s.pw, s.ph, f.c, f.s, id % s.pw, id / s.pw);
+    source_[q] = {f.e, pair_of_[p] % opt_.rotations, id % s.pw, id / s.pw, static_cast<float>(u[0]),
+                  static_cast<float>(u[1])};
   }
+  int continuing(const ElExemplarPoint& g, int p, int dx, int dy, const SearchImage& s) const;
   // Approximate search: source position (buffer offset in the pixel's own
   // search image) of every synthesised pixel, -1 for the others; the known
   // first-pass neighbours' window slots; the short list.
@@ -631,9 +642,11 @@ class Synthesizer {
   // Coherent candidates of the current pixel (sorted, unique); see
   // ElOptions::coherence.
   std::vector<int> coh_;
+  // Those that continue a given pixel's source (ElInput::known_source).
+  std::vector<int> coh_given_;
   bool given_in_window_ = false;  // a Known (given) pixel lies in the current window
   void add_coherent_to_preselect();
-  bool pick_coherent(int& id) const;
+  bool pick_coherent(int& id);
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
   std::vector<int> ann_turned_;
 };
@@ -717,6 +730,12 @@ void Synthesizer::validate() {
   if (!in_.exemplar_index.empty() && in_.exemplar_index.size() != n)
     bad("exemplar_index has " + std::to_string(in_.exemplar_index.size()) +
         " entries, target has " + std::to_string(n) + " pixels");
+  if (!in_.known_source.empty() && in_.known_source.size() != n)
+    bad("known_source has " + std::to_string(in_.known_source.size()) + " entries, target has " +
+        std::to_string(n) + " pixels");
+  for (const ElExemplarPoint& g : in_.known_source)
+    if (g.exemplar >= 0 && (!std::isfinite(g.x) || !std::isfinite(g.y)))
+      bad("known_source holds a non-finite point");
 }
 
 void Synthesizer::prepare_search_images() {
@@ -759,7 +778,13 @@ void Synthesizer::prepare_search_images() {
       search_[j] = &prep_->get(pairs[j] / K, pairs[j] % K);
     });
   });
-  for (std::size_t j = 0; j < pairs.size(); ++j) slot[pairs[j]] = static_cast<int>(j);
+  frame_.resize(pairs.size());
+  for (std::size_t j = 0; j < pairs.size(); ++j) {
+    slot[pairs[j]] = static_cast<int>(j);
+    const int e = pairs[j] / K;
+    const double a = 2.0 * M_PI * (pairs[j] % K) / K;
+    frame_[j] = {e, prep_->exemplars[e].width, prep_->exemplars[e].height, std::cos(a), std::sin(a)};
+  }
   key_.assign(n, -1);
   for (std::size_t p = 0; p < n; ++p)
     if (pair_of[p] >= 0) key_[p] = slot[pair_of[p]];
@@ -776,6 +801,7 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   p1_slot_.clear();
   short_.clear();
   coh_.clear();
+  coh_given_.clear();
   given_in_window_ = false;
   const int px = p % W, py = p / W;
   const int lo = lo_of(window_), hi = hi_of(window_);
@@ -801,6 +827,10 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
         int c = -1;
         if (src_[q] >= 0 && key_[q] == key_[p])
           c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
+        else if (src_[q] >= 0)  // another orientation: through the exemplar
+          c = continuing(ElExemplarPoint{source_[q].exemplar, source_[q].ex, source_[q].ey}, p, dx, dy, s);
+        else if (state_[q] == PixelState::Known && !in_.known_source.empty() && opt_.coherence > 0)
+          if ((c = continuing(in_.known_source[q], p, dx, dy, s)) >= 0) coh_given_.push_back(c);
         if (s.ann) {
           p1_slot_.push_back((dy - flo) * first_ + (dx - flo));
           if (c >= 0) short_.push_back(c);
@@ -1140,6 +1170,26 @@ void Synthesizer::synthesize_pixel(int p) {
   ++synthesized_;
 }
 
+// The candidate of pixel p (offset (dx, dy) from a neighbour whose value was
+// read at exemplar point g: a given pixel's ElInput::known_source, or a
+// synthesised pixel of another orientation) that continues it in p's search
+// image: g in p's rotation, moved back by the offset; -1 if g is in another
+// exemplar or that is no candidate. Periodic canvases: the copy of g that
+// lies on the canvas.
+int Synthesizer::continuing(const ElExemplarPoint& g, int p, int dx, int dy, const SearchImage& s) const {
+  const Frame& f = frame_[key_[p]];
+  if (g.exemplar != f.e) return -1;
+  const int shift[3] = {0, -1, 1}, tiles = s.periodic ? 3 : 1;
+  for (int ty = 0; ty < tiles; ++ty)
+    for (int tx = 0; tx < tiles; ++tx) {
+      const auto c = rotated_point(f.w, f.h, s.pw, s.ph, f.c, f.s, g.x + shift[tx] * f.w, g.y + shift[ty] * f.h);
+      const long long i = std::llround(c[0]) - dx, j = std::llround(c[1]) - dy;
+      if (i < 0 || j < 0 || i >= s.pw || j >= s.ph) continue;
+      return s.candidate_at(j * s.pw + i);
+    }
+  return -1;
+}
+
 // Coherent candidates join pass 2 even when pass 1 ranked them out.
 void Synthesizer::add_coherent_to_preselect() {
   if (coh_.empty()) return;
@@ -1153,14 +1203,20 @@ void Synthesizer::add_coherent_to_preselect() {
 
 // ElOptions::coherence: the best coherent candidate of pass 2 replaces the
 // random pick when its error is within (1 + coherence) of the best error
-// (scored_ holds every pass-2 candidate, its best first). Not next to given
-// (Known) pixels: there the boundary condition decides (a patch's seams).
-// Returns whether it did.
-bool Synthesizer::pick_coherent(int& id) const {
-  if (coh_.empty() || scored_.empty() || given_in_window_) return false;
+// (scored_ holds every pass-2 candidate, its best first). Next to given
+// (Known) pixels, those that continue a given pixel's source
+// (ElInput::known_source) come first; without such sources the boundary
+// condition decides there (a patch's seams, decision 506); with them, the
+// synthesised pixels near the seam continue the given ones, and so may their
+// neighbours. Returns whether it did.
+bool Synthesizer::pick_coherent(int& id) {
+  const bool given_only = given_in_window_ && (!coh_given_.empty() || in_.known_source.empty());
+  std::vector<int>& pool = given_only ? coh_given_ : coh_;
+  if (pool.empty() || scored_.empty()) return false;
+  std::sort(pool.begin(), pool.end());
   const Scored* best = nullptr;
   for (const Scored& v : scored_)
-    if (std::binary_search(coh_.begin(), coh_.end(), v.second) && (!best || v < *best)) best = &v;
+    if (std::binary_search(pool.begin(), pool.end(), v.second) && (!best || v < *best)) best = &v;
   if (!best || best->first > scored_[0].first * (1.0 + opt_.coherence) + 1e-12) return false;
   id = best->second;
   return true;

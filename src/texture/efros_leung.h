@@ -74,7 +74,8 @@ struct ElOptions {
   /// neighbour's source (its source shifted by the offset) is taken when its
   /// full-window error is at most (1 + coherence) times the best; the best
   /// such, ties by position; not where the window holds given (Known)
-  /// pixels, whose boundary condition decides. Larger features (bricks, tiles) then come out
+  /// pixels, whose boundary condition decides, unless the candidate continues
+  /// a given pixel's source (ElInput::known_source). Larger features (bricks, tiles) then come out
   /// whole instead of in fragments. >= 0; 0 = off (the published rule).
   /// Default 5 (decision 506).
   double coherence = 5.0;
@@ -119,6 +120,12 @@ struct ElOptions {
 /// Opaque; made by el_prepare_exemplars.
 struct ElPreparedExemplars;
 
+/// A point of exemplar `exemplar` in its own (unrotated) pixel coordinates.
+struct ElExemplarPoint {
+  int exemplar = -1;
+  float x = 0.f, y = 0.f;
+};
+
 /// Everything a synthesis run reads besides the options.
 struct ElInput {
   /// One or more exemplars (Gorla 5), same channels, each >= `window` per side
@@ -141,12 +148,21 @@ struct ElInput {
   /// Optional per-pixel exemplar index (0-based, row-major, width*height);
   /// empty = exemplar 0 everywhere. Read at Fill pixels only.
   std::vector<int> exemplar_index;
+  /// Optional, per pixel (row-major, width*height): where a Known pixel's value
+  /// was read in the exemplars (ElExemplarPoint; exemplar -1 = not known). A Fill
+  /// pixel next to it then gets the coherent candidate that continues it, which
+  /// may win next to given pixels too (ElOptions::coherence): a patch continues
+  /// its neighbours' texture across the seam instead of matching it anew.
+  std::vector<ElExemplarPoint> known_source;
 };
 
 /// Where a synthesised pixel took its value: pixel (x, y) of `exemplar` rotated
 /// by `rotation` (rotate_exemplar_step with K = rotations, margin window / 2); exemplar -1 = not synthesised.
 struct ElSource {
   int exemplar = -1, rotation = 0, x = 0, y = 0;
+  /// (x, y) in the unrotated exemplar's pixel coordinates (rotated_exemplars.h
+  /// exemplar_point).
+  float ex = 0.f, ey = 0.f;
 };
 
 struct ElResult {

@@ -341,6 +341,38 @@ bool sample_neighbour(const std::vector<FlatPatch>& patches, const PatchFaces& p
   return sample_inside(fq, images[q], pq[0], pq[1], out);
 }
 
+// Where the neighbour's texture at that point came from (its nearest Inside
+// pixel's source moved by the sub-pixel offset, in exemplar coordinates), so
+// the synthesis can continue it across the seam (ElInput::known_source);
+// exemplar -1 if no pixel of the 2 x 2 footprint is Inside with a source.
+ElExemplarPoint neighbour_source(const std::vector<FlatPatch>& patches, const PatchFaces& pf,
+                                 const std::vector<std::vector<ElSource>>& sources, int rotations, int face,
+                                 const std::array<float, 3>& b) {
+  const int q = pf.patch[face];
+  const FlatPatch& fq = patches[q];
+  const FlatTriangle& tq = fq.triangles[pf.slot[face]];
+  const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
+  const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
+  const auto pq = fq.to_pixel(u, v);
+  const double fx = pq[0] - 0.5, fy = pq[1] - 0.5;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  ElExemplarPoint best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int x = x0 + i, y = y0 + j;
+      if (fq.state(x, y) != PatchPixel::Inside || sources[q].empty()) continue;
+      const ElSource& s = sources[q][fq.index(x, y)];
+      const double ox = fx - x, oy = fy - y, d = ox * ox + oy * oy;
+      if (s.exemplar < 0 || !(d < best_d)) continue;
+      // A raster offset is the same offset in the rotated exemplar's canvas.
+      const double a = 2.0 * M_PI * s.rotation / rotations, c = std::cos(a), sn = std::sin(a);
+      best = {s.exemplar, static_cast<float>(s.ex + c * ox - sn * oy), static_cast<float>(s.ey + sn * ox + c * oy)};
+      best_d = d;
+    }
+  return best;
+}
+
 // The synthesis of one patch image (3.3): its Inside pixels are filled by
 // Efros-Leung, steered per pixel by the direction field, from the boundary
 // conditions its available neighbours' images give.
@@ -388,6 +420,7 @@ class PatchSynthesizer {
     in.state.assign(n, PixelState::Outside);
     if (fields_.oriented) in.angle = Image(fp.bw, fp.bh, 1, 0.f);
     if (opt_.multi != MultiTexture::None) in.exemplar_index.assign(n, 0);
+    if (opt_.el.coherence > 0) in.known_source.assign(n, ElExemplarPoint());
     double mean_c = 0, mean_s = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const PatchPixel kind = fp.pixel[i];
@@ -398,6 +431,9 @@ class PatchSynthesizer {
                              &in.target.data[i * C_])) {
           in.state[i] = PixelState::Known;
           ++known_[p];
+          if (!in.known_source.empty())
+            in.known_source[i] = neighbour_source(patches_, faces_, res_.sources, opt_.el.rotations,
+                                                  fp.pixel_face[i], fp.pixel_bary[i]);
         }
         continue;
       }
