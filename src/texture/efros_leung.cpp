@@ -647,6 +647,8 @@ class Synthesizer {
   bool given_in_window_ = false;  // a Known (given) pixel lies in the current window
   void add_coherent_to_preselect();
   bool pick_coherent(int& id);
+  std::vector<int>& coherent_pool();
+  bool coherent_tie();
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
   std::vector<int> ann_turned_;
 };
@@ -911,7 +913,8 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // candidates over the whole exemplar (one in each run of N/n consecutive
 // candidates, drawn from a hash of the seed and the pixel, so the
 // synthesis's random stream is untouched), as the exhaustive pass would
-// see them. Pixels without such ties are unchanged.
+// see them. Pixels without such ties are unchanged, and so are those with a
+// coherent candidate among the ties (coherent_tie).
 //
 // Order of work: when the short list fits the preselect (the usual case, no
 // ranking needed) pass 2 scores it first, and the first-pass errors of the
@@ -934,7 +937,7 @@ void Synthesizer::short_list_passes(const SearchImage& s, std::size_t n, int p) 
     add_coherent_to_preselect();
     score_full(s, pre_, scored_);
   }
-  const bool widen = short_list_ties(s);
+  const bool widen = short_list_ties(s) && !coherent_tie();
   last_widened_ = widen;
   if (first && !widen) {
     pass1_candidates_ += short_.size();
@@ -966,6 +969,20 @@ bool Synthesizer::short_list_ties(const SearchImage& s) {
   std::size_t ties = 0;
   for (const auto& v : p1_scored_) ties += v.first <= p1_tie_;
   return ties >= static_cast<std::size_t>(opt_.ann_candidates) && s.ids.size() > short_.size();
+}
+
+// Whether a candidate of the coherent pool (pick_coherent's) is among the
+// short list's first-pass ties. The widening exists for pixels whose short
+// list is an arbitrary part of a larger tie set (the kd-tree's leaf), where a
+// random pick would lock into that part; a pixel continued by coherence has
+// its pick from its neighbours instead, so it keeps its short list: stripes
+// wider than the window cost a short list, not a sample of the whole
+// exemplar (issue 19; decision 501, session 28).
+bool Synthesizer::coherent_tie() {
+  const std::vector<int>& pool = coherent_pool();
+  for (const auto& v : p1_scored_)
+    if (v.first <= p1_tie_ && std::find(pool.begin(), pool.end(), v.second) != pool.end()) return true;
+  return false;
 }
 
 // The short list (widened by the stratified sample when `widen`) ranked by
@@ -1209,9 +1226,13 @@ void Synthesizer::add_coherent_to_preselect() {
 // condition decides there (a patch's seams, decision 506); with them, the
 // synthesised pixels near the seam continue the given ones, and so may their
 // neighbours. Returns whether it did.
-bool Synthesizer::pick_coherent(int& id) {
+std::vector<int>& Synthesizer::coherent_pool() {
   const bool given_only = given_in_window_ && (!coh_given_.empty() || in_.known_source.empty());
-  std::vector<int>& pool = given_only ? coh_given_ : coh_;
+  return given_only ? coh_given_ : coh_;
+}
+
+bool Synthesizer::pick_coherent(int& id) {
+  std::vector<int>& pool = coherent_pool();
   if (pool.empty() || scored_.empty()) return false;
   std::sort(pool.begin(), pool.end());
   const Scored* best = nullptr;

@@ -37,7 +37,7 @@ enum class ElSearch {
   /// (Ashikhmin 2001) and the `ann_candidates` nearest by a kd-tree over PCA
   /// coefficients (partial_neighbourhood_index.h), ranked exactly by pass 1;
   /// widened by a sample of the whole exemplar when its best candidates tie
-  /// (flat regions; decision 501).
+  /// and none of them continues a neighbour (flat regions; decision 501).
   Approximate,
   /// Every candidate position (Gorla's pass 1 as published; cost grows with
   /// the exemplar area). The reference.
