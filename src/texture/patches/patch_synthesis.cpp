@@ -10,10 +10,12 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "geometry/direction_field.h"
 #include "geometry/mesh_util.h"
@@ -327,18 +329,25 @@ std::vector<int> choose_patch_order(const std::vector<std::vector<int>>& adj,
   return order;
 }
 
-// A patch point (barycentric b in a face of another patch) looked up in that
-// patch's image, Inside pixels only (3.2: the boundary triangles rotated into
-// the plane carry their own patch's texture); false if none is Inside.
-bool sample_neighbour(const std::vector<FlatPatch>& patches, const PatchFaces& pf,
-                      const std::vector<Image>& images, int face, const std::array<float, 3>& b, float* out) {
+// A patch point (barycentric b in a face of another patch): that patch and
+// the point's position in its raster.
+std::pair<int, std::array<double, 2>> neighbour_pixel(const std::vector<FlatPatch>& patches, const PatchFaces& pf,
+                                                      int face, const std::array<float, 3>& b) {
   const int q = pf.patch[face];
   const FlatPatch& fq = patches[q];
   const FlatTriangle& tq = fq.triangles[pf.slot[face]];
   const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
   const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
-  const auto pq = fq.to_pixel(u, v);
-  return sample_inside(fq, images[q], pq[0], pq[1], out);
+  return {q, fq.to_pixel(u, v)};
+}
+
+// The point looked up in that patch's image, Inside pixels only (3.2: the
+// boundary triangles rotated into the plane carry their own patch's
+// texture); false if none is Inside.
+bool sample_neighbour(const std::vector<FlatPatch>& patches, const PatchFaces& pf,
+                      const std::vector<Image>& images, int face, const std::array<float, 3>& b, float* out) {
+  const auto [q, pq] = neighbour_pixel(patches, pf, face, b);
+  return sample_inside(patches[q], images[q], pq[0], pq[1], out);
 }
 
 // Where the neighbour's texture at that point came from (its nearest Inside
@@ -348,12 +357,8 @@ bool sample_neighbour(const std::vector<FlatPatch>& patches, const PatchFaces& p
 ElExemplarPoint neighbour_source(const std::vector<FlatPatch>& patches, const PatchFaces& pf,
                                  const std::vector<std::vector<ElSource>>& sources, int rotations, int face,
                                  const std::array<float, 3>& b) {
-  const int q = pf.patch[face];
+  const auto [q, pq] = neighbour_pixel(patches, pf, face, b);
   const FlatPatch& fq = patches[q];
-  const FlatTriangle& tq = fq.triangles[pf.slot[face]];
-  const double u = b[0] * tq.corner[0][0] + b[1] * tq.corner[1][0] + b[2] * tq.corner[2][0];
-  const double v = b[0] * tq.corner[0][1] + b[1] * tq.corner[1][1] + b[2] * tq.corner[2][1];
-  const auto pq = fq.to_pixel(u, v);
   const double fx = pq[0] - 0.5, fy = pq[1] - 0.5;
   const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
   ElExemplarPoint best;
