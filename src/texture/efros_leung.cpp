@@ -649,6 +649,7 @@ class Synthesizer {
   bool pick_coherent(int& id);
   std::vector<int>& coherent_pool();
   bool coherent_tie();
+  int ann_k_ = 16;  // kd-tree neighbours asked for the current pixel
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
   std::vector<int> ann_turned_;
 };
@@ -666,6 +667,8 @@ void Synthesizer::validate() {
     bad("search holds an unknown value " + std::to_string(static_cast<int>(opt_.search)));
   if (opt_.ann_candidates < 1 || opt_.ann_candidates > 256)
     bad("ann_candidates " + std::to_string(opt_.ann_candidates) + " outside 1..256");
+  if (opt_.ann_coherent_candidates < 1 || opt_.ann_coherent_candidates > 256)
+    bad("ann_coherent_candidates " + std::to_string(opt_.ann_coherent_candidates) + " outside 1..256");
   if (opt_.ann_pca_dims < 1) bad("ann_pca_dims " + std::to_string(opt_.ann_pca_dims) + " < 1");
   if (opt_.ann_stride < 1 || opt_.ann_stride > 4)
     bad("ann_stride " + std::to_string(opt_.ann_stride) + " outside 1..4");
@@ -903,7 +906,8 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // first-pass neighbourhoods -- deduplicated and ranked exactly by the
 // first-pass SSD; the n best (by (error, position)) go to pre_, then pass 2.
 //
-// Ties: when at least ann_candidates of the short list are within the
+// Ties: when at least as many as the kd-tree neighbours asked for
+// (ann_k_) of the short list are within the
 // pick tolerance of its best (a flat or repeated region: many candidates
 // share the query's known pixels, often with identical PCA coefficients),
 // the kd-tree's hits are an arbitrary subset of a larger tie set -- the
@@ -925,7 +929,9 @@ int Synthesizer::pass1(const SearchImage& s, std::size_t n) {
 // (checked byte for byte on patches and synth outputs, decision 501).
 void Synthesizer::short_list_passes(const SearchImage& s, std::size_t n, int p) {
   const int nk = static_cast<int>(p1_slot_.size());
-  s.ann_query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(opt_.ann_candidates),
+  // Coherent candidates stand for part of the search (ElOptions::ann_coherent_candidates).
+  ann_k_ = coh_.empty() ? opt_.ann_candidates : std::min(opt_.ann_candidates, opt_.ann_coherent_candidates);
+  s.ann_query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(ann_k_),
               static_cast<float>(opt_.ann_eps), short_, ann_scratch_, ann_turned_);
   std::sort(short_.begin(), short_.end());
   short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
@@ -968,7 +974,7 @@ bool Synthesizer::short_list_ties(const SearchImage& s) {
   }
   std::size_t ties = 0;
   for (const auto& v : p1_scored_) ties += v.first <= p1_tie_;
-  return ties >= static_cast<std::size_t>(opt_.ann_candidates) && s.ids.size() > short_.size();
+  return ties >= static_cast<std::size_t>(ann_k_) && s.ids.size() > short_.size();
 }
 
 // Whether a candidate of the coherent pool (pick_coherent's) is among the

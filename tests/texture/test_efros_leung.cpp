@@ -429,6 +429,9 @@ TEST(EfrosLeung, InvalidOptionsThrowNamingTheOption) {
   o.ann_candidates = 0;
   expect_named(o, "ann_candidates");
   o = ElOptions();
+  o.ann_coherent_candidates = 257;
+  expect_named(o, "ann_coherent_candidates");
+  o = ElOptions();
   o.ann_pca_dims = 0;
   expect_named(o, "ann_pca_dims");
   o = ElOptions();
