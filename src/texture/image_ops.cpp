@@ -146,15 +146,10 @@ Image rotate_image(const Image& img, double radians, int out_w, int out_h, bool 
   Image out(out_w, out_h, img.channels);
   if (valid) *valid = Image(out_w, out_h, 1);
   const double c = std::cos(radians), s = std::sin(radians);
-  const double scx = (img.width - 1) * 0.5, scy = (img.height - 1) * 0.5;
-  const double ocx = (out_w - 1) * 0.5, ocy = (out_h - 1) * 0.5;
   const double eps = 1e-9;
   for (int j = 0; j < out_h; ++j)
     for (int i = 0; i < out_w; ++i) {
-      // Forward map M = [[c, s], [-s, c]] sends exemplar x to (c, -s); inverse is M^T.
-      const double u = i - ocx, v = j - ocy;
-      const double x = c * u - s * v + scx;
-      const double y = s * u + c * v + scy;
+      const auto [x, y] = exemplar_point(img.width, img.height, out_w, out_h, c, s, i, j);
       const bool inside =
           x >= -eps && y >= -eps && x <= img.width - 1 + eps && y <= img.height - 1 + eps;
       if (valid) valid->at(i, j) = (wrap || inside) ? 1.f : 0.f;

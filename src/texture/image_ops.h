@@ -8,6 +8,8 @@
 // top-left). Every function but as_rgb throws InvalidInputError (naming the
 // argument) on an empty image or an out-of-range parameter.
 
+#include <array>
+
 #include "geometry/image.h"
 
 namespace surftex {
@@ -50,6 +52,22 @@ Image resize_bilinear(const Image& img, int w, int h, bool wrap = false);
 /// integers). With `wrap`, coordinates wrap around; without, they are clamped.
 /// Writes img.channels values to `out`.
 void sample_bilinear(const Image& img, double x, double y, bool wrap, float* out);
+
+/// Where exemplar point (x, y) (pixel coordinates of the w x h exemplar) lies
+/// in its rotation by the angle of cosine c and sine s stored in an ow x oh
+/// canvas: rotate_image's map, centre on centre (rotated_exemplars.h: the
+/// quarter-turned orientations of rotate_exemplar_step share it). Wrapped
+/// (periodic) canvases hold other copies too.
+inline std::array<double, 2> rotated_point(int w, int h, int ow, int oh, double c, double s, double x, double y) {
+  const double dx = x - (w - 1) * 0.5, dy = y - (h - 1) * 0.5;
+  return {c * dx + s * dy + (ow - 1) * 0.5, -s * dx + c * dy + (oh - 1) * 0.5};
+}
+
+/// The inverse of rotated_point: the exemplar point of canvas point (i, j).
+inline std::array<double, 2> exemplar_point(int w, int h, int ow, int oh, double c, double s, double i, double j) {
+  const double u = i - (ow - 1) * 0.5, v = j - (oh - 1) * 0.5;
+  return {c * u - s * v + (w - 1) * 0.5, s * u + c * v + (h - 1) * 0.5};
+}
 
 /// Rotates `img` by `radians` counter-clockwise as displayed (y down on
 /// screen, so the exemplar +x axis maps to (cos a, -sin a) in pixel

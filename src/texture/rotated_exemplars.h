@@ -16,10 +16,10 @@
 // periodic one as a (W + 2m) x (H + 2m) wrapped block. Rotation 0 is an exact
 // copy. In full: docs/decisions/505.
 
-#include <array>
 #include <vector>
 
 #include "geometry/image.h"
+#include "texture/image_ops.h"  // rotated_point / exemplar_point: rotate_exemplar's map
 
 namespace surftex {
 
@@ -55,22 +55,6 @@ int rotation_index(double radians, int rotations);
 /// One rotation of `exemplar` by `radians` (convention above).
 RotatedExemplar rotate_exemplar(const Image& exemplar, double radians, bool periodic,
                                 int margin = 0);
-
-/// Where exemplar point (x, y) (pixel coordinates of the w x h exemplar) lies
-/// in its rotation by the angle of cosine c and sine s stored in an ow x oh
-/// canvas (rotate_exemplar's map, centre on centre; the quarter-turned
-/// orientations of rotate_exemplar_step share it). Periodic canvases hold
-/// other copies too.
-inline std::array<double, 2> rotated_point(int w, int h, int ow, int oh, double c, double s, double x, double y) {
-  const double dx = x - (w - 1) * 0.5, dy = y - (h - 1) * 0.5;
-  return {c * dx + s * dy + (ow - 1) * 0.5, -s * dx + c * dy + (oh - 1) * 0.5};
-}
-
-/// The inverse of rotated_point: the exemplar point of canvas point (i, j).
-inline std::array<double, 2> exemplar_point(int w, int h, int ow, int oh, double c, double s, double i, double j) {
-  const double u = i - (ow - 1) * 0.5, v = j - (oh - 1) * 0.5;
-  return {c * u - s * v + (w - 1) * 0.5, s * u + c * v + (h - 1) * 0.5};
-}
 
 /// Position (x, y) of a w-wide image after one exact quarter turn (the
 /// rotation by +pi/2 of the convention above; the turned image is h x w).
