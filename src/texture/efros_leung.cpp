@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <atomic>
 #include <cmath>
@@ -283,36 +284,10 @@ struct SearchImage {
     return c >= 0 && c < static_cast<long long>(is_candidate.size()) && is_candidate[c] ? static_cast<int>(c) : -1;
   }
   std::vector<std::uint8_t> valid;  // per buffer position: 1 = a usable sample
-  // Approximate search only: the index of this image, or (quarter > 0) of
-  // the image it is `quarter` quarter turns of (ann_pw wide), whose
-  // first-pass slots ann_slot maps ours to.
+  // Approximate search only: the index of this image's first-pass windows.
   std::shared_ptr<const PartialNeighbourhoodIndex> ann;
-  int quarter = 0, ann_pw = 0;
-  std::vector<int> ann_slot;
-  int hit_at = 0, hit_dx = 0, hit_dy = 0;  // base pixel (x, y) is our position hit_at + x hit_dx + y hit_dy
 
   const float* plane(int c) const { return planes.data() + static_cast<std::size_t>(c) * pw * ph; }
-
-  /// The index's hits for a partly known first-pass window (slots in this
-  /// image's frame) appended to out as candidate positions of this image.
-  void ann_query(const int* slot, const float* values, int known, std::size_t k, float eps, std::vector<int>& out,
-                 PartialNeighbourhoodIndex::Scratch& scratch, std::vector<int>& turned) const {
-    if (quarter == 0) {
-      ann->query(slot, values, known, k, eps, out, scratch);
-      return;
-    }
-    turned.resize(static_cast<std::size_t>(known));
-    for (int i = 0; i < known; ++i) turned[i] = ann_slot[slot[i]];
-    const std::size_t first = out.size();
-    ann->query(turned.data(), values, known, k, eps, out, scratch);
-    // A candidate turned is a candidate (odd windows: the turned window is
-    // the same window), so every hit is kept.
-    for (std::size_t i = first; i < out.size(); ++i) {
-      const int x = out[i] % ann_pw, y = out[i] / ann_pw;
-      out[i] = hit_at + x * hit_dx + y * hit_dy;
-      assert(is_candidate[out[i]]);
-    }
-  }
 };
 
 // Candidate centres, spans and blocks of a search image whose size, planes
@@ -337,10 +312,10 @@ SearchImage make_search_image(const RotatedExemplar& r, int window, bool periodi
 }
 
 // `base` turned by q quarter turns (rotated_exemplars.h): its planes and
-// validity permuted, its candidates indexed anew; with share_index (odd
-// windows only: a turned window is then the same window) the approximate
-// index is base's, queried through the turn (SearchImage::ann_query).
-SearchImage turned_search_image(const SearchImage& base, int q, int window, int first_window, bool share_index) {
+// validity permuted, its candidates indexed anew. Only for windows of even
+// size: with odd windows a turned orientation is searched in its base
+// through the turn, never built (ElPreparedExemplars::searched_through_turn).
+SearchImage turned_search_image(const SearchImage& base, int q, int window) {
   SearchImage s;
   const bool odd = q % 2 == 1;
   s.pw = odd ? base.ph : base.pw;
@@ -367,32 +342,6 @@ SearchImage turned_search_image(const SearchImage& base, int q, int window, int 
     for (int x = 0; x < s.pw; ++x) v[x] = base.valid[row + x * sx];
   }
   index_candidates(s, window, false, 0, 0, 0);
-  if (base.ann && share_index) {
-    s.ann = base.ann;
-    s.quarter = q;
-    s.ann_pw = base.pw;
-    auto turned_id = [&](int x, int y) {
-      quarter_turns_position(base.pw, base.ph, q, x, y);
-      return y * s.pw + x;
-    };
-    s.hit_at = turned_id(0, 0);
-    s.hit_dx = turned_id(1, 0) - s.hit_at;
-    s.hit_dy = turned_id(0, 1) - s.hit_at;
-    // One turn sends a base offset (a, b) to (b, -a); so our offset (a, b)
-    // is base offset (-b, a), turned back q times.
-    const int f = first_window, lo = lo_of(f);
-    s.ann_slot.resize(static_cast<std::size_t>(f) * f);
-    for (int dy = lo; dy < lo + f; ++dy)
-      for (int dx = lo; dx < lo + f; ++dx) {
-        int a = dx, b = dy;
-        for (int t = 0; t < q; ++t) {
-          const int na = -b;
-          b = a;
-          a = na;
-        }
-        s.ann_slot[(dy - lo) * f + (dx - lo)] = (b - lo) * f + (a - lo);
-      }
-  }
   return s;
 }
 
@@ -483,10 +432,15 @@ void validate_exemplars(const std::vector<Image>& exemplars, const ElOptions& op
 }  // namespace
 
 // Search images built on first use: slot e * rotations + k holds exemplar e
-// rotated by 2 pi k / rotations (rotate_exemplar_step: k >= K/4 as quarter
-// turns of k mod K/4, sharing its approximate index). Each slot is built
+// rotated by 2 pi k / rotations (rotate_exemplar_step). Each slot is built
 // once (its own once_flag, so different slots build concurrently); a built
-// slot never changes.
+// slot never changes. Orientation k >= K/4 is q = k / (K/4) quarter turns of
+// k mod K/4; with odd windows it is never built but searched in that base
+// with the pixel's window read through the turn (searched_through_turn: a
+// quarter turn maps an odd square window onto itself), so a 512 px exemplar
+// costs 16 search images, not 64 (issue 19: building the other 48 was a
+// third of the synthesis, decision 501). With even windows it is built as q
+// turns of its base (turned_search_image).
 struct ElPreparedExemplars {
   std::vector<Image> exemplars;
   int window = 0, first_window = 0, rotations = 1, ann_pca_dims = 0, ann_stride = 1;
@@ -494,6 +448,12 @@ struct ElPreparedExemplars {
   ElSearch search = ElSearch::Approximate;
   mutable std::unique_ptr<std::once_flag[]> once;
   mutable std::unique_ptr<std::unique_ptr<SearchImage>[]> slots;
+
+  /// Whether orientation k of exemplar e is searched in orientation
+  /// k mod K/4 through k / (K/4) quarter turns of the pixel's window.
+  bool searched_through_turn(int e, int k) const {
+    return window % 2 == 1 && first_window % 2 == 1 && quarter_turns_of(exemplars[e], k, rotations, periodic) > 0;
+  }
 
   const SearchImage& get(int e, int k) const {
     const std::size_t i = static_cast<std::size_t>(e) * rotations + k;
@@ -509,11 +469,8 @@ struct ElPreparedExemplars {
     const int margin = std::max(-lo_of(window), hi_of(window));
     std::unique_ptr<SearchImage> s;
     if (const int q = quarter_turns_of(ex, k, rotations, periodic); q > 0) {
-      // Orientation k is q quarter turns of k mod K/4 (rotate_exemplar_step);
-      // its approximate index is shared when both windows are odd.
-      const bool share = window % 2 == 1 && first_window % 2 == 1;
-      s = std::make_unique<SearchImage>(
-          turned_search_image(get(e, k % (rotations / 4)), q, window, first_window, share));
+      assert(!searched_through_turn(e, k));
+      s = std::make_unique<SearchImage>(turned_search_image(get(e, k % (rotations / 4)), q, window));
     } else {
       RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
       s = std::make_unique<SearchImage>(make_search_image(r, window, periodic, margin, ex.width, ex.height));
@@ -524,7 +481,7 @@ struct ElPreparedExemplars {
                               " degrees has no position where the whole window " + std::to_string(window) +
                               " fits; use a larger exemplar, a smaller window or "
                               "periodic_exemplar");
-    if (search == ElSearch::Approximate && !s->ann)
+    if (search == ElSearch::Approximate)
       s->ann = std::make_shared<const PartialNeighbourhoodIndex>(s->planes.data(), static_cast<std::size_t>(s->pw) * s->ph,
                                                            s->pw, s->channels, s->ids, first_window, ann_pca_dims,
                                                            ann_stride);
@@ -618,6 +575,12 @@ class Synthesizer {
   bool last_widened_ = false;  // the previous short list was widened
   std::size_t synthesized_ = 0, seeded_ = 0, pass1_candidates_ = 0, widened_ = 0;
   std::vector<int> pair_of_;             // per pixel: e * rotations + k (or -1)
+  // Per pixel: quarter turns from its search image to its orientation
+  // (ElPreparedExemplars::searched_through_turn), and per turn q the window
+  // offset (dx, dy) of the target that search-image offset g (row-major
+  // over the full window) reads: (dx, dy) = q quarter turns of g's (a, b).
+  std::vector<std::uint8_t> turn_;
+  std::array<std::vector<std::array<int, 2>>, 4> turned_offset_;
   std::vector<ElSource> source_;         // per pixel: where its value came from
   // Per search image: its exemplar, that exemplar's size and the cosine and
   // sine of its rotation (rotated_point / exemplar_point).
@@ -628,9 +591,11 @@ class Synthesizer {
   std::vector<Frame> frame_;
   void record_source(int q, int p, int id, const SearchImage& s) {
     const Frame& f = frame_[key_[p]];
-    const auto u = exemplar_point(f.w, f.h, s.pw, s.ph, f.c, f.s, id % s.pw, id / s.pw);
-    source_[q] = {f.e, pair_of_[p] % opt_.rotations, id % s.pw, id / s.pw, static_cast<float>(u[0]),
-                  static_cast<float>(u[1])};
+    const int bx = id % s.pw, by = id / s.pw;
+    const auto u = exemplar_point(f.w, f.h, s.pw, s.ph, f.c, f.s, bx, by);
+    int x = bx, y = by;  // in the pixel's own orientation (rotate_exemplar_step)
+    quarter_turns_position(s.pw, s.ph, turn_[p], x, y);
+    source_[q] = {f.e, pair_of_[p] % opt_.rotations, x, y, static_cast<float>(u[0]), static_cast<float>(u[1])};
   }
   int continuing(const ElExemplarPoint& g, int p, int dx, int dy, const SearchImage& s) const;
   // Approximate search: source position (buffer offset in the pixel's own
@@ -650,8 +615,8 @@ class Synthesizer {
   std::vector<int>& coherent_pool();
   bool coherent_tie();
   int ann_k_ = 16;  // kd-tree neighbours asked for the current pixel
+  int orientations_used_ = 0;  // distinct (exemplar, orientation) pairs
   PartialNeighbourhoodIndex::Scratch ann_scratch_;
-  std::vector<int> ann_turned_;
 };
 
 void Synthesizer::validate() {
@@ -748,7 +713,8 @@ void Synthesizer::prepare_search_images() {
   const bool oriented = !in_.angle.empty() || static_cast<bool>(in_.angle_fn);
   const int K = opt_.rotations;
   const int E = static_cast<int>(prep_->exemplars.size());
-  std::vector<int> pair_of(n, -1);
+  std::vector<int> pair_of(n, -1), searched(n, -1);
+  turn_.assign(n, 0);
   std::vector<std::uint8_t> needed(static_cast<std::size_t>(E) * K, 0);
   for (std::size_t p = 0; p < n; ++p) {
     if (state_[p] != PixelState::Fill) continue;
@@ -770,7 +736,12 @@ void Synthesizer::prepare_search_images() {
       k = rotation_index(a, K);
     }
     pair_of[p] = e * K + k;
-    needed[pair_of[p]] = 1;
+    if (prep_->searched_through_turn(e, k)) {
+      turn_[p] = static_cast<std::uint8_t>(k / (K / 4));
+      k %= K / 4;
+    }
+    searched[p] = e * K + k;
+    needed[searched[p]] = 1;
   }
   // The needed rotations not built yet are built side by side (each build's
   // own parallel part is small; isolated, see ElPreparedExemplars::get).
@@ -792,8 +763,28 @@ void Synthesizer::prepare_search_images() {
   }
   key_.assign(n, -1);
   for (std::size_t p = 0; p < n; ++p)
-    if (pair_of[p] >= 0) key_[p] = slot[pair_of[p]];
+    if (searched[p] >= 0) key_[p] = slot[searched[p]];
+  std::vector<std::uint8_t> used(needed.size(), 0);
+  for (int pr : pair_of)
+    if (pr >= 0) used[pr] = 1;
+  orientations_used_ = static_cast<int>(std::count(used.begin(), used.end(), 1));
   pair_of_ = std::move(pair_of);
+  // Target offset read for each search-image offset, per quarter turn: one
+  // turn sends an offset (a, b) to (b, -a) (quarter_turn_position).
+  const int lo = lo_of(window_), hi = hi_of(window_);
+  for (int q = 0; q < 4; ++q) {
+    turned_offset_[q].clear();
+    for (int b = lo; b <= hi; ++b)
+      for (int a = lo; a <= hi; ++a) {
+        int dx = a, dy = b;
+        for (int t = 0; t < q; ++t) {
+          const int nx = dy;
+          dy = -dx;
+          dx = nx;
+        }
+        turned_offset_[q].push_back({dx, dy});
+      }
+  }
   source_.assign(n, ElSource());
 }
 
@@ -816,47 +807,52 @@ void Synthesizer::gather_known(int p, const SearchImage& s) {
   p2_gmask_.clear();
   p2_w_.clear();
   p2_t_.clear();
+  // Offsets (a, b) in the search image's frame, row by row; the target
+  // pixel each reads is at the turned offset (dx, dy) (turned_offset_).
+  const std::vector<std::array<int, 2>>& turned = turned_offset_[turn_[p]];
   int g = 0;
-  for (int dy = lo; dy <= hi; ++dy)
-    for (int dx = lo; dx <= hi; ++dx, ++g) {
-      const int x = px + dx, y = py + dy;
+  for (int b = lo; b <= hi; ++b)
+    for (int a = lo; a <= hi; ++a, ++g) {
+      const int x = px + turned[g][0], y = py + turned[g][1];
       if (x < 0 || y < 0 || x >= W || y >= H) continue;
       const int q = y * W + x;
       if (!known_[q]) continue;
       const float* v = out_.pixel(x, y);
+      const int offset = b * s.pw + a;
       given_in_window_ = given_in_window_ || state_[q] == PixelState::Known;
-      if (dx >= flo && dx <= fhi && dy >= flo && dy <= fhi) {
-        p1_delta_.push_back(dy * s.pw + dx);
+      if (a >= flo && a <= fhi && b >= flo && b <= fhi) {
+        p1_delta_.push_back(offset);
         p1_value_.insert(p1_value_.end(), v, v + C);
-        // Coherent candidate: q's source shifted back by q's offset (same search image only).
+        // Coherent candidate: q's source shifted back by q's offset (same
+        // search image and turn only).
         int c = -1;
-        if (src_[q] >= 0 && key_[q] == key_[p])
-          c = s.candidate_at(static_cast<long long>(src_[q]) - (static_cast<long long>(dy) * s.pw + dx));
+        if (src_[q] >= 0 && key_[q] == key_[p] && turn_[q] == turn_[p])
+          c = s.candidate_at(static_cast<long long>(src_[q]) - offset);
         else if (src_[q] >= 0)  // another orientation: through the exemplar
-          c = continuing(ElExemplarPoint{source_[q].exemplar, source_[q].ex, source_[q].ey}, p, dx, dy, s);
+          c = continuing(ElExemplarPoint{source_[q].exemplar, source_[q].ex, source_[q].ey}, p, a, b, s);
         else if (state_[q] == PixelState::Known && !in_.known_source.empty() && opt_.coherence > 0)
-          if ((c = continuing(in_.known_source[q], p, dx, dy, s)) >= 0) coh_given_.push_back(c);
+          if ((c = continuing(in_.known_source[q], p, a, b, s)) >= 0) coh_given_.push_back(c);
         if (s.ann) {
-          p1_slot_.push_back((dy - flo) * first_ + (dx - flo));
+          p1_slot_.push_back((b - flo) * first_ + (a - flo));
           if (c >= 0) short_.push_back(c);
         }
         if (c >= 0 && opt_.coherence > 0) coh_.push_back(c);
       }
-      delta_.push_back(dy * s.pw + dx);
+      delta_.push_back(offset);
       weight_.push_back(gauss_[g]);
       value_.insert(value_.end(), v, v + C);
       // Row-grouped copy for the pass-2 kernel.
-      if (p2_roff_.empty() || p2_row_dy_ != dy) {
-        p2_row_dy_ = dy;
-        p2_roff_.push_back(dy * s.pw + lo);
+      if (p2_roff_.empty() || p2_row_dy_ != b) {
+        p2_row_dy_ = b;
+        p2_roff_.push_back(b * s.pw + lo);
         p2_gmask_.push_back(0u);
         p2_w_.resize(p2_w_.size() + rowlen, 0.f);
         p2_t_.resize(p2_t_.size() + static_cast<std::size_t>(rowlen) * C, 0.f);
       }
       const std::size_t r = p2_roff_.size() - 1;
-      p2_gmask_[r] |= 1u << ((dx - lo) / kLanes);
-      p2_w_[r * rowlen + (dx - lo)] = gauss_[g];
-      for (int c = 0; c < C; ++c) p2_t_[(r * C + c) * rowlen + (dx - lo)] = v[c];
+      p2_gmask_[r] |= 1u << ((a - lo) / kLanes);
+      p2_w_[r * rowlen + (a - lo)] = gauss_[g];
+      for (int c = 0; c < C; ++c) p2_t_[(r * C + c) * rowlen + (a - lo)] = v[c];
     }
 }
 
@@ -931,8 +927,8 @@ void Synthesizer::short_list_passes(const SearchImage& s, std::size_t n, int p) 
   const int nk = static_cast<int>(p1_slot_.size());
   // Coherent candidates stand for part of the search (ElOptions::ann_coherent_candidates).
   ann_k_ = coh_.empty() ? opt_.ann_candidates : std::min(opt_.ann_candidates, opt_.ann_coherent_candidates);
-  s.ann_query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(ann_k_),
-              static_cast<float>(opt_.ann_eps), short_, ann_scratch_, ann_turned_);
+  s.ann->query(p1_slot_.data(), p1_value_.data(), nk, static_cast<std::size_t>(ann_k_),
+               static_cast<float>(opt_.ann_eps), short_, ann_scratch_);
   std::sort(short_.begin(), short_.end());
   short_.erase(std::unique(short_.begin(), short_.end()), short_.end());
   // Scored first unless the previous pixel widened (ties come in regions:
@@ -1130,17 +1126,25 @@ void Synthesizer::seed_patch(int p) {
   const SearchImage& s = *search_[search_key(p)];
   const int id = s.ids[rng_() % s.ids.size()];
   const int px = p % W, py = p / W;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
+  for (int b = -1; b <= 1; ++b)
+    for (int a = -1; a <= 1; ++a) {
+      // Search-image offset (a, b) lands on the target at its turned offset.
+      int dx = a, dy = b;
+      for (int t = 0; t < turn_[p]; ++t) {
+        const int nx = dy;
+        dy = -dx;
+        dx = nx;
+      }
       const int x = px + dx, y = py + dy;
       if (x < 0 || y < 0 || x >= W || y >= H) continue;
       const int q = y * W + x;
       // Only Fill pixels that search the same exemplar and orientation, so
       // a seed never puts texture k where the index map asks for another.
-      if (state_[q] != PixelState::Fill || known_[q] || key_[q] != key_[p]) continue;
-      for (int c = 0; c < C; ++c) out_.at(x, y, c) = s.plane(c)[id + dy * s.pw + dx];
-      record_source(q, p, id + dy * s.pw + dx, s);
-      src_[q] = id + dy * s.pw + dx;
+      if (state_[q] != PixelState::Fill || known_[q] || pair_of_[q] != pair_of_[p]) continue;
+      const int at = id + b * s.pw + a;
+      for (int c = 0; c < C; ++c) out_.at(x, y, c) = s.plane(c)[at];
+      record_source(q, p, at, s);
+      src_[q] = at;
       mark_filled(q);
       ++seeded_;
     }
@@ -1193,12 +1197,12 @@ void Synthesizer::synthesize_pixel(int p) {
   ++synthesized_;
 }
 
-// The candidate of pixel p (offset (dx, dy) from a neighbour whose value was
-// read at exemplar point g: a given pixel's ElInput::known_source, or a
-// synthesised pixel of another orientation) that continues it in p's search
-// image: g in p's rotation, moved back by the offset; -1 if g is in another
-// exemplar or that is no candidate. Periodic canvases: the copy of g that
-// lies on the canvas.
+// The candidate of pixel p that continues a neighbour whose value was read
+// at exemplar point g (a given pixel's ElInput::known_source, or a
+// synthesised pixel of another orientation or turn), the neighbour at offset
+// (dx, dy) in the frame of p's search image: g in that image, moved back by
+// the offset; -1 if g is in another exemplar or that is no candidate.
+// Periodic canvases: the copy of g that lies on the canvas.
 int Synthesizer::continuing(const ElExemplarPoint& g, int p, int dx, int dy, const SearchImage& s) const {
   const Frame& f = frame_[key_[p]];
   if (g.exemplar != f.e) return -1;
@@ -1378,7 +1382,8 @@ ElResult Synthesizer::run() {
   ElResult res;
   res.window = window_;
   res.first_pass_window = first_;
-  res.rotations_used = static_cast<int>(search_.size());
+  res.rotations_used = orientations_used_;
+  res.search_images = static_cast<int>(search_.size());
   if (counts.to_fill > 0) {
     if (counts.known == 0 && opt_.order == FillOrder::OnionPeel) seed_at_centre();
     onion_ = opt_.order == FillOrder::OnionPeel;

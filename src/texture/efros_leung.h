@@ -179,6 +179,10 @@ struct ElResult {
   int window = 0;              ///< effective full window
   int first_pass_window = 0;   ///< effective first-pass window
   int rotations_used = 0;      ///< distinct (exemplar, orientation) pairs searched
+  /// Distinct search images those pairs needed: with odd windows a quarter
+  /// turn of an orientation is searched in it (ElPreparedExemplars), so 64
+  /// orientations of a non-periodic exemplar with sides of equal parity need 16.
+  int search_images = 0;
   /// Candidates ranked by pass 1, summed over the pixels.
   std::size_t pass1_candidates = 0;
   /// Approximate search: pixels whose short list was widened by a sample of

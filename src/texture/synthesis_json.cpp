@@ -9,6 +9,7 @@ nlohmann::json to_json(const ElResult& r) {
   return {{"window", r.window},
           {"first_pass_window", r.first_pass_window},
           {"orientations_searched", r.rotations_used},
+          {"search_images", r.search_images},
           {"seeded_pixels", r.seeded}};
 }
 

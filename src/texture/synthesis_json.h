@@ -13,7 +13,8 @@ namespace surftex {
 
 /// A two-pass Efros-Leung run (Gorla et al. 2003, 3.3): "window" and
 /// "first_pass_window" (effective diameters, px), "orientations_searched"
-/// (distinct exemplar orientations) and "seeded_pixels" (pixels filled by
+/// (distinct exemplar orientations), "search_images" (the rotated exemplars
+/// those needed built) and "seeded_pixels" (pixels filled by
 /// random seed patches). The image, the sources and the timing are left to
 /// the caller.
 nlohmann::json to_json(const ElResult& result);

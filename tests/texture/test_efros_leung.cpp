@@ -553,8 +553,8 @@ TEST(EfrosLeung, ApproximateSearchKeepsTheQualityOfTheExhaustiveOne) {
   }
 }
 
-// Orientations k >= K/4 are quarter turns of k mod K/4 and query its index
-// through the turn (slots and hits mapped): at 90 and 270 degrees the
+// Orientations k >= K/4 are quarter turns of k mod K/4, searched in it with
+// the pixel's window read through the turn: at 90 and 270 degrees the
 // approximate search keeps the exhaustive one's quality against the turned
 // exemplar, as at 0 degrees.
 TEST(EfrosLeung, ApproximateSearchOnQuarterTurnedOrientations) {
@@ -582,8 +582,8 @@ TEST(EfrosLeung, ApproximateSearchOnQuarterTurnedOrientations) {
   }
 }
 
-// Orientations k >= K/4 are quarter turns of k mod K/4 and query its index
-// through the turn (slots and hits mapped). A pixel whose whole window is
+// Orientations k >= K/4 are quarter turns of k mod K/4, searched in it with
+// the pixel's window read through the turn. A pixel whose whole window is
 // known, cut from the exemplar turned by q quarter turns, has one exact
 // match; searched at orientation 16 q of 64 it is found exactly when the same
 // window searched unturned at orientation 0 finds it (the approximate index
@@ -622,6 +622,30 @@ TEST(EfrosLeung, QuarterTurnedOrientationsFindWhatTheirBaseFinds) {
     }
   }
   EXPECT_GE(base_found, 5) << "the unturned search finds too few exact matches to compare";
+}
+
+// With odd windows a quarter-turned orientation is searched in its base
+// (ElResult::search_images): a field that turns through every one of the 64
+// orientations needs 16 rotated exemplars, not 64 (with an even window, or an
+// exemplar whose sides differ in parity, all 64); both searches.
+TEST(EfrosLeung, QuarterTurnedOrientationsNeedNoSearchImageOfTheirOwn) {
+  const Image ex = binomial_blur(noise(24, 24, 3, 4));
+  for (ElSearch search : {ElSearch::Approximate, ElSearch::Exhaustive})
+    for (int window : {5, 6}) {
+      for (int width : {24, 23}) {
+        ElInput in;
+        in.exemplars = {crop(ex, 0, 0, width, 24, false)};
+        in.target = Image(64, 2, 3);
+        in.angle_fn = [](int x, int) { return 2.0 * M_PI * x / 64; };
+        ElOptions opt;
+        opt.window = window;
+        opt.first_pass_window = 3;
+        opt.search = search;
+        const ElResult r = efros_leung_synthesize(in, opt);
+        EXPECT_EQ(r.rotations_used, 64);
+        EXPECT_EQ(r.search_images, window % 2 == 1 && width == 24 ? 16 : 64) << "window " << window << ", width " << width;
+      }
+    }
 }
 
 TEST(EfrosLeung, ApproximateSearchSameBytesForOneAndTwoThreadsAndPrepared) {

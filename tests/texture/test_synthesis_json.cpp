@@ -26,9 +26,12 @@ TEST(SynthesisJson, EfrosLeungResultKeepsEveryReportedField) {
   r.window = 11;
   r.first_pass_window = 5;
   r.rotations_used = 64;
+  r.search_images = 16;
   r.seeded = 9;
   const nlohmann::json j = to_json(r);
-  EXPECT_EQ(keys(j), (std::set<std::string>{"window", "first_pass_window", "orientations_searched", "seeded_pixels"}));
+  EXPECT_EQ(keys(j), (std::set<std::string>{"window", "first_pass_window", "orientations_searched", "search_images",
+                                            "seeded_pixels"}));
+  EXPECT_EQ(j["search_images"], 16);
   EXPECT_EQ(j["window"], 11);
   EXPECT_EQ(j["first_pass_window"], 5);
   EXPECT_EQ(j["orientations_searched"], 64);
