@@ -451,4 +451,33 @@ std::vector<DirectionConstraint> constraints_from_constant_vector(const Mesh& me
   return out;
 }
 
+std::array<double, 3> floor_vector(std::array<double, 3> v) {
+  const Vector3 d(v[0], v[1], v[2]);
+  if (!(norm(d) > 0) || !std::isfinite(norm(d)))
+    throw InvalidInputError("floor_vector: vector must be non-zero and finite");
+  int axis = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(v[i]) < std::abs(v[axis])) axis = i;
+  const Vector3 e(axis == 0, axis == 1, axis == 2);
+  const Vector3 f = CGAL::cross_product(d, e);
+  const double len = norm(f);
+  return {f.x() / len, f.y() / len, f.z() / len};
+}
+
+std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<double, 3> v,
+                                                   double max_projection) {
+  const Vector3 d(v[0], v[1], v[2]);
+  const std::array<double, 3> fv = floor_vector(v);
+  const Vector3 s(fv[0], fv[1], fv[2]);
+  std::vector<DirectionConstraint> out;
+  for (FaceIndex f : mesh.faces()) {
+    const Vector3 n = robust_face_normal(mesh, f);
+    if (norm(d - (d * n) * n) >= max_projection * norm(d)) continue;
+    const Vector3 t = s - (s * n) * n;
+    if (norm(t) > 0.5)  // the face is near orthogonal to v, so s lies nearly in it
+      out.push_back({static_cast<std::uint32_t>(f.idx()), {t.x(), t.y(), t.z()}});
+  }
+  return out;
+}
+
 }  // namespace surftex

@@ -83,4 +83,22 @@ std::vector<DirectionConstraint> constraints_from_constant_vector(const Mesh& me
                                                                   std::array<double, 3> v,
                                                                   double min_projection = 0.3);
 
+/// The direction a floor facing along v takes: v crossed with the world axis
+/// least aligned with it (ties: x, then y, then z), unit. For v = +y (glTF's
+/// up) it is -z, away from a viewer on +z, as a photograph of a pavement
+/// looking down has its top away from the camera. Throws InvalidInputError
+/// for a zero or non-finite vector.
+std::array<double, 3> floor_vector(std::array<double, 3> v);
+
+/// Floors and ceilings of a constant-vector field: the faces whose plane is
+/// within `max_projection` of orthogonal to v (|projection| < max_projection
+/// * |v|: flat tops and bottoms, a CAD part's faces facing along v) get the
+/// projection of floor_vector(v). Interpolated from their rims instead, a
+/// flat top bounded by walls holds the field's singularity in its middle (its
+/// rows circle the walls: radial fragments); so constrained it holds parallel
+/// rows, and the turn is at its rim. Curved surfaces have few such faces (a
+/// crown's tip). Throws InvalidInputError for a zero vector.
+std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<double, 3> v,
+                                                   double max_projection = 0.05);
+
 }  // namespace surftex

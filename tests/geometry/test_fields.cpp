@@ -3,12 +3,16 @@
 // N-symmetry direction fields, scalar fields, effect areas.
 #include <gtest/gtest.h>
 
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
 #include "geometry/direction_field.h"
+#include "geometry/errors.h"
 #include "geometry/direction_field_singularities.h"
 #include "geometry/effect_area.h"
 #include "geometry/mesh_util.h"
@@ -221,6 +225,49 @@ TEST(DirectionField, LocksConstraintsAndNeverNan) {
   EXPECT_THROW(interpolate_direction_field(m, {}, {}), InvalidInputError);
   EXPECT_THROW(interpolate_direction_field(m, {{99999, {1, 0, 0}}}, {}), InvalidInputError);
   EXPECT_THROW(interpolate_direction_field(m, {{0, {0, 0, 1}}}, {}), InvalidInputError);
+}
+
+TEST(DirectionField, FloorVectorIsOrthogonalToTheVectorAndAwayFromTheViewer) {
+  const auto f = floor_vector({0, 1, 0});
+  EXPECT_NEAR(f[0], 0, 1e-12);
+  EXPECT_NEAR(f[1], 0, 1e-12);
+  EXPECT_NEAR(f[2], -1, 1e-12);
+  const auto g = floor_vector({0.3, -2, 5});
+  EXPECT_NEAR(g[0] * 0.3 - g[1] * 2 + g[2] * 5, 0, 1e-12);
+  EXPECT_NEAR(g[0] * g[0] + g[1] * g[1] + g[2] * g[2], 1, 1e-12);
+  EXPECT_THROW(floor_vector({0, 0, 0}), InvalidInputError);
+  EXPECT_THROW(floor_vector({0, NAN, 1}), InvalidInputError);
+}
+
+// A box's top and bottom are orthogonal to the up vector, so its projection
+// constrains only the walls, whose directions circle the top: interpolated
+// into it, they meet in a singularity (radial rows on a CAD part's flat top,
+// issue 18). With floor_constraints the top holds one direction.
+TEST(DirectionField, FlatTopsHoldParallelRowsNotTheRimsSingularity) {
+  Mesh box;
+  make_cube(box, 2.0);
+  CGAL::Polygon_mesh_processing::split_long_edges(edges(box), 0.25, box);
+  const std::array<double, 3> up{0, 1, 0};
+  auto top_spread_deg = [&](bool floors) {
+    std::vector<DirectionConstraint> c = constraints_from_constant_vector(box, up);
+    if (floors)
+      for (const DirectionConstraint& f : floor_constraints(box, up)) c.push_back(f);
+    DirectionFieldOptions o;
+    o.symmetry = 1;
+    interpolate_direction_field(box, c, o);
+    auto dir = find(box, kFaceDirection).first;
+    double worst = 0;
+    int top = 0;
+    for (FaceIndex f : box.faces()) {
+      if (robust_face_normal(box, f).y() < 0.99) continue;
+      ++top;
+      worst = std::max(worst, std::acos(std::clamp(dir[f] * Vector3(0, 0, -1), -1.0, 1.0)) * 180 / M_PI);
+    }
+    EXPECT_GE(top, 16);
+    return worst;
+  };
+  EXPECT_LT(top_spread_deg(true), 1.0);
+  EXPECT_GT(top_spread_deg(false), 60.0);  // the case the floors are for
 }
 
 int index_sum(const Mesh& m, int n) {

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -220,6 +222,28 @@ TEST(PatchSynthesis, TheConstantFieldStandsTheExemplarUpright) {
   };
   EXPECT_GT(run(1.0), 0.95) << "up +z: the bands' bright tops must face +z";
   EXPECT_LT(run(-1.0), 0.05) << "up -z: turned over";
+}
+
+// A flat top facing the constant vector (a CAD part's, a table's) gets the
+// floor direction (floor_constraints), not the singularity that its walls'
+// rows meet in when interpolated over it: its rows are parallel, along +x
+// for the default +y (the exemplar's top along floor_vector = -z).
+TEST(PatchSynthesis, TheConstantFieldLaysParallelRowsOnFlatTops) {
+  Mesh m;
+  make_cube(m, 2.0);
+  CGAL::Polygon_mesh_processing::split_long_edges(edges(m), 0.25, m);
+  PatchSynthesisOptions o = small_options(sanitized() ? 16 : 24);
+  o.field = PatchField::Constant;
+  synthesize_patches(m, {make_stripes(48, 8, 0)}, o);
+  auto dir = find(m, kFaceDirection);
+  ASSERT_TRUE(dir.second);
+  int top = 0;
+  for (FaceIndex f : m.faces()) {
+    if (robust_face_normal(m, f).y() < 0.99) continue;
+    ++top;
+    EXPECT_GT(dir.first[f] * Vector3(1, 0, 0), std::cos(M_PI / 180)) << "face " << f;
+  }
+  EXPECT_GE(top, 16);
 }
 
 TEST(PatchSynthesis, MultiTexturingByHeight) {

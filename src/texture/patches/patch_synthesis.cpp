@@ -143,6 +143,8 @@ void turn_up_field_to_rows(const Mesh& mesh, FaceVectorMap fd) {
   }
 }
 
+constexpr double kFloorProjection = 0.05;
+
 // The face directions: a constant vector projected (3.3.2.1, 1-symmetric) or
 // the principal directions of the most anisotropic faces (3.3.2.2,
 // 2-symmetric), interpolated over the rest; zero where there is no constraint.
@@ -153,8 +155,12 @@ std::vector<Vector3> face_directions(Mesh& mesh, const PatchSynthesisOptions& op
   if (opt.field == PatchField::Constant) {
     dfo.symmetry = 1;
     cons = constraints_from_constant_vector(mesh, opt.constant_vector);
-    if (cons.empty())  // every face nearly orthogonal to the vector: take them all
-      cons = constraints_from_constant_vector(mesh, opt.constant_vector, 1e-9);
+    if (cons.empty())  // every face nearly orthogonal to the vector: all but the floors
+      cons = constraints_from_constant_vector(mesh, opt.constant_vector, kFloorProjection);
+    // Flat faces facing along the vector (|projection| below kFloorProjection,
+    // so no face is constrained twice): parallel rows (floor_constraints).
+    for (const DirectionConstraint& c : floor_constraints(mesh, opt.constant_vector, kFloorProjection))
+      cons.push_back(c);
   } else {
     dfo.symmetry = 2;
     cons = principal_constraints(mesh, opt.field, opt.constraint_fraction);
