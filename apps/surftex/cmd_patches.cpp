@@ -244,7 +244,8 @@ SubcommandRegistrar reg{
            ->required();
        app.add_option("--field", a->field,
                       "Texture orientation. up: the exemplar stands upright, its top edge towards +y projected on "
-                      "the surface, its rows horizontal (a photograph of a wall keeps its bricks in rows); "
+                      "the surface, its rows horizontal (a photograph of a wall keeps its bricks in rows); on flat "
+                      "faces facing +y or -y (floors, a part's top) its top edge points to -z, rows parallel; "
                       "kmax|kmin (greatest/least signed normal curvature), kmax-abs|kmin-abs (greatest/least "
                       "absolute curvature): the exemplar's +x (its rows) follows that principal direction (Gorla "
                       "2003, Fig. 11); none: no orientation, for isotropic textures (default up)")
