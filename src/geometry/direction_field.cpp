@@ -469,10 +469,23 @@ std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<
   const Vector3 d(v[0], v[1], v[2]);
   const std::array<double, 3> fv = floor_vector(v);
   const Vector3 s(fv[0], fv[1], fv[2]);
-  std::vector<DirectionConstraint> out;
+  std::vector<std::uint8_t> flat(mesh.num_faces(), 0);
   for (FaceIndex f : mesh.faces()) {
     const Vector3 n = robust_face_normal(mesh, f);
-    if (norm(d - (d * n) * n) >= max_projection * norm(d)) continue;
+    flat[f.idx()] = norm(d - (d * n) * n) < max_projection * norm(d);
+  }
+  std::vector<DirectionConstraint> out;
+  for (FaceIndex f : mesh.faces()) {
+    if (!flat[f.idx()]) continue;
+    // A flat region, not a band of a curved surface (a flat torus's crest):
+    // every face across an edge is flat too.
+    bool inside = true;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      const FaceIndex g = mesh.face(mesh.opposite(h));
+      inside = inside && (g == Mesh::null_face() || flat[g.idx()]);
+    }
+    if (!inside) continue;
+    const Vector3 n = robust_face_normal(mesh, f);
     const Vector3 t = s - (s * n) * n;
     if (norm(t) > 0.5)  // the face is near orthogonal to v, so s lies nearly in it
       out.push_back({static_cast<std::uint32_t>(f.idx()), {t.x(), t.y(), t.z()}});

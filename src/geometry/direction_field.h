@@ -92,13 +92,16 @@ std::array<double, 3> floor_vector(std::array<double, 3> v);
 
 /// Floors and ceilings of a constant-vector field: the faces whose plane is
 /// within `max_projection` of orthogonal to v (|projection| < max_projection
-/// * |v|: flat tops and bottoms, a CAD part's faces facing along v) get the
-/// projection of floor_vector(v). Interpolated from their rims instead, a
-/// flat top bounded by walls holds the field's singularity in its middle (its
-/// rows circle the walls: radial fragments); so constrained it holds parallel
-/// rows, and the turn is at its rim. Curved surfaces have few such faces (a
-/// crown's tip). Throws InvalidInputError for a zero vector.
+/// * |v|: flat tops and bottoms, a CAD part's faces facing along v) and whose
+/// neighbours across every edge are too get the projection of
+/// floor_vector(v). Interpolated from their rims instead, a flat top bounded
+/// by walls holds the field's singularity in its middle (its rows circle the
+/// walls: radial fragments); so constrained it holds parallel rows, and the
+/// turn is at its rim. The neighbour rule leaves out the thin bands where a
+/// curved surface turns through orthogonal (a flat torus's crest, whose
+/// rows circle it without a singularity). Throws InvalidInputError for a zero
+/// vector.
 std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<double, 3> v,
-                                                   double max_projection = 0.05);
+                                                   double max_projection = 0.01);
 
 }  // namespace surftex

