@@ -469,9 +469,10 @@ std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<
   const Vector3 d(v[0], v[1], v[2]);
   const std::array<double, 3> fv = floor_vector(v);
   const Vector3 s(fv[0], fv[1], fv[2]);
+  std::vector<Vector3> normal(mesh.num_faces(), Vector3(0, 0, 0));
   std::vector<std::uint8_t> flat(mesh.num_faces(), 0);
   for (FaceIndex f : mesh.faces()) {
-    const Vector3 n = robust_face_normal(mesh, f);
+    const Vector3 n = normal[f.idx()] = robust_face_normal(mesh, f);
     flat[f.idx()] = norm(d - (d * n) * n) < max_projection * norm(d);
   }
   std::vector<DirectionConstraint> out;
@@ -485,7 +486,7 @@ std::vector<DirectionConstraint> floor_constraints(const Mesh& mesh, std::array<
       inside = inside && (g == Mesh::null_face() || flat[g.idx()]);
     }
     if (!inside) continue;
-    const Vector3 n = robust_face_normal(mesh, f);
+    const Vector3& n = normal[f.idx()];
     const Vector3 t = s - (s * n) * n;
     if (norm(t) > 0.5)  // the face is near orthogonal to v, so s lies nearly in it
       out.push_back({static_cast<std::uint32_t>(f.idx()), {t.x(), t.y(), t.z()}});

@@ -449,10 +449,10 @@ struct ElPreparedExemplars {
   mutable std::unique_ptr<std::once_flag[]> once;
   mutable std::unique_ptr<std::unique_ptr<SearchImage>[]> slots;
 
-  /// Whether orientation k of exemplar e is searched in orientation
-  /// k mod K/4 through k / (K/4) quarter turns of the pixel's window.
-  bool searched_through_turn(int e, int k) const {
-    return window % 2 == 1 && first_window % 2 == 1 && quarter_turns_of(exemplars[e], k, rotations, periodic) > 0;
+  /// The quarter turns through which orientation k of exemplar e is searched
+  /// in orientation k mod K/4 (quarter_turns_of), or 0: searched in its own.
+  int searched_through_turn(int e, int k) const {
+    return window % 2 == 1 && first_window % 2 == 1 ? quarter_turns_of(exemplars[e], k, rotations, periodic) : 0;
   }
 
   const SearchImage& get(int e, int k) const {
@@ -469,7 +469,7 @@ struct ElPreparedExemplars {
     const int margin = std::max(-lo_of(window), hi_of(window));
     std::unique_ptr<SearchImage> s;
     if (const int q = quarter_turns_of(ex, k, rotations, periodic); q > 0) {
-      assert(!searched_through_turn(e, k));
+      assert(searched_through_turn(e, k) == 0);
       s = std::make_unique<SearchImage>(turned_search_image(get(e, k % (rotations / 4)), q, window));
     } else {
       RotatedExemplar r = rotate_exemplar(ex, 2.0 * M_PI * k / rotations, periodic, margin);
@@ -736,8 +736,8 @@ void Synthesizer::prepare_search_images() {
       k = rotation_index(a, K);
     }
     pair_of[p] = e * K + k;
-    if (prep_->searched_through_turn(e, k)) {
-      turn_[p] = static_cast<std::uint8_t>(k / (K / 4));
+    if (const int q = prep_->searched_through_turn(e, k); q > 0) {
+      turn_[p] = static_cast<std::uint8_t>(q);
       k %= K / 4;
     }
     searched[p] = e * K + k;
@@ -769,19 +769,14 @@ void Synthesizer::prepare_search_images() {
     if (pr >= 0) used[pr] = 1;
   orientations_used_ = static_cast<int>(std::count(used.begin(), used.end(), 1));
   pair_of_ = std::move(pair_of);
-  // Target offset read for each search-image offset, per quarter turn: one
-  // turn sends an offset (a, b) to (b, -a) (quarter_turn_position).
+  // Target offset read for each search-image offset, per quarter turn.
   const int lo = lo_of(window_), hi = hi_of(window_);
   for (int q = 0; q < 4; ++q) {
     turned_offset_[q].clear();
     for (int b = lo; b <= hi; ++b)
       for (int a = lo; a <= hi; ++a) {
         int dx = a, dy = b;
-        for (int t = 0; t < q; ++t) {
-          const int nx = dy;
-          dy = -dx;
-          dx = nx;
-        }
+        quarter_turns_offset(q, dx, dy);
         turned_offset_[q].push_back({dx, dy});
       }
   }
@@ -1130,11 +1125,7 @@ void Synthesizer::seed_patch(int p) {
     for (int a = -1; a <= 1; ++a) {
       // Search-image offset (a, b) lands on the target at its turned offset.
       int dx = a, dy = b;
-      for (int t = 0; t < turn_[p]; ++t) {
-        const int nx = dy;
-        dy = -dx;
-        dx = nx;
-      }
+      quarter_turns_offset(turn_[p], dx, dy);
       const int x = px + dx, y = py + dy;
       if (x < 0 || y < 0 || x >= W || y >= H) continue;
       const int q = y * W + x;

@@ -74,6 +74,16 @@ inline void quarter_turns_position(int w, int h, int q, int& x, int& y) {
   }
 }
 
+/// An offset (dx, dy) between two pixels after q quarter turns (q = 0..3):
+/// quarter_turn_position sends (dx, dy) to (dy, -dx).
+inline void quarter_turns_offset(int q, int& dx, int& dy) {
+  for (int t = 0; t < q; ++t) {
+    const int nx = dy;
+    dy = -dx;
+    dx = nx;
+  }
+}
+
 /// `r` turned by q exact quarter turns (q = 0..3): the exemplar rotated by
 /// r.angle + q pi/2, its samples permuted, not resampled.
 RotatedExemplar turn_quarters(const RotatedExemplar& r, int q);
