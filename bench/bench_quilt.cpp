@@ -283,7 +283,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   }
   // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SHAPE,
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
-  // BENCH_CLEARANCE (swatch units; negative = automatic), BENCH_SEED (the run's seed, default 1: the spread of a figure over seeds).
+  // BENCH_CLEARANCE (swatch units; negative = automatic), BENCH_KEEP_CUT (0/1: refused inputs' cut parts kept), BENCH_SEED (the run's seed, default 1: the spread of a figure over seeds).
   if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
@@ -293,6 +293,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
+  if (const char* e = std::getenv("BENCH_KEEP_CUT")) qo.step.keep_cut_refused_inputs = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
   Mesh out;
@@ -331,6 +332,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_pushed", r.stats.crossing_pushed},
          {"crossings_resolved", r.crossings_resolved},
          {"crossing_elements_embedded", er.crossing_elements},
+         {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},

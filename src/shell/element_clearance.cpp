@@ -235,12 +235,7 @@ std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<ch
         ok = false;
         break;
       }
-      P3 c{0, 0, 0};
-      for (int v : l)
-        for (int d = 0; d < 3; ++d) c[d] += e.points[static_cast<std::size_t>(v)][d] / static_cast<double>(l.size());
-      const int cv = static_cast<int>(e.points.size());
-      e.points.push_back(c);
-      for (std::size_t k = 0; k < l.size(); ++k) e.tris.push_back({l[(k + 1) % l.size()], l[k], cv});
+      cap_loop(e, l);
     }
     if (ok && is_closed_oriented(e)) out.push_back(std::move(e));
   }

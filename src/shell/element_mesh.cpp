@@ -94,6 +94,68 @@ bool boundary_loops(const ElementMesh& m, std::vector<std::vector<int>>& loops) 
   return true;
 }
 
+namespace {
+// Joins two closed rings sampled at the same parameters j / size (outer `o`,
+// inner `in`, both in the loop's direction) by a strip of triangles, taking
+// whichever ring's next vertex comes first.
+void zip_rings(ElementMesh& m, const std::vector<int>& o, const std::vector<int>& in) {
+  const std::size_t no = o.size(), ni = in.size();
+  std::size_t a = 0, b = 0;
+  while (a < no || b < ni) {
+    // Outer next when its parameter (a + 1) / no is not past (b + 1) / ni.
+    const bool outer = b == ni || (a < no && (a + 1) * ni <= (b + 1) * no);
+    if (outer) {
+      m.tris.push_back({o[(a + 1) % no], o[a % no], in[b % ni]});
+      ++a;
+    } else {
+      m.tris.push_back({o[a % no], in[b % ni], in[(b + 1) % ni]});
+      ++b;
+    }
+  }
+}
+}  // namespace
+
+void cap_loop(ElementMesh& m, const std::vector<int>& loop) {
+  const std::size_t n = loop.size();
+  if (n < 3) return;
+  P3 c{0, 0, 0};
+  for (int v : loop)
+    for (int d = 0; d < 3; ++d) c[d] += m.points[static_cast<std::size_t>(v)][d] / static_cast<double>(n);
+  auto dist = [](const P3& p, const P3& q) {
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+  };
+  double edge = 0, radius = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const P3& p = m.points[static_cast<std::size_t>(loop[k])];
+    edge += dist(p, m.points[static_cast<std::size_t>(loop[(k + 1) % n])]) / static_cast<double>(n);
+    radius += dist(p, c) / static_cast<double>(n);
+  }
+  // Rings at 1 - i / (rings + 1) of the way out, i = 1..rings: spokes of about one edge.
+  const int rings = edge > 0 ? std::max(0, static_cast<int>(std::lround(radius / edge)) - 1) : 0;
+  std::vector<int> outer = loop;
+  for (int i = 1; i <= rings; ++i) {
+    const double t = 1.0 - static_cast<double>(i) / (rings + 1);
+    const std::size_t ni = std::max<std::size_t>(3, static_cast<std::size_t>(std::lround(static_cast<double>(n) * t)));
+    std::vector<int> inner(ni);
+    for (std::size_t j = 0; j < ni; ++j) {
+      // The loop's point at parameter j / ni (linear between its vertices), shrunk by t towards c.
+      const double f = static_cast<double>(j * n) / static_cast<double>(ni);
+      const std::size_t k = std::min(n - 1, static_cast<std::size_t>(f));
+      const double w = f - static_cast<double>(k);
+      const P3 &p = m.points[static_cast<std::size_t>(loop[k])], &q = m.points[static_cast<std::size_t>(loop[(k + 1) % n])];
+      P3 r{};
+      for (int d = 0; d < 3; ++d) r[d] = c[d] + t * ((1 - w) * p[d] + w * q[d] - c[d]);
+      inner[j] = static_cast<int>(m.points.size());
+      m.points.push_back(r);
+    }
+    zip_rings(m, outer, inner);
+    outer = std::move(inner);
+  }
+  const int cv = static_cast<int>(m.points.size());
+  m.points.push_back(c);
+  for (std::size_t k = 0; k < outer.size(); ++k) m.tris.push_back({outer[(k + 1) % outer.size()], outer[k], cv});
+}
+
 std::vector<P3> face_normals(const ElementMesh& m) {
   std::vector<P3> n(m.tris.size(), P3{0, 0, 0});
   for (std::size_t i = 0; i < m.tris.size(); ++i) {

@@ -41,6 +41,14 @@ bool is_closed_oriented(const ElementMesh& m);
 /// ab). Returns false if the border is not a set of simple loops (a vertex with
 /// more than one outgoing border edge).
 bool boundary_loops(const ElementMesh& m, std::vector<std::vector<int>>& loops);
+/// Closes the border loop `loop` of `m` (a boundary_loops loop) with new
+/// triangles, oriented as the loop's own. Concentric rings of new vertices,
+/// each the loop shrunk towards its centroid, keep the cap's edges near the
+/// loop's mean edge (a fan from the centroid alone has spokes as long as the
+/// loop's radius: a 48-vertex cut gets edges 7.6 times its mean edge); loops
+/// no wider than their mean edge get that fan. Needs >= 3 vertices (else
+/// nothing is added).
+void cap_loop(ElementMesh& m, const std::vector<int>& loop);
 /// Unit area-weighted vertex normals (zero for isolated vertices).
 std::vector<P3> vertex_normals(const ElementMesh& m);
 /// Unit face normals (zero for degenerate triangles).

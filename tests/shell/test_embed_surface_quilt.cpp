@@ -17,6 +17,7 @@
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
+#include "shell/element_mesh.h"
 #include "shell/embed_outside_shell.h"
 #include "shell/quilting/embed_surface_quilt.h"
 #include "shell/shell_map.h"
@@ -167,6 +168,90 @@ TEST(EmbedSurfaceQuilt, VerticesJustPastFaceEdgesAreLocatedInTheirChartAndStayIn
     }
   }
   EXPECT_GT(bottoms, 0u);
+}
+
+namespace {
+// A closed tube (thread) of 8 x 24 vertices from a to b (xy, at height zc),
+// radius rxy across in the plane and rz in height, capped, added to q as one
+// element located on the grid `base` (faces found by their barycentrics).
+void add_tube(SurfaceQuilt& q, const Mesh& base, std::array<double, 2> a, std::array<double, 2> b, double zc, double rxy,
+              double rz) {
+  ElementMesh t;
+  const int nu = 8, nv = 24;
+  const double dx = b[0] - a[0], dy = b[1] - a[1], len = std::hypot(dx, dy);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double s = static_cast<double>(j) / (nv - 1), ph = 2 * M_PI * i / nu;
+      const double side = rxy * std::cos(ph);
+      t.points.push_back({a[0] + s * dx - side * dy / len, a[1] + s * dy + side * dx / len, zc + rz * std::sin(ph)});
+    }
+  for (int j = 0; j + 1 < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const int p = j * nu + i, r = j * nu + (i + 1) % nu;
+      t.tris.push_back({p, r, r + nu});
+      t.tris.push_back({p, r + nu, p + nu});
+    }
+  std::vector<std::vector<int>> loops;
+  ASSERT_TRUE(boundary_loops(t, loops));
+  for (const auto& l : loops) cap_loop(t, l);
+  ASSERT_TRUE(is_closed_oriented(t));
+  const int first = static_cast<int>(q.vertices.size());
+  for (const P3& p : t.points) {
+    SurfaceQuiltVertex v;
+    for (FaceIndex f : base.faces()) {
+      const Vec3 o = face_point(base, f, 0, 0), e1 = face_point(base, f, 1, 0), e2 = face_point(base, f, 0, 1);
+      const double ux = e1[0] - o[0], uy = e1[1] - o[1], wx = e2[0] - o[0], wy = e2[1] - o[1];
+      const double det = ux * wy - uy * wx, px = p[0] - o[0], py = p[1] - o[1];
+      const double b1 = (px * wy - py * wx) / det, b2 = (ux * py - uy * px) / det;
+      if (b1 >= -1e-12 && b2 >= -1e-12 && b1 + b2 <= 1 + 1e-12) {
+        v = {static_cast<int>(f.idx()), b1, b2, p[2]};
+        break;
+      }
+    }
+    ASSERT_GE(v.face, 0);
+    q.vertices.push_back(v);
+  }
+  for (const Tri& tr : t.tris) {
+    q.tris.push_back({tr[0] + first, tr[1] + first, tr[2] + first});
+    q.tri_element.push_back(q.elements);
+  }
+  q.element_compact.push_back(0);
+  ++q.elements;
+}
+}  // namespace
+
+// Issue 17 item 1: whatever still crosses after the embedding is resolved:
+// threads cut and capped for a few rounds, then removed whole, so that no
+// crossing is left however many the cuts would need.
+TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
+  Mesh base;
+  make_grid(base, 6, 6, 1.0, 1.0);
+  SurfaceQuilt q;
+  q.scale = 0.2;
+  q.z_min = 0;
+  q.z_max = 1;
+  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
+  const std::size_t first_faces = q.tris.size();
+  add_tube(q, base, {0.5, 0.1}, {0.5, 0.9}, 0.5, 0.06, 0.3);
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 5;
+  eo.measure_outside_shell = false;
+  eo.resolve_crossings = false;
+  Mesh out;
+  const EmbedSurfaceQuiltResult crossing = embed_surface_quilt(base, q, out, eo);
+  ASSERT_GT(crossing.self_intersections_between, 0u);  // the two threads cross
+  eo.resolve_crossings = true;
+  const EmbedSurfaceQuiltResult trimmed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(trimmed.embed.self_intersecting_pairs, 0u);
+  EXPECT_EQ(trimmed.crossing_elements_removed_last, 0u);  // the later thread cut at the crossing, its pieces capped
+  EXPECT_GT(out.number_of_faces(), first_faces);
+  eo.crossing_trim_rounds = 0;  // no cut allowed: the later thread goes, the first stays whole
+  const EmbedSurfaceQuiltResult removed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(removed.embed.self_intersecting_pairs, 0u);
+  EXPECT_EQ(removed.crossing_elements_removed_last, 1u);
+  EXPECT_EQ(out.number_of_faces(), first_faces);
+  eo.crossing_trim_rounds = 9;
+  EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
 }
 
 // The invariant the embedding relies on: after the stretch minimisation (only

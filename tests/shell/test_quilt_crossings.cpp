@@ -120,6 +120,63 @@ TEST(ElementClearance, TrimAndCapLeavesClosedPiecesAwayFromTheHits) {
   EXPECT_THROW(trim_and_cap(ring, std::vector<char>(3, 0), 1, 1), InvalidInputError);
 }
 
+namespace {
+double longest_edge(const ElementMesh& m) {
+  double l = 0;
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 &a = m.points[static_cast<std::size_t>(t[k])], &b = m.points[static_cast<std::size_t>(t[(k + 1) % 3])];
+      l = std::max(l, std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])));
+    }
+  return l;
+}
+}  // namespace
+
+// Issue 17, no shards: a wide cut (a pebble or a ring cut across) is closed
+// by rings shrinking towards the centre, not by one fan whose spokes are as
+// long as the cut's radius (7.6 rim edges for a 48-vertex rim).
+TEST(ElementCaps, WideCutsAreClosedWithEdgesNearTheRimEdge) {
+  const int n = 48;
+  ElementMesh tube;  // open tube, radius 1, rims of n vertices at z = 0 and z = 0.1
+  for (int r = 0; r < 2; ++r)
+    for (int i = 0; i < n; ++i)
+      tube.points.push_back({std::cos(2 * M_PI * i / n), std::sin(2 * M_PI * i / n), 0.1 * r});
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    tube.tris.push_back({i, j, n + j});
+    tube.tris.push_back({i, n + j, n + i});
+  }
+  const double rim = 2 * std::sin(M_PI / n);
+  std::vector<std::vector<int>> loops;
+  ASSERT_TRUE(boundary_loops(tube, loops));
+  ASSERT_EQ(loops.size(), 2u);
+  for (const auto& l : loops) cap_loop(tube, l);
+  EXPECT_TRUE(is_closed_oriented(tube));
+  EXPECT_LT(longest_edge(tube), 2 * rim);
+  // Outward normals: the caps face -z at z = 0 and +z at z = 0.1.
+  const std::vector<P3> fn = face_normals(tube);
+  for (std::size_t t = 2 * n; t < tube.tris.size(); ++t) {
+    const double z = tube.points[static_cast<std::size_t>(tube.tris[t][0])][2];
+    EXPECT_NEAR(fn[t][2], z > 0.05 ? 1.0 : -1.0, 1e-9);
+  }
+  // A loop no wider than its edge keeps the single fan.
+  ElementMesh tri{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}}};
+  ASSERT_TRUE(boundary_loops(tri, loops));
+  cap_loop(tri, loops[0]);
+  EXPECT_EQ(tri.points.size(), 5u);
+  EXPECT_TRUE(is_closed_oriented(tri));
+  // trim_and_cap (cuts at crossings) caps so too: a sphere cut in half keeps its own edge length.
+  Mesh s;
+  make_icosphere(s, 4);
+  ElementMesh ball = element_mesh_from(s);
+  std::vector<char> drop(ball.tris.size(), 0);
+  for (std::size_t t = 0; t < ball.tris.size(); ++t) drop[t] = ball.points[static_cast<std::size_t>(ball.tris[t][0])][2] > 0.05;
+  const std::vector<ElementMesh> pieces = trim_and_cap(ball, drop, 0, 20);
+  ASSERT_EQ(pieces.size(), 1u);
+  EXPECT_TRUE(is_closed_oriented(pieces[0]));
+  EXPECT_LT(longest_edge(pieces[0]), 2 * longest_edge(ball));
+}
+
 TEST(SwatchAxis, ThinAxisIsDetectedAndTurnedOntoZ) {
   Mesh m;
   ScatterOptions so;

@@ -742,7 +742,7 @@ void stitch_kept_parts(const ElementMesh& a, const std::vector<char>& keep_a, co
 
 namespace {
 // The kept part of closed `m` split into components, each cut loop closed by
-// a fan around the loop's centroid (see MergeResult::capped_b).
+// by cap_loop (see MergeResult::capped_b).
 std::vector<ElementMesh> capped_kept_components(const ElementMesh& m, const std::vector<char>& keep) {
   std::vector<ElementMesh> out;
   std::size_t kept = 0;
@@ -763,10 +763,7 @@ std::vector<ElementMesh> capped_kept_components(const ElementMesh& m, const std:
     std::vector<std::vector<int>> loops;
     if (!boundary_loops(e, loops) || loops.size() != 1) continue;
     for (const std::vector<int>& l : loops) {
-      if (l.size() < 3) continue;
-      const int cv = static_cast<int>(e.points.size());
-      e.points.push_back(loop_centroid(e, l));
-      for (std::size_t k = 0; k < l.size(); ++k) e.tris.push_back({l[(k + 1) % l.size()], l[k], cv});
+      cap_loop(e, l);
     }
     if (is_closed_oriented(e)) out.push_back(std::move(e));
   }

@@ -26,8 +26,9 @@ namespace {
 // mesh that intersect (exact); of two elements the later yields its faces,
 // an element crossing itself both; a compact element with such faces is
 // removed, another has them (and one ring) cut out and its pieces capped
-// (trim_and_cap). `out` is rebuilt.
-void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact,
+// (trim_and_cap); with `remove`, every element with such faces is removed.
+// `out` is rebuilt.
+void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact, bool remove,
                                 std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
   for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
@@ -58,7 +59,8 @@ void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<
       continue;
     }
     ++res.crossing_elements;
-    if (c) continue;
+    if (remove) ++res.crossing_elements_removed_last;
+    if (c || remove) continue;
     for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
       kept.push_back(std::move(piece));
       kept_compact.push_back(0);
@@ -236,19 +238,22 @@ void count_mapping(const SurfaceQuilt& quilt, const QuiltVertexMapping& vm, Embe
 }
 
 /// Resolution rounds when asked (a cut piece's cap may meet another element),
-/// each reusing the exact check that the count reports; then the
-/// self-intersecting face pairs counted, within and between elements.
+/// each reusing the exact check that the count reports; what still crosses
+/// after opt.crossing_trim_rounds is removed whole (removing adds no crossing, so none is
+/// left); then the self-intersecting face pairs counted, within and between
+/// elements.
 void resolve_and_count_crossings(const SurfaceQuilt& quilt, const EmbedSurfaceQuiltOptions& opt,
                                  std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<FacePair> pairs;
   bool checked = false;
   if (opt.resolve_crossings) {
     std::vector<char> compact = quilt.element_compact;
-    for (int round = 0; round < 3; ++round) {
+    const int trim_rounds = opt.crossing_trim_rounds;
+    for (int round = 0; round <= trim_rounds; ++round) {
       pairs = self_intersecting_faces(out);
       checked = true;
       if (pairs.empty()) break;
-      resolve_embedded_crossings(pairs, compact, els, out, res);
+      resolve_embedded_crossings(pairs, compact, round == trim_rounds, els, out, res);
       checked = false;
     }
   }
@@ -274,6 +279,9 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
                                             const EmbedSurfaceQuiltOptions& opt) {
   if (!(opt.shell_height > 0) || !std::isfinite(opt.shell_height))
     throw InvalidInputError("embed_surface_quilt: shell_height must be > 0 (" + std::to_string(opt.shell_height) + ")");
+  if (opt.crossing_trim_rounds < 0 || opt.crossing_trim_rounds > 8)
+    throw InvalidInputError("embed_surface_quilt: crossing_trim_rounds must be in 0..8 (" +
+                            std::to_string(opt.crossing_trim_rounds) + ")");
   const double h = opt.shell_height * (quilt.z_max - quilt.z_min) * quilt.scale;
   if (!(h > 0)) throw InvalidInputError("embed_surface_quilt: the quilt has zero height or scale");
   EmbedSurfaceQuiltResult res;

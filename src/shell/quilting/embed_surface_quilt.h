@@ -47,8 +47,11 @@ struct EmbedSurfaceQuiltOptions {
   bool check_self_intersections = true;
   /// Issue 17 item 1: faces still intersecting after the embedding are resolved
   /// before the count (the later element yields: compact ones removed, others
-  /// cut and capped). Default true.
+  /// cut and capped; what still crosses after crossing_trim_rounds such
+  /// rounds is removed whole, so none is left). Default true.
   bool resolve_crossings = true;
+  /// Rounds that cut and cap crossing threads before the removal; 0..8, default 3.
+  int crossing_trim_rounds = 3;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
   OutsideShellOptions outside_shell;
@@ -76,6 +79,8 @@ struct EmbedSurfaceQuiltResult {
   std::size_t self_intersections_within = 0, self_intersections_between = 0;
   /// Elements cut or removed by EmbedSurfaceQuiltOptions::resolve_crossings.
   std::size_t crossing_elements = 0;
+  /// Of those, removed whole because they still crossed after the trimming rounds.
+  std::size_t crossing_elements_removed_last = 0;
   /// Embedded vertices outside the geometric shell (the union of the shell's
   /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;
