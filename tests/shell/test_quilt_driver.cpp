@@ -209,7 +209,7 @@ TEST(QuiltDriver, SurfaceDriverRefusesAScaleAbove10AndOversizedRunsBeforeQuiltin
 // base's diagonal every placement on a small sphere is stretched or crosses
 // and nothing is left ("no element was placed"); the default size gives one
 // element 1/16 of the diagonal, and the sphere gets covered with pebbles.
-// Swatches of several small elements (tori, chain mail) keep 0.25; threads
+// Swatches of several small flat elements (tori) keep 0.25; threads
 // (the weave's, which span the swatch) are capped at 1/8 of the diagonal in
 // length, so the weave gets about half of 0.25.
 TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOrOfLongThreads) {
@@ -222,7 +222,7 @@ TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOrOfLongThreads) {
   make_chainmail_swatch(chain, ChainmailOptions{});
   make_weave_swatch(weave, WeaveOptions{});
   EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(tori)), 0.25);
-  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(chain)), 0.25);
+  EXPECT_LT(default_surface_quilt_size(make_swatch(chain)), 0.16);  // standing rings: the height cap below
   const Swatch ws = make_swatch(weave);
   double longest = 0;  // the longest thread's larger xy side (swatch units)
   for (std::size_t e = 0; e < ws.elements.size(); ++e) {
@@ -259,8 +259,9 @@ TEST(QuiltDriver, DefaultSizeShrinksASwatchOfOneLargeElementOrOfLongThreads) {
 
 // The height cap: a pebble as tall as it is wide (splaying more when lifted
 // over curved ground) gets a smaller default than a flat one of the same
-// width: its height is at most 1/32 of the diagonal; flat rings (tori, chain
-// mail) keep 0.25.
+// width: its height is at most 1/32 of the diagonal; so do standing
+// chain-mail rings, which are neither compact nor long (session 30: bare
+// area on the bunny 8.3% -> 5.3%); tilted tori keep 0.25.
 TEST(QuiltDriver, DefaultSizeIsSmallerForATallElementThanForAFlatOne) {
   Mesh flat, tall, tori, mail;
   make_ellipsoid(flat, 1.0, 0.8, 0.35, 2);
@@ -276,7 +277,13 @@ TEST(QuiltDriver, DefaultSizeIsSmallerForATallElementThanForAFlatOne) {
   EXPECT_NEAR(dt, expect, 1e-9);
   EXPECT_LT(dt, 0.045);
   EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(tori, SwatchAxis::kAuto)), 0.25);
-  EXPECT_DOUBLE_EQ(default_surface_quilt_size(make_swatch(mail, SwatchAxis::kAuto)), 0.25);
+  const Swatch sm = make_swatch(mail, SwatchAxis::kAuto);
+  std::vector<double> h;
+  for (const SwatchElement& e : sm.elements) h.push_back(e.bbox_max[2] - e.bbox_min[2]);
+  std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
+  const double mail_expect = (1.0 / 32) * std::max(sm.length(), sm.width()) / h[h.size() / 2];
+  EXPECT_LT(mail_expect, 0.2);
+  EXPECT_NEAR(default_surface_quilt_size(sm), mail_expect, 1e-12);
 }
 
 TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {

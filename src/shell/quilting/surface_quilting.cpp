@@ -1813,23 +1813,28 @@ double default_surface_quilt_size(const Swatch& swatch) {
   // patch it can be expressed in (decision 102, session 24).
   const double longest = longest_thread(swatch);
   if (longest > 0) size = std::min(size, kThreadLength * whole / longest);
-  std::vector<double> sides, heights;  // larger xy side and z extent of each compact element
-  for (const ElementMesh& m : compact_swatch_elements(swatch)) {
-    double lo[3], hi[3];
-    for (int d = 0; d < 3; ++d) lo[d] = std::numeric_limits<double>::infinity(), hi[d] = -lo[d];
-    for (const P3& q : m.points)
-      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
-    const double side = std::max(hi[0] - lo[0], hi[1] - lo[1]);
-    if (side > 0) sides.push_back(side), heights.push_back(std::max(0.0, hi[2] - lo[2]));
-  }
-  if (sides.empty()) return size;
   auto median = [](std::vector<double>& v) {
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
     return v[v.size() / 2];
   };
-  size = std::min(size, kElementSize * whole / median(sides));
-  const double h = median(heights);
-  if (h > 0) size = std::min(size, kElementHeight * whole / h);
+  // Every element's height (z extent) at most 1/32 of the diagonal: standing
+  // chain-mail rings too, which are neither compact nor long (session 30).
+  std::vector<double> heights;
+  for (const SwatchElement& e : swatch.elements) heights.push_back(std::max(0.0, e.bbox_max[2] - e.bbox_min[2]));
+  if (!heights.empty()) {
+    const double h = median(heights);
+    if (h > 0) size = std::min(size, kElementHeight * whole / h);
+  }
+  std::vector<double> sides;  // larger xy side of each compact element
+  for (const ElementMesh& m : compact_swatch_elements(swatch)) {
+    double lo[2], hi[2];
+    for (int d = 0; d < 2; ++d) lo[d] = std::numeric_limits<double>::infinity(), hi[d] = -lo[d];
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    const double side = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+    if (side > 0) sides.push_back(side);
+  }
+  if (!sides.empty()) size = std::min(size, kElementSize * whole / median(sides));
   return size;
 }
 

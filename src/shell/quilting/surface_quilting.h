@@ -210,10 +210,12 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 /// The default relative size (the CLI's, when --scale is not given): 0.25,
 /// lowered for swatches of few large compact elements (a single pebble) so
 /// that the median compact element's larger xy side is at most 1/16 of the
-/// base's diagonal, i.e. 0.0625 * (swatch side / element side), and its
-/// height (z, along the normal) at most 1/32: lifted along the normals over
-/// curved ground an element splays in proportion to its height, so a pebble
-/// as tall as it is wide gets smaller than a flat ring of the same width.
+/// base's diagonal, i.e. 0.0625 * (swatch side / element side), and for
+/// swatches of tall elements so that the median element's height (z, along
+/// the normal; every element, compact or not) is at most 1/32: lifted along
+/// the normals over curved ground an element splays in proportion to its
+/// height, so a pebble as tall as it is wide gets smaller than a flat ring of
+/// the same width, and standing chain-mail rings (0.148) than lying tori.
 /// Threads (elements that are not compact: a weave's) are capped at 1/8 of
 /// the diagonal in length: on curved ground a longer thread runs past the
 /// patch that can express it and is cut into pieces (decision 102).
