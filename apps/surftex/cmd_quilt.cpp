@@ -259,9 +259,10 @@ SubcommandRegistrar reg_quilt{
        app.add_flag("--no-render", a->no_render, "Do not write a render");
        app.add_option("--scale", a->scale,
                       "The paper's s. On a mesh: the swatch's larger side as a fraction of the base mesh's "
-                      "bounding-box diagonal, (0, 10]; 0 = 0.25, or less for a swatch of few large compact "
-                      "elements (a single pebble) so that one element is at most 1/16 of the diagonal wide and "
-                      "1/32 of it tall (a tall element splays over curved ground), and for threads (a weave) so that the "
+                      "bounding-box diagonal, (0, 10]; 0 = 0.25, or less: for a swatch of few large compact "
+                      "elements (a single pebble) so that one element is at most 1/16 of the diagonal wide; for tall "
+                      "elements (a pebble, standing chain-mail rings) so that the median one is at most 1/32 of it "
+                      "tall (a tall element splays over curved ground); and for threads (a weave) so that the "
                       "longest is at most 1/8 of the diagonal long (a longer one is cut where the surface curves). On a "
                       "plane: factor applied to the swatch, 0 = 1 (default 0)")
            ->check(number_above(0, false));
