@@ -333,6 +333,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossings_resolved", r.crossings_resolved},
          {"crossing_elements_embedded", er.crossing_elements},
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
+         {"elements_stretched_embedded", er.elements_stretched_embedded},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},

@@ -156,6 +156,16 @@ void cap_loop(ElementMesh& m, const std::vector<int>& loop) {
   for (std::size_t k = 0; k < outer.size(); ++k) m.tris.push_back({outer[(k + 1) % outer.size()], outer[k], cv});
 }
 
+double longest_edge_length(const ElementMesh& m) {
+  double l2 = 0;
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 &a = m.points[static_cast<std::size_t>(t[k])], &b = m.points[static_cast<std::size_t>(t[(k + 1) % 3])];
+      l2 = std::max(l2, (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    }
+  return std::sqrt(l2);
+}
+
 std::vector<P3> face_normals(const ElementMesh& m) {
   std::vector<P3> n(m.tris.size(), P3{0, 0, 0});
   for (std::size_t i = 0; i < m.tris.size(); ++i) {

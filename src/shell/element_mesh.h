@@ -49,6 +49,8 @@ bool boundary_loops(const ElementMesh& m, std::vector<std::vector<int>>& loops);
 /// no wider than their mean edge get that fan. Needs >= 3 vertices (else
 /// nothing is added).
 void cap_loop(ElementMesh& m, const std::vector<int>& loop);
+/// Length of the longest edge; 0 if none.
+double longest_edge_length(const ElementMesh& m);
 /// Unit area-weighted vertex normals (zero for isolated vertices).
 std::vector<P3> vertex_normals(const ElementMesh& m);
 /// Unit face normals (zero for degenerate triangles).

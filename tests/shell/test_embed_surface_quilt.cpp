@@ -241,7 +241,9 @@ TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
   const EmbedSurfaceQuiltResult crossing = embed_surface_quilt(base, q, out, eo);
   ASSERT_GT(crossing.self_intersections_between, 0u);  // the two threads cross
   eo.resolve_crossings = true;
+  eo.max_edge = 1.0;  // a shard bound nothing passes leaves the elements to the crossing rounds
   const EmbedSurfaceQuiltResult trimmed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(trimmed.elements_stretched_embedded, 0u);
   EXPECT_EQ(trimmed.embed.self_intersecting_pairs, 0u);
   EXPECT_EQ(trimmed.crossing_elements_removed_last, 0u);  // the later thread cut at the crossing, its pieces capped
   EXPECT_GT(out.number_of_faces(), first_faces);
@@ -251,6 +253,39 @@ TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
   EXPECT_EQ(removed.crossing_elements_removed_last, 1u);
   EXPECT_EQ(out.number_of_faces(), first_faces);
   eo.crossing_trim_rounds = 9;
+  EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
+}
+
+// Issue 17 item 2 after the shell map: the shard bound (max_edge) is held on
+// the embedded elements, which the map may stretch past what the quilt held
+// lifted: a thread loses the triangles with a longer edge (the rest capped),
+// a compact element goes whole; 0 leaves them.
+TEST(EmbedSurfaceQuilt, TheShardBoundHoldsOnTheEmbeddedElements) {
+  Mesh base;
+  make_grid(base, 6, 6, 1.0, 1.0);
+  SurfaceQuilt q;
+  q.scale = 0.2;
+  q.z_min = 0;
+  q.z_max = 1;
+  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 5;
+  eo.measure_outside_shell = false;
+  Mesh out;
+  const EmbedSurfaceQuiltResult whole = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(whole.elements_stretched_embedded, 0u);
+  const double longest = longest_edge_length(element_mesh_from(out));
+  ASSERT_EQ(out.number_of_faces(), q.tris.size());
+  eo.max_edge = 0.99 * longest;
+  const EmbedSurfaceQuiltResult cut = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(cut.elements_stretched_embedded, 1u);
+  EXPECT_LT(out.number_of_faces(), q.tris.size());
+  EXPECT_LE(longest_edge_length(element_mesh_from(out)), eo.max_edge);
+  q.element_compact = {1};
+  const EmbedSurfaceQuiltResult removed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(removed.elements_stretched_embedded, 1u);
+  EXPECT_EQ(out.number_of_faces(), 0u);
+  eo.max_edge = -1;
   EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
 }
 

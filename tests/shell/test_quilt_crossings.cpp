@@ -120,18 +120,6 @@ TEST(ElementClearance, TrimAndCapLeavesClosedPiecesAwayFromTheHits) {
   EXPECT_THROW(trim_and_cap(ring, std::vector<char>(3, 0), 1, 1), InvalidInputError);
 }
 
-namespace {
-double longest_edge(const ElementMesh& m) {
-  double l = 0;
-  for (const Tri& t : m.tris)
-    for (int k = 0; k < 3; ++k) {
-      const P3 &a = m.points[static_cast<std::size_t>(t[k])], &b = m.points[static_cast<std::size_t>(t[(k + 1) % 3])];
-      l = std::max(l, std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])));
-    }
-  return l;
-}
-}  // namespace
-
 // Issue 17, no shards: a wide cut (a pebble or a ring cut across) is closed
 // by rings shrinking towards the centre, not by one fan whose spokes are as
 // long as the cut's radius (7.6 rim edges for a 48-vertex rim).
@@ -152,7 +140,7 @@ TEST(ElementCaps, WideCutsAreClosedWithEdgesNearTheRimEdge) {
   ASSERT_EQ(loops.size(), 2u);
   for (const auto& l : loops) cap_loop(tube, l);
   EXPECT_TRUE(is_closed_oriented(tube));
-  EXPECT_LT(longest_edge(tube), 2 * rim);
+  EXPECT_LT(longest_edge_length(tube), 2 * rim);
   // Outward normals: the caps face -z at z = 0 and +z at z = 0.1.
   const std::vector<P3> fn = face_normals(tube);
   for (std::size_t t = 2 * n; t < tube.tris.size(); ++t) {
@@ -174,7 +162,7 @@ TEST(ElementCaps, WideCutsAreClosedWithEdgesNearTheRimEdge) {
   const std::vector<ElementMesh> pieces = trim_and_cap(ball, drop, 0, 20);
   ASSERT_EQ(pieces.size(), 1u);
   EXPECT_TRUE(is_closed_oriented(pieces[0]));
-  EXPECT_LT(longest_edge(pieces[0]), 2 * longest_edge(ball));
+  EXPECT_LT(longest_edge_length(pieces[0]), 2 * longest_edge_length(ball));
 }
 
 TEST(SwatchAxis, ThinAxisIsDetectedAndTurnedOntoZ) {

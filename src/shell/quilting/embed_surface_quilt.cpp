@@ -26,10 +26,11 @@ namespace {
 // mesh that intersect (exact); of two elements the later yields its faces,
 // an element crossing itself both; a compact element with such faces is
 // removed, another has them (and one ring) cut out and its pieces capped
-// (trim_and_cap); with `remove`, every element with such faces is removed.
+// (trim_and_cap; a piece with an edge over max_edge > 0 is left out); with
+// `remove`, every element with such faces is removed.
 // `out` is rebuilt.
 void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact, bool remove,
-                                std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+                                double max_edge, std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
   for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
   auto element_of = [&](std::uint32_t f) {
@@ -62,6 +63,7 @@ void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<
     if (remove) ++res.crossing_elements_removed_last;
     if (c || remove) continue;
     for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
+      if (max_edge > 0 && longest_edge_length(piece) > max_edge) continue;  // a cap over the shard bound
       kept.push_back(std::move(piece));
       kept_compact.push_back(0);
     }
@@ -237,23 +239,68 @@ void count_mapping(const SurfaceQuilt& quilt, const QuiltVertexMapping& vm, Embe
   }
 }
 
+/// The shard bound held on the embedded elements (EmbedSurfaceQuiltOptions::
+/// max_edge): triangles with a longer edge are cut out of threads (with one
+/// ring, the pieces capped; a piece whose cap is over the bound too is left
+/// out) and compact elements with one are removed.
+/// `compact` follows `els`; `out` is rebuilt if anything changed.
+void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::vector<ElementMesh>& els, Mesh& out,
+                            EmbedSurfaceQuiltResult& res) {
+  if (!(max_edge > 0)) return;
+  const double lim2 = max_edge * max_edge;
+  std::vector<std::vector<char>> bad(els.size());  // per element: its triangles with a longer edge (empty: none)
+  bool changed = false;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const ElementMesh& m = els[e];
+    for (std::size_t t = 0; t < m.tris.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const P3 &a = m.points[static_cast<std::size_t>(m.tris[t][k])], &b = m.points[static_cast<std::size_t>(m.tris[t][(k + 1) % 3])];
+        if ((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]) <= lim2) continue;
+        if (bad[e].empty()) bad[e].assign(m.tris.size(), 0);
+        bad[e][t] = 1;
+        changed = true;
+        break;
+      }
+  }
+  if (!changed) return;
+  std::vector<ElementMesh> kept;
+  std::vector<char> kept_compact;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const bool c = e < compact.size() && compact[e];
+    if (bad[e].empty()) {
+      kept.push_back(std::move(els[e]));
+      kept_compact.push_back(c);
+      continue;
+    }
+    ++res.elements_stretched_embedded;
+    if (c) continue;
+    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
+      if (longest_edge_length(piece) > max_edge) continue;  // its cap is over the bound too
+      kept.push_back(std::move(piece));
+      kept_compact.push_back(0);
+    }
+  }
+  els.swap(kept);
+  compact.swap(kept_compact);
+  mesh_from_elements(els, out);
+}
+
 /// Resolution rounds when asked (a cut piece's cap may meet another element),
 /// each reusing the exact check that the count reports; what still crosses
 /// after opt.crossing_trim_rounds is removed whole (removing adds no crossing, so none is
 /// left); then the self-intersecting face pairs counted, within and between
 /// elements.
-void resolve_and_count_crossings(const SurfaceQuilt& quilt, const EmbedSurfaceQuiltOptions& opt,
+void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQuiltOptions& opt,
                                  std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<FacePair> pairs;
   bool checked = false;
   if (opt.resolve_crossings) {
-    std::vector<char> compact = quilt.element_compact;
     const int trim_rounds = opt.crossing_trim_rounds;
     for (int round = 0; round <= trim_rounds; ++round) {
       pairs = self_intersecting_faces(out);
       checked = true;
       if (pairs.empty()) break;
-      resolve_embedded_crossings(pairs, compact, round == trim_rounds, els, out, res);
+      resolve_embedded_crossings(pairs, compact, round == trim_rounds, opt.max_edge, els, out, res);
       checked = false;
     }
   }
@@ -279,6 +326,8 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
                                             const EmbedSurfaceQuiltOptions& opt) {
   if (!(opt.shell_height > 0) || !std::isfinite(opt.shell_height))
     throw InvalidInputError("embed_surface_quilt: shell_height must be > 0 (" + std::to_string(opt.shell_height) + ")");
+  if (!(opt.max_edge >= 0) || !std::isfinite(opt.max_edge))
+    throw InvalidInputError("embed_surface_quilt: max_edge must be >= 0 (" + std::to_string(opt.max_edge) + ")");
   if (opt.crossing_trim_rounds < 0 || opt.crossing_trim_rounds > 8)
     throw InvalidInputError("embed_surface_quilt: crossing_trim_rounds must be in 0..8 (" +
                             std::to_string(opt.crossing_trim_rounds) + ")");
@@ -313,7 +362,9 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     res.outside_shell_measured = true;
   }
   count_mapping(quilt, vm, res);
-  resolve_and_count_crossings(quilt, opt, els, out, res);
+  std::vector<char> compact = quilt.element_compact;
+  remove_embedded_shards(opt.max_edge, compact, els, out, res);
+  resolve_and_count_crossings(compact, opt, els, out, res);
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);
   return res;

@@ -52,6 +52,14 @@ struct EmbedSurfaceQuiltOptions {
   bool resolve_crossings = true;
   /// Rounds that cut and cap crossing threads before the removal; 0..8, default 3.
   int crossing_trim_rounds = 3;
+  /// The shard bound held again on the embedded elements, mesh units (0 =
+  /// none, the default): an element with a longer edge (the shell map
+  /// stretches what was within the bound lifted) is removed if compact, else
+  /// those triangles are cut out and the pieces capped, before the crossings
+  /// are resolved (whose cut pieces are held to it too). quilt_swatch_on_surface
+  /// sets SurfaceQuiltOptions::max_edge_stretch times the swatch's longest
+  /// edge, scaled.
+  double max_edge = 0;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
   OutsideShellOptions outside_shell;
@@ -81,6 +89,8 @@ struct EmbedSurfaceQuiltResult {
   std::size_t crossing_elements = 0;
   /// Of those, removed whole because they still crossed after the trimming rounds.
   std::size_t crossing_elements_removed_last = 0;
+  /// Elements with an embedded edge over max_edge, removed or cut.
+  std::size_t elements_stretched_embedded = 0;
   /// Embedded vertices outside the geometric shell (the union of the shell's
   /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;

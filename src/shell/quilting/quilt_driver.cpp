@@ -13,6 +13,7 @@
 #include "geometry/read_mesh.h"
 #include "geometry/timer.h"
 #include "shell/element_colors.h"
+#include "shell/element_mesh.h"
 #include "shell/swatch_generators.h"
 
 namespace surftex {
@@ -138,6 +139,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                             " (the swatch may be too large for the mesh: lower --scale)");
   EmbedSurfaceQuiltOptions eo = opt.embed;
   eo.stretch.seed = opt.seed;
+  if (eo.max_edge == 0) eo.max_edge = qo.max_edge_stretch * longest_edge_length(r.swatch.mesh) * r.local.scale;
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();
