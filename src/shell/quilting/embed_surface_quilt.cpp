@@ -22,6 +22,37 @@
 namespace surftex {
 
 namespace {
+// Rebuilds `els` (with `compact` and `out`) after some triangles were found
+// bad (bad[e] empty: none in element e): an element without any is kept;
+// one with some is removed if compact or `remove`, else cut there (one ring
+// more) and its pieces capped, a piece with an edge over max_edge (> 0) left
+// out. Returns how many elements were removed or cut.
+std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove, double max_edge,
+                          std::vector<char>& compact, std::vector<ElementMesh>& els, Mesh& out) {
+  std::vector<ElementMesh> kept;
+  std::vector<char> kept_compact;
+  std::size_t touched = 0;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const bool c = e < compact.size() && compact[e];
+    if (bad[e].empty()) {
+      kept.push_back(std::move(els[e]));
+      kept_compact.push_back(c);
+      continue;
+    }
+    ++touched;
+    if (c || remove) continue;
+    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
+      if (max_edge > 0 && longest_edge_length(piece) > max_edge) continue;  // a cap over the shard bound
+      kept.push_back(std::move(piece));
+      kept_compact.push_back(0);
+    }
+  }
+  els.swap(kept);
+  compact.swap(kept_compact);
+  mesh_from_elements(els, out);
+  return touched;
+}
+
 // EmbedSurfaceQuiltOptions::resolve_crossings: the face pairs of the embedded
 // mesh that intersect (exact); of two elements the later yields its faces,
 // an element crossing itself both; a compact element with such faces is
@@ -50,27 +81,9 @@ void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<
       mark(std::max(a, b), a > b ? p[0] : p[1]);
     }
   }
-  std::vector<ElementMesh> kept;
-  std::vector<char> kept_compact;
-  for (std::size_t e = 0; e < els.size(); ++e) {
-    const bool c = e < compact.size() && compact[e];
-    if (bad[e].empty()) {
-      kept.push_back(std::move(els[e]));
-      kept_compact.push_back(c);
-      continue;
-    }
-    ++res.crossing_elements;
-    if (remove) ++res.crossing_elements_removed_last;
-    if (c || remove) continue;
-    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
-      if (max_edge > 0 && longest_edge_length(piece) > max_edge) continue;  // a cap over the shard bound
-      kept.push_back(std::move(piece));
-      kept_compact.push_back(0);
-    }
-  }
-  els.swap(kept);
-  compact.swap(kept_compact);
-  mesh_from_elements(els, out);
+  const std::size_t n = cut_or_remove(bad, remove, max_edge, compact, els, out);
+  res.crossing_elements += n;
+  if (remove) res.crossing_elements_removed_last += n;
 }
 
 /// The shell space of Zhou et al. 2006 s.3.1 over the charted base mesh, of
@@ -262,27 +275,7 @@ void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::ve
         break;
       }
   }
-  if (!changed) return;
-  std::vector<ElementMesh> kept;
-  std::vector<char> kept_compact;
-  for (std::size_t e = 0; e < els.size(); ++e) {
-    const bool c = e < compact.size() && compact[e];
-    if (bad[e].empty()) {
-      kept.push_back(std::move(els[e]));
-      kept_compact.push_back(c);
-      continue;
-    }
-    ++res.elements_stretched_embedded;
-    if (c) continue;
-    for (ElementMesh& piece : trim_and_cap(els[e], bad[e], 1, std::max<std::size_t>(24, els[e].tris.size() / 10))) {
-      if (longest_edge_length(piece) > max_edge) continue;  // its cap is over the bound too
-      kept.push_back(std::move(piece));
-      kept_compact.push_back(0);
-    }
-  }
-  els.swap(kept);
-  compact.swap(kept_compact);
-  mesh_from_elements(els, out);
+  if (changed) res.elements_stretched_embedded += cut_or_remove(bad, false, max_edge, compact, els, out);
 }
 
 /// Resolution rounds when asked (a cut piece's cap may meet another element),
