@@ -1421,11 +1421,7 @@ void SurfaceQuilter::fit_z(Element& el) {
 // elements, whose pieces are capped (trim_element), and compact elements
 // with one removed (issue 17 item 2: their space is refilled, refill()).
 void SurfaceQuilter::settle_and_trim(std::size_t from) {
-  double max_edge = 0;
-  for (const Tri& t : swatch_.mesh.tris)
-    for (int k = 0; k < 3; ++k)
-      max_edge = std::max(max_edge, norm3(sub3(swatch_.mesh.points[static_cast<std::size_t>(t[k])],
-                                               swatch_.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])])));
+  const double max_edge = longest_edge_length(swatch_.mesh);
   const double bound = opt_.max_edge_stretch * max_edge * S_, cap_max = 2 * swatch_h_ * S_;
   stretch_bound2_ = opt_.max_edge_stretch > 0 ? bound * bound : 0.0;
   // (The pieces appended are checked in turn: a cap's edges, lifted along
@@ -1735,11 +1731,8 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
   out.z_min = lo;
   out.z_max = hi;
   // The longest element edge (lifted) over the swatch's longest edge, scaled.
-  double max_edge = 0, longest = 0;
-  for (const Tri& t : swatch_.mesh.tris)
-    for (int k = 0; k < 3; ++k)
-      max_edge = std::max(max_edge, norm3(sub3(swatch_.mesh.points[static_cast<std::size_t>(t[k])],
-                                               swatch_.mesh.points[static_cast<std::size_t>(t[(k + 1) % 3])])));
+  const double max_edge = longest_edge_length(swatch_.mesh);
+  double longest = 0;
   for (const Tri& t : out.tris)
     for (int k = 0; k < 3; ++k)
       longest = std::max(longest, norm3(sub3(lifted(out.vertices[static_cast<std::size_t>(t[k])]),
