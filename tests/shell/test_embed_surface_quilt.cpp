@@ -218,6 +218,23 @@ void add_tube(SurfaceQuilt& q, const Mesh& base, std::array<double, 2> a, std::a
   q.element_compact.push_back(0);
   ++q.elements;
 }
+
+// A 6 x 6 grid over the unit square and a quilt of one thread across it along x
+// (scale 0.2, z in [0, 1]).
+void tube_on_grid(Mesh& base, SurfaceQuilt& q) {
+  make_grid(base, 6, 6, 1.0, 1.0);
+  q.scale = 0.2;
+  q.z_min = 0;
+  q.z_max = 1;
+  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
+}
+
+EmbedSurfaceQuiltOptions quick_embedding() {
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 5;
+  eo.measure_outside_shell = false;
+  return eo;
+}
 }  // namespace
 
 // Issue 17 item 1: whatever still crosses after the embedding is resolved:
@@ -225,17 +242,11 @@ void add_tube(SurfaceQuilt& q, const Mesh& base, std::array<double, 2> a, std::a
 // crossing is left however many the cuts would need.
 TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
   Mesh base;
-  make_grid(base, 6, 6, 1.0, 1.0);
   SurfaceQuilt q;
-  q.scale = 0.2;
-  q.z_min = 0;
-  q.z_max = 1;
-  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
+  tube_on_grid(base, q);
   const std::size_t first_faces = q.tris.size();
   add_tube(q, base, {0.5, 0.1}, {0.5, 0.9}, 0.5, 0.06, 0.3);
-  EmbedSurfaceQuiltOptions eo;
-  eo.stretch.iterations = 5;
-  eo.measure_outside_shell = false;
+  EmbedSurfaceQuiltOptions eo = quick_embedding();
   eo.resolve_crossings = false;
   Mesh out;
   const EmbedSurfaceQuiltResult crossing = embed_surface_quilt(base, q, out, eo);
@@ -262,15 +273,9 @@ TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
 // a compact element goes whole; 0 leaves them.
 TEST(EmbedSurfaceQuilt, TheShardBoundHoldsOnTheEmbeddedElements) {
   Mesh base;
-  make_grid(base, 6, 6, 1.0, 1.0);
   SurfaceQuilt q;
-  q.scale = 0.2;
-  q.z_min = 0;
-  q.z_max = 1;
-  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
-  EmbedSurfaceQuiltOptions eo;
-  eo.stretch.iterations = 5;
-  eo.measure_outside_shell = false;
+  tube_on_grid(base, q);
+  EmbedSurfaceQuiltOptions eo = quick_embedding();
   Mesh out;
   const EmbedSurfaceQuiltResult whole = embed_surface_quilt(base, q, out, eo);
   EXPECT_EQ(whole.elements_stretched_embedded, 0u);
