@@ -18,15 +18,17 @@
 // Usage: bench_el_search [TEXTURE_DIR] [NAME,NAME,...|-] [threads]
 // One JSON line per texture, then a summary line (how many within 5%).
 // SURFTEX_BENCH_EL_ANN="K,D,EPS;K,D,EPS..." also runs these settings of
-// (ann_candidates, ann_pca_dims, ann_eps[, ann_stride]) (tuning; "settings" in
-// the lines; ann_stride defaults to the library's).
+// (ann_candidates, ann_pca_dims, ann_eps[, ann_stride[, ann_coherent_candidates]])
+// (tuning; "settings" in the lines; the last two default to the library's).
 // SURFTEX_BENCH_EL_REFERENCE=FILE takes the exhaustive figures from an
-// earlier run's output instead of recomputing them.
+// earlier run's output instead of recomputing them (the exhaustive search is
+// deterministic): per seed when that run had at least as many seeds, so the
+// approximate search over hundreds of seeds costs only its own runs.
 // SURFTEX_BENCH_EL_SEEDS=N (default 1) runs both searches with seeds 1..N and
 // compares their mean BDS (textures whose synthesis is bimodal, such as two
 // flat colours in stripes wider than the window, make one seed's ratio a coin
-// toss); the per-seed figures are printed as well. Not with a reference file.
-// With both, each setting's ratio is the mean over the same seeds too.
+// toss); the per-seed figures are printed as well. With both, each setting's
+// ratio is the mean over the same seeds too.
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
@@ -58,11 +60,11 @@ struct Run {
 };
 
 // One approximate-search setting (ann_candidates, ann_pca_dims, ann_eps,
-// ann_stride; stride 0 = the library's default).
+// ann_stride, ann_coherent_candidates; 0 = the library's default).
 struct AnnSetting {
   int candidates, dims;
   double eps;
-  int stride = 0;
+  int stride = 0, coherent = 0;
 };
 
 Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann = nullptr, std::uint64_t seed = 1) {
@@ -73,6 +75,7 @@ Run synthesize(const Image& ex, int size, ElSearch search, const AnnSetting* ann
     o.ann_pca_dims = ann->dims;
     o.ann_eps = ann->eps;
     if (ann->stride > 0) o.ann_stride = ann->stride;
+    if (ann->coherent > 0) o.ann_coherent_candidates = ann->coherent;
   }
   o.seed = seed;
   Run r;
@@ -106,8 +109,9 @@ int main(int argc, char** argv) {
   if (const char* t = std::getenv("SURFTEX_BENCH_EL_ANN")) {
     std::stringstream ss(t);
     for (std::string item; std::getline(ss, item, ';');) {
-      AnnSetting st{16, 10, 1.0, 0};
-      if (std::sscanf(item.c_str(), "%d,%d,%lf,%d", &st.candidates, &st.dims, &st.eps, &st.stride) >= 3)
+      AnnSetting st{16, 10, 1.0, 0, 0};
+      if (std::sscanf(item.c_str(), "%d,%d,%lf,%d,%d", &st.candidates, &st.dims, &st.eps, &st.stride,
+                      &st.coherent) >= 3)
         settings.push_back(st);
     }
   }
@@ -115,15 +119,25 @@ int main(int argc, char** argv) {
   // JSON lines (same size; the exhaustive search is deterministic).
   const char* seeds_env = std::getenv("SURFTEX_BENCH_EL_SEEDS");
   const int seeds = seeds_env && std::atoi(seeds_env) > 1 ? std::atoi(seeds_env) : 1;
-  std::map<std::string, std::pair<double, double>> reference;
-  if (const char* ref = seeds > 1 ? nullptr : std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
+  // Per texture: the exhaustive BDS of seeds 1..n and the CPU of all n.
+  struct Reference {
+    std::vector<double> bds;
+    double cpu = 0;
+  };
+  std::map<std::string, Reference> reference;
+  if (const char* ref = std::getenv("SURFTEX_BENCH_EL_REFERENCE")) {
     std::ifstream in(ref);
     for (std::string line; std::getline(in, line);) {
       if (line.empty() || line[0] != '{') continue;
       const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
       if (j.is_discarded() || !j.contains("texture") || j.value("output", 0) != size) continue;
-      reference[j["texture"].get<std::string>()] = {j["bds_exhaustive"].get<double>(),
-                                                    j["cpu_seconds"]["exhaustive"].get<double>()};
+      Reference r;
+      r.cpu = j["cpu_seconds"]["exhaustive"].get<double>();
+      if (j.contains("seeds"))
+        for (const auto& ps : j["seeds"]) r.bds.push_back(ps["exhaustive"].get<double>());
+      else
+        r.bds.push_back(j["bds_exhaustive"].get<double>());
+      if (static_cast<int>(r.bds.size()) >= seeds) reference[j["texture"].get<std::string>()] = r;
     }
   }
   std::vector<fs::path> files;
@@ -137,19 +151,24 @@ int main(int argc, char** argv) {
       const std::string name = f.stem().string();
       if (!only.empty() && std::find(only.begin(), only.end(), name) == only.end()) continue;
       const Image ex = read_image(f.string());
-      Run a;
-      if (reference.count(name)) {
-        a.bds = reference[name].first;
-        a.cpu = reference[name].second;
-      } else {
-        a = synthesize(ex, size, ElSearch::Exhaustive);
-      }
+      const auto ref = reference.find(name);
+      // The exhaustive run of seed sd, or its figure from the reference (its
+      // CPU: the reference's mean per seed).
+      auto exhaustive = [&](int sd) {
+        if (ref == reference.end())
+          return synthesize(ex, size, ElSearch::Exhaustive, nullptr, static_cast<std::uint64_t>(sd));
+        Run r;
+        r.bds = ref->second.bds[sd - 1];
+        r.cpu = ref->second.cpu / static_cast<double>(ref->second.bds.size());
+        return r;
+      };
+      Run a = exhaustive(1);
       Run b = synthesize(ex, size, ElSearch::Approximate);
       nlohmann::json per_seed = nlohmann::json::array();
       if (seeds > 1) {
         per_seed.push_back({{"seed", 1}, {"exhaustive", a.bds}, {"approximate", b.bds}});
         for (int sd = 2; sd <= seeds; ++sd) {
-          const Run a2 = synthesize(ex, size, ElSearch::Exhaustive, nullptr, static_cast<std::uint64_t>(sd));
+          const Run a2 = exhaustive(sd);
           const Run b2 = synthesize(ex, size, ElSearch::Approximate, nullptr, static_cast<std::uint64_t>(sd));
           per_seed.push_back({{"seed", sd}, {"exhaustive", a2.bds}, {"approximate", b2.bds}});
           a.bds += a2.bds, a.cpu += a2.cpu, a.wall += a2.wall;
@@ -165,7 +184,7 @@ int main(int argc, char** argv) {
           c.bds += c2.bds, c.cpu += c2.cpu;
         }
         c.bds /= seeds;
-        tried.push_back({{"ann", {st.candidates, st.dims, st.eps, st.stride}},
+        tried.push_back({{"ann", {st.candidates, st.dims, st.eps, st.stride, st.coherent}},
                          {"ratio", c.bds / std::max(a.bds, 1e-12)},
                          {"cpu_seconds", c.cpu}});
       }

@@ -101,9 +101,11 @@ struct ElOptions {
   /// good or better on the textures measured).
   int ann_coherent_candidates = 8;
   /// Approximate search: PCA coefficients of the first-pass neighbourhood,
-  /// 1..first_pass_window^2 * channels (clamped). Default 4 (the kd-tree
-  /// stays shallow; pass 1 re-ranks the hits exactly).
-  int ann_pca_dims = 4;
+  /// 1..first_pass_window^2 * channels (clamped); 0 = automatic
+  /// (el_ann_pca_dims: 4, so the kd-tree stays shallow and pass 1 re-ranks
+  /// the hits exactly; 6 for a 4-channel exemplar, whose alpha edges take
+  /// most of the variance). Default 0.
+  int ann_pca_dims = 0;
   /// Approximate search: (1 + eps)-approximate kd-tree distances, >= 0. Default 1.
   double ann_eps = 1.0;
   /// Approximate search: the kd-tree holds every ann_stride-th row and column,
@@ -206,5 +208,9 @@ std::shared_ptr<const ElPreparedExemplars> el_prepare_exemplars(const std::vecto
 
 /// The effective first-pass window for `opt` (resolves the 0 default).
 int el_first_pass_window(const ElOptions& opt);
+
+/// The PCA coefficients the approximate search keeps for exemplars of
+/// `channels` channels (resolves ElOptions::ann_pca_dims's 0 default).
+int el_ann_pca_dims(const ElOptions& opt, int channels);
 
 }  // namespace surftex
