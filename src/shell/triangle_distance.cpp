@@ -107,6 +107,7 @@ struct TriangleDistance::Impl {
   std::vector<std::array<P3, 2>> edges;  // per triangle in leaf order: b - a, c - a
   std::vector<triangle_distance_detail::Box> boxes;  // per triangle in leaf order
   std::vector<int> original;            // leaf order -> index into mesh.tris
+  std::vector<int> leaf;                // index into mesh.tris -> leaf order
   std::vector<triangle_distance_detail::Node> nodes;
 
   void build(int node, int first, int count, std::vector<P3>& centroid) {
@@ -160,6 +161,8 @@ TriangleDistance::TriangleDistance(const ElementMesh& m) : impl_(std::make_uniqu
   std::vector<std::array<P3, 3>> ordered(n);
   for (int i = 0; i < n; ++i) ordered[i] = impl_->tris[impl_->original[i]];
   impl_->tris = std::move(ordered);
+  impl_->leaf.resize(n);
+  for (int i = 0; i < n; ++i) impl_->leaf[impl_->original[i]] = i;
   impl_->edges.resize(n);
   impl_->boxes.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -178,7 +181,7 @@ double TriangleDistance::box_squared_distance(const P3& q) const {
   return impl_->nodes.empty() ? 0.0 : impl_->nodes[0].box.squared_distance(q);
 }
 
-TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
+TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
   Hit h;
   const Impl& I = *impl_;
   if (I.tris.empty()) return h;
@@ -202,6 +205,11 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q) const {
       h.point = x;
     }
   };
+  // The hint first: a near hit prunes the descent below. The winner is the
+  // least (distance, index) over all triangles, and no box holding it is
+  // ever pruned (its distance is at most the best), so the hint changes
+  // only how many boxes are opened.
+  if (hint >= 0 && hint < static_cast<int>(I.leaf.size())) try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
   // Each stack entry carries its box's squared distance, computed once when pushed.
   int stack[128];
   double stack_d[128];

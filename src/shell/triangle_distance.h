@@ -28,7 +28,11 @@ class TriangleDistance {
     P3 point{0, 0, 0};     ///< the closest point
     P3 bary{0, 0, 0};      ///< its barycentric coordinates in tri (alpha, beta, gamma)
   };
-  Hit closest(const P3& q) const;
+  /// The closest point of the triangles to q. `hint` (a triangle index, or
+  /// -1) is tried first: the previous hit of a query nearby bounds the search
+  /// from the start (a mesh's vertices in order, a pattern's neighbouring
+  /// shifts). The result does not depend on it.
+  Hit closest(const P3& q, int hint = -1) const;
   /// Squared distance from q to the bounding box of the triangles, a lower
   /// bound of closest(q).distance squared (0 for an empty mesh).
   double box_squared_distance(const P3& q) const;

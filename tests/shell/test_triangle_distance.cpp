@@ -140,3 +140,34 @@ TEST(TriangleDistance, NonFiniteQueryGivesNaN) {
   EXPECT_GE(h.tri, 0);
   EXPECT_LT(h.tri, static_cast<int>(s.mesh.tris.size()));
 }
+
+// The hint (the previous query's triangle) only orders the search: any hint,
+// far, near, out of range or at a tie, gives the hit of no hint, bit for bit.
+TEST(TriangleDistance, AHintNeverChangesTheHit) {
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  const TriangleDistance td(s.mesh);
+  const int n = static_cast<int>(s.mesh.tris.size());
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
+    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
+  };
+  int hint = -1;
+  for (int i = 0; i < 300; ++i) {
+    P3 q;
+    for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
+    const auto plain = td.closest(q);
+    EXPECT_TRUE(same(plain, td.closest(q, hint)));             // the previous hit, as the callers pass it
+    EXPECT_TRUE(same(plain, td.closest(q, (i * 7919) % n)));   // any triangle
+    EXPECT_TRUE(same(plain, td.closest(q, n + i)));            // out of range: ignored
+    hint = plain.tri;
+  }
+  // Ties: twenty copies of one triangle; hinting a later copy still reports the first.
+  ElementMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (int i = 0; i < 20; ++i) m.tris.push_back({0, 1, 2});
+  const TriangleDistance tie(m);
+  EXPECT_EQ(tie.closest({0.2, 0.2, 1.0}, 17).tri, 0);
+}

@@ -98,8 +98,9 @@ ElementCorrespondences find_element_correspondences(const std::vector<ElementMes
   }
   std::vector<TriangleDistance::Hit> hits(queries.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    int hint = -1;  // consecutive queries are neighbouring vertices (TriangleDistance::closest)
     for (std::size_t k = r.begin(); k < r.end(); ++k)
-      hits[k] = tree.closest(out[queries[k].oe].points[static_cast<std::size_t>(queries[k].v)]);
+      hint = (hits[k] = tree.closest(out[queries[k].oe].points[static_cast<std::size_t>(queries[k].v)], hint)).tri;
   });
   std::vector<VertexFacePair> pairs;
   for (std::size_t k = 0; k < queries.size(); ++k) {

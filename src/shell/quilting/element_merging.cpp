@@ -65,7 +65,12 @@ double auto_match(const ElementMesh& a, const ElementMesh& b, const MergeOptions
 double cut_cost(const ElementMesh& a, const ElementMesh& b, const std::vector<char>& keep) {
   TriangleDistance tb(b);
   std::vector<double> d(a.points.size());
-  for (std::size_t i = 0; i < a.points.size(); ++i) d[i] = tb.closest(a.points[i]).distance;
+  int hint = -1;  // (TriangleDistance::closest: the previous vertex's hit bounds the search)
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    const auto h = tb.closest(a.points[i], hint);
+    d[i] = h.distance;
+    hint = h.tri;
+  }
   double c = 0;
   for (const DualEdge& e : dual_edges(a))
     if (keep[e.t1] != keep[e.t2]) c += (1 + dist(a.points[e.vi], a.points[e.vj])) * (1 + d[e.vi] + d[e.vj]);
@@ -109,8 +114,9 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   for (std::size_t v = 0; v < a.points.size(); ++v) need[v] = need[v] || sink_rule[v];
   std::vector<TriangleDistance::Hit> hit(a.points.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.points.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    int hint = -1;
     for (std::size_t v = r.begin(); v < r.end(); ++v)
-      if (need[v]) hit[v] = tb.closest(a.points[v]);
+      if (need[v]) hint = (hit[v] = tb.closest(a.points[v], hint)).tri;
   });
   // B's faces farther from A's bounding box than `match` are not covered
   // (the closest point of A is farther still); a margin of 1e-9 relative
@@ -129,11 +135,16 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
   std::vector<char> b_in(b.tris.size());
   for (std::size_t g = 0; g < b.tris.size(); ++g) b_in[g] = !owns(side_b, region(centroid(b, b.tris[g])));  // not in B's own outside
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b.tris.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    int ha = -1, hb = -1;
     for (std::size_t g = r.begin(); g < r.end(); ++g) {
       const P3 c = centroid(b, b.tris[g]);
       if (ta.box_squared_distance(c) > far2) continue;
-      const auto q = ta.closest(c);
-      covered[g] = q.distance <= match && dist(tb.closest(q.point).point, c) <= round_trip;
+      const auto q = ta.closest(c, ha);
+      ha = q.tri;
+      if (!(q.distance <= match)) continue;
+      const auto back = tb.closest(q.point, hb);
+      hb = back.tri;
+      covered[g] = dist(back.point, c) <= round_trip;
     }
   });
   // Edge-neighbours of B's faces.
@@ -200,8 +211,10 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
     const double g = opt.guide_factor * std::max(wmax, 1.0);
     std::vector<TriangleDistance::Hit> ch(static_cast<std::size_t>(nt));
     tbb::parallel_for(tbb::blocked_range<int>(0, nt, 64), [&](const tbb::blocked_range<int>& r) {
+      int hint = -1;
       for (int t = r.begin(); t < r.end(); ++t)
-        if (!force_keep[t] && !force_del[t]) ch[static_cast<std::size_t>(t)] = tb.closest(centroid(a, a.tris[t]));
+        if (!force_keep[t] && !force_del[t])
+          hint = (ch[static_cast<std::size_t>(t)] = tb.closest(centroid(a, a.tris[t]), hint)).tri;
     });
     for (int t = 0; t < nt; ++t) {
       if (force_keep[t] || force_del[t]) continue;

@@ -306,8 +306,10 @@ QuiltMatch match_swatch_placement(const Swatch& swatch, const TriangleDistance& 
   // above the bound; the chosen candidates' costs are exact, the same bytes).
   auto match_cost = [&](const P3& t, double bound) {
     double e = 0;
+    int hint = -1;  // consecutive vertices are neighbours: the last hit bounds the next search
     for (std::size_t v = 0; v < mv.size(); ++v) {
-      const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]});
+      const auto h = swatch_tree.closest({mv[v][0] - t[0], mv[v][1] - t[1], mv[v][2] - t[2]}, hint);
+      hint = h.tri;
       const P3& nf = fn[h.tri];
       const double dn = std::sqrt((mn[v][0] - nf[0]) * (mn[v][0] - nf[0]) + (mn[v][1] - nf[1]) * (mn[v][1] - nf[1]) +
                                   (mn[v][2] - nf[2]) * (mn[v][2] - nf[2]));
