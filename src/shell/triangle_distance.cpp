@@ -14,6 +14,9 @@
 #include <numeric>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "geometry/vec3.h"
 
 namespace surftex {
@@ -26,6 +29,14 @@ struct Box {
         -std::numeric_limits<double>::infinity()};
   void add(const P3& p) {
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  double squared_distance(const Box& o) const {
+    double d = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double e = std::max({0.0, o.lo[k] - hi[k], lo[k] - o.hi[k]});
+      d += e * e;
+    }
+    return d;
   }
   double squared_distance(const P3& q) const {
     double d = 0;
@@ -109,6 +120,28 @@ struct TriangleDistance::Impl {
   std::vector<int> original;            // leaf order -> index into mesh.tris
   std::vector<int> leaf;                // index into mesh.tris -> leaf order
   std::vector<triangle_distance_detail::Node> nodes;
+  // build_cell_lists: cell (i, j, k) lists cell_items[cell_start[c] ..
+  // cell_start[c + 1]) (leaf-order triangles), c = (k * ny + j) * nx + i.
+  P3 grid_lo{0, 0, 0};
+  double grid_cell = 0;
+  int nx = 0, ny = 0, nz = 0;
+  std::vector<std::size_t> cell_start;
+  std::vector<int> cell_items;
+
+  /// The cell holding q, or -1 (outside the grid, no grid, not finite).
+  long long cell_of(const P3& q) const {
+    if (cell_start.empty()) return -1;
+    long long c[3];
+    const int n[3] = {nx, ny, nz};
+    for (int k = 0; k < 3; ++k) {
+      const double x = (q[k] - grid_lo[k]) / grid_cell;
+      if (!(x >= 0) || !(x < n[k])) return -1;
+      c[k] = static_cast<long long>(x);
+    }
+    return (c[2] * ny + c[1]) * nx + c[0];
+  }
+  /// Leaf-order triangles whose box is within sqrt(r2) of box b (tree walk).
+  void triangles_near(const triangle_distance_detail::Box& b, double r2, std::vector<int>& out) const;
 
   void build(int node, int first, int count, std::vector<P3>& centroid) {
     Box box, cbox;
@@ -171,6 +204,65 @@ TriangleDistance::TriangleDistance(const ElementMesh& m) : impl_(std::make_uniqu
     for (const P3& p : t) impl_->boxes[i].add(p);
   }
 }
+void TriangleDistance::Impl::triangles_near(const Box& b, double r2, std::vector<int>& out) const {
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& nd = nodes[stack[--top]];
+    if (nd.box.squared_distance(b) > r2) continue;
+    if (nd.count > 0) {
+      for (int i = nd.first; i < nd.first + nd.count; ++i)
+        if (boxes[i].squared_distance(b) <= r2) out.push_back(i);
+      continue;
+    }
+    stack[top++] = nd.first;
+    stack[top++] = nd.first + 1;
+  }
+  std::sort(out.begin(), out.end());
+}
+
+// A point p of a cell is at most |p - centre| <= half its diagonal from the
+// centre, so its closest triangle is within U = d(centre) + half diagonal of
+// p, and that triangle's box within U of the cell's box: the list holds it,
+// and every triangle tying with it (a slack of 1e-9 covers rounding).
+void TriangleDistance::build_cell_lists(double cell, std::size_t max_cells) {
+  Impl& I = *impl_;
+  if (I.tris.empty() || !(cell > 0) || !std::isfinite(cell)) return;
+  const Box& all = I.nodes[0].box;
+  auto count_for = [&](double h, int n[3]) {
+    std::size_t total = 1;
+    for (int k = 0; k < 3; ++k) {
+      n[k] = static_cast<int>(std::ceil((all.hi[k] - all.lo[k]) / h)) + 4;  // two cells of margin each side
+      total *= static_cast<std::size_t>(n[k]);
+    }
+    return total;
+  };
+  int n[3];
+  while (count_for(cell, n) > max_cells) cell *= 1.25;
+  I.grid_cell = cell;
+  for (int k = 0; k < 3; ++k) I.grid_lo[k] = all.lo[k] - 2 * cell;
+  I.nx = n[0], I.ny = n[1], I.nz = n[2];
+  const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
+  std::vector<std::vector<int>> lists(cells);
+  const double half_diag = 0.5 * std::sqrt(3.0) * cell;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c < r.end(); ++c) {
+      const std::size_t i = c % n[0], j = (c / n[0]) % n[1], k = c / (static_cast<std::size_t>(n[0]) * n[1]);
+      Box b;
+      b.lo = {I.grid_lo[0] + i * cell, I.grid_lo[1] + j * cell, I.grid_lo[2] + k * cell};
+      b.hi = {b.lo[0] + cell, b.lo[1] + cell, b.lo[2] + cell};
+      const P3 centre{b.lo[0] + 0.5 * cell, b.lo[1] + 0.5 * cell, b.lo[2] + 0.5 * cell};
+      const double u = (closest(centre).distance + half_diag) * (1 + 1e-9) + 1e-12 * cell;
+      I.triangles_near(b, u * u, lists[c]);
+    }
+  });
+  I.cell_start.assign(cells + 1, 0);
+  for (std::size_t c = 0; c < cells; ++c) I.cell_start[c + 1] = I.cell_start[c] + lists[c].size();
+  I.cell_items.resize(I.cell_start[cells]);
+  for (std::size_t c = 0; c < cells; ++c) std::copy(lists[c].begin(), lists[c].end(), I.cell_items.begin() + I.cell_start[c]);
+}
+
 TriangleDistance::~TriangleDistance() = default;
 TriangleDistance::TriangleDistance(TriangleDistance&&) noexcept = default;
 TriangleDistance& TriangleDistance::operator=(TriangleDistance&&) noexcept = default;
@@ -205,6 +297,13 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
       h.point = x;
     }
   };
+  if (const long long c = I.cell_of(q); c >= 0) {  // the cell's list holds the winner and its ties
+    for (std::size_t k = I.cell_start[c]; k < I.cell_start[c + 1]; ++k) try_triangle(I.cell_items[k]);
+    h.tri = I.original[best_i];
+    h.distance = std::sqrt(best);
+    h.bary = best_bary;
+    return h;
+  }
   // The hint first: a near hit prunes the descent below. The winner is the
   // least (distance, index) over all triangles, and no box holding it is
   // ever pruned (its distance is at most the best), so the hint changes

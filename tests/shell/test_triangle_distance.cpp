@@ -171,3 +171,44 @@ TEST(TriangleDistance, AHintNeverChangesTheHit) {
   const TriangleDistance tie(m);
   EXPECT_EQ(tie.closest({0.2, 0.2, 1.0}, 17).tri, 0);
 }
+
+// Cell lists (build_cell_lists) answer queries inside their grid from a list:
+// the same hits as the tree walk, bit for bit, inside, at the margin and
+// outside the grid, on a swatch and on soups with degenerate triangles.
+TEST(TriangleDistance, CellListsGiveTheTreesHits) {
+  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
+    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
+  };
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  const TriangleDistance tree(s.mesh);
+  TriangleDistance cells(s.mesh);
+  cells.build_cell_lists(s.mean_edge_length);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  int differ = 0;
+  for (int i = 0; i < 2000; ++i) {
+    P3 q;
+    for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
+    differ += !same(tree.closest(q), cells.closest(q));
+  }
+  for (const P3& p : s.mesh.points) differ += !same(tree.closest(p), cells.closest(p));  // on the surface: ties
+  EXPECT_EQ(differ, 0);
+  std::normal_distribution<double> g(0, 1);
+  ElementMesh m;
+  for (int t = 0; t < 300; ++t) {
+    const int base = static_cast<int>(m.points.size());
+    const P3 c{g(rng), g(rng), g(rng)};
+    for (int k = 0; k < 3; ++k) m.points.push_back({c[0] + 0.2 * g(rng), c[1] + 0.2 * g(rng), c[2] + 0.2 * g(rng)});
+    if (t % 10 == 0) m.points[base + 2] = m.points[base + 1];  // degenerate
+    m.tris.push_back({base, base + 1, base + 2});
+  }
+  std::vector<P3> q;
+  for (int i = 0; i < 2000; ++i) q.push_back({2 * g(rng), 2 * g(rng), 2 * g(rng)});
+  TriangleDistance soup(m);
+  soup.build_cell_lists(0.1, 4096);  // coarser than asked: the cell grows to fit 4096 cells
+  const TriangleDistance soup_tree(m);
+  for (const P3& p : q) differ += !same(soup_tree.closest(p), soup.closest(p));
+  EXPECT_EQ(differ, 0);
+}

@@ -623,6 +623,9 @@ class SurfaceQuilter {
 SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const SurfaceQuiltOptions& opt)
     : mesh_(mesh), swatch_(swatch), opt_(opt), b_(make_base(mesh)), tree_(swatch.mesh), rng_(opt.seed), growth_(mesh) {
   check_options(opt);
+  // The matching (2.4) asks the swatch's closest points for every vertex of
+  // every candidate placement: cell lists answer most without a tree walk.
+  tree_.build_cell_lists(0.5 * swatch.mean_edge_length, std::size_t(1) << 19);
   nf_ = static_cast<int>(b_.faces.size());
   S_ = surface_quilt_scale(mesh, swatch, opt.relative_size);  // relative_size > 0 (check_options)
   if (!(S_ > 0)) throw InvalidInputError("quilt_surface: the base mesh has a zero-size bounding box");
