@@ -14,6 +14,7 @@
 //         TopologyError (mesh_from_elements: a face Surface_mesh refuses).
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "geometry/mesh_fwd.h"
@@ -70,5 +71,11 @@ ElementMesh element_mesh_from(const Mesh& mesh);
 /// Throws TopologyError naming the element if Surface_mesh refuses a face
 /// (non-manifold vertex or edge).
 void mesh_from_elements(const std::vector<ElementMesh>& elements, Mesh& out);
+/// The faces (indices in mesh_from_elements's order) of the elements marked
+/// in `changed` and of every element whose bounding box meets a marked one's:
+/// all a crossing check must test again when only the marked ones changed
+/// since a check that found no pair among the others.
+std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<ElementMesh>& elements,
+                                                       const std::vector<char>& changed);
 
 }  // namespace surftex

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "geometry/mesh.h"
+#include "geometry/errors.h"
 #include "geometry/self_intersections.h"
 
 namespace surftex {
@@ -198,3 +199,36 @@ TEST(ExactPredicates, SelfIntersectionOfFacesSharingOnlyAVertex) {
 
 }  // namespace
 }  // namespace surftex
+
+// The face-subset check (a recheck after part of a mesh changed) reports
+// exactly the pairs of the whole check with both faces in the subset, and
+// refuses a face the mesh does not have.
+TEST(ExactPredicates, SelfIntersectionsAmongASubsetOfFaces) {
+  Mesh m;
+  std::uint64_t h = 12345;
+  auto rnd = [&] {
+    h = h * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(h >> 11) / static_cast<double>(1ull << 53);
+  };
+  for (int t = 0; t < 200; ++t) {  // a soup of random triangles in the unit cube: many crossings
+    const Point3 c(rnd(), rnd(), rnd());
+    VertexIndex v[3];
+    for (auto& x : v) x = m.add_vertex(Point3(c.x() + 0.2 * (rnd() - 0.5), c.y() + 0.2 * (rnd() - 0.5), c.z() + 0.2 * (rnd() - 0.5)));
+    m.add_face(v[0], v[1], v[2]);
+  }
+  const std::vector<FacePair> all = self_intersecting_faces(m);
+  ASSERT_GT(all.size(), 20u);
+  std::vector<std::uint32_t> subset, every;
+  for (std::uint32_t f = 0; f < m.number_of_faces(); ++f) {
+    every.push_back(f);
+    if (f % 3 != 0) subset.push_back(f);
+  }
+  EXPECT_EQ(self_intersecting_faces(m, every), all);
+  std::vector<FacePair> expected;
+  for (const FacePair& p : all)
+    if (p[0] % 3 != 0 && p[1] % 3 != 0) expected.push_back(p);
+  ASSERT_LT(expected.size(), all.size());
+  EXPECT_EQ(self_intersecting_faces(m, subset), expected);
+  EXPECT_TRUE(self_intersecting_faces(m, std::vector<std::uint32_t>{}).empty());
+  EXPECT_THROW(self_intersecting_faces(m, std::vector<std::uint32_t>{999}), InvalidInputError);
+}

@@ -26,17 +26,20 @@ namespace {
 // bad (bad[e] empty: none in element e): an element without any is kept;
 // one with some is removed if compact or `remove`, else cut there (one ring
 // more) and its pieces capped, a piece with an edge over max_edge (> 0) left
-// out. Returns how many elements were removed or cut.
+// out. Returns how many elements were removed or cut. `fresh` (if given)
+// becomes, per element after, 1 for a cut piece and 0 for one kept as it was.
 std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove, double max_edge,
-                          std::vector<char>& compact, std::vector<ElementMesh>& els, Mesh& out) {
+                          std::vector<char>& compact, std::vector<ElementMesh>& els, Mesh& out,
+                          std::vector<char>* fresh = nullptr) {
   std::vector<ElementMesh> kept;
-  std::vector<char> kept_compact;
+  std::vector<char> kept_compact, kept_fresh;
   std::size_t touched = 0;
   for (std::size_t e = 0; e < els.size(); ++e) {
     const bool c = e < compact.size() && compact[e];
     if (bad[e].empty()) {
       kept.push_back(std::move(els[e]));
       kept_compact.push_back(c);
+      kept_fresh.push_back(0);
       continue;
     }
     ++touched;
@@ -45,10 +48,12 @@ std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove
       if (max_edge > 0 && longest_edge_length(piece) > max_edge) continue;  // a cap over the shard bound
       kept.push_back(std::move(piece));
       kept_compact.push_back(0);
+      kept_fresh.push_back(1);
     }
   }
   els.swap(kept);
   compact.swap(kept_compact);
+  if (fresh) fresh->swap(kept_fresh);
   mesh_from_elements(els, out);
   return touched;
 }
@@ -61,7 +66,8 @@ std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove
 // `remove`, every element with such faces is removed.
 // `out` is rebuilt.
 void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact, bool remove,
-                                double max_edge, std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+                                double max_edge, std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res,
+                                std::vector<char>& fresh) {
   std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
   for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
   auto element_of = [&](std::uint32_t f) {
@@ -81,7 +87,7 @@ void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<
       mark(std::max(a, b), a > b ? p[0] : p[1]);
     }
   }
-  const std::size_t n = cut_or_remove(bad, remove, max_edge, compact, els, out);
+  const std::size_t n = cut_or_remove(bad, remove, max_edge, compact, els, out, &fresh);
   res.crossing_elements += n;
   if (remove) res.crossing_elements_removed_last += n;
 }
@@ -287,18 +293,24 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
                                  std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<FacePair> pairs;
   bool checked = false;
+  // After a resolution round: its cut pieces. Every pair of the round's check
+  // changed an element it met, so two elements kept as they were cannot cross
+  // (nor one itself): the next check needs only the pieces and what they may
+  // touch (faces_near_changed_elements), and finds every pair a whole one would.
+  std::vector<char> fresh;
   if (opt.resolve_crossings) {
     const int trim_rounds = opt.crossing_trim_rounds;
     for (int round = 0; round <= trim_rounds; ++round) {
-      pairs = self_intersecting_faces(out);
+      pairs = round == 0 ? self_intersecting_faces(out) : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
       checked = true;
       if (pairs.empty()) break;
-      resolve_embedded_crossings(pairs, compact, round == trim_rounds, opt.max_edge, els, out, res);
+      resolve_embedded_crossings(pairs, compact, round == trim_rounds, opt.max_edge, els, out, res, fresh);
       checked = false;
     }
   }
   if (opt.check_self_intersections) {
-    if (!checked) pairs = self_intersecting_faces(out);
+    if (!checked)  // after the last round (which removes, so nothing is fresh), or with no resolution
+      pairs = fresh.empty() ? self_intersecting_faces(out) : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
     auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
     for (const FacePair& fp : pairs) {
       if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])
