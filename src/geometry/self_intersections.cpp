@@ -23,7 +23,8 @@ void check_triangles(const Mesh& mesh) {
 }
 
 template <class FaceRange>
-std::vector<FacePair> sorted_pairs(const FaceRange& faces, const Mesh& mesh, const SelfIntersectionOptions& opt) {
+std::vector<FacePair> sorted_pairs(const FaceRange& faces, const Mesh& mesh,
+                                   const SelfIntersectionOptions& opt) {
   std::vector<std::pair<FaceIndex, FaceIndex>> raw;
 #if defined(CGAL_LINKED_WITH_TBB)
   if (opt.parallel)

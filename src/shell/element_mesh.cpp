@@ -275,7 +275,8 @@ void mesh_from_elements(const std::vector<ElementMesh>& elements, Mesh& out) {
   }
 }
 
-std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<ElementMesh>& els, const std::vector<char>& fresh) {
+std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<ElementMesh>& els,
+                                                       const std::vector<char>& fresh) {
   struct Box3 {
     P3 lo, hi;
   };
@@ -283,7 +284,8 @@ std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<Element
   for (std::size_t e = 0; e < els.size(); ++e) {
     box[e] = {{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
     for (const P3& p : els[e].points)
-      for (int k = 0; k < 3; ++k) box[e].lo[k] = std::min(box[e].lo[k], p[k]), box[e].hi[k] = std::max(box[e].hi[k], p[k]);
+      for (int k = 0; k < 3; ++k)
+        box[e].lo[k] = std::min(box[e].lo[k], p[k]), box[e].hi[k] = std::max(box[e].hi[k], p[k]);
   }
   auto meet = [&](std::size_t a, std::size_t b) {
     for (int k = 0; k < 3; ++k)
@@ -300,7 +302,8 @@ std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<Element
   std::uint32_t first = 0;
   for (std::size_t e = 0; e < els.size(); ++e) {
     if (take[e])
-      for (std::size_t t = 0; t < els[e].tris.size(); ++t) faces.push_back(first + static_cast<std::uint32_t>(t));
+      for (std::size_t t = 0; t < els[e].tris.size(); ++t)
+        faces.push_back(first + static_cast<std::uint32_t>(t));
     first += static_cast<std::uint32_t>(els[e].tris.size());
   }
   return faces;

@@ -246,21 +246,23 @@ void TriangleDistance::build_cell_lists(double cell, std::size_t max_cells) {
   const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
   std::vector<std::vector<int>> lists(cells);
   const double half_diag = 0.5 * std::sqrt(3.0) * cell;
+  auto fill = [&](std::size_t c) {
+    const std::size_t i = c % n[0], j = (c / n[0]) % n[1], k = c / (static_cast<std::size_t>(n[0]) * n[1]);
+    Box b;
+    b.lo = {I.grid_lo[0] + i * cell, I.grid_lo[1] + j * cell, I.grid_lo[2] + k * cell};
+    b.hi = {b.lo[0] + cell, b.lo[1] + cell, b.lo[2] + cell};
+    const P3 centre{b.lo[0] + 0.5 * cell, b.lo[1] + 0.5 * cell, b.lo[2] + 0.5 * cell};
+    const double u = (closest(centre).distance + half_diag) * (1 + 1e-9) + 1e-12 * cell;
+    I.triangles_near(b, u * u, lists[c]);
+  };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c < r.end(); ++c) {
-      const std::size_t i = c % n[0], j = (c / n[0]) % n[1], k = c / (static_cast<std::size_t>(n[0]) * n[1]);
-      Box b;
-      b.lo = {I.grid_lo[0] + i * cell, I.grid_lo[1] + j * cell, I.grid_lo[2] + k * cell};
-      b.hi = {b.lo[0] + cell, b.lo[1] + cell, b.lo[2] + cell};
-      const P3 centre{b.lo[0] + 0.5 * cell, b.lo[1] + 0.5 * cell, b.lo[2] + 0.5 * cell};
-      const double u = (closest(centre).distance + half_diag) * (1 + 1e-9) + 1e-12 * cell;
-      I.triangles_near(b, u * u, lists[c]);
-    }
+    for (std::size_t c = r.begin(); c < r.end(); ++c) fill(c);
   });
   I.cell_start.assign(cells + 1, 0);
   for (std::size_t c = 0; c < cells; ++c) I.cell_start[c + 1] = I.cell_start[c] + lists[c].size();
   I.cell_items.resize(I.cell_start[cells]);
-  for (std::size_t c = 0; c < cells; ++c) std::copy(lists[c].begin(), lists[c].end(), I.cell_items.begin() + I.cell_start[c]);
+  for (std::size_t c = 0; c < cells; ++c)
+    std::copy(lists[c].begin(), lists[c].end(), I.cell_items.begin() + I.cell_start[c]);
 }
 
 TriangleDistance::~TriangleDistance() = default;
@@ -308,7 +310,8 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
   // least (distance, index) over all triangles, and no box holding it is
   // ever pruned (its distance is at most the best), so the hint changes
   // only how many boxes are opened.
-  if (hint >= 0 && hint < static_cast<int>(I.leaf.size())) try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
+  if (hint >= 0 && hint < static_cast<int>(I.leaf.size()))
+    try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
   // Each stack entry carries its box's squared distance, computed once when pushed.
   int stack[128];
   double stack_d[128];

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "geometry/mesh.h"
 #include "geometry/errors.h"
+#include "geometry/mesh.h"
 #include "geometry/self_intersections.h"
 
 namespace surftex {
@@ -213,7 +213,9 @@ TEST(ExactPredicates, SelfIntersectionsAmongASubsetOfFaces) {
   for (int t = 0; t < 200; ++t) {  // a soup of random triangles in the unit cube: many crossings
     const Point3 c(rnd(), rnd(), rnd());
     VertexIndex v[3];
-    for (auto& x : v) x = m.add_vertex(Point3(c.x() + 0.2 * (rnd() - 0.5), c.y() + 0.2 * (rnd() - 0.5), c.z() + 0.2 * (rnd() - 0.5)));
+    for (auto& x : v)
+      x = m.add_vertex(
+          Point3(c.x() + 0.2 * (rnd() - 0.5), c.y() + 0.2 * (rnd() - 0.5), c.z() + 0.2 * (rnd() - 0.5)));
     m.add_face(v[0], v[1], v[2]);
   }
   const std::vector<FacePair> all = self_intersecting_faces(m);

@@ -159,9 +159,9 @@ TEST(TriangleDistance, AHintNeverChangesTheHit) {
     P3 q;
     for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
     const auto plain = td.closest(q);
-    EXPECT_TRUE(same(plain, td.closest(q, hint)));             // the previous hit, as the callers pass it
-    EXPECT_TRUE(same(plain, td.closest(q, (i * 7919) % n)));   // any triangle
-    EXPECT_TRUE(same(plain, td.closest(q, n + i)));            // out of range: ignored
+    EXPECT_TRUE(same(plain, td.closest(q, hint)));            // the previous hit, as the callers pass it
+    EXPECT_TRUE(same(plain, td.closest(q, (i * 7919) % n)));  // any triangle
+    EXPECT_TRUE(same(plain, td.closest(q, n + i)));           // out of range: ignored
     hint = plain.tri;
   }
   // Ties: twenty copies of one triangle; hinting a later copy still reports the first.
@@ -193,14 +193,16 @@ TEST(TriangleDistance, CellListsGiveTheTreesHits) {
     for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
     differ += !same(tree.closest(q), cells.closest(q));
   }
-  for (const P3& p : s.mesh.points) differ += !same(tree.closest(p), cells.closest(p));  // on the surface: ties
+  for (const P3& p : s.mesh.points)
+    differ += !same(tree.closest(p), cells.closest(p));  // on the surface: ties
   EXPECT_EQ(differ, 0);
   std::normal_distribution<double> g(0, 1);
   ElementMesh m;
   for (int t = 0; t < 300; ++t) {
     const int base = static_cast<int>(m.points.size());
     const P3 c{g(rng), g(rng), g(rng)};
-    for (int k = 0; k < 3; ++k) m.points.push_back({c[0] + 0.2 * g(rng), c[1] + 0.2 * g(rng), c[2] + 0.2 * g(rng)});
+    for (int k = 0; k < 3; ++k)
+      m.points.push_back({c[0] + 0.2 * g(rng), c[1] + 0.2 * g(rng), c[2] + 0.2 * g(rng)});
     if (t % 10 == 0) m.points[base + 2] = m.points[base + 1];  // degenerate
     m.tris.push_back({base, base + 1, base + 2});
   }

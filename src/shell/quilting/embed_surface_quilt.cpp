@@ -66,8 +66,8 @@ std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove
 // `remove`, every element with such faces is removed.
 // `out` is rebuilt.
 void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact, bool remove,
-                                double max_edge, std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res,
-                                std::vector<char>& fresh) {
+                                double max_edge, std::vector<ElementMesh>& els, Mesh& out,
+                                EmbedSurfaceQuiltResult& res, std::vector<char>& fresh) {
   std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
   for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
   auto element_of = [&](std::uint32_t f) {
@@ -301,7 +301,8 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
   if (opt.resolve_crossings) {
     const int trim_rounds = opt.crossing_trim_rounds;
     for (int round = 0; round <= trim_rounds; ++round) {
-      pairs = round == 0 ? self_intersecting_faces(out) : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
+      pairs = round == 0 ? self_intersecting_faces(out)
+                         : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
       checked = true;
       if (pairs.empty()) break;
       resolve_embedded_crossings(pairs, compact, round == trim_rounds, opt.max_edge, els, out, res, fresh);
@@ -310,7 +311,8 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
   }
   if (opt.check_self_intersections) {
     if (!checked)  // after the last round (which removes, so nothing is fresh), or with no resolution
-      pairs = fresh.empty() ? self_intersecting_faces(out) : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
+      pairs = fresh.empty() ? self_intersecting_faces(out)
+                            : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
     auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
     for (const FacePair& fp : pairs) {
       if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])
