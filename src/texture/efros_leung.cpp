@@ -1406,9 +1406,8 @@ int el_first_pass_window(const ElOptions& opt) {
 }
 
 // An alpha channel's 0/1 edges hold most of a 4-channel window's variance:
-// with 4 coefficients the kd-tree matched the holes' layout and little of
-// the colour (cane_weave_rgba_128 over 400 seeds: BDS 1.091x the exhaustive
-// search's with 4, 1.033x with 6, 1.046x with 8; decision 501, session 31).
+// with 4 coefficients the kd-tree matches the holes' layout and little of
+// the colour, so such an exemplar keeps 6 (decision 501, session 31).
 int el_ann_pca_dims(const ElOptions& opt, int channels) {
   if (opt.ann_pca_dims > 0) return opt.ann_pca_dims;
   return channels == 4 ? 6 : 4;

@@ -403,9 +403,8 @@ TEST(EfrosLeung, PreparedExemplarsGiveTheSameBytesAndMustMatchTheOptions) {
   EXPECT_THROW(el_prepare_exemplars({Image(5, 5, 3)}, opt), InvalidInputError);  // < window
 }
 
-// Decision 501, session 31: an alpha channel's 0/1 edges took most of the 4
-// coefficients (cane_weave_rgba_128: 1.091x the exhaustive search's BDS over
-// 400 seeds, 1.033x with 6), so a 4-channel exemplar's index keeps 6.
+// Decision 501, session 31: an alpha channel's 0/1 edges take most of 4
+// coefficients, so a 4-channel exemplar's index keeps 6.
 TEST(EfrosLeung, AnExemplarWithAlphaKeepsMorePcaCoefficients) {
   ElOptions opt;
   EXPECT_EQ(4, el_ann_pca_dims(opt, 1));
