@@ -299,43 +299,42 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
       h.point = x;
     }
   };
+  // Each stack entry carries its box's squared distance, computed once when pushed.
+  auto walk_tree = [&] {
+    int stack[128];
+    double stack_d[128];
+    int top = 0;
+    stack[top] = 0;
+    stack_d[top++] = I.nodes[0].box.squared_distance(q);
+    while (top > 0) {
+      --top;
+      if (stack_d[top] > best) continue;  // (equal: a tie may still win, see below)
+      const Node& nd = I.nodes[stack[top]];
+      if (nd.count > 0) {
+        for (int i = nd.first; i < nd.first + nd.count; ++i) try_triangle(i);
+        continue;
+      }
+      const int l = nd.first, r = nd.first + 1;
+      const double dl = I.nodes[l].box.squared_distance(q), dr = I.nodes[r].box.squared_distance(q);
+      // Nearer child on top of the stack (visited first); the depth is below 2 log2(n) + 2.
+      if (dl <= dr) {
+        stack[top] = r, stack_d[top++] = dr;
+        stack[top] = l, stack_d[top++] = dl;
+      } else {
+        stack[top] = l, stack_d[top++] = dl;
+        stack[top] = r, stack_d[top++] = dr;
+      }
+    }
+  };
   if (const long long c = I.cell_of(q); c >= 0) {  // the cell's list holds the winner and its ties
     for (std::size_t k = I.cell_start[c]; k < I.cell_start[c + 1]; ++k) try_triangle(I.cell_items[k]);
-    h.tri = I.original[best_i];
-    h.distance = std::sqrt(best);
-    h.bary = best_bary;
-    return h;
-  }
-  // The hint first: a near hit prunes the descent below. The winner is the
-  // least (distance, index) over all triangles, and no box holding it is
-  // ever pruned (its distance is at most the best), so the hint changes
-  // only how many boxes are opened.
-  if (hint >= 0 && hint < static_cast<int>(I.leaf.size()))
-    try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
-  // Each stack entry carries its box's squared distance, computed once when pushed.
-  int stack[128];
-  double stack_d[128];
-  int top = 0;
-  stack[top] = 0;
-  stack_d[top++] = I.nodes[0].box.squared_distance(q);
-  while (top > 0) {
-    --top;
-    if (stack_d[top] > best) continue;  // (equal: a tie may still win, see below)
-    const Node& nd = I.nodes[stack[top]];
-    if (nd.count > 0) {
-      for (int i = nd.first; i < nd.first + nd.count; ++i) try_triangle(i);
-      continue;
-    }
-    const int l = nd.first, r = nd.first + 1;
-    const double dl = I.nodes[l].box.squared_distance(q), dr = I.nodes[r].box.squared_distance(q);
-    // Nearer child on top of the stack (visited first); the depth is below 2 log2(n) + 2.
-    if (dl <= dr) {
-      stack[top] = r, stack_d[top++] = dr;
-      stack[top] = l, stack_d[top++] = dl;
-    } else {
-      stack[top] = l, stack_d[top++] = dl;
-      stack[top] = r, stack_d[top++] = dr;
-    }
+  } else {
+    // The hint first: a near hit prunes the walk. The winner is the least
+    // (distance, index) over all triangles, and no box holding it is ever
+    // pruned (its distance is at most the best), so the hint changes only
+    // how many boxes are opened.
+    if (hint >= 0 && hint < static_cast<int>(I.leaf.size())) try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
+    walk_tree();
   }
   if (best_i < 0) {  // a non-finite query point: no distance compares
     h.tri = I.original[0];
