@@ -47,6 +47,40 @@ std::size_t count_border_edges(const ElementMesh& m) {
   return n;
 }
 
+int element_genus(const std::vector<Tri>& tris) {
+  if (tris.empty()) return 0;
+  int n = 0;
+  for (const Tri& t : tris) n = std::max({n, t[0] + 1, t[1] + 1, t[2] + 1});
+  std::unordered_map<std::uint64_t, int> uses;
+  std::vector<char> used(static_cast<std::size_t>(n), 0);
+  UnionFind<int> parts(static_cast<std::size_t>(n));
+  for (const Tri& t : tris)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      ++uses[edge_key(std::min(a, b), std::max(a, b))];
+      used[static_cast<std::size_t>(a)] = 1;
+      parts.unite(a, b);
+    }
+  // Border loops: components of the graph of border edges.
+  UnionFind<int> border(static_cast<std::size_t>(n));
+  std::vector<char> on_border(static_cast<std::size_t>(n), 0);
+  for (const auto& [key, count] : uses) {
+    if (count != 1) continue;
+    const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
+    border.unite(a, b);
+    on_border[static_cast<std::size_t>(a)] = on_border[static_cast<std::size_t>(b)] = 1;
+  }
+  long long v = 0, c = 0, loops = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!used[static_cast<std::size_t>(i)]) continue;
+    ++v;
+    c += parts.find(i) == i;
+    loops += on_border[static_cast<std::size_t>(i)] && border.find(i) == i;
+  }
+  const long long chi = v - static_cast<long long>(uses.size()) + static_cast<long long>(tris.size());
+  return static_cast<int>((2 * c - chi - loops) / 2);
+}
+
 bool is_closed_oriented(const ElementMesh& m) {
   std::unordered_map<std::uint64_t, int> directed;
   for (const Tri& t : m.tris)

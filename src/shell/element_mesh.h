@@ -34,6 +34,11 @@ struct ElementMesh {
 int triangle_components(const ElementMesh& m, std::vector<int>& tri_component);
 /// Undirected edges used by exactly one triangle (border edges of the element).
 std::size_t count_border_edges(const ElementMesh& m);
+/// Handles of an edge-manifold element given by its triangles (a ring or
+/// torus 1, a pebble or a ring cut open 0), summed over its components:
+/// (2 c - chi - b) / 2 with chi = V - E + F over the vertices the triangles
+/// use, c components, b border loops (components of the border-edge graph).
+int element_genus(const std::vector<Tri>& tris);
 /// True if every undirected edge is used exactly twice, once in each direction
 /// (closed, consistently oriented, edge-manifold).
 bool is_closed_oriented(const ElementMesh& m);

@@ -165,6 +165,36 @@ TEST(ElementCaps, WideCutsAreClosedWithEdgesNearTheRimEdge) {
   EXPECT_LT(longest_edge_length(pieces[0]), 2 * longest_edge_length(ball));
 }
 
+// Handles of an element (remove_broken_rings' test of a ring cut open): a
+// torus 1, a ball 0, a torus cut open and capped 0 (open, uncapped: still 0),
+// two tori as one element 2, an open cylinder (two border loops) 0.
+TEST(ElementGenus, CountsHandlesOfClosedAndOpenElements) {
+  Mesh tor, ball, cyl;
+  make_torus(tor, 2.0, 0.3, 32, 8);
+  make_icosphere(ball, 2);
+  make_cylinder(cyl, 1.0, 2.0, 12, 3);
+  const ElementMesh ring = element_mesh_from(tor);
+  EXPECT_EQ(element_genus(ring.tris), 1);
+  EXPECT_EQ(element_genus(element_mesh_from(ball).tris), 0);
+  EXPECT_EQ(element_genus(element_mesh_from(cyl).tris), 0);
+  std::vector<char> drop(ring.tris.size(), 0);
+  for (std::size_t t = 0; t < ring.tris.size(); ++t) {
+    const P3& p = ring.points[static_cast<std::size_t>(ring.tris[t][0])];
+    drop[t] = p[0] > 1.5 && std::abs(p[1]) < 0.4;  // a cut through the tube at +x
+  }
+  std::vector<Tri> open;
+  for (std::size_t t = 0; t < ring.tris.size(); ++t)
+    if (!drop[t]) open.push_back(ring.tris[t]);
+  EXPECT_EQ(element_genus(open), 0);
+  const std::vector<ElementMesh> capped = trim_and_cap(ring, drop, 0, 20);
+  ASSERT_EQ(capped.size(), 1u);
+  EXPECT_EQ(element_genus(capped[0].tris), 0);
+  ElementMesh two = ring;
+  append(two, ring);
+  EXPECT_EQ(element_genus(two.tris), 2);
+  EXPECT_EQ(element_genus({}), 0);
+}
+
 TEST(SwatchAxis, ThinAxisIsDetectedAndTurnedOntoZ) {
   Mesh m;
   ScatterOptions so;
@@ -568,6 +598,74 @@ TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
   EXPECT_GT(tight.elements, 10);
 }
 
+// Issue 17 item 2 (no shards): rings quilted over a tube thinner than they are
+// wide are cut at patch borders, crossings and refused merges, and a cut ring
+// capped is a C-shaped piece (18 of 23 elements here). With remove_broken_rings no output element of a tori
+// swatch has fewer handles than a torus (without it some do), and the
+// scatter fill puts whole rings in their place: the bare fraction stays low.
+TEST(SurfaceQuiltingShards, NoRingIsLeftCutOpen) {
+  Mesh base;
+  make_torus(base, 1.0, 0.2, 64, 24);  // a tube thinner than a ring is wide
+  const Swatch s = small_tori(3);
+  auto run = [&](bool remove) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.5;
+    o.remove_broken_rings = remove;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    std::vector<std::vector<Tri>> tris(static_cast<std::size_t>(q.elements));
+    for (std::size_t t = 0; t < q.tris.size(); ++t) tris[static_cast<std::size_t>(q.tri_element[t])].push_back(q.tris[t]);
+    int broken = 0;
+    for (const auto& e : tris) broken += element_genus(e) < 1;
+    std::cout << "[ rings ] remove " << remove << ": " << r.elements << " elements, " << broken << " without a handle, "
+              << r.broken_rings_removed << " removed, bare " << r.bare_fraction << "\n";
+    return std::make_pair(broken, r);
+  };
+  const auto [broken_off, roff] = run(false);
+  const auto [broken_on, ron] = run(true);
+  EXPECT_GT(broken_off, 0);
+  EXPECT_EQ(roff.broken_rings_removed, 0u);
+  EXPECT_EQ(broken_on, 0);
+  EXPECT_GT(ron.broken_rings_removed, 0u);
+  EXPECT_LT(ron.bare_fraction, 0.05);
+}
+
+// Issue 17 item 4 (even coverage): on a tube thinner than a ring is wide a
+// whole ring bends over the surface, past the quilting patches' 80 degrees of
+// normal, and stretches on its outside; the scatter fill's patches take 120
+// degrees and its rings stretch up to 2: with either at the quilting's values
+// (80 degrees; 1.5) fewer rings are placed and more of the tube stays bare.
+TEST(SurfaceQuiltingCoverage, ScatteredRingsBendOverAThinTube) {
+  Mesh base;
+  make_torus(base, 1.0, 0.16, 64, 24);  // a tube thinner than a ring is wide
+  const Swatch s = small_tori(3);
+  auto run = [&](double stretch, double cone) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.5;
+    o.scatter_max_stretch = stretch;
+    o.scatter_max_normal_angle_deg = cone;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    std::cout << "[ tube ] scatter stretch " << stretch << ", cone " << cone << ": " << r.elements << " elements, placed "
+              << r.scatter_placed << ", bare " << r.bare_fraction << ", edge stretch max " << r.edge_stretch_max << "\n";
+    return r;
+  };
+  const SurfaceQuiltOptions d;
+  const SurfaceQuiltResult stiff = run(1.5, d.scatter_max_normal_angle_deg);
+  const SurfaceQuiltResult narrow = run(d.scatter_max_stretch, d.max_normal_angle_deg);
+  const SurfaceQuiltResult both = run(d.scatter_max_stretch, d.scatter_max_normal_angle_deg);
+  for (const SurfaceQuiltResult* r : {&stiff, &narrow}) {
+    EXPECT_GT(both.scatter_placed, r->scatter_placed);
+    EXPECT_LT(both.bare_fraction, 0.5 * r->bare_fraction);
+  }
+  for (auto [stretch, cone] : {std::pair{0.5, 120.0}, std::pair{2.0, 0.0}, std::pair{2.0, 200.0}}) {
+    SurfaceQuiltOptions bad;
+    bad.scatter_max_stretch = stretch;
+    bad.scatter_max_normal_angle_deg = cone;
+    SurfaceQuilt q;
+    EXPECT_THROW(quilt_surface(base, s, q, bad), InvalidInputError);
+  }
+}
+
 }  // namespace
 }  // namespace surftex
-

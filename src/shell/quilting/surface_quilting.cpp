@@ -427,6 +427,10 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.refill_rounds < 0 || o.refill_rounds > 8) bad("refill_rounds must be in [0, 8]", o.refill_rounds);
   if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
+  if (!(o.scatter_max_stretch >= 1 && o.scatter_max_stretch <= 10))
+    bad("scatter_max_stretch must be in [1, 10]", o.scatter_max_stretch);
+  if (!(o.scatter_max_normal_angle_deg >= 1 && o.scatter_max_normal_angle_deg <= 180))
+    bad("scatter_max_normal_angle_deg must be in [1, 180]", o.scatter_max_normal_angle_deg);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -546,7 +550,7 @@ class SurfaceQuilter {
 
   // Stages (public for the tests through quilt_surface's results only; see the header).
   int find_seed() const;
-  void grow_and_flatten(int seed, Patch& p, double radius);
+  void grow_and_flatten(int seed, Patch& p, double radius, double cos_max);
   void orient(Patch& p);
   void align(Patch& p);
   void frame_triangles(Patch& p);
@@ -558,6 +562,7 @@ class SurfaceQuilter {
   void finish();
   std::size_t refill();
   void scatter_into_bare();
+  void remove_broken_rings();
   void emit(SurfaceQuilt& out);
 
  private:
@@ -587,7 +592,7 @@ class SurfaceQuilter {
   const SurfaceQuiltOptions& opt_;
   Base b_;
   int nf_ = 0;
-  double S_ = 0, c_ = 0, swatch_diag_ = 0, cos_max_ = 0, swatch_h_ = 0;
+  double S_ = 0, c_ = 0, swatch_diag_ = 0, cos_max_ = 0, swatch_h_ = 0, scatter_cos_max_ = 0;
   int sx_ = 0, sy_ = 0, r_full_ = 0;
   P3 up_{0, 1, 0};
   std::vector<P3> field_dir_;
@@ -617,6 +622,7 @@ class SurfaceQuilter {
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
+  int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
   SurfaceQuiltResult res_;
 };
 
@@ -638,6 +644,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   swatch_diag_ = std::hypot(swatch.length(), swatch.width()) * S_;
   swatch_h_ = swatch.bbox_max[2] - swatch.bbox_min[2];
   cos_max_ = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
+  scatter_cos_max_ = std::cos(opt.scatter_max_normal_angle_deg * kPi / 180.0);
   const double l = norm3(opt.up);
   if (l > 0) up_ = {opt.up[0] / l, opt.up[1] / l, opt.up[2] / l};
   if (opt.field == SurfaceQuiltOptions::Field::kUp && opt.smooth_field) {
@@ -662,6 +669,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   compact_ = compact_swatch_elements(swatch);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
+  ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
+  for (const ElementMesh& m : compact_) ring_handles_ = std::min(ring_handles_, element_genus(m.tris));
   processed_.assign(nf_, 0);
   constrained_.assign(nf_, 0);
   patch_slot_.assign(nf_, -1);
@@ -684,8 +693,10 @@ int SurfaceQuilter::find_seed() const {
   return seed;
 }
 
-// 2-3. Surface patch and its flattening, shrunk while the area distortion exceeds the bound.
-void SurfaceQuilter::grow_and_flatten(int seed, Patch& p, double radius) {
+// 2-3. Surface patch (the faces within `radius` whose normals are within
+// acos(cos_max) of the seed's) and its flattening, shrunk while the area
+// distortion exceeds the bound.
+void SurfaceQuilter::grow_and_flatten(int seed, Patch& p, double radius, double cos_max) {
   p.seed = seed;
   p.R = radius;
   bool ok = false;
@@ -695,7 +706,7 @@ void SurfaceQuilter::grow_and_flatten(int seed, Patch& p, double radius) {
     const double r2 = p.R * p.R;
     auto accept = [&](int f) {
       const P3 d = sub3(b_.centroid[f], c0);
-      return dot3(d, d) <= r2 && dot3(b_.normal[f], n0) >= cos_max_;
+      return dot3(d, d) <= r2 && dot3(b_.normal[f], n0) >= cos_max;
     };
     const std::vector<int> faces = grow_disc_chart(mesh_, seed, accept, static_cast<std::size_t>(opt_.max_patch_faces), growth_);
     ok = flatten_patch(mesh_, b_, faces, p.flat, err);
@@ -1349,7 +1360,7 @@ void SurfaceQuilter::quilt_unprocessed() {
     report_progress(opt_.progress, "quilt", static_cast<double>(done_) / nf_);
     Timer tp;
     Patch p;
-    grow_and_flatten(seed, p, opt_.patch_radius * swatch_diag_);
+    grow_and_flatten(seed, p, opt_.patch_radius * swatch_diag_, cos_max_);
     orient(p);
     align(p);
     const PatchLocator loc0(p.ftris, c_);
@@ -1556,6 +1567,22 @@ void SurfaceQuilter::remove_misshapen() {
   }
 }
 
+// Finish: rings cut open (remove_broken_rings). A ring or torus cut at a
+// patch border, by a crossing or a refused merge is capped into a C-shaped
+// piece with no handle; Zhou 2.7 merges elements or keeps them whole, so such
+// a piece is a shard: removed, its space refilled and scattered like any
+// bare space. Pieces of handle-free elements (a capped pebble piece still
+// looks like a pebble) stay.
+void SurfaceQuilter::remove_broken_rings() {
+  if (!opt_.remove_broken_rings || ring_handles_ == 0) return;
+  for (Element& el : elements_) {
+    if (!el.alive || el.finished || !(el.compact || all_compact_) || el.mesh.tris.empty()) continue;
+    if (element_genus(el.mesh.tris) >= ring_handles_) continue;
+    el.alive = false;
+    ++res_.broken_rings_removed;
+  }
+}
+
 void SurfaceQuilter::finish() {
   Timer t;
   settle_and_trim(0);
@@ -1565,6 +1592,7 @@ void SurfaceQuilter::finish() {
     resolve_crossings_lifted();
     settle_and_trim(n);  // the pieces it cut, against the stretch bound
   }
+  remove_broken_rings();
   for (Element& el : elements_) el.finished = el.alive;
   res_.seconds_finish += t.seconds();
 }
@@ -1619,13 +1647,12 @@ ElementMesh SurfaceQuilter::lifted_mesh(const Element& el) const {
 // One scatter candidate: the template turned by `quarter` quarter turns,
 // moved by `offset` (frame units) from the patch's seed. Kept (in `el`) only
 // if every vertex lies on the patch (no extrapolation), no lifted edge is
-// stretched past kScatterMaxStretch times its swatch length (nor past the
+// stretched past scatter_max_stretch times its swatch length (nor past the
 // shard bound, SurfaceQuiltOptions::max_edge_stretch), and the lifted
 // element neither crosses nor comes within half the swatch's smallest gap of
 // an element already placed.
 bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& loc, const ElementMesh& tpl, int quarter,
                                            const V2& offset, ElementCollider& coll, Element& el) {
-  constexpr double kScatterMaxStretch = 1.5;
   static constexpr int kCos[4] = {1, 0, -1, 0}, kSin[4] = {0, 1, 0, -1};
   const int c = kCos[quarter & 3], sn = kSin[quarter & 3];
   el = Element{};
@@ -1640,7 +1667,7 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     el.loc[v] = {p.flat.faces[static_cast<std::size_t>(k)], w[1], w[2], q[2]};
   }
   const ElementMesh m = lifted_mesh(el);
-  const double lim2 = kScatterMaxStretch * kScatterMaxStretch * S_ * S_;
+  const double lim2 = opt_.scatter_max_stretch * opt_.scatter_max_stretch * S_ * S_;
   for (const Tri& t : tpl.tris)
     for (int k = 0; k < 3; ++k) {
       const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
@@ -1678,7 +1705,7 @@ void SurfaceQuilter::scatter_into_bare() {
   for (int f = 0; f < nf_; ++f) {
     if (!face_is_bare(b_, f, feet)) continue;
     Patch p;
-    grow_and_flatten(f, p, 2 * reach * S_);
+    grow_and_flatten(f, p, 2 * reach * S_, scatter_cos_max_);
     orient(p);
     frame_triangles(p);
     const PatchLocator loc(p.ftris, c_);

@@ -82,6 +82,12 @@ struct SurfaceQuiltOptions {
   /// (merged with a neighbour, or deformed) is removed, then refilled. >= 0,
   /// 0 = none. Default 1.5.
   double max_shape_ratio = 1.5;
+  /// Broken rings (Zhou 2.7 keeps elements whole or merges them): when every
+  /// compact swatch element has a handle (tori, chain-mail rings), a compact
+  /// output element with fewer handles than the fewest of them (a ring cut open
+  /// at a patch border, a crossing or a refused merge: a C-shaped shard) is
+  /// removed, then refilled. Default true.
+  bool remove_broken_rings = true;
   /// After the loop, elements that cross when lifted are resolved exactly (the
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
@@ -93,6 +99,16 @@ struct SurfaceQuiltOptions {
   /// without crossing or stretching (four quarter turns, then moved by up to
   /// half the element spacing). In [0, 64]; 0 = none. Default 16.
   int scatter_attempts = 16;
+  /// The scatter fill's stretch bound: no lifted edge of a scattered element
+  /// longer than this many times its swatch length (a ring bent over a leg or
+  /// an ear stretches on its outside). In [1, 10]. Default 2 (1.5 left the
+  /// thin parts bare; decision 102, session 32).
+  double scatter_max_stretch = 2.0;
+  /// The scatter fill's patches take the faces whose normals are within this
+  /// angle of the seed's (the quilting patches: max_normal_angle_deg), so a
+  /// ring can bend over an ear's or a paw's rim; the stretch bound above
+  /// keeps what the wider flattening distorts out. In [1, 180]. Default 120.
+  double scatter_max_normal_angle_deg = 120.0;
   /// The output's z range may grow past the swatch's by this many swatch
   /// heights per side; elements beyond are shifted (squeezed) in. [0, 10], default 0.
   double max_z_growth = 0;
@@ -172,6 +188,8 @@ struct SurfaceQuiltResult {
   std::size_t elements_stretched = 0;
   /// Compact elements removed for spreading past max_shape_ratio.
   std::size_t elements_misshapen = 0;
+  /// Broken rings removed (remove_broken_rings).
+  std::size_t broken_rings_removed = 0;
   /// Longest lifted element edge over the swatch's longest, scaled.
   double edge_stretch_max = 0;
   /// Of elements_not_expressible, those left out of the step entirely.
