@@ -280,9 +280,10 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.scatter_attempts = 0;
     qo.max_shape_ratio = 0;
     qo.remove_broken_rings = false;
+    qo.min_piece_fraction = 0;
     qo.max_edge_stretch = 12;
   }
-  // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE (degrees), BENCH_SHAPE, BENCH_RINGS (0/1),
+  // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE (degrees), BENCH_SHAPE, BENCH_RINGS (0/1), BENCH_PIECES (fraction),
   // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
   // BENCH_CLEARANCE (swatch units; negative = automatic), BENCH_KEEP_CUT (0/1: refused inputs' cut parts kept), BENCH_SEED (the run's seed, default 1: the spread of a figure over seeds).
   if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
@@ -293,6 +294,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_SCATTER_CONE")) qo.scatter_max_normal_angle_deg = std::atof(e);
   if (const char* e = std::getenv("BENCH_SHAPE")) qo.max_shape_ratio = std::atof(e);
   if (const char* e = std::getenv("BENCH_RINGS")) qo.remove_broken_rings = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_PIECES")) qo.min_piece_fraction = std::atof(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
@@ -345,6 +347,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"scatter_placed", r.scatter_placed},
          {"elements_misshapen", r.elements_misshapen},
          {"broken_rings_removed", r.broken_rings_removed},
+         {"small_pieces_removed", r.small_pieces_removed},
          {"bare_quilt", r.bare_fraction},
          {"steps", r.steps},
          {"stretch_before", er.stretch.stretch_before},

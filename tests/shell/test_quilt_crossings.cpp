@@ -600,9 +600,10 @@ TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
 
 // Issue 17 item 2 (no shards): rings quilted over a tube thinner than they are
 // wide are cut at patch borders, crossings and refused merges, and a cut ring
-// capped is a C-shaped piece (18 of 23 elements here). With remove_broken_rings no output element of a tori
-// swatch has fewer handles than a torus (without it some do), and the
-// scatter fill puts whole rings in their place: the bare fraction stays low.
+// capped is a C-shaped piece (10 of 22 elements here, beside the small pieces
+// min_piece_fraction removes). With remove_broken_rings no output element of
+// a tori swatch has fewer handles than a torus, and the scatter fill puts
+// whole rings in their place: the bare fraction stays low.
 TEST(SurfaceQuiltingShards, NoRingIsLeftCutOpen) {
   Mesh base;
   make_torus(base, 1.0, 0.2, 64, 24);  // a tube thinner than a ring is wide
@@ -665,6 +666,39 @@ TEST(SurfaceQuiltingCoverage, ScatteredRingsBendOverAThinTube) {
     SurfaceQuilt q;
     EXPECT_THROW(quilt_surface(base, s, q, bad), InvalidInputError);
   }
+}
+
+// Issue 17 item 2 (no shards): a pebble cut at a patch border or a crossing
+// and capped is a crumpled piece, not a pebble. With min_piece_fraction no
+// output element has fewer faces than that fraction of the swatch's pebble
+// (without it 15 of 40 elements on this tube), and the space is refilled.
+TEST(SurfaceQuiltingShards, NoSmallPieceOfAPebbleIsLeft) {
+  Mesh base, pebble;
+  make_torus(base, 1.0, 0.3, 64, 24);
+  make_ellipsoid(pebble, 1.0, 0.8, 0.35, 2);  // one pebble as the swatch
+  const Swatch s = make_swatch(pebble);
+  const double lim = SurfaceQuiltOptions{}.min_piece_fraction * static_cast<double>(s.elements[0].faces);
+  auto run = [&](double fraction) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.15;
+    o.min_piece_fraction = fraction;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    std::vector<int> faces(static_cast<std::size_t>(q.elements), 0);
+    for (int e : q.tri_element) ++faces[static_cast<std::size_t>(e)];
+    int small = 0;
+    for (int f : faces) small += f < lim;
+    std::cout << "[ pebbles ] piece fraction " << fraction << ": " << r.elements << " elements, " << small
+              << " small pieces, " << r.small_pieces_removed << " removed, bare " << r.bare_fraction << "\n";
+    return std::make_pair(small, r);
+  };
+  const auto [small_off, roff] = run(0);
+  const auto [small_on, ron] = run(SurfaceQuiltOptions{}.min_piece_fraction);
+  EXPECT_GT(small_off, 0);
+  EXPECT_EQ(roff.small_pieces_removed, 0u);
+  EXPECT_EQ(small_on, 0);
+  EXPECT_GT(ron.small_pieces_removed, 0u);
+  EXPECT_LT(ron.bare_fraction, 0.05);
 }
 
 }  // namespace

@@ -56,6 +56,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["elements_stretched"] = r.elements_stretched;
   j["elements_misshapen"] = r.elements_misshapen;
   j["broken_rings_removed"] = r.broken_rings_removed;
+  j["small_pieces_removed"] = r.small_pieces_removed;
   j["edge_stretch_max"] = r.edge_stretch_max;
   j["crossings_resolved"] = r.crossings_resolved;
   j["finish_elements_checked"] = r.finish_elements_checked;

@@ -427,6 +427,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.refill_rounds < 0 || o.refill_rounds > 8) bad("refill_rounds must be in [0, 8]", o.refill_rounds);
   if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
+  if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
+    bad("min_piece_fraction must be in [0, 1]", o.min_piece_fraction);
   if (!(o.scatter_max_stretch >= 1 && o.scatter_max_stretch <= 10))
     bad("scatter_max_stretch must be in [1, 10]", o.scatter_max_stretch);
   if (!(o.scatter_max_normal_angle_deg >= 1 && o.scatter_max_normal_angle_deg <= 180))
@@ -562,7 +564,7 @@ class SurfaceQuilter {
   void finish();
   std::size_t refill();
   void scatter_into_bare();
-  void remove_broken_rings();
+  void remove_broken_elements();
   void emit(SurfaceQuilt& out);
 
  private:
@@ -1567,19 +1569,27 @@ void SurfaceQuilter::remove_misshapen() {
   }
 }
 
-// Finish: rings cut open (remove_broken_rings). A ring or torus cut at a
-// patch border, by a crossing or a refused merge is capped into a C-shaped
-// piece with no handle; Zhou 2.7 merges elements or keeps them whole, so such
-// a piece is a shard: removed, its space refilled and scattered like any
-// bare space. Pieces of handle-free elements (a capped pebble piece still
-// looks like a pebble) stay.
-void SurfaceQuilter::remove_broken_rings() {
-  if (!opt_.remove_broken_rings || ring_handles_ == 0) return;
+// Finish: broken compact elements. A ring or torus cut open (at a patch
+// border, by a crossing or a refused merge) is capped into a C-shaped piece
+// with no handle (remove_broken_rings); a small piece of any compact element
+// is a crumpled cap more than a pebble (min_piece_fraction). Zhou 2.7 merges
+// elements or keeps them whole, so both are shards: removed, their space
+// refilled and scattered like any bare space.
+void SurfaceQuilter::remove_broken_elements() {
+  if (compact_.empty()) return;
+  std::size_t smallest = std::numeric_limits<std::size_t>::max();
+  for (const ElementMesh& m : compact_) smallest = std::min(smallest, m.tris.size());
+  const double min_faces = opt_.min_piece_fraction * static_cast<double>(smallest);
+  const bool rings = opt_.remove_broken_rings && ring_handles_ > 0;
   for (Element& el : elements_) {
     if (!el.alive || el.finished || !(el.compact || all_compact_) || el.mesh.tris.empty()) continue;
-    if (element_genus(el.mesh.tris) >= ring_handles_) continue;
-    el.alive = false;
-    ++res_.broken_rings_removed;
+    if (static_cast<double>(el.mesh.tris.size()) < min_faces) {
+      el.alive = false;
+      ++res_.small_pieces_removed;
+    } else if (rings && element_genus(el.mesh.tris) < ring_handles_) {
+      el.alive = false;
+      ++res_.broken_rings_removed;
+    }
   }
 }
 
@@ -1592,7 +1602,7 @@ void SurfaceQuilter::finish() {
     resolve_crossings_lifted();
     settle_and_trim(n);  // the pieces it cut, against the stretch bound
   }
-  remove_broken_rings();
+  remove_broken_elements();
   for (Element& el : elements_) el.finished = el.alive;
   res_.seconds_finish += t.seconds();
 }

@@ -88,6 +88,12 @@ struct SurfaceQuiltOptions {
   /// at a patch border, a crossing or a refused merge: a C-shaped shard) is
   /// removed, then refilled. Default true.
   bool remove_broken_rings = true;
+  /// Small pieces of compact elements (a pebble or ring cut at a patch
+  /// border, a crossing or a refused merge, then capped: a crumpled cap more
+  /// than an element): one with fewer faces than this fraction of the
+  /// smallest compact swatch element is removed, then refilled. In [0, 1];
+  /// 0 = none. Default 0.4 (decision 102, session 32).
+  double min_piece_fraction = 0.4;
   /// After the loop, elements that cross when lifted are resolved exactly (the
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
@@ -190,6 +196,8 @@ struct SurfaceQuiltResult {
   std::size_t elements_misshapen = 0;
   /// Broken rings removed (remove_broken_rings).
   std::size_t broken_rings_removed = 0;
+  /// Small pieces of compact elements removed (min_piece_fraction).
+  std::size_t small_pieces_removed = 0;
   /// Longest lifted element edge over the swatch's longest, scaled.
   double edge_stretch_max = 0;
   /// Of elements_not_expressible, those left out of the step entirely.
