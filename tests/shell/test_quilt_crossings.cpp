@@ -598,6 +598,13 @@ TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
   EXPECT_GT(tight.elements, 10);
 }
 
+// The triangles of each element of a surface quilt.
+std::vector<std::vector<Tri>> element_triangles(const SurfaceQuilt& q) {
+  std::vector<std::vector<Tri>> tris(static_cast<std::size_t>(q.elements));
+  for (std::size_t t = 0; t < q.tris.size(); ++t) tris[static_cast<std::size_t>(q.tri_element[t])].push_back(q.tris[t]);
+  return tris;
+}
+
 // Issue 17 item 2 (no shards): rings quilted over a tube thinner than they are
 // wide are cut at patch borders, crossings and refused merges, and a cut ring
 // capped is a C-shaped piece (10 of 22 elements here, beside the small pieces
@@ -614,10 +621,8 @@ TEST(SurfaceQuiltingShards, NoRingIsLeftCutOpen) {
     o.remove_broken_rings = remove;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-    std::vector<std::vector<Tri>> tris(static_cast<std::size_t>(q.elements));
-    for (std::size_t t = 0; t < q.tris.size(); ++t) tris[static_cast<std::size_t>(q.tri_element[t])].push_back(q.tris[t]);
     int broken = 0;
-    for (const auto& e : tris) broken += element_genus(e) < 1;
+    for (const auto& e : element_triangles(q)) broken += element_genus(e) < 1;
     std::cout << "[ rings ] remove " << remove << ": " << r.elements << " elements, " << broken << " without a handle, "
               << r.broken_rings_removed << " removed, bare " << r.bare_fraction << "\n";
     return std::make_pair(broken, r);
@@ -684,10 +689,8 @@ TEST(SurfaceQuiltingShards, NoSmallPieceOfAPebbleIsLeft) {
     o.min_piece_fraction = fraction;
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-    std::vector<int> faces(static_cast<std::size_t>(q.elements), 0);
-    for (int e : q.tri_element) ++faces[static_cast<std::size_t>(e)];
     int small = 0;
-    for (int f : faces) small += f < lim;
+    for (const auto& e : element_triangles(q)) small += static_cast<double>(e.size()) < lim;
     std::cout << "[ pebbles ] piece fraction " << fraction << ": " << r.elements << " elements, " << small
               << " small pieces, " << r.small_pieces_removed << " removed, bare " << r.bare_fraction << "\n";
     return std::make_pair(small, r);
