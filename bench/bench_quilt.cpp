@@ -300,6 +300,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
   if (const char* e = std::getenv("BENCH_KEEP_CUT")) qo.step.keep_cut_refused_inputs = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_LOOP_GAP")) qo.blob_loop_gap = std::atof(e);
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
   Mesh out;

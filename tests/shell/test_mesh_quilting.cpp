@@ -19,6 +19,7 @@
 #include "shell/quilting/element_merging.h"
 #include "shell/element_mesh.h"
 #include "shell/quilting/mesh_quilting.h"
+#include "shell/quilting/surface_quilting.h"
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
 
@@ -276,7 +277,7 @@ TEST(ElementMerging, ThreadsSideBySideAreNotZipped) {
     EXPECT_EQ(r.reason.rfind("misaligned", 0), 0u) << r.reason;
     // The same pair without the checks: the zip they prevent crosses itself.
     MergeOptions off;
-    off.max_loop_offset = off.max_loop_radius_ratio = off.max_loop_angle_deg = 0;
+    off.max_loop_offset = off.max_loop_gap = off.max_loop_radius_ratio = off.max_loop_angle_deg = 0;
     off.refuse_self_intersecting = false;
     const MergeResult z = merge_elements(a, Region::kOld, b, Region::kNew, band, off);
     if (!z.stitched) {
@@ -691,3 +692,28 @@ TEST(PlanarQuiltingChainmail, RingsPlacedAgainAreKeptWholeNotDuplicated) {
 }
 }  // namespace
 }  // namespace surftex
+
+// Issue 17, no shards: two overlapping pebbles (balls of radius 1, centres
+// 1.3-2.2 apart across the overlap band) are cut far from each other, their
+// loops 0.57-0.98 radii apart along the cut normal. Zipped, the strip is a
+// neck between them with edges 3.6-6.2 times the ball's longest edge (the
+// rock swatch's merged pebbles, decision 102). With max_loop_gap at half a
+// loop radius (SurfaceQuiltOptions::blob_loop_gap, the surface quilter's
+// setting for a swatch of compact elements) they are refused as misaligned.
+TEST(ElementMerging, PebblesCutFarApartAreNotBridgedByANeck) {
+  for (double d : {1.3, 1.6, 1.9, 2.2}) {
+    Mesh s;
+    make_icosphere(s, 3);
+    ElementMesh a = element_mesh_from(s), b = a;
+    for (P3& p : a.points) p[0] += 2.5 - d / 2;
+    for (P3& p : b.points) p[0] += 2.5 + d / 2, p[1] += 0.2;
+    MergeOptions close;
+    close.max_loop_gap = SurfaceQuiltOptions{}.blob_loop_gap;
+    const MergeResult r = merge_elements(a, Region::kOld, b, Region::kNew, band, close);
+    EXPECT_FALSE(r.stitched) << "d " << d;
+    EXPECT_EQ(r.reason.rfind("misaligned", 0), 0u) << r.reason;
+    const MergeResult z = merge_elements(a, Region::kOld, b, Region::kNew, band);  // max_loop_gap 2
+    ASSERT_TRUE(z.stitched) << z.reason;
+    EXPECT_GT(longest_edge_length(z.merged), 3.5 * longest_edge_length(a)) << "d " << d;
+  }
+}

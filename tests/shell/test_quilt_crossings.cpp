@@ -26,6 +26,8 @@
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
 #include "shell_test_util.h"
+#include "geometry/read_mesh.h"
+#include "test_support.h"
 
 namespace surftex {
 namespace {
@@ -702,6 +704,47 @@ TEST(SurfaceQuiltingShards, NoSmallPieceOfAPebbleIsLeft) {
   EXPECT_EQ(small_on, 0);
   EXPECT_GT(ron.small_pieces_removed, 0u);
   EXPECT_LT(ron.bare_fraction, 0.05);
+}
+
+// Issue 17, no shards: copies of a real pebble (swatches/rock_1.obj) quilted
+// on a sphere overlap and merge (2.7). Two copies cut far apart were zipped by
+// a neck of long edges; for a swatch of pebbles the merge now zips loops at
+// most blob_loop_gap (half a loop radius) apart along the cut normal. Counted:
+// elements with an edge over twice the pebble's longest edge (13 with the gap
+// of threads, 2 loop radii; 1 with the default when this test was written).
+TEST(SurfaceQuiltingShards, PebblesAreNotMergedAcrossAWideGap) {
+  Mesh base, rock;
+  make_icosphere(base, 4);
+  read_mesh(test::shared_data("swatches/rock_1.obj"), rock);
+  const Swatch s = make_swatch(rock);
+  const double longest = longest_edge_length(element_mesh_from(rock));
+  auto run = [&](double gap) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.05;
+    o.blob_loop_gap = gap;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    Mesh out;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, out);
+    const auto el = find(out, kFaceElement).first;
+    std::vector<double> worst(static_cast<std::size_t>(q.elements), 0);
+    for (FaceIndex f : out.faces()) {
+      auto h = out.halfedge(f);
+      for (int k = 0; k < 3; ++k, h = out.next(h)) {
+        const double l = std::sqrt(CGAL::squared_distance(out.point(out.source(h)), out.point(out.target(h))));
+        worst[static_cast<std::size_t>(el[f])] = std::max(worst[static_cast<std::size_t>(el[f])], l);
+      }
+    }
+    int necked = 0;
+    for (double w : worst) necked += w > 2 * longest * q.scale;
+    std::cout << "[ pebbles merged ] loop gap " << gap << ": " << r.elements << " elements, " << r.stats.stitched
+              << " stitched, " << necked << " with an edge over 2x the pebble's longest, bare " << r.bare_fraction << "\n";
+    return std::make_pair(necked, r.bare_fraction);
+  };
+  const auto [off, bare_off] = run(0);
+  const auto [on, bare_on] = run(SurfaceQuiltOptions{}.blob_loop_gap);
+  EXPECT_GT(off, 3 * std::max(on, 1));
+  EXPECT_LT(bare_on, 0.02);
 }
 
 }  // namespace

@@ -518,11 +518,12 @@ std::string loop_pair_mismatch(const ElementMesh& pa, const std::vector<int>& la
     if (l > 0)
       for (double& x : axis) x /= l;
   }
-  if (opt.max_loop_offset > 0) {
+  if (opt.max_loop_offset > 0 || opt.max_loop_gap > 0) {
     const P3 off{cb[0] - ca[0], cb[1] - ca[1], cb[2] - ca[2]};
     const double along = off[0] * axis[0] + off[1] * axis[1] + off[2] * axis[2];
     const double side = dist(off, P3{along * axis[0], along * axis[1], along * axis[2]});
-    if (side > opt.max_loop_offset * r || std::abs(along) > 2 * opt.max_loop_offset * r)
+    if ((opt.max_loop_offset > 0 && side > opt.max_loop_offset * r) ||
+        (opt.max_loop_gap > 0 && std::abs(along) > opt.max_loop_gap * r))
       return "misaligned loops: centroids " + std::to_string(side) + " apart sideways and " + std::to_string(along) +
              " along the cut normal, loop radius " + std::to_string(r);
   }

@@ -60,9 +60,11 @@ struct MergeOptions {
   bool average_across_axis_only = true;
   /// Geometric test of every zipped loop pair (ours; the paper asks only that
   /// cut paths be "close"): centroids at most max_loop_offset x the larger radius
-  /// apart sideways (twice along), radii within max_loop_radius_ratio, normals at
-  /// most max_loop_angle_deg apart. 0 disables a test. Defaults 1, 2, 60.
+  /// apart sideways and max_loop_gap x it along the cut normal, radii within
+  /// max_loop_radius_ratio, normals at most max_loop_angle_deg apart. 0
+  /// disables a test. Defaults 1, 2, 2, 60.
   double max_loop_offset = 1.0;
+  double max_loop_gap = 2.0;
   double max_loop_radius_ratio = 2.0;
   double max_loop_angle_deg = 60.0;
   /// Refuse a stitch whose result (after the stitching deformation) has more

@@ -584,7 +584,7 @@ void merge_group(QuiltStepState& s, const std::vector<int>& outs, const std::vec
     MergeOptions mo = opt.merge;
     mo.mu = opt.mu;
     if (!opt.check_stitch_geometry) {
-      mo.max_loop_offset = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;
+      mo.max_loop_offset = mo.max_loop_gap = mo.max_loop_radius_ratio = mo.max_loop_angle_deg = 0;
       mo.refuse_self_intersecting = false;
     }
     MergeResult r = merge_elements(acc, acc_side, x, is_out ? Region::kOld : Region::kNew,

@@ -429,6 +429,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
     bad("min_piece_fraction must be in [0, 1]", o.min_piece_fraction);
+  if (!(o.blob_loop_gap >= 0) || !std::isfinite(o.blob_loop_gap))
+    bad("blob_loop_gap must be >= 0", o.blob_loop_gap);
   if (!(o.scatter_max_stretch >= 1 && o.scatter_max_stretch <= 10))
     bad("scatter_max_stretch must be in [1, 10]", o.scatter_max_stretch);
   if (!(o.scatter_max_normal_angle_deg >= 1 && o.scatter_max_normal_angle_deg <= 180))
@@ -625,6 +627,7 @@ class SurfaceQuilter {
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
+  bool all_blobs_ = false;     // every swatch element is compact without a handle (pebbles)
   SurfaceQuiltResult res_;
 };
 
@@ -673,6 +676,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
   for (const ElementMesh& m : compact_) ring_handles_ = std::min(ring_handles_, element_genus(m.tris));
+  all_blobs_ = all_compact_;
+  for (const ElementMesh& m : compact_) all_blobs_ = all_blobs_ && element_genus(m.tris) == 0;
   processed_.assign(nf_, 0);
   constrained_.assign(nf_, 0);
   patch_slot_.assign(nf_, -1);
@@ -1142,7 +1147,9 @@ void SurfaceQuilter::merge(Patch& p, FrameElements& fe, QuiltGrid& grid, const P
   const std::size_t n_in = fe.mesh.size();
   std::vector<char> alive(n_in, 1);
   QuiltStepStats stats;
-  const QuiltPlacement placed = quilt_step(swatch_, tree_, grid, fe.mesh, alive, rng_, opt_.step, stats);
+  QuiltStepOptions so = opt_.step;
+  if (all_blobs_ && opt_.blob_loop_gap > 0) so.merge.max_loop_gap = opt_.blob_loop_gap;
+  const QuiltPlacement placed = quilt_step(swatch_, tree_, grid, fe.mesh, alive, rng_, so, stats);
   res_.stats.add(stats);
   auto to_loc = [&](const P3& q) {
     auto it = fe.keep_loc.find(q);

@@ -95,6 +95,14 @@ struct SurfaceQuiltOptions {
   /// smallest compact swatch element is removed, then refilled. In [0, 1];
   /// 0 = none. Default 0.4 (decision 102, session 32).
   double min_piece_fraction = 0.4;
+  /// When every swatch element is compact and without a handle (pebbles), a
+  /// merge zips two cut loops only if they are at most this many loop radii
+  /// apart along the cut normal (MergeOptions::max_loop_gap, 2 otherwise): two
+  /// pebbles cut further apart were bridged by a neck of long edges. A ring's
+  /// cut loops are cross-sections of its tube, as a thread's, and keep 2.
+  /// >= 0; 0 = the merge's own max_loop_gap. Default 0.5 (decision 102,
+  /// session 33).
+  double blob_loop_gap = 0.5;
   /// After the loop, elements that cross when lifted are resolved exactly (the
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
