@@ -303,6 +303,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_LOOP_GAP")) qo.blob_loop_gap = std::atof(e);
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
+  if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
   const Swatch& s = run.swatch;
@@ -368,6 +369,11 @@ json run_case(const std::string& name, const std::string& outdir) {
     std::string stem = name;
     std::replace(stem.begin(), stem.end(), ':', '_');
     write_mesh(outdir + "/" + stem + ".glb", out);
+    if (std::getenv("BENCH_LIFTED")) {  // the quilt before the shell map: feet on the base, height along the normal
+      Mesh lifted;
+      surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, lifted);
+      write_mesh(outdir + "/" + stem + "_lifted.glb", lifted);
+    }
     Mesh scene;
     surface_quilt_scene(base, out, scene);
     ViewOptions vo;  // +Y up, as the meshes and glTF

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/pca_kdtree.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <Eigen/Dense>
 #include <nanoflann.hpp>
 
@@ -13,10 +17,21 @@ namespace surftex {
 
 void PcaBasis::project(const float* v, float* out) const {
   // Four directions at a time: four independent sums, each still in index
-  // order (the same floats as one at a time), so they overlap in the
-  // pipeline instead of waiting on one chain of additions.
+  // order (the same floats as one at a time: a product rounded, then a sum
+  // rounded, in both paths), so they overlap in the pipeline instead of
+  // waiting on one chain of additions; with basis4, one SSE lane each.
   int k = 0;
+  const std::size_t quads = basis4.size() / (4 * static_cast<std::size_t>(dim > 0 ? dim : 1));
   for (; k + 4 <= dims; k += 4) {
+#if defined(__SSE2__)
+    if (static_cast<std::size_t>(k / 4) < quads) {
+      const float* b = &basis4[static_cast<std::size_t>(k / 4) * 4 * dim];
+      __m128 s = _mm_setzero_ps();
+      for (int i = 0; i < dim; ++i) s = _mm_add_ps(s, _mm_mul_ps(_mm_loadu_ps(b + 4 * i), _mm_set1_ps(v[i] - mean[i])));
+      _mm_storeu_ps(out + k, s);
+      continue;
+    }
+#endif
     const float* b = &basis[static_cast<std::size_t>(k) * dim];
     float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     for (int i = 0; i < dim; ++i) {
@@ -40,7 +55,23 @@ void PcaBasis::project(const float* v, float* out) const {
 }
 
 void PcaBasis::project(const float* v, double* out) const {
-  for (int k = 0; k < dims; ++k) {
+  int k = 0;
+  for (; k + 4 <= dims; k += 4) {  // four independent sums, as the float version
+    const double* b = &basis_d[static_cast<std::size_t>(k) * dim];
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    for (int i = 0; i < dim; ++i) {
+      const double d = static_cast<double>(v[i]) - mean_d[i];
+      s0 += b[i] * d;
+      s1 += b[dim + i] * d;
+      s2 += b[2 * dim + i] * d;
+      s3 += b[3 * dim + i] * d;
+    }
+    out[k] = s0;
+    out[k + 1] = s1;
+    out[k + 2] = s2;
+    out[k + 3] = s3;
+  }
+  for (; k < dims; ++k) {
     const double* b = &basis_d[static_cast<std::size_t>(k) * dim];
     double s = 0;
     for (int i = 0; i < dim; ++i) s += b[i] * (static_cast<double>(v[i]) - mean_d[i]);
@@ -117,6 +148,12 @@ PcaBasis PcaFit::fit(int dims, const std::string& what) const {
       b.basis[static_cast<std::size_t>(k) * dim_ + i] = static_cast<float>(ev[i]);
     }
   }
+  const int quads = dims / 4;
+  b.basis4.assign(static_cast<std::size_t>(quads) * 4 * dim_, 0.f);
+  for (int k = 0; k < quads * 4; ++k)
+    for (int i = 0; i < dim_; ++i)
+      b.basis4[static_cast<std::size_t>(k / 4) * 4 * dim_ + 4 * static_cast<std::size_t>(i) + k % 4] =
+          b.basis[static_cast<std::size_t>(k) * dim_ + i];
   return b;
 }
 

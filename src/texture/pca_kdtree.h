@@ -27,6 +27,9 @@ struct PcaBasis {
   std::vector<float> mean, basis;       ///< float copies: mean (dim), basis (dims x dim, row-major)
   std::vector<double> mean_d, basis_d;  ///< the same in double
   std::vector<double> eigenvalues;      ///< every eigenvalue (dim), decreasing, clamped at 0
+  /// `basis` four directions at a time, interleaved: basis4[(k / 4) * 4 * dim + 4 * i + k % 4]
+  /// for k < dims rounded down to 4 (set by PcaFit::fit; empty = not used).
+  std::vector<float> basis4;
   /// out[k] = sum_i basis[k][i] * (v[i] - mean[i]), float arithmetic in index order.
   void project(const float* v, float* out) const;
   /// The same in double arithmetic.
