@@ -303,6 +303,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_LOOP_GAP")) qo.blob_loop_gap = std::atof(e);
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
+  if (const char* e = std::getenv("BENCH_RECENTRE")) o.embed.recentre_caps = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
@@ -342,6 +343,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_elements_embedded", er.crossing_elements},
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"elements_stretched_embedded", er.elements_stretched_embedded},
+         {"caps_recentred", er.caps_recentred},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},

@@ -2,6 +2,7 @@
 #include "shell/element_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -9,6 +10,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/newell.h"
 #include "geometry/properties.h"
 #include "geometry/union_find.h"
 
@@ -188,6 +190,57 @@ void cap_loop(ElementMesh& m, const std::vector<int>& loop) {
   const int cv = static_cast<int>(m.points.size());
   m.points.push_back(c);
   for (std::size_t k = 0; k < outer.size(); ++k) m.tris.push_back({outer[(k + 1) % outer.size()], outer[k], cv});
+}
+
+std::size_t recentre_fans(ElementMesh& m, int min_valence, double min_offset) {
+  auto point_dist = [](const P3& a, const P3& b) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  };
+  // (vertex, next, after) per triangle corner: around v, next -> after.
+  std::vector<std::array<int, 3>> corners;
+  corners.reserve(3 * m.tris.size());
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) corners.push_back({t[k], t[(k + 1) % 3], t[(k + 2) % 3]});
+  std::sort(corners.begin(), corners.end());
+  std::vector<std::pair<int, P3>> moves;
+  for (std::size_t i = 0; i < corners.size();) {
+    std::size_t j = i;
+    while (j < corners.size() && corners[j][0] == corners[i][0]) ++j;
+    const int v = corners[i][0], n = static_cast<int>(j - i);
+    if (n >= min_valence) {
+      std::unordered_map<int, int> next;
+      for (std::size_t c = i; c < j; ++c) next[corners[c][1]] = corners[c][2];
+      std::vector<int> ring{corners[i][1]};  // walk the fan; skip unless it closes after n steps
+      while (static_cast<int>(ring.size()) <= n) {
+        auto it = next.find(ring.back());
+        if (it == next.end()) break;
+        ring.push_back(it->second);
+      }
+      if (static_cast<int>(ring.size()) == n + 1 && ring.back() == ring.front()) {
+        ring.pop_back();
+        const P3& p = m.points[static_cast<std::size_t>(v)];
+        P3 mean{0, 0, 0};
+        double spoke = 0;
+        for (int u : ring) {
+          const P3& q = m.points[static_cast<std::size_t>(u)];
+          for (int d = 0; d < 3; ++d) mean[d] += q[d] / n;
+          spoke += point_dist(p, q) / n;
+        }
+        const std::array<double, 3> nn =
+            newell_normal(ring.size(), [&](std::size_t k) -> const P3& { return m.points[static_cast<std::size_t>(ring[k])]; });
+        const double ln = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+        P3 off{mean[0] - p[0], mean[1] - p[1], mean[2] - p[2]};
+        if (ln > 0) {
+          const double a = (off[0] * nn[0] + off[1] * nn[1] + off[2] * nn[2]) / (ln * ln);
+          for (int d = 0; d < 3; ++d) off[d] -= a * nn[d];
+        }
+        if (point_dist(off, P3{0, 0, 0}) > min_offset * spoke) moves.push_back({v, P3{p[0] + off[0], p[1] + off[1], p[2] + off[2]}});
+      }
+    }
+    i = j;
+  }
+  for (const auto& [v, q] : moves) m.points[static_cast<std::size_t>(v)] = q;
+  return moves.size();
 }
 
 double longest_edge_length(const ElementMesh& m) {

@@ -55,6 +55,15 @@ bool boundary_loops(const ElementMesh& m, std::vector<std::vector<int>>& loops);
 /// no wider than their mean edge get that fan. Needs >= 3 vertices (else
 /// nothing is added).
 void cap_loop(ElementMesh& m, const std::vector<int>& loop);
+/// Cap centres put back in the middle of their cap: every vertex of at least
+/// `min_valence` neighbours whose one-ring is one closed fan is moved by the
+/// part of (mean of its ring - its position) that lies in the ring's plane
+/// (Newell normal), when that part is over `min_offset` times its mean spoke.
+/// A cap fanned from its loop's centroid and then deformed with its loop (a
+/// quilting step's Laplacian deformation) can end with its centre at one end
+/// of the loop: a spike of spokes. A sphere's pole or any vertex already in
+/// the middle of its ring stays. Returns how many vertices moved.
+std::size_t recentre_fans(ElementMesh& m, int min_valence = 9, double min_offset = 0.25);
 /// Length of the longest edge; 0 if none.
 double longest_edge_length(const ElementMesh& m);
 /// Unit area-weighted vertex normals (zero for isolated vertices).

@@ -167,6 +167,53 @@ TEST(ElementCaps, WideCutsAreClosedWithEdgesNearTheRimEdge) {
   EXPECT_LT(longest_edge_length(pieces[0]), 2 * longest_edge_length(ball));
 }
 
+// Issue 17, no shards: a cap fanned from its loop's centroid keeps its centre
+// there only until the loop is deformed; the weave's caps ended with centres
+// at one end of the loop (spokes over 4 median edges: 30 of bunny:weave's 33
+// edges over 4x the median). recentre_fans moves such a centre back within
+// the cap's plane; a centre already in the middle, or a cone's apex over
+// its base, stays where it is.
+TEST(ElementCaps, CapCentresPulledToOneEndAreMovedBack) {
+  const int n = 12;
+  ElementMesh prism;  // an elliptic prism (a flat thread's end), rims at z = 0 and z = 1, capped by fans
+  for (int r = 0; r < 2; ++r)
+    for (int i = 0; i < n; ++i) prism.points.push_back({2.5 * std::cos(2 * M_PI * i / n), 0.4 * std::sin(2 * M_PI * i / n), double(r)});
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    prism.tris.push_back({i, j, n + j});
+    prism.tris.push_back({i, n + j, n + i});
+  }
+  prism.points.push_back({0, 0, 0});  // the caps: fans from the rims' centroids
+  prism.points.push_back({0, 0, 1});
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    prism.tris.push_back({j, i, 2 * n});
+    prism.tris.push_back({n + i, n + j, 2 * n + 1});
+  }
+  ASSERT_TRUE(is_closed_oriented(prism));
+  ElementMesh moved = prism;
+  const std::size_t top = 2 * n + 1;  // the z = 1 cap's centre, pulled to x = 2 as a deformation left it
+  moved.points[top] = {2.0, 0.1, 1.0};
+  const double before = longest_edge_length(moved);
+  EXPECT_EQ(recentre_fans(moved), 1u);
+  EXPECT_NEAR(moved.points[top][0], 0.0, 1e-9);
+  EXPECT_NEAR(moved.points[top][1], 0.0, 1e-9);
+  EXPECT_NEAR(moved.points[top][2], 1.0, 1e-9);  // within the cap's plane
+  EXPECT_LT(longest_edge_length(moved), 0.6 * before);
+  EXPECT_EQ(recentre_fans(prism), 0u);  // centres in the middle stay
+  // A cone's apex (valence 16) lies off its ring's plane, over its centre: not moved.
+  ElementMesh cone;
+  for (int i = 0; i < 16; ++i) cone.points.push_back({std::cos(2 * M_PI * i / 16), std::sin(2 * M_PI * i / 16), 0});
+  cone.points.push_back({0, 0, 2});
+  for (int i = 0; i < 16; ++i) cone.tris.push_back({i, (i + 1) % 16, 16});
+  std::vector<std::vector<int>> loops;
+  ASSERT_TRUE(boundary_loops(cone, loops));
+  cap_loop(cone, loops[0]);
+  const P3 apex = cone.points[16];
+  EXPECT_EQ(recentre_fans(cone), 0u);
+  EXPECT_EQ(cone.points[16], apex);
+}
+
 // Handles of an element (remove_broken_rings' test of a ring cut open): a
 // torus 1, a ball 0, a torus cut open and capped 0 (open, uncapped: still 0),
 // two tori as one element 2, an open cylinder (two border loops) 0.

@@ -363,6 +363,8 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   const QuiltVertexMapping vm = map_quilt_vertices(quilt, shell, map, face_uv);
   // Elements as meshes (kFaceElement = element id).
   std::vector<ElementMesh> els = quilt_elements(quilt, vm.pos);
+  if (opt.recentre_caps)
+    for (ElementMesh& e : els) res.caps_recentred += recentre_fans(e);
   mesh_from_elements(els, out);
   if (opt.measure_outside_shell) {
     res.outside_shell = measure_outside_shell(vm.pos, shell, map, opt.outside_shell);

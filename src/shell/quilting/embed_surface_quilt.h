@@ -60,6 +60,9 @@ struct EmbedSurfaceQuiltOptions {
   /// sets SurfaceQuiltOptions::max_edge_stretch times the swatch's longest
   /// edge, scaled.
   double max_edge = 0;
+  /// Cap centres moved back to the middle of their caps (recentre_fans) on the
+  /// embedded elements, before the shard bound and the crossings. Default true.
+  bool recentre_caps = true;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
   OutsideShellOptions outside_shell;
@@ -91,6 +94,8 @@ struct EmbedSurfaceQuiltResult {
   std::size_t crossing_elements_removed_last = 0;
   /// Elements with an embedded edge over max_edge, removed or cut.
   std::size_t elements_stretched_embedded = 0;
+  /// Cap centres moved by recentre_caps.
+  std::size_t caps_recentred = 0;
   /// Embedded vertices outside the geometric shell (the union of the shell's
   /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;

@@ -77,6 +77,7 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
   j["crossing_elements_removed_last"] = er.crossing_elements_removed_last;  // still crossing after the trims: removed
   j["elements_stretched_embedded"] = er.elements_stretched_embedded;  // over the shard bound after the shell map
+  j["caps_recentred"] = er.caps_recentred;
   j["charts"] = er.atlas.num_charts;
   j["tets"] = er.tets;
   j["shell_height"] = er.shell_height;
