@@ -254,6 +254,14 @@ void TriangleDistance::build_cell_lists(double cell, std::size_t max_cells) {
     const P3 centre{b.lo[0] + 0.5 * cell, b.lo[1] + 0.5 * cell, b.lo[2] + 0.5 * cell};
     const double u = (closest(centre).distance + half_diag) * (1 + 1e-9) + 1e-12 * cell;
     I.triangles_near(b, u * u, lists[c]);
+    // Nearest to the centre first: a query then meets a near hit early and
+    // skips the rest by their boxes (the hit does not depend on the order:
+    // ties go to the first triangle of the mesh).
+    std::vector<std::pair<double, int>> by_d;
+    by_d.reserve(lists[c].size());
+    for (int t : lists[c]) by_d.push_back({I.boxes[static_cast<std::size_t>(t)].squared_distance(centre), t});
+    std::sort(by_d.begin(), by_d.end());
+    for (std::size_t m = 0; m < by_d.size(); ++m) lists[c][m] = by_d[m].second;
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 256), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) fill(c);
