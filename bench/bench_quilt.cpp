@@ -31,6 +31,15 @@
 //   --old-defaults: the CLI's defaults and the method before issue 17 (up +Z,
 //   the swatch's z taken as its thin axis, crossings not resolved, no refill,
 //   the stretch bound at 12), for before/after tables.
+//   Environment overrides for experiments (each sets one option of
+//   SurfaceQuiltOptions / QuiltSwatchOnSurfaceOptions; unset = the default):
+//   BENCH_SEED, BENCH_RELATIVE_SIZE, BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS,
+//   BENCH_SCATTER (attempts), BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE,
+//   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
+//   BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
+//   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_STRETCH_ITERS (the
+//   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
+//   quilt before the shell map: feet on the base, height along face normals).
 // The history of the old single-case benchmark is docs/decisions/100-quilt-bench-history.md.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
