@@ -15,27 +15,20 @@
 
 namespace surftex {
 
-void PcaBasis::project(const float* v, float* out) const {
-  // Four directions at a time: four independent sums, each still in index
-  // order (the same floats as one at a time: a product rounded, then a sum
-  // rounded, in both paths), so they overlap in the pipeline instead of
-  // waiting on one chain of additions; with basis4, one SSE lane each.
-  int k = 0;
-  const std::size_t quads = basis4.size() / (4 * static_cast<std::size_t>(dim > 0 ? dim : 1));
+namespace {
+// out[k] for k = k0 .. dims-1: four directions at a time, four independent
+// sums, each still in index order (the same numbers as one at a time: a
+// product rounded, then a sum rounded), so they overlap in the pipeline
+// instead of waiting on one chain of additions.
+template <class T>
+void project_from(const float* v, const std::vector<T>& basis, const std::vector<T>& mean, int dim, int dims, int k0,
+                  T* out) {
+  int k = k0;
   for (; k + 4 <= dims; k += 4) {
-#if defined(__SSE2__)
-    if (static_cast<std::size_t>(k / 4) < quads) {
-      const float* b = &basis4[static_cast<std::size_t>(k / 4) * 4 * dim];
-      __m128 s = _mm_setzero_ps();
-      for (int i = 0; i < dim; ++i) s = _mm_add_ps(s, _mm_mul_ps(_mm_loadu_ps(b + 4 * i), _mm_set1_ps(v[i] - mean[i])));
-      _mm_storeu_ps(out + k, s);
-      continue;
-    }
-#endif
-    const float* b = &basis[static_cast<std::size_t>(k) * dim];
-    float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    const T* b = &basis[static_cast<std::size_t>(k) * dim];
+    T s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     for (int i = 0; i < dim; ++i) {
-      const float d = v[i] - mean[i];
+      const T d = static_cast<T>(v[i]) - mean[i];
       s0 += b[i] * d;
       s1 += b[dim + i] * d;
       s2 += b[2 * dim + i] * d;
@@ -47,37 +40,31 @@ void PcaBasis::project(const float* v, float* out) const {
     out[k + 3] = s3;
   }
   for (; k < dims; ++k) {
-    const float* b = &basis[static_cast<std::size_t>(k) * dim];
-    float s = 0;
-    for (int i = 0; i < dim; ++i) s += b[i] * (v[i] - mean[i]);
+    const T* b = &basis[static_cast<std::size_t>(k) * dim];
+    T s = 0;
+    for (int i = 0; i < dim; ++i) s += b[i] * (static_cast<T>(v[i]) - mean[i]);
     out[k] = s;
   }
+}
+}  // namespace
+
+void PcaBasis::project(const float* v, float* out) const {
+  int k = 0;
+#if defined(__SSE2__)
+  // With basis4, each group of four directions is one SSE lane each (the
+  // same product and sum per lane as project_from's).
+  const std::size_t quads = dim > 0 ? basis4.size() / (4 * static_cast<std::size_t>(dim)) : 0;
+  for (; k + 4 <= dims && static_cast<std::size_t>(k / 4) < quads; k += 4) {
+    const float* b = &basis4[static_cast<std::size_t>(k / 4) * 4 * dim];
+    __m128 s = _mm_setzero_ps();
+    for (int i = 0; i < dim; ++i) s = _mm_add_ps(s, _mm_mul_ps(_mm_loadu_ps(b + 4 * i), _mm_set1_ps(v[i] - mean[i])));
+    _mm_storeu_ps(out + k, s);
+  }
+#endif
+  project_from(v, basis, mean, dim, dims, k, out);
 }
 
-void PcaBasis::project(const float* v, double* out) const {
-  int k = 0;
-  for (; k + 4 <= dims; k += 4) {  // four independent sums, as the float version
-    const double* b = &basis_d[static_cast<std::size_t>(k) * dim];
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    for (int i = 0; i < dim; ++i) {
-      const double d = static_cast<double>(v[i]) - mean_d[i];
-      s0 += b[i] * d;
-      s1 += b[dim + i] * d;
-      s2 += b[2 * dim + i] * d;
-      s3 += b[3 * dim + i] * d;
-    }
-    out[k] = s0;
-    out[k + 1] = s1;
-    out[k + 2] = s2;
-    out[k + 3] = s3;
-  }
-  for (; k < dims; ++k) {
-    const double* b = &basis_d[static_cast<std::size_t>(k) * dim];
-    double s = 0;
-    for (int i = 0; i < dim; ++i) s += b[i] * (static_cast<double>(v[i]) - mean_d[i]);
-    out[k] = s;
-  }
-}
+void PcaBasis::project(const float* v, double* out) const { project_from(v, basis_d, mean_d, dim, dims, 0, out); }
 
 // Samples are summed in blocks of kBlock (one rank-kBlock update of the
 // lower triangle instead of kBlock rank-1 updates: the search index's build

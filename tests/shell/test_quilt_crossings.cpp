@@ -477,6 +477,15 @@ double spread13(const std::vector<Vec3>& pts) {
   return best;
 }
 
+// quilt_surface(base, s, q, o), then the quilt displaced over the base to its
+// full height (surface_quilt_displaced): its faces carry kFaceElement.
+SurfaceQuiltResult quilt_displaced(const Mesh& base, const Swatch& s, const SurfaceQuiltOptions& o, SurfaceQuilt& q,
+                                   Mesh& out) {
+  const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+  surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, out);
+  return r;
+}
+
 // Issue 17 item 2 (Zhou 2006's elements keep their shape): a compact element
 // that merging (2.7) or deformation (2.6) spread wider than max_shape_ratio
 // times the swatch's largest compact element is removed, and its space
@@ -501,9 +510,8 @@ TEST(SurfaceQuiltingShape, CompactElementsSpreadNoWiderThanTheShapeBound) {
     o.relative_size = 0.12;
     o.max_shape_ratio = ratio;
     SurfaceQuilt q;
-    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
     Mesh out;
-    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, out);
+    const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
     const auto el = find(out, kFaceElement).first;
     std::vector<std::vector<Vec3>> pts(static_cast<std::size_t>(q.elements));
     for (FaceIndex f : out.faces())
@@ -770,9 +778,8 @@ TEST(SurfaceQuiltingShards, PebblesAreNotMergedAcrossAWideGap) {
     o.relative_size = 0.05;
     o.blob_loop_gap = gap;
     SurfaceQuilt q;
-    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
     Mesh out;
-    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, out);
+    const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
     const auto el = find(out, kFaceElement).first;
     std::vector<double> worst(static_cast<std::size_t>(q.elements), 0);
     for (FaceIndex f : out.faces()) {
