@@ -292,9 +292,8 @@ json run_case(const std::string& name, const std::string& outdir) {
     qo.min_piece_fraction = 0;
     qo.max_edge_stretch = 12;
   }
-  // Experiments (not the benchmark's figures): BENCH_RELATIVE_SIZE (0 = the default), BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS, BENCH_SCATTER, BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE (degrees), BENCH_SHAPE, BENCH_RINGS (0/1), BENCH_PIECES (fraction),
-  // BENCH_RESOLVE (0/1: both crossing stages), BENCH_TRIM_NEW (0/1), BENCH_PUSH (0/1),
-  // BENCH_CLEARANCE (swatch units; negative = automatic), BENCH_KEEP_CUT (0/1: refused inputs' cut parts kept), BENCH_SEED (the run's seed, default 1: the spread of a figure over seeds).
+  // Experiments (not the benchmark's figures; listed in the header). BENCH_RELATIVE_SIZE 0 = the default size,
+  // BENCH_CLEARANCE in swatch units (negative = automatic), BENCH_SEED the run's seed (default 1).
   if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);

@@ -13,6 +13,7 @@
 #include "geometry/newell.h"
 #include "geometry/properties.h"
 #include "geometry/union_find.h"
+#include "geometry/vec3.h"
 
 namespace surftex {
 namespace {
@@ -193,9 +194,6 @@ void cap_loop(ElementMesh& m, const std::vector<int>& loop) {
 }
 
 std::size_t recentre_fans(ElementMesh& m, int min_valence, double min_offset) {
-  auto point_dist = [](const P3& a, const P3& b) {
-    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-  };
   // (vertex, next, after) per triangle corner: around v, next -> after.
   std::vector<std::array<int, 3>> corners;
   corners.reserve(3 * m.tris.size());
@@ -224,17 +222,13 @@ std::size_t recentre_fans(ElementMesh& m, int min_valence, double min_offset) {
         for (int u : ring) {
           const P3& q = m.points[static_cast<std::size_t>(u)];
           for (int d = 0; d < 3; ++d) mean[d] += q[d] / n;
-          spoke += point_dist(p, q) / n;
+          spoke += vec3::norm(vec3::sub(q, p)) / n;
         }
-        const std::array<double, 3> nn =
+        const P3 nn =
             newell_normal(ring.size(), [&](std::size_t k) -> const P3& { return m.points[static_cast<std::size_t>(ring[k])]; });
-        const double ln = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-        P3 off{mean[0] - p[0], mean[1] - p[1], mean[2] - p[2]};
-        if (ln > 0) {
-          const double a = (off[0] * nn[0] + off[1] * nn[1] + off[2] * nn[2]) / (ln * ln);
-          for (int d = 0; d < 3; ++d) off[d] -= a * nn[d];
-        }
-        if (point_dist(off, P3{0, 0, 0}) > min_offset * spoke) moves.push_back({v, P3{p[0] + off[0], p[1] + off[1], p[2] + off[2]}});
+        P3 off = vec3::sub(mean, p);
+        if (const double ln = vec3::norm(nn); ln > 0) off = vec3::sub(off, vec3::mul(nn, vec3::dot(off, nn) / (ln * ln)));
+        if (vec3::norm(off) > min_offset * spoke) moves.push_back({v, vec3::add(p, off)});
       }
     }
     i = j;

@@ -627,7 +627,7 @@ class SurfaceQuilter {
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
-  bool all_blobs_ = false;     // every swatch element is compact without a handle (pebbles)
+  QuiltStepOptions merge_step_;  // opt_.step, with blob_loop_gap for a swatch of pebbles
   SurfaceQuiltResult res_;
 };
 
@@ -675,9 +675,15 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
-  for (const ElementMesh& m : compact_) ring_handles_ = std::min(ring_handles_, element_genus(m.tris));
-  all_blobs_ = all_compact_;
-  for (const ElementMesh& m : compact_) all_blobs_ = all_blobs_ && element_genus(m.tris) == 0;
+  int most_handles = 0;
+  for (const ElementMesh& m : compact_) {
+    const int g = element_genus(m.tris);
+    ring_handles_ = std::min(ring_handles_, g);
+    most_handles = std::max(most_handles, g);
+  }
+  // A swatch of pebbles: its merges zip only close loops (blob_loop_gap).
+  merge_step_ = opt.step;
+  if (all_compact_ && most_handles == 0 && opt.blob_loop_gap > 0) merge_step_.merge.max_loop_gap = opt.blob_loop_gap;
   processed_.assign(nf_, 0);
   constrained_.assign(nf_, 0);
   patch_slot_.assign(nf_, -1);
@@ -1147,9 +1153,7 @@ void SurfaceQuilter::merge(Patch& p, FrameElements& fe, QuiltGrid& grid, const P
   const std::size_t n_in = fe.mesh.size();
   std::vector<char> alive(n_in, 1);
   QuiltStepStats stats;
-  QuiltStepOptions so = opt_.step;
-  if (all_blobs_ && opt_.blob_loop_gap > 0) so.merge.max_loop_gap = opt_.blob_loop_gap;
-  const QuiltPlacement placed = quilt_step(swatch_, tree_, grid, fe.mesh, alive, rng_, so, stats);
+  const QuiltPlacement placed = quilt_step(swatch_, tree_, grid, fe.mesh, alive, rng_, merge_step_, stats);
   res_.stats.add(stats);
   auto to_loc = [&](const P3& q) {
     auto it = fe.keep_loc.find(q);
