@@ -24,7 +24,7 @@
 //   CPU seconds.
 // Usage: bench_quilt [CASE ...] [--out DIR]
 //   CASE = mesh:swatch (e.g. bunny:weave; meshes bunny, koala, knot or a file name of shared/data/meshes such as elephant.off; swatches
-//   weave, chainmail, tori, rock) or bunny5k (the issue 8 benchmark: CGAL's
+//   weave, chainmail, tori, rock or a file name of shared/data/swatches such as wingnut.obj) or bunny5k (the issue 8 benchmark: CGAL's
 //   bunny00.off decimated to about 5K faces, weave at relative size 0.12; goals
 //   <= 60 s and stretch <= 1.05). No CASE: the 12 cases of the matrix.
 //   --out DIR: writes DIR/<case>.glb and DIR/<case>.png (base + quilt).
@@ -146,7 +146,9 @@ Mesh make_named_swatch(const std::string& kind) {
   else if (kind == "chainmail") make_chainmail_swatch(sm);
   else if (kind == "tori") make_tori_swatch(sm);
   else if (kind == "rock") read_mesh(std::string(SURFTEX_SHARED_DATA_DIR) + "/swatches/rock_1.obj", sm);
-  else throw InvalidInputError("bench_quilt: unknown swatch '" + kind + "' (weave, chainmail, tori, rock)");
+  else if (kind.find('.') != std::string::npos)  // any other swatch of shared/data/swatches, by file name
+    read_mesh(std::string(SURFTEX_SHARED_DATA_DIR) + "/swatches/" + kind, sm);
+  else throw InvalidInputError("bench_quilt: unknown swatch '" + kind + "' (weave, chainmail, tori, rock or a file of shared/data/swatches)");
   return sm;
 }
 
