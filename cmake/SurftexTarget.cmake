@@ -39,11 +39,20 @@ function(surftex_add_module name)
   endif()
 endfunction()
 
-# SURFTEX_PCH: one precompiled header per target, made of the headers most of
-# its sources include (docs/decisions/504-first-build.md, 801-ci-time.md).
+# SURFTEX_PCH: one precompiled header for the whole build, made by
+# surftex_geometry (CGAL's kernel and Surface_mesh, Eigen, nlohmann/json: the
+# headers most sources include) and reused by every other target. GCC's
+# precompiled header of mesh.h alone is about 560 MB; one per target filled the
+# CI machine's disk (docs/decisions/504-first-build.md, 801-ci-time.md).
+set(SURFTEX_PCH_HEADERS "${PROJECT_SOURCE_DIR}/src/geometry/mesh.h" <Eigen/Dense> <nlohmann/json.hpp>)
 function(surftex_precompile target)
-  if(SURFTEX_PCH)
-    target_precompile_headers(${target} PRIVATE ${ARGN})
+  if(NOT SURFTEX_PCH)
+    return()
+  endif()
+  if(target STREQUAL "surftex_geometry")
+    target_precompile_headers(${target} PRIVATE ${SURFTEX_PCH_HEADERS})
+  else()
+    target_precompile_headers(${target} REUSE_FROM surftex_geometry)
   endif()
 endfunction()
 
