@@ -56,6 +56,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unordered_map>
@@ -68,6 +69,7 @@
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/render_view.h"
+#include "geometry/self_intersections.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
 #include "shell/quilting/quilt_driver.h"
@@ -385,6 +387,15 @@ json run_case(const std::string& name, const std::string& outdir) {
       Mesh lifted;
       surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, lifted);
       write_mesh(outdir + "/" + stem + "_lifted.glb", lifted);
+      // Its crossings within elements: made by quilting (before the shell map).
+      auto el = lifted.property_map<FaceIndex, int>(kFaceElement.name).first;
+      std::map<int, std::size_t> within;
+      for (const FacePair& fp : self_intersecting_faces(lifted))
+        if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])]) ++within[el[FaceIndex(fp[0])]];
+      std::size_t sum = 0;
+      for (const auto& [e, n] : within) sum += n;
+      j["lifted_pairs_within"] = sum;
+      j["lifted_elements_crossing_themselves"] = within.size();
     }
     Mesh scene;
     surface_quilt_scene(base, out, scene);

@@ -205,6 +205,8 @@ void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Me
   if (!si.is_null())
     what = si.dump() + " intersecting face pairs (" + rep["self_intersections_within_elements"].dump() +
            " within elements, " + rep["self_intersections_between_elements"].dump() + " between)";
+  if (rep.value("elements_self_crossing_kept", 0) > 0)
+    what += ", of which the swatch's own crossings in " + rep["elements_self_crossing_kept"].dump() + " elements";
   std::fprintf(stderr, "quilt: stretch %.4f -> %.4f, self-intersections %s\n",
                rep["stretch_before"].get<double>(), rep["stretch_after"].get<double>(), what.c_str());
 }

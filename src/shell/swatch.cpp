@@ -12,6 +12,7 @@
 #include "geometry/mesh.h"
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
+#include "geometry/self_intersections.h"
 #include "shell/element_clearance.h"
 
 namespace surftex {
@@ -153,6 +154,17 @@ std::vector<ElementMesh> swatch_element_meshes(const Swatch& s) {
   out.reserve(n);
   for (const std::vector<int>& t : tris) out.push_back(extract_triangles(s.mesh, t));
   return out;
+}
+
+std::size_t swatch_element_self_crossings(const Swatch& s) {
+  Mesh m;
+  mesh_from_elements({s.mesh}, m);  // face t = triangle t
+  std::vector<std::size_t> per(s.elements.size(), 0);
+  for (const FacePair& p : self_intersecting_faces(m)) {
+    const int a = s.face_element[p[0]], b = s.face_element[p[1]];
+    if (a == b) ++per[static_cast<std::size_t>(a)];
+  }
+  return per.empty() ? 0 : *std::max_element(per.begin(), per.end());
 }
 
 ElementMesh swatch_element(const Swatch& s, int e) {

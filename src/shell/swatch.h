@@ -74,6 +74,10 @@ Swatch load_swatch(const std::string& path);
 std::vector<ElementMesh> swatch_element_meshes(const Swatch& swatch);
 /// The triangles of element `e` as their own ElementMesh.
 ElementMesh swatch_element(const Swatch& swatch, int e);
+/// The most self-intersecting face pairs (exact) within one element of the
+/// swatch: 0 for a clean swatch; a scanned object may have a few (wingnut.obj
+/// 3), which every copy of the element carries into a quilt.
+std::size_t swatch_element_self_crossings(const Swatch& swatch);
 
 /// Writes kFaceElement on `mesh` = connected component id (in order of first
 /// face) and returns the number of components.

@@ -801,5 +801,48 @@ TEST(SurfaceQuiltingShards, PebblesAreNotMergedAcrossAWideGap) {
   EXPECT_LT(bare_on, 0.02);
 }
 
+// A swatch element that crosses itself (a scan such as wingnut.obj has a few
+// such pairs): every copy carries them, and the embedding's crossing
+// resolution leaves them (EmbedSurfaceQuiltOptions::swatch_self_crossings)
+// instead of removing every copy (wingnut.obj on spot.ply: 2 pieces left).
+TEST(SurfaceQuiltingCrossings, CopiesOfASelfCrossingElementKeepItsOwnCrossings) {
+  Mesh base, rock;
+  make_icosphere(base, 3);
+  read_mesh(test::shared_data("swatches/rock_1.obj"), rock);
+  // The top vertex pushed down through the bottom: its fan pierces it.
+  VertexIndex top = *rock.vertices().begin();
+  double zmin = 1e300;
+  for (VertexIndex v : rock.vertices()) {
+    if (rock.point(v).z() > rock.point(top).z()) top = v;
+    zmin = std::min(zmin, rock.point(v).z());
+  }
+  const Point3 p = rock.point(top);
+  rock.point(top) = Point3(p.x(), p.y(), zmin - 0.05 * (p.z() - zmin));
+  const Swatch s = make_swatch(rock);
+  const std::size_t own = swatch_element_self_crossings(s);
+  ASSERT_GT(own, 0u);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.05;
+  SurfaceQuilt q;
+  quilt_surface(base, s, q, o);
+  auto embed = [&](std::size_t tolerated, Mesh& out) {
+    EmbedSurfaceQuiltOptions eo;
+    eo.swatch_self_crossings = tolerated;
+    const EmbedSurfaceQuiltResult r = embed_surface_quilt(base, q, out, eo);
+    std::cout << "[ own crossings ] " << own << " in the swatch, tolerated " << tolerated << ": " << out.number_of_faces()
+              << " faces, " << r.elements_self_crossing_kept << " elements keep theirs, pairs within "
+              << r.self_intersections_within << " between " << r.self_intersections_between << "\n";
+    return r;
+  };
+  Mesh strict, kept;
+  const EmbedSurfaceQuiltResult rs = embed(0, strict);
+  const EmbedSurfaceQuiltResult rk = embed(own, kept);
+  EXPECT_EQ(rs.self_intersections_within + rs.self_intersections_between, 0u);
+  EXPECT_GT(rk.elements_self_crossing_kept, 0u);
+  EXPECT_EQ(rk.self_intersections_between, 0u);
+  EXPECT_LE(rk.self_intersections_within, own * rk.elements_self_crossing_kept);
+  EXPECT_GT(kept.number_of_faces(), 2 * strict.number_of_faces());
+}
+
 }  // namespace
 }  // namespace surftex

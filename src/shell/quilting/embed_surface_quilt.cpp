@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -284,6 +285,26 @@ void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::ve
   if (changed) res.elements_stretched_embedded += cut_or_remove(bad, false, max_edge, compact, els, out);
 }
 
+/// The pairs to resolve: those between two elements, and those within an
+/// element that has more than `own` of them (at most `own` are the swatch
+/// element's own crossings, which the copy keeps); `kept` = elements keeping theirs.
+std::vector<FacePair> pairs_to_resolve(const std::vector<FacePair>& pairs, const Mesh& out, std::size_t own,
+                                       std::size_t& kept) {
+  kept = 0;
+  if (own == 0) return pairs;
+  auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
+  std::map<int, std::size_t> within;
+  for (const FacePair& fp : pairs)
+    if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])]) ++within[el[FaceIndex(fp[0])]];
+  std::vector<FacePair> act;
+  for (const FacePair& fp : pairs) {
+    const int a = el[FaceIndex(fp[0])];
+    if (a != el[FaceIndex(fp[1])] || within[a] > own) act.push_back(fp);
+  }
+  for (const auto& [e, n] : within) kept += n <= own ? 1 : 0;
+  return act;
+}
+
 /// Resolution rounds when asked (a cut piece's cap may meet another element),
 /// each reusing the exact check that the count reports; what still crosses
 /// after opt.crossing_trim_rounds is removed whole (removing adds no crossing, so none is
@@ -292,7 +313,7 @@ void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::ve
 void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQuiltOptions& opt,
                                  std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<FacePair> pairs;
-  bool checked = false;
+  bool checked = false, checked_whole = false;
   // After a resolution round: its cut pieces. Every pair of the round's check
   // changed an element it met, so two elements kept as they were cannot cross
   // (nor one itself): the next check needs only the pieces and what they may
@@ -304,15 +325,24 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
       pairs = round == 0 ? self_intersecting_faces(out)
                          : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
       checked = true;
-      if (pairs.empty()) break;
-      resolve_embedded_crossings(pairs, compact, round == trim_rounds, opt.max_edge, els, out, res, fresh);
+      checked_whole = round == 0;
+      const std::vector<FacePair> act =
+          pairs_to_resolve(pairs, out, opt.swatch_self_crossings, res.elements_self_crossing_kept);
+      if (act.empty()) break;
+      resolve_embedded_crossings(act, compact, round == trim_rounds, opt.max_edge, els, out, res, fresh);
       checked = false;
     }
   }
   if (opt.check_self_intersections) {
-    if (!checked)  // after the last round (which removes, so nothing is fresh), or with no resolution
-      pairs = fresh.empty() ? self_intersecting_faces(out)
-                            : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
+    // After the last round (which removes, so nothing is fresh), or with no
+    // resolution. Elements keeping their own crossings are not fresh but
+    // cross: with them, the count is of the whole mesh.
+    const bool own = opt.swatch_self_crossings > 0;
+    if (!checked || (own && !checked_whole)) {
+      pairs = fresh.empty() || own ? self_intersecting_faces(out)
+                                   : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
+      pairs_to_resolve(pairs, out, opt.swatch_self_crossings, res.elements_self_crossing_kept);
+    }
     auto el = out.property_map<FaceIndex, int>(kFaceElement.name).first;
     for (const FacePair& fp : pairs) {
       if (el[FaceIndex(fp[0])] == el[FaceIndex(fp[1])])

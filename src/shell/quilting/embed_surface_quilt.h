@@ -52,6 +52,11 @@ struct EmbedSurfaceQuiltOptions {
   bool resolve_crossings = true;
   /// Rounds that cut and cap crossing threads before the removal; 0..8, default 3.
   int crossing_trim_rounds = 3;
+  /// The swatch's own crossings (swatch_element_self_crossings): an element
+  /// with at most this many self-intersecting pairs within itself keeps them
+  /// (every copy of a swatch element carries the element's); one with more is
+  /// resolved as above. quilt_swatch_on_surface sets it; default 0.
+  std::size_t swatch_self_crossings = 0;
   /// The shard bound held again on the embedded elements, mesh units (0 =
   /// none, the default): an element with a longer edge (the shell map
   /// stretches what was within the bound lifted) is removed if compact, else
@@ -92,6 +97,9 @@ struct EmbedSurfaceQuiltResult {
   std::size_t crossing_elements = 0;
   /// Of those, removed whole because they still crossed after the trimming rounds.
   std::size_t crossing_elements_removed_last = 0;
+  /// Elements that kept their own crossings (EmbedSurfaceQuiltOptions::swatch_self_crossings),
+  /// counted at the last check.
+  std::size_t elements_self_crossing_kept = 0;
   /// Elements with an embedded edge over max_edge, removed or cut.
   std::size_t elements_stretched_embedded = 0;
   /// Cap centres moved by recentre_caps.

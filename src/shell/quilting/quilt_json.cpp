@@ -102,6 +102,8 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
     j["self_intersections"] = er.embed.self_intersecting_pairs;
     j["self_intersections_within_elements"] = er.self_intersections_within;
     j["self_intersections_between_elements"] = er.self_intersections_between;
+    // Elements keeping the swatch element's own crossings (within-element pairs).
+    j["elements_self_crossing_kept"] = er.elements_self_crossing_kept;
   } else {
     j["self_intersections"] = nullptr;
   }
