@@ -197,7 +197,11 @@ void write_quilt_outputs(const QuiltArgs& a, const std::vector<std::string>& out
 // The summary lines on stderr (unless --quiet).
 void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Mesh& out, double seconds) {
   if (a.common.quiet) return;
-  std::fprintf(stderr, "quilt: %d elements, %zu faces (%.1f s) -> %s\n", rep["elements"].get<int>(),
+  std::string elements = std::to_string(rep["elements"].get<int>()) + " elements";
+  if (rep.contains("elements_embedded") && rep["elements_embedded"] != rep["elements"])
+    elements = rep["elements_embedded"].dump() + " elements (" + std::to_string(rep["elements"].get<int>()) +
+               " quilted; the embedding removed or cut those that crossed or stretched)";
+  std::fprintf(stderr, "quilt: %s, %zu faces (%.1f s) -> %s\n", elements.c_str(),
                static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
   if (!rep.contains("stretch_before")) return;
   const auto& si = rep["self_intersections"];

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <set>
 #include <string>
 
 #include "geometry/errors.h"
@@ -177,6 +178,10 @@ TEST(QuiltDriver, SurfaceDriverIsTheQuiltThenTheEmbeddingColouredAndReportsItsOp
   EXPECT_EQ(j["faces"], out.number_of_faces());
   EXPECT_EQ(j["base_faces"], base.number_of_faces());
   EXPECT_TRUE(j["self_intersections"].is_null());  // not checked
+  // The output's elements (the embedding may remove or cut some), beside the quilt's.
+  std::set<int> ids;
+  for (FaceIndex f : out.faces()) ids.insert(find(out, kFaceElement).first[f]);
+  EXPECT_EQ(j["elements_embedded"], ids.size());
   for (const char* key : {"vertices", "swatch_faces", "swatch_elements", "stretch_after", "stitched", "seconds"})
     EXPECT_TRUE(j.contains(key)) << key;
 

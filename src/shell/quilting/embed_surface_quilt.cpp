@@ -404,6 +404,7 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   std::vector<char> compact = quilt.element_compact;
   remove_embedded_shards(opt.max_edge, compact, els, out, res);
   resolve_and_count_crossings(compact, opt, els, out, res);
+  res.elements = els.size();
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);
   return res;

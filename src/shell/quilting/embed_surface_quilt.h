@@ -104,6 +104,9 @@ struct EmbedSurfaceQuiltResult {
   std::size_t elements_stretched_embedded = 0;
   /// Cap centres moved by recentre_caps.
   std::size_t caps_recentred = 0;
+  /// Elements in `out` (the quilt's, less those the shard bound and the
+  /// crossing resolution removed, plus the pieces they cut).
+  std::size_t elements = 0;
   /// Embedded vertices outside the geometric shell (the union of the shell's
   /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;

@@ -83,6 +83,7 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["shell_height"] = er.shell_height;
   j["clamped_vertices"] = er.clamped_vertices;
   if (er.unfolded_vertices > 0) j["unfolded_vertices"] = er.unfolded_vertices;  // only when a fold was undone
+  j["elements_embedded"] = er.elements;  // in the output (elements: the quilt's)
   j["stretch_before"] = er.stretch.stretch_before;
   j["stretch_after"] = er.stretch.stretch_after;
   j["outside_vertices"] = er.embed.outside;
