@@ -467,9 +467,11 @@ class FootGrid {
   std::unordered_map<long long, std::vector<P3>> grid_;
 };
 
-// A base face is bare if two or more of four sample points (its centroid and
-// its corner triangles' centroids) have no foot within the grid's radius.
-bool face_is_bare(const Base& b, int f, const FootGrid& feet) {
+// Of four sample points of a base face (its centroid and its corner
+// triangles' centroids), how many have no foot within the grid's radius: a
+// quarter of the face's area each in the bare area; the face is bare (to be
+// refilled or scattered into) if two or more are.
+int bare_samples(const Base& b, int f, const FootGrid& feet) {
   const auto& t = b.faces[f];
   int nbare = feet.covered(b.centroid[f]) ? 0 : 1;
   for (int k = 0; k < 3; ++k) {
@@ -477,8 +479,9 @@ bool face_is_bare(const Base& b, int f, const FootGrid& feet) {
     const P3 s{(4 * a[0] + b1[0] + b2[0]) / 6, (4 * a[1] + b1[1] + b2[1]) / 6, (4 * a[2] + b1[2] + b2[2]) / 6};
     nbare += feet.covered(s) ? 0 : 1;
   }
-  return nbare >= 2;
+  return nbare;
 }
+bool face_is_bare(const Base& b, int f, const FootGrid& feet) { return bare_samples(b, f, feet) >= 2; }
 
 // The largest extent of `pts` along 13 directions (the axes, the face and
 // the body diagonals of a cube): the diameter within about 10%, whatever the
@@ -582,14 +585,16 @@ class SurfaceQuilter {
   void drift(const Patch& p);
   P3 lifted(const SurfaceQuiltVertex& v) const;
   ElementMesh lifted_mesh(const Element& el) const;
-  FootGrid element_feet() const;
+  FootGrid element_feet(bool without_fragments = false) const;
   bool place_scatter_element(const Patch& p, const PatchLocator& loc, const ElementMesh& tpl, int quarter, const V2& offset,
                              ElementCollider& coll, Element& el);
   void fit_z(Element& el);
   void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
   void remove_misshapen();
-  std::vector<char> bare_faces() const;
+  std::vector<char> bare_faces(bool without_fragments = false) const;  // bare_samples per face
+  bool is_fragment(const Element& el) const;
+  double bare_area_fraction(const std::vector<char>& bare) const;
 
   const Mesh& mesh_;
   const Swatch& swatch_;
@@ -1618,21 +1623,36 @@ void SurfaceQuilter::finish() {
   res_.seconds_finish += t.seconds();
 }
 
-// Base faces at least half bare: of four sample points (the centroid and the
-// corner triangles' centroids) two or more have no element vertex's foot
-// within half the swatch's element spacing (swatch_element_spacing, scaled).
-FootGrid SurfaceQuilter::element_feet() const {
+// The feet of the live elements' vertices, for bare_samples: radius half the
+// swatch's element spacing (swatch_element_spacing, scaled).
+FootGrid SurfaceQuilter::element_feet(bool without_fragments) const {
   FootGrid feet(0.5 * swatch_element_spacing(swatch_) * S_);
   for (const Element& el : elements_)
-    if (el.alive)
+    if (el.alive && !(without_fragments && is_fragment(el)))
       for (const auto& v : el.loc) feet.add(base_point(b_, v));
   return feet;
 }
 
-std::vector<char> SurfaceQuilter::bare_faces() const {
-  const FootGrid feet = element_feet();
+// Fragments (pieces of cut elements, outer parts split off at a broken
+// seam) smaller than a tenth of the swatch's smallest element are no
+// elements: emit leaves them out, and they cover nothing. At least 4 faces,
+// never more than the smallest element has (a one-triangle swatch's elements stay).
+bool SurfaceQuilter::is_fragment(const Element& el) const {
+  std::size_t smallest = std::numeric_limits<std::size_t>::max();
+  for (const SwatchElement& e : swatch_.elements) smallest = std::min(smallest, e.faces);
+  return el.mesh.tris.size() < std::min(smallest, std::max<std::size_t>(4, smallest / 10));
+}
+
+double SurfaceQuilter::bare_area_fraction(const std::vector<char>& bare) const {
+  double a = 0, ab = 0;
+  for (int f = 0; f < nf_; ++f) a += b_.area[f], ab += 0.25 * bare[static_cast<std::size_t>(f)] * b_.area[f];
+  return a > 0 ? ab / a : 0;
+}
+
+std::vector<char> SurfaceQuilter::bare_faces(bool without_fragments) const {
+  const FootGrid feet = element_feet(without_fragments);
   std::vector<char> bare(static_cast<std::size_t>(nf_), 0);
-  for (int f = 0; f < nf_; ++f) bare[static_cast<std::size_t>(f)] = face_is_bare(b_, f, feet);
+  for (int f = 0; f < nf_; ++f) bare[static_cast<std::size_t>(f)] = static_cast<char>(bare_samples(b_, f, feet));
   return bare;
 }
 
@@ -1645,7 +1665,7 @@ std::size_t SurfaceQuilter::refill() {
   const std::vector<char> bare = bare_faces();
   std::size_t n = 0;
   for (int f = 0; f < nf_; ++f) {
-    if (!bare[static_cast<std::size_t>(f)] || !processed_[f]) continue;
+    if (bare[static_cast<std::size_t>(f)] < 2 || !processed_[f]) continue;
     processed_[f] = 0;
     --done_;
     for (int g : b_.vertex_nb[f]) --constrained_[g];
@@ -1752,16 +1772,9 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
   out.scale = S_;
   out.z_min = swatch_.bbox_min[2];
   out.z_max = swatch_.bbox_max[2];
-  // Fragments (pieces of cut elements, outer parts split off at a broken
-  // seam) smaller than a tenth of the swatch's smallest element are no
-  // elements: they are left out (counted). At least 4 faces, never more
-  // than the smallest element has (a one-triangle swatch's elements stay).
-  std::size_t smallest = std::numeric_limits<std::size_t>::max();
-  for (const SwatchElement& e : swatch_.elements) smallest = std::min(smallest, e.faces);
-  const std::size_t min_faces = std::min(smallest, std::max<std::size_t>(4, smallest / 10));
   for (Element& el : elements_) {
     if (!el.alive || el.mesh.tris.empty()) continue;
-    if (el.mesh.tris.size() < min_faces) {
+    if (is_fragment(el)) {
       ++res_.fragments_removed;
       continue;
     }
@@ -1806,13 +1819,8 @@ SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
     scatter_into_bare();
     res_.seconds_finish += ts.seconds();
   }
-  res_.bare_fraction = 0;
-  {
-    const std::vector<char> bare = bare_faces();
-    double a = 0, ab = 0;
-    for (int f = 0; f < nf_; ++f) a += b_.area[f], ab += bare[static_cast<std::size_t>(f)] ? b_.area[f] : 0.0;
-    res_.bare_fraction = a > 0 ? ab / a : 0;
-  }
+  // Of the output: without the fragments emit leaves out.
+  res_.bare_fraction = bare_area_fraction(bare_faces(true));
   emit(out);
   res_.elements = out.elements;
   res_.faces = out.tris.size();

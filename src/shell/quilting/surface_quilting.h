@@ -218,10 +218,13 @@ struct SurfaceQuiltResult {
   std::size_t finish_elements_checked = 0;
   /// Output pieces left out for being smaller than a tenth of the swatch's smallest element.
   std::size_t fragments_removed = 0;
-  /// Base faces reopened by refill_rounds; bare area fraction at the end.
+  /// Base faces reopened by refill_rounds.
   std::size_t faces_refilled = 0;
   /// Single compact elements placed by the scatter fill (scatter_attempts).
   std::size_t scatter_placed = 0;
+  /// Bare area fraction at the end: a quarter of a face's area for each of
+  /// four sample points (centroid, corner triangles' centroids) with no
+  /// element foot within half the swatch's element spacing (issue 17 item 4).
   double bare_fraction = 0;
   /// Elements and vertices fitted into the z range; its growth below / above (swatch units).
   std::size_t z_fitted_elements = 0, z_fitted_vertices = 0;
