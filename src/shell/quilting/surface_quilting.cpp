@@ -633,6 +633,7 @@ class SurfaceQuilter {
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
   QuiltStepOptions merge_step_;  // opt_.step, with blob_loop_gap for a swatch of pebbles
+  std::size_t fragment_faces_ = 0;  // elements with fewer faces are fragments (constructor)
   SurfaceQuiltResult res_;
 };
 
@@ -686,6 +687,13 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     ring_handles_ = std::min(ring_handles_, g);
     most_handles = std::max(most_handles, g);
   }
+  // Fragments (pieces of cut elements, outer parts split off at a broken
+  // seam) smaller than a tenth of the swatch's smallest element are no
+  // elements. At least 4 faces, never more than the smallest element has (a
+  // one-triangle swatch's elements stay).
+  std::size_t smallest = std::numeric_limits<std::size_t>::max();
+  for (const SwatchElement& e : swatch.elements) smallest = std::min(smallest, e.faces);
+  fragment_faces_ = std::min(smallest, std::max<std::size_t>(4, smallest / 10));
   // A swatch of pebbles: its merges zip only close loops (blob_loop_gap).
   merge_step_ = opt.step;
   if (all_compact_ && most_handles == 0 && opt.blob_loop_gap > 0) merge_step_.merge.max_loop_gap = opt.blob_loop_gap;
@@ -1633,15 +1641,8 @@ FootGrid SurfaceQuilter::element_feet(bool without_fragments) const {
   return feet;
 }
 
-// Fragments (pieces of cut elements, outer parts split off at a broken
-// seam) smaller than a tenth of the swatch's smallest element are no
-// elements: emit leaves them out, and they cover nothing. At least 4 faces,
-// never more than the smallest element has (a one-triangle swatch's elements stay).
-bool SurfaceQuilter::is_fragment(const Element& el) const {
-  std::size_t smallest = std::numeric_limits<std::size_t>::max();
-  for (const SwatchElement& e : swatch_.elements) smallest = std::min(smallest, e.faces);
-  return el.mesh.tris.size() < std::min(smallest, std::max<std::size_t>(4, smallest / 10));
-}
+// Fragments: emit leaves them out, and they cover nothing (fragment_faces_).
+bool SurfaceQuilter::is_fragment(const Element& el) const { return el.mesh.tris.size() < fragment_faces_; }
 
 double SurfaceQuilter::bare_area_fraction(const std::vector<char>& bare) const {
   double a = 0, ab = 0;
