@@ -200,7 +200,9 @@ void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Me
   std::string elements = std::to_string(rep["elements"].get<int>()) + " elements";
   if (rep.contains("elements_embedded") && rep["elements_embedded"] != rep["elements"])
     elements = rep["elements_embedded"].dump() + " elements (" + std::to_string(rep["elements"].get<int>()) +
-               " quilted; the embedding removed or cut those that crossed or stretched)";
+               (rep.value("scatter_only", false) ? " placed" : " quilted") +
+               "; the embedding removed or cut those that crossed or stretched)";
+  if (rep.value("scatter_only", false)) elements += ", whole copies of the swatch's one element";
   std::fprintf(stderr, "quilt: %s, %zu faces (%.1f s) -> %s\n", elements.c_str(),
                static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
   if (!rep.contains("stretch_before")) return;
@@ -249,8 +251,9 @@ SubcommandRegistrar reg_quilt{
        auto a = std::make_shared<QuiltArgs>();
        app.add_option("mesh", a->base, "Base mesh (OFF/OBJ/PLY/STL) or, with --plane, the swatch");
        app.add_option("swatch", a->swatch,
-                      "Swatch: a mesh file (elements = connected components; its thin axis, see --swatch-up, "
-                      "becomes the height over the surface) or chainmail, weave, scatter or tori to generate one "
+                      "Swatch: a mesh file (elements = connected components, those passing through each other "
+                      "joined; its thin axis, see --swatch-up, becomes the height over the surface; a swatch of "
+                      "one compact element is scattered as whole copies, not quilted) or chainmail, weave, scatter or tori to generate one "
                       "(seeded by --seed)");
        app.add_option("--swatch-up", a->swatch_up,
                       "The swatch's thin axis, which stands on the surface normal: auto (the axis of the smallest "

@@ -13,9 +13,40 @@
 #include "geometry/properties.h"
 #include "geometry/read_mesh.h"
 #include "geometry/self_intersections.h"
+#include "geometry/union_find.h"
 #include "shell/element_clearance.h"
 
 namespace surftex {
+
+namespace {
+
+// Components of `m` that pass through each other (an exact self-intersection
+// between two of them) joined into one element: a scanned or modelled group
+// such as apples sunk into their bowl is one element to quilting, which
+// copies, merges and removes elements whole (Zhou 2.5-2.7) and would resolve
+// the copies' crossings by dropping the apples. Relabels `face_element`
+// (components of triangle_components, 0..n-1) in order of first face and
+// returns the number of elements.
+int group_crossing_components(const ElementMesh& m, std::vector<int>& face_element, int n) {
+  if (n < 2) return n;
+  Mesh whole;
+  mesh_from_elements({m}, whole);  // face t = triangle t
+  UnionFind<int> groups(static_cast<std::size_t>(n));
+  bool joined = false;
+  for (const FacePair& p : self_intersecting_faces(whole))
+    joined |= groups.unite(face_element[p[0]], face_element[p[1]]);
+  if (!joined) return n;
+  std::vector<int> relabel(static_cast<std::size_t>(n), -1);
+  int count = 0;
+  for (int& e : face_element) {
+    int& r = relabel[static_cast<std::size_t>(groups.find(e))];
+    if (r < 0) r = count++;
+    e = r;
+  }
+  return count;
+}
+
+}  // namespace
 
 Swatch make_swatch(const Mesh& mesh) {
   if (mesh.number_of_faces() == 0) throw InvalidInputError("swatch: the mesh has no faces");
@@ -31,7 +62,8 @@ Swatch make_swatch(const Mesh& mesh) {
   }
   Swatch s;
   s.mesh = element_mesh_from(mesh);
-  const int n = triangle_components(s.mesh, s.face_element);
+  s.components = triangle_components(s.mesh, s.face_element);
+  const int n = group_crossing_components(s.mesh, s.face_element, s.components);
   s.elements.assign(static_cast<std::size_t>(n), SwatchElement{});
   const std::vector<ElementMesh> els = swatch_element_meshes(s);
   s.bbox_min = {1e300, 1e300, 1e300};

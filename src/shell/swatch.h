@@ -30,6 +30,9 @@ struct Swatch {
   ElementMesh mesh;                   ///< all triangles of the swatch
   std::vector<int> face_element;      ///< element id per triangle (kFaceElement), 0..elements-1
   std::vector<SwatchElement> elements;
+  /// Connected components of the mesh; more than elements when components
+  /// that pass through each other were joined into one element (make_swatch).
+  int components = 0;
   P3 bbox_min{0, 0, 0}, bbox_max{0, 0, 0};
   double mean_edge_length = 0;
   /// The smallest distance between two elements (vertex to triangle; 0 for
@@ -43,7 +46,8 @@ struct Swatch {
   double height() const { return bbox_max[2] - bbox_min[2]; }  ///< h_in (z)
 };
 
-/// Builds a swatch: elements = connected components (by first face). Throws
+/// Builds a swatch: elements = connected components (by first face), those
+/// that pass through each other (an exact crossing) joined into one. Throws
 /// InvalidInputError for no face, a non-triangle, a non-finite coordinate or a
 /// zero xy extent; a flat swatch is accepted here (embedding refuses it).
 Swatch make_swatch(const Mesh& mesh);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <iostream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "geometry/disc_chart.h"
@@ -558,6 +559,7 @@ TEST(SurfaceQuiltingShape, CompactElementsSpreadNoWiderThanTheShapeBound) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.12;
     o.max_shape_ratio = ratio;
+    o.scatter_single_element = false;  // quilted, not scattered
     SurfaceQuilt q;
     Mesh out;
     const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
@@ -793,6 +795,7 @@ TEST(SurfaceQuiltingShards, NoSmallPieceOfAPebbleIsLeft) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.15;
     o.min_piece_fraction = fraction;
+    o.scatter_single_element = false;  // quilted, not scattered
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
     int small = 0;
@@ -826,6 +829,7 @@ TEST(SurfaceQuiltingShards, PebblesAreNotMergedAcrossAWideGap) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.05;
     o.blob_loop_gap = gap;
+    o.scatter_single_element = false;  // quilted, not scattered
     SurfaceQuilt q;
     Mesh out;
     const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
@@ -891,6 +895,42 @@ TEST(SurfaceQuiltingCrossings, CopiesOfASelfCrossingElementKeepItsOwnCrossings) 
   EXPECT_EQ(rk.self_intersections_between, 0u);
   EXPECT_LE(rk.self_intersections_within, own * rk.elements_self_crossing_kept);
   EXPECT_GT(kept.number_of_faces(), 2 * strict.number_of_faces());
+}
+
+// A swatch of one compact element (a pebble): the quilting's overlapping
+// copies of it were cut where they overlap and merged, leaving jagged pieces
+// (rock_1 on spot.ply: 435 inputs kept cut) or, for a large thin element
+// (wingnut.obj), folded ones that the embedding removed (20 of 226 left).
+// Placed whole by the scatter alone (scatter_single_element), every output
+// element is a whole copy: as many faces as the swatch.
+TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
+  Mesh base, rock;
+  make_icosphere(base, 4);
+  read_mesh(test::shared_data("swatches/rock_1.obj"), rock);
+  const Swatch s = make_swatch(rock);
+  ASSERT_EQ(s.elements.size(), 1u);
+  auto run = [&](bool single) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.05;
+    o.scatter_single_element = single;
+    SurfaceQuilt q;
+    Mesh out;
+    const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
+    const auto el = find(out, kFaceElement).first;
+    std::vector<std::size_t> faces(static_cast<std::size_t>(q.elements), 0);
+    for (FaceIndex f : out.faces()) ++faces[static_cast<std::size_t>(el[f])];
+    const auto whole = std::count(faces.begin(), faces.end(), s.mesh.tris.size());
+    std::cout << "[ one element ] scatter only " << single << ": " << q.elements << " elements, " << whole
+              << " whole, bare " << r.bare_fraction << "\n";
+    EXPECT_EQ(r.scatter_only, single);
+    return std::make_tuple(q.elements, static_cast<int>(whole), r.bare_fraction);
+  };
+  const auto [n_quilted, whole_quilted, bare_quilted] = run(false);
+  const auto [n, whole, bare] = run(true);
+  EXPECT_LT(whole_quilted, n_quilted);  // cut and merged pieces
+  EXPECT_GT(n, 50);
+  EXPECT_EQ(whole, n);
+  EXPECT_LT(bare, 0.03);
 }
 
 }  // namespace

@@ -63,6 +63,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["fragments_removed"] = r.fragments_removed;
   j["faces_refilled"] = r.faces_refilled;
   j["scatter_placed"] = r.scatter_placed;
+  j["scatter_only"] = r.scatter_only;
   j["bare_fraction"] = r.bare_fraction;
   j["elements_not_expressible"] = r.elements_not_expressible;
   j["elements_not_expressed"] = r.elements_not_expressed;
@@ -137,6 +138,7 @@ nlohmann::json to_json(const QuiltSwatchOnPlaneResult& r) {
   j["plane"] = {r.width, r.height};
   j["swatch_faces"] = r.swatch.mesh.tris.size();
   j["swatch_elements"] = r.swatch.elements.size();
+  j["swatch_components"] = r.swatch.components;  // more than elements: crossing components joined
   j["element_length_mean"] = r.element_length_mean;
   j["element_length_max"] = r.element_length_max;
   return j;
@@ -147,6 +149,7 @@ nlohmann::json to_json(const QuiltSwatchOnSurfaceResult& r) {
   j["base_faces"] = r.base_faces;
   j["swatch_faces"] = r.swatch.mesh.tris.size();
   j["swatch_elements"] = r.swatch.elements.size();
+  j["swatch_components"] = r.swatch.components;  // more than elements: crossing components joined
   j["swatch_up"] = axis_name(r.swatch.up_axis);
   j["up"] = r.up;
   j["scale"] = r.relative_size;

@@ -435,6 +435,13 @@ void check_options(const SurfaceQuiltOptions& o) {
     bad("scatter_max_stretch must be in [1, 10]", o.scatter_max_stretch);
   if (!(o.scatter_max_normal_angle_deg >= 1 && o.scatter_max_normal_angle_deg <= 180))
     bad("scatter_max_normal_angle_deg must be in [1, 180]", o.scatter_max_normal_angle_deg);
+  if (o.scatter_passes < 1 || o.scatter_passes > 16) bad("scatter_passes must be in [1, 16]", o.scatter_passes);
+  if (o.scatter_single_attempts < 1 || o.scatter_single_attempts > 64)
+    bad("scatter_single_attempts must be in [1, 64]", o.scatter_single_attempts);
+  if (!(o.scatter_single_max_stretch >= 1 && o.scatter_single_max_stretch <= 10))
+    bad("scatter_single_max_stretch must be in [1, 10]", o.scatter_single_max_stretch);
+  if (!(o.scatter_clearance >= 0 && o.scatter_clearance <= 1))
+    bad("scatter_clearance must be in [0, 1]", o.scatter_clearance);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
@@ -569,6 +576,8 @@ class SurfaceQuilter {
   void finish();
   std::size_t refill();
   void scatter_into_bare();
+  void quilt_and_refill();
+  void scatter_whole_elements();
   void remove_broken_elements();
   void emit(SurfaceQuilt& out);
 
@@ -631,6 +640,8 @@ class SurfaceQuilter {
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
+  bool scatter_only_ = false;  // one compact element: placed by the scatter fill alone
+  double scatter_clearance_ = 0;  // the scatter's gap to elements already placed (mesh units)
   int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
   QuiltStepOptions merge_step_;  // opt_.step, with blob_loop_gap for a swatch of pebbles
   std::size_t fragment_faces_ = 0;  // elements with fewer faces are fragments (constructor)
@@ -680,6 +691,9 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   compact_ = compact_swatch_elements(swatch);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
+  scatter_only_ = opt.scatter_single_element && opt.scatter_attempts > 0 && all_compact_ && compact_.size() == 1;
+  scatter_clearance_ = scatter_only_ ? opt.scatter_clearance * std::max(swatch.length(), swatch.width()) * S_
+                                     : 0.5 * swatch.min_gap * S_;
   ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
   int most_handles = 0;
   for (const ElementMesh& m : compact_) {
@@ -1709,14 +1723,15 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     el.loc[v] = {p.flat.faces[static_cast<std::size_t>(k)], w[1], w[2], q[2]};
   }
   const ElementMesh m = lifted_mesh(el);
-  const double lim2 = opt_.scatter_max_stretch * opt_.scatter_max_stretch * S_ * S_;
+  const double stretch = scatter_only_ ? opt_.scatter_single_max_stretch : opt_.scatter_max_stretch;
+  const double lim2 = stretch * stretch * S_ * S_;
   for (const Tri& t : tpl.tris)
     for (int k = 0; k < 3; ++k) {
       const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
       const P3 d1 = sub3(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
       if (dot3(d1, d1) > lim2 * dot3(d0, d0) || (stretch_bound2_ > 0 && dot3(d1, d1) > stretch_bound2_)) return false;
     }
-  const std::vector<char> hit = coll.hits(m, -1, 0.5 * swatch_.min_gap * S_);
+  const std::vector<char> hit = coll.hits(m, -1, scatter_clearance_);
   if (std::find(hit.begin(), hit.end(), 1) != hit.end()) return false;
   coll.add(m, static_cast<int>(elements_.size()));
   return true;
@@ -1753,7 +1768,8 @@ void SurfaceQuilter::scatter_into_bare() {
     const PatchLocator loc(p.ftris, c_);
     Element el;
     bool placed = false;
-    for (int a = 0; a < opt_.scatter_attempts && !placed; ++a) {
+    const int attempts = scatter_only_ ? opt_.scatter_single_attempts : opt_.scatter_attempts;
+    for (int a = 0; a < attempts && !placed; ++a) {
       const ElementMesh& t = tpl[static_cast<std::size_t>(rng_() % tpl.size())];
       const V2 off = a < 4 ? V2{0, 0} : V2{jitter * unit(rng_), jitter * unit(rng_)};
       placed = place_scatter_element(p, loc, t, a, off, coll, el);
@@ -1805,8 +1821,8 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
   res_.edge_stretch_max = max_edge > 0 ? longest / (max_edge * S_) : 0;
 }
 
-SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
-  Timer timer;
+// Zhou's loop (3.1) over every unprocessed face, then the refill rounds.
+void SurfaceQuilter::quilt_and_refill() {
   quilt_unprocessed();
   finish();
   for (int round = 0; round < opt_.refill_rounds; ++round) {
@@ -1815,10 +1831,34 @@ SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
     quilt_unprocessed();
     finish();
   }
-  if (opt_.scatter_attempts > 0) {
-    Timer ts;
+}
+
+// A swatch of one compact element: the scatter fill alone places whole
+// copies, pass after pass while a pass still places some (at most
+// scatter_passes), the copies kept scatter_clearance of the element's larger
+// side apart (the shell map moves touching copies into each other).
+void SurfaceQuilter::scatter_whole_elements() {
+  Timer ts;
+  res_.scatter_only = true;
+  for (int pass = 0; pass < opt_.scatter_passes; ++pass) {
+    const std::size_t before = res_.scatter_placed;
     scatter_into_bare();
-    res_.seconds_finish += ts.seconds();
+    if (res_.scatter_placed == before) break;
+  }
+  res_.seconds_finish += ts.seconds();
+}
+
+SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
+  Timer timer;
+  if (scatter_only_) {
+    scatter_whole_elements();
+  } else {
+    quilt_and_refill();
+    if (opt_.scatter_attempts > 0) {
+      Timer ts;
+      scatter_into_bare();
+      res_.seconds_finish += ts.seconds();
+    }
   }
   // Of the output: without the fragments emit leaves out.
   res_.bare_fraction = bare_area_fraction(bare_faces(true));
