@@ -933,5 +933,41 @@ TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   EXPECT_LT(bare, 0.03);
 }
 
+// The copies keep the guidance field's orientation, as a quilted swatch does:
+// on a flat square with the field along +y, every copy of an elongated pebble
+// lies along x (the scatter's quarter turns had laid about half along y).
+TEST(SurfaceQuiltingScatter, OneElementCopiesFollowTheField) {
+  Mesh base, pebble;
+  make_grid(base, 40, 40, 1.0, 1.0);
+  make_ellipsoid(pebble, 1.0, 0.45, 0.3, 2);
+  const Swatch s = make_swatch(pebble);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.08;
+  SurfaceQuilt q;
+  Mesh out;
+  const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
+  ASSERT_TRUE(r.scatter_only);
+  const auto el = find(out, kFaceElement).first;
+  std::vector<std::array<double, 3>> xy(static_cast<std::size_t>(q.elements), {0, 0, 0});  // sums x, y, count
+  std::vector<std::array<double, 3>> m2(static_cast<std::size_t>(q.elements), {0, 0, 0});  // xx, yy, xy
+  for (int pass = 0; pass < 2; ++pass)
+    for (FaceIndex f : out.faces())
+      for (VertexIndex v : out.vertices_around_face(out.halfedge(f))) {
+        const std::size_t e = static_cast<std::size_t>(el[f]);
+        const Point3& p = out.point(v);
+        if (pass == 0) {
+          xy[e][0] += p.x(), xy[e][1] += p.y(), xy[e][2] += 1;
+          continue;
+        }
+        const double dx = p.x() - xy[e][0] / xy[e][2], dy = p.y() - xy[e][1] / xy[e][2];
+        m2[e][0] += dx * dx, m2[e][1] += dy * dy, m2[e][2] += dx * dy;
+      }
+  int along_x = 0;
+  for (const auto& m : m2) along_x += m[0] > 2 * m[1];
+  std::cout << "[ field ] " << q.elements << " copies, " << along_x << " along x\n";
+  EXPECT_GT(q.elements, 20);
+  EXPECT_EQ(along_x, q.elements);
+}
+
 }  // namespace
 }  // namespace surftex

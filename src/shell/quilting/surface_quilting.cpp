@@ -1742,10 +1742,10 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // and are removed again, so holes of about one element stay. Here each face
 // still bare gets, on a small patch around it (flattened and oriented as a
 // quilting patch, section 3.1), one of the swatch's compact elements at a
-// time: tried in four quarter turns at the face, then moved by up to half
-// the element spacing, and kept where it fits
-// (place_scatter_element). Threads (weaves) are not scattered: a cut thread
-// is no element.
+// time: tried in four quarter turns at the face (a one-element swatch: in the
+// field's orientation only), then moved by up to half the element spacing,
+// and kept where it fits (place_scatter_element). Threads (weaves) are not
+// scattered: a cut thread is no element.
 void SurfaceQuilter::scatter_into_bare() {
   const std::vector<ElementMesh>& tpl = compact_;
   if (tpl.empty()) return;
@@ -1769,10 +1769,13 @@ void SurfaceQuilter::scatter_into_bare() {
     Element el;
     bool placed = false;
     const int attempts = scatter_only_ ? opt_.scatter_single_attempts : opt_.scatter_attempts;
+    // One element alone keeps the field's orientation, as a quilted swatch
+    // does (tubes in rows, not turned every which way); it is only moved.
+    const int turns = scatter_only_ ? 1 : 4;
     for (int a = 0; a < attempts && !placed; ++a) {
       const ElementMesh& t = tpl[static_cast<std::size_t>(rng_() % tpl.size())];
-      const V2 off = a < 4 ? V2{0, 0} : V2{jitter * unit(rng_), jitter * unit(rng_)};
-      placed = place_scatter_element(p, loc, t, a, off, coll, el);
+      const V2 off = a < turns ? V2{0, 0} : V2{jitter * unit(rng_), jitter * unit(rng_)};
+      placed = place_scatter_element(p, loc, t, scatter_only_ ? 0 : a, off, coll, el);
     }
     for (int g : p.flat.faces) patch_slot_[g] = -1;
     if (!placed) continue;
