@@ -35,7 +35,7 @@
 //   SurfaceQuiltOptions / QuiltSwatchOnSurfaceOptions; unset = the default):
 //   BENCH_SEED, BENCH_RELATIVE_SIZE, BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS,
 //   BENCH_SCATTER (attempts), BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE,
-//   BENCH_SCATTER_ONLY (0: quilt a one-element swatch too), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
+//   BENCH_SCATTER_ONLY (scatter_swatch_elements; 0: always quilt), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_STRETCH_ITERS (the
@@ -314,7 +314,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_CLEARANCE")) qo.step.clearance = std::atof(e);
   if (const char* e = std::getenv("BENCH_KEEP_CUT")) qo.step.keep_cut_refused_inputs = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_LOOP_GAP")) qo.blob_loop_gap = std::atof(e);
-  if (const char* e = std::getenv("BENCH_SCATTER_ONLY")) qo.scatter_single_element = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_SCATTER_ONLY")) qo.scatter_swatch_elements = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_PASSES")) qo.scatter_passes = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_CLEARANCE")) qo.scatter_clearance = std::atof(e);
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);

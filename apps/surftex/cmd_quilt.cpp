@@ -202,7 +202,7 @@ void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Me
     elements = rep["elements_embedded"].dump() + " elements (" + std::to_string(rep["elements"].get<int>()) +
                (rep.value("scatter_only", false) ? " placed" : " quilted") +
                "; the embedding removed or cut those that crossed or stretched)";
-  if (rep.value("scatter_only", false)) elements += ", whole copies of the swatch's one element";
+  if (rep.value("scatter_only", false)) elements += ", whole copies of the swatch's few elements";
   std::fprintf(stderr, "quilt: %s, %zu faces (%.1f s) -> %s\n", elements.c_str(),
                static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
   if (!rep.contains("stretch_before")) return;
@@ -253,7 +253,7 @@ SubcommandRegistrar reg_quilt{
        app.add_option("swatch", a->swatch,
                       "Swatch: a mesh file (elements = connected components, those passing through each other "
                       "joined; its thin axis, see --swatch-up, becomes the height over the surface; a swatch of "
-                      "one compact element is scattered as whole copies, not quilted) or chainmail, weave, scatter or tori to generate one "
+                      "at most 3 compact elements is scattered as whole copies, not quilted) or chainmail, weave, scatter or tori to generate one "
                       "(seeded by --seed)");
        app.add_option("--swatch-up", a->swatch_up,
                       "The swatch's thin axis, which stands on the surface normal: auto (the axis of the smallest "

@@ -559,7 +559,7 @@ TEST(SurfaceQuiltingShape, CompactElementsSpreadNoWiderThanTheShapeBound) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.12;
     o.max_shape_ratio = ratio;
-    o.scatter_single_element = false;  // quilted, not scattered
+    o.scatter_swatch_elements = 0;  // quilted, not scattered
     SurfaceQuilt q;
     Mesh out;
     const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
@@ -795,7 +795,7 @@ TEST(SurfaceQuiltingShards, NoSmallPieceOfAPebbleIsLeft) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.15;
     o.min_piece_fraction = fraction;
-    o.scatter_single_element = false;  // quilted, not scattered
+    o.scatter_swatch_elements = 0;  // quilted, not scattered
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
     int small = 0;
@@ -829,7 +829,7 @@ TEST(SurfaceQuiltingShards, PebblesAreNotMergedAcrossAWideGap) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.05;
     o.blob_loop_gap = gap;
-    o.scatter_single_element = false;  // quilted, not scattered
+    o.scatter_swatch_elements = 0;  // quilted, not scattered
     SurfaceQuilt q;
     Mesh out;
     const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);
@@ -901,7 +901,7 @@ TEST(SurfaceQuiltingCrossings, CopiesOfASelfCrossingElementKeepItsOwnCrossings) 
 // copies of it were cut where they overlap and merged, leaving jagged pieces
 // (rock_1 on spot.ply: 435 inputs kept cut) or, for a large thin element
 // (wingnut.obj), folded ones that the embedding removed (20 of 226 left).
-// Placed whole by the scatter alone (scatter_single_element), every output
+// Placed whole by the scatter alone (scatter_swatch_elements), every output
 // element is a whole copy: as many faces as the swatch.
 TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   Mesh base, rock;
@@ -912,7 +912,7 @@ TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   auto run = [&](bool single) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.05;
-    o.scatter_single_element = single;
+    o.scatter_swatch_elements = single ? SurfaceQuiltOptions{}.scatter_swatch_elements : 0;
     SurfaceQuilt q;
     Mesh out;
     const SurfaceQuiltResult r = quilt_displaced(base, s, o, q, out);

@@ -435,11 +435,13 @@ void check_options(const SurfaceQuiltOptions& o) {
     bad("scatter_max_stretch must be in [1, 10]", o.scatter_max_stretch);
   if (!(o.scatter_max_normal_angle_deg >= 1 && o.scatter_max_normal_angle_deg <= 180))
     bad("scatter_max_normal_angle_deg must be in [1, 180]", o.scatter_max_normal_angle_deg);
+  if (o.scatter_swatch_elements < 0 || o.scatter_swatch_elements > 64)
+    bad("scatter_swatch_elements must be in [0, 64]", o.scatter_swatch_elements);
   if (o.scatter_passes < 1 || o.scatter_passes > 16) bad("scatter_passes must be in [1, 16]", o.scatter_passes);
-  if (o.scatter_single_attempts < 1 || o.scatter_single_attempts > 64)
-    bad("scatter_single_attempts must be in [1, 64]", o.scatter_single_attempts);
-  if (!(o.scatter_single_max_stretch >= 1 && o.scatter_single_max_stretch <= 10))
-    bad("scatter_single_max_stretch must be in [1, 10]", o.scatter_single_max_stretch);
+  if (o.scatter_alone_attempts < 1 || o.scatter_alone_attempts > 64)
+    bad("scatter_alone_attempts must be in [1, 64]", o.scatter_alone_attempts);
+  if (!(o.scatter_alone_max_stretch >= 1 && o.scatter_alone_max_stretch <= 10))
+    bad("scatter_alone_max_stretch must be in [1, 10]", o.scatter_alone_max_stretch);
   if (!(o.scatter_clearance >= 0 && o.scatter_clearance <= 1))
     bad("scatter_clearance must be in [0, 1]", o.scatter_clearance);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
@@ -640,7 +642,7 @@ class SurfaceQuilter {
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
-  bool scatter_only_ = false;  // one compact element: placed by the scatter fill alone
+  bool scatter_only_ = false;  // few compact elements: placed by the scatter fill alone
   double scatter_clearance_ = 0;  // the scatter's gap to elements already placed (mesh units)
   int ring_handles_ = 0;       // the fewest handles of a compact swatch element (rings: 1)
   QuiltStepOptions merge_step_;  // opt_.step, with blob_loop_gap for a swatch of pebbles
@@ -691,7 +693,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   compact_ = compact_swatch_elements(swatch);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
-  scatter_only_ = opt.scatter_single_element && opt.scatter_attempts > 0 && all_compact_ && compact_.size() == 1;
+  scatter_only_ = opt.scatter_attempts > 0 && all_compact_ &&
+                  compact_.size() <= static_cast<std::size_t>(opt.scatter_swatch_elements);
   scatter_clearance_ = scatter_only_ ? opt.scatter_clearance * std::max(swatch.length(), swatch.width()) * S_
                                      : 0.5 * swatch.min_gap * S_;
   ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
@@ -1723,7 +1726,7 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     el.loc[v] = {p.flat.faces[static_cast<std::size_t>(k)], w[1], w[2], q[2]};
   }
   const ElementMesh m = lifted_mesh(el);
-  const double stretch = scatter_only_ ? opt_.scatter_single_max_stretch : opt_.scatter_max_stretch;
+  const double stretch = scatter_only_ ? opt_.scatter_alone_max_stretch : opt_.scatter_max_stretch;
   const double lim2 = stretch * stretch * S_ * S_;
   for (const Tri& t : tpl.tris)
     for (int k = 0; k < 3; ++k) {
@@ -1742,8 +1745,8 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // and are removed again, so holes of about one element stay. Here each face
 // still bare gets, on a small patch around it (flattened and oriented as a
 // quilting patch, section 3.1), one of the swatch's compact elements at a
-// time: tried in four quarter turns at the face (a one-element swatch: in the
-// field's orientation only), then moved by up to half the element spacing,
+// time: tried in four quarter turns at the face (a swatch scattered alone: in
+// the field's orientation only), then moved by up to half the element spacing,
 // and kept where it fits (place_scatter_element). Threads (weaves) are not
 // scattered: a cut thread is no element.
 void SurfaceQuilter::scatter_into_bare() {
@@ -1768,9 +1771,9 @@ void SurfaceQuilter::scatter_into_bare() {
     const PatchLocator loc(p.ftris, c_);
     Element el;
     bool placed = false;
-    const int attempts = scatter_only_ ? opt_.scatter_single_attempts : opt_.scatter_attempts;
-    // One element alone keeps the field's orientation, as a quilted swatch
-    // does (tubes in rows, not turned every which way); it is only moved.
+    const int attempts = scatter_only_ ? opt_.scatter_alone_attempts : opt_.scatter_attempts;
+    // Scattered alone, elements keep the field's orientation, as a quilted
+    // swatch does (tubes in rows, not turned every which way); only moved.
     const int turns = scatter_only_ ? 1 : 4;
     for (int a = 0; a < attempts && !placed; ++a) {
       const ElementMesh& t = tpl[static_cast<std::size_t>(rng_() % tpl.size())];
@@ -1836,8 +1839,8 @@ void SurfaceQuilter::quilt_and_refill() {
   }
 }
 
-// A swatch of one compact element: the scatter fill alone places whole
-// copies, pass after pass while a pass still places some (at most
+// A swatch of few compact elements (scatter_swatch_elements): the scatter
+// fill alone places whole copies, pass after pass while a pass still places some (at most
 // scatter_passes), the copies kept scatter_clearance of the element's larger
 // side apart (the shell map moves touching copies into each other).
 void SurfaceQuilter::scatter_whole_elements() {

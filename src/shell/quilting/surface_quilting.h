@@ -124,23 +124,26 @@ struct SurfaceQuiltOptions {
   /// ring can bend over an ear's or a paw's rim; the stretch bound above
   /// keeps what the wider flattening distorts out. In [1, 180]. Default 120.
   double scatter_max_normal_angle_deg = 120.0;
-  /// A swatch of one compact element (a pebble, a wing nut, a bowl of apples
-  /// joined into one element by make_swatch) is placed whole by the scatter
-  /// fill alone, not quilted: the quilting's matching needs neighbouring
-  /// elements, and overlapping copies of one element were cut and merged
-  /// into folded shapes (decision 102, session 35). Default true.
-  bool scatter_single_element = true;
-  /// Then: scatter passes while a pass still places an element, [1, 16]
-  /// (default 3); the gap kept between copies, in the element's larger xy
-  /// side, [0, 1] (default 0.05); tries per bare face, [1, 64] (default 32),
-  /// and the stretch bound, [1, 10] (default 2.5), in place of
+  /// A swatch of at most this many elements, all compact (a pebble, a wing
+  /// nut, a bowl of apples joined into one element by make_swatch, a loaf and
+  /// a slice), is placed as whole copies by the scatter fill alone, in the
+  /// field's orientation, not quilted: the quilting's matching needs
+  /// neighbouring elements, and overlapping copies of so few were cut and
+  /// merged into jagged or folded pieces (decision 102, session 35). In
+  /// [0, 64]; 0 = always quilt. Default 3.
+  int scatter_swatch_elements = 3;
+  /// Then (scatter_swatch_elements): scatter passes while a pass still
+  /// places an element, [1, 16] (default 3); the gap kept between copies, in
+  /// the swatch's larger xy side, [0, 1] (default 0.05: the shell map moves
+  /// copies that touch into each other); tries per bare face, [1, 64]
+  /// (default 32), and the stretch bound, [1, 10] (default 2.5), in place of
   /// scatter_attempts and scatter_max_stretch: with no quilted patch around
-  /// them, thin parts are covered only by bent copies (koala + rock_1: 2 left
-  /// 17% of the lowest band bare; decision 102, session 35).
+  /// them, thin parts are covered only by bent copies (koala + rock_1 with
+  /// 16 and 2: 17% of the lowest band bare; decision 102, session 35).
   int scatter_passes = 3;
   double scatter_clearance = 0.05;
-  int scatter_single_attempts = 32;
-  double scatter_single_max_stretch = 2.5;
+  int scatter_alone_attempts = 32;
+  double scatter_alone_max_stretch = 2.5;
   /// The output's z range may grow past the swatch's by this many swatch
   /// heights per side; elements beyond are shifted (squeezed) in. [0, 10], default 0.
   double max_z_growth = 0;
@@ -239,8 +242,8 @@ struct SurfaceQuiltResult {
   std::size_t faces_refilled = 0;
   /// Single compact elements placed by the scatter fill (scatter_attempts).
   std::size_t scatter_placed = 0;
-  /// The swatch was one compact element, placed by the scatter alone
-  /// (SurfaceQuiltOptions::scatter_single_element): no quilting patch.
+  /// The swatch's few compact elements were placed by the scatter alone
+  /// (SurfaceQuiltOptions::scatter_swatch_elements): no quilting patch.
   bool scatter_only = false;
   /// Bare area fraction at the end: a quarter of a face's area for each of
   /// four sample points (centroid, corner triangles' centroids) with no
