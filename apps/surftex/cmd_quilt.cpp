@@ -153,6 +153,7 @@ QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
   d.embed.progress = o.progress;
   d.seed = a.common.seed;
   d.mesh_name = a.base;
+  d.swatch_name = "the swatch '" + a.swatch + "'";
   d.check_work = [&a](const WorkEstimate& e) { check_budget(e, a.common); };
   return d;
 }

@@ -151,9 +151,10 @@ TEST(CmdQuiltHostile, FlatSwatchQuiltsAPlaneButIsRefusedOnAMesh) {
   EXPECT_GT(xmax, 1.5);  // the 2x2 plane is covered past the first swatch
 
   const std::string base = write_icosahedron(dir);
-  expect_refused(test::run_surftex("quilt " + q(base) + " " + q(dir + "/flat.obj") + " -o " + q(dir + "/s.obj") +
-                                   " --stretch-iterations 0 --no-check --quiet"),
-                 "zero height");
+  const test::RunResult flat = test::run_surftex("quilt " + q(base) + " " + q(dir + "/flat.obj") + " -o " +
+                                                q(dir + "/s.obj") + " --stretch-iterations 0 --no-check");
+  expect_refused(flat, "flat.obj' has zero height");
+  EXPECT_EQ(flat.err.find("estimate"), std::string::npos) << flat.err;  // refused before the work
   for (const char* f : {"s.obj", "s.ply", "s.glb", "s_render.png"}) EXPECT_FALSE(fs::exists(dir + "/" + f)) << f;
 }
 

@@ -126,6 +126,13 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                                                    const QuiltSwatchOnSurfaceOptions& opt) {
   QuiltSwatchOnSurfaceResult r;
   r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
+  // Before the estimate and any work: a flat swatch gives a shell of no
+  // thickness (embed_surface_quilt would refuse it after the quilting).
+  if (!(r.swatch.height() > 0))
+    throw InvalidInputError("quilt: " + opt.swatch_name + " has zero height: its thinnest extent (its " +
+                            axis_name(r.swatch.up_axis) +
+                            " axis, see --swatch-up) is 0, so the shell over the mesh would have no thickness; "
+                            "a flat swatch quilts a plane (--plane WxH)");
   SurfaceQuiltOptions qo = opt.quilt;
   if (!(qo.relative_size > 0)) qo.relative_size = default_surface_quilt_size(r.swatch);
   check_surface_quilt_size(base, r.swatch, qo, opt.check_work);

@@ -85,8 +85,8 @@ struct QuiltSwatchOnSurfaceOptions {
   EmbedSurfaceQuiltOptions embed;
   /// Seed of the quilt, of the shell map's stretch minimisation and of the element colours.
   std::uint64_t seed = 1;
-  /// The base mesh as the messages name it.
-  std::string mesh_name;
+  /// The base mesh and the swatch as the messages name them.
+  std::string mesh_name, swatch_name = "the swatch";
   /// As QuiltSwatchOnPlaneOptions::check_work.
   std::function<void(const WorkEstimate&)> check_work;
 };
