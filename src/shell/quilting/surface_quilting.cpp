@@ -1763,6 +1763,7 @@ void SurfaceQuilter::scatter_into_bare() {
   const double jitter = 0.5 * swatch_element_spacing(swatch_);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int f = 0; f < nf_; ++f) {
+    if (f % 256 == 0) report_progress(opt_.progress, "scatter", static_cast<double>(f) / nf_);
     if (!face_is_bare(b_, f, feet)) continue;
     Patch p;
     grow_and_flatten(f, p, 2 * reach * S_, scatter_cos_max_);
@@ -1840,9 +1841,10 @@ void SurfaceQuilter::quilt_and_refill() {
 }
 
 // A swatch of few compact elements (scatter_swatch_elements): the scatter
-// fill alone places whole copies, pass after pass while a pass still places some (at most
-// scatter_passes), the copies kept scatter_clearance of the element's larger
-// side apart (the shell map moves touching copies into each other).
+// fill alone places whole copies, pass after pass while a pass still places
+// some (at most scatter_passes), the copies kept scatter_clearance of the
+// swatch's larger side apart (the shell map moves touching copies into each
+// other).
 void SurfaceQuilter::scatter_whole_elements() {
   Timer ts;
   res_.scatter_only = true;
