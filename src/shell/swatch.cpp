@@ -20,21 +20,25 @@ namespace surftex {
 
 namespace {
 
-// Components of `m` that pass through each other (an exact self-intersection
-// between two of them) joined into one element: a scanned or modelled group
-// such as apples sunk into their bowl is one element to quilting, which
-// copies, merges and removes elements whole (Zhou 2.5-2.7) and would resolve
-// the copies' crossings by dropping the apples. Relabels `face_element`
+// The swatch's self-intersecting face pairs, exact (face t = triangle t).
+std::vector<FacePair> swatch_crossings(const ElementMesh& m) {
+  Mesh whole;
+  mesh_from_elements({m}, whole);
+  return self_intersecting_faces(whole);
+}
+
+// Components that pass through each other (a pair of `crossings` between two
+// of them) joined into one element: a scanned or modelled group such as
+// apples sunk into their bowl is one element to quilting, which copies,
+// merges and removes elements whole (Zhou 2.5-2.7) and would resolve the
+// copies' crossings by dropping the apples. Relabels `face_element`
 // (components of triangle_components, 0..n-1) in order of first face and
 // returns the number of elements.
-int group_crossing_components(const ElementMesh& m, std::vector<int>& face_element, int n) {
+int group_crossing_components(const std::vector<FacePair>& crossings, std::vector<int>& face_element, int n) {
   if (n < 2) return n;
-  Mesh whole;
-  mesh_from_elements({m}, whole);  // face t = triangle t
   UnionFind<int> groups(static_cast<std::size_t>(n));
   bool joined = false;
-  for (const FacePair& p : self_intersecting_faces(whole))
-    joined |= groups.unite(face_element[p[0]], face_element[p[1]]);
+  for (const FacePair& p : crossings) joined |= groups.unite(face_element[p[0]], face_element[p[1]]);
   if (!joined) return n;
   std::vector<int> relabel(static_cast<std::size_t>(n), -1);
   int count = 0;
@@ -44,6 +48,14 @@ int group_crossing_components(const ElementMesh& m, std::vector<int>& face_eleme
     e = r;
   }
   return count;
+}
+
+// The most of `crossings` within one of the n elements.
+std::size_t most_crossings_within(const std::vector<FacePair>& crossings, const std::vector<int>& face_element, int n) {
+  std::vector<std::size_t> per(static_cast<std::size_t>(n), 0);
+  for (const FacePair& p : crossings)
+    if (face_element[p[0]] == face_element[p[1]]) ++per[static_cast<std::size_t>(face_element[p[0]])];
+  return per.empty() ? 0 : *std::max_element(per.begin(), per.end());
 }
 
 }  // namespace
@@ -63,7 +75,9 @@ Swatch make_swatch(const Mesh& mesh) {
   Swatch s;
   s.mesh = element_mesh_from(mesh);
   s.components = triangle_components(s.mesh, s.face_element);
-  const int n = group_crossing_components(s.mesh, s.face_element, s.components);
+  const std::vector<FacePair> crossings = swatch_crossings(s.mesh);
+  const int n = group_crossing_components(crossings, s.face_element, s.components);
+  s.element_self_crossings = most_crossings_within(crossings, s.face_element, n);
   s.elements.assign(static_cast<std::size_t>(n), SwatchElement{});
   const std::vector<ElementMesh> els = swatch_element_meshes(s);
   s.bbox_min = {1e300, 1e300, 1e300};
@@ -188,16 +202,6 @@ std::vector<ElementMesh> swatch_element_meshes(const Swatch& s) {
   return out;
 }
 
-std::size_t swatch_element_self_crossings(const Swatch& s) {
-  Mesh m;
-  mesh_from_elements({s.mesh}, m);  // face t = triangle t
-  std::vector<std::size_t> per(s.elements.size(), 0);
-  for (const FacePair& p : self_intersecting_faces(m)) {
-    const int a = s.face_element[p[0]], b = s.face_element[p[1]];
-    if (a == b) ++per[static_cast<std::size_t>(a)];
-  }
-  return per.empty() ? 0 : *std::max_element(per.begin(), per.end());
-}
 
 ElementMesh swatch_element(const Swatch& s, int e) {
   std::vector<int> tris;

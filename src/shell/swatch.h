@@ -33,6 +33,11 @@ struct Swatch {
   /// Connected components of the mesh; more than elements when components
   /// that pass through each other were joined into one element (make_swatch).
   int components = 0;
+  /// The most self-intersecting face pairs (exact) within one element: 0 for
+  /// a clean swatch; a scanned object may have a few (wingnut.obj 3), a group
+  /// of crossing components many (apples_bowl.obj 887), which every copy of
+  /// the element carries into a quilt. From the same exact pass as the grouping.
+  std::size_t element_self_crossings = 0;
   P3 bbox_min{0, 0, 0}, bbox_max{0, 0, 0};
   double mean_edge_length = 0;
   /// The smallest distance between two elements (vertex to triangle; 0 for
@@ -49,7 +54,8 @@ struct Swatch {
 /// Builds a swatch: elements = connected components (by first face), those
 /// that pass through each other (an exact crossing) joined into one. Throws
 /// InvalidInputError for no face, a non-triangle, a non-finite coordinate or a
-/// zero xy extent; a flat swatch is accepted here (embedding refuses it).
+/// zero xy extent; a flat swatch is accepted here (a plane quilts it;
+/// quilt_swatch_on_surface refuses it on a mesh).
 Swatch make_swatch(const Mesh& mesh);
 /// As above with the thin axis `up` turned onto z first (a cyclic permutation,
 /// handedness kept; kAuto: swatch_thin_axis); Swatch::up_axis records it.
@@ -78,10 +84,6 @@ Swatch load_swatch(const std::string& path);
 std::vector<ElementMesh> swatch_element_meshes(const Swatch& swatch);
 /// The triangles of element `e` as their own ElementMesh.
 ElementMesh swatch_element(const Swatch& swatch, int e);
-/// The most self-intersecting face pairs (exact) within one element of the
-/// swatch: 0 for a clean swatch; a scanned object may have a few (wingnut.obj
-/// 3), which every copy of the element carries into a quilt.
-std::size_t swatch_element_self_crossings(const Swatch& swatch);
 
 /// Writes kFaceElement on `mesh` = connected component id (in order of first
 /// face) and returns the number of components.

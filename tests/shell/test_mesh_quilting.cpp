@@ -127,7 +127,7 @@ TEST(Swatch, ComponentsThatPassThroughEachOtherAreOneElement) {
   ASSERT_EQ(s.elements.size(), 2u);
   EXPECT_EQ(s.elements[0].faces, parts[0].tris.size() + parts[1].tris.size() + parts[2].tris.size());
   EXPECT_EQ(s.elements[1].faces, parts[3].tris.size());
-  EXPECT_GT(swatch_element_self_crossings(s), 0u);  // the apples' crossings are the group's own
+  EXPECT_GT(s.element_self_crossings, 0u);  // the apples' crossings are the group's own
   // Apart, they stay four elements.
   parts[1].points = parts[3].points;
   for (P3& p : parts[1].points) p[0] -= 3.6;

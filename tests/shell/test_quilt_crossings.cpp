@@ -872,7 +872,7 @@ TEST(SurfaceQuiltingCrossings, CopiesOfASelfCrossingElementKeepItsOwnCrossings) 
   const Point3 p = rock.point(top);
   rock.point(top) = Point3(p.x(), p.y(), zmin - 0.05 * (p.z() - zmin));
   const Swatch s = make_swatch(rock);
-  const std::size_t own = swatch_element_self_crossings(s);
+  const std::size_t own = s.element_self_crossings;
   ASSERT_GT(own, 0u);
   SurfaceQuiltOptions o;
   o.relative_size = 0.05;

@@ -52,7 +52,7 @@ struct EmbedSurfaceQuiltOptions {
   bool resolve_crossings = true;
   /// Rounds that cut and cap crossing threads before the removal; 0..8, default 3.
   int crossing_trim_rounds = 3;
-  /// The swatch's own crossings (swatch_element_self_crossings): an element
+  /// The swatch's own crossings (Swatch::element_self_crossings): an element
   /// with at most this many self-intersecting pairs within itself keeps them
   /// (every copy of a swatch element carries the element's); one with more is
   /// resolved as above. quilt_swatch_on_surface sets it; default 0.

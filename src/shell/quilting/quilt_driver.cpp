@@ -147,7 +147,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   EmbedSurfaceQuiltOptions eo = opt.embed;
   eo.stretch.seed = opt.seed;
   if (eo.max_edge == 0) eo.max_edge = qo.max_edge_stretch * longest_edge_length(r.swatch.mesh) * r.local.scale;
-  eo.swatch_self_crossings = swatch_element_self_crossings(r.swatch);
+  eo.swatch_self_crossings = r.swatch.element_self_crossings;
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();
