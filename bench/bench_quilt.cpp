@@ -11,13 +11,15 @@
 //   faces, elements (the output's connected components) and quilt_elements
 //   (the quilt's own count); intersecting face pairs between / within elements
 //   (exact CGAL count on the embedded mesh) and as fractions of the faces;
-//   edge_max_over_median (longest output edge / median output edge; goal <= 4)
+//   edge_max_over_median (longest output edge / median output edge; goal <= 4;
+//   edge_longest: that edge, mesh units)
 //   and edge_stretch_max (longest element edge over the same edge where it
 //   was placed, SurfaceQuiltResult::edge_stretch_max); stretch_before/after
 //   (shell map, eq. 9); bare area overall and in 4 bands of height along +Y
-//   (base area with no quilt vertex's foot within half the swatch's element
-//   spacing: the median distance from an element's centroid to the nearest
-//   other's; the swatch's larger side for a single element); the nearest-gap
+//   (output_bare_area, the report's: base area with no output vertex's foot
+//   within half the swatch's element spacing: the median distance from an
+//   element's centroid to the nearest other's; the swatch's larger side for a
+//   single element; bare_quilt: the quilt's before the embedding); the nearest-gap
 //   ratio (per output element the smallest vertex distance to another element,
 //   its min and median over the elements divided by the median of the same
 //   over the swatch's elements, scaled); seconds (quilt, embed, total) and user
@@ -38,9 +40,11 @@
 //   BENCH_SCATTER_ONLY (scatter_swatch_elements; 0: always quilt), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
-//   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_STRETCH_ITERS (the
+//   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
+//   resolution after the shell map), BENCH_STRETCH_ITERS (the
 //   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
-//   quilt before the shell map: feet on the base, height along face normals).
+//   quilt before the shell map: feet on the base, height along face normals)
+//   and prints its crossings within elements and its bare area (lifted_bare).
 // The history of the old single-case benchmark is docs/decisions/100-quilt-bench-history.md.
 #include <CGAL/number_utils.h>  // CGAL 5.5's Bounded_normal_change_placement.h uses is_positive unqualified
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
@@ -178,44 +182,6 @@ void bunny5k(Mesh& base) {
   base.collect_garbage();
 }
 
-// Bare base area (see the header) overall and in 4 bands of height along up.
-json bare_area(const Mesh& base, const SurfaceQuilt& q, double rad, const Vector3& up) {
-  std::vector<std::array<Point3, 3>> fp(base.number_of_faces());
-  for (FaceIndex f : base.faces()) {
-    int k = 0;
-    for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) fp[f.idx()][static_cast<std::size_t>(k++)] = base.point(v);
-  }
-  PointGrid grid(rad);
-  for (const SurfaceQuiltVertex& v : q.vertices) {
-    const auto& t = fp[static_cast<std::size_t>(v.face)];
-    const double b0 = 1 - v.b1 - v.b2;
-    grid.add({b0 * t[0].x() + v.b1 * t[1].x() + v.b2 * t[2].x(), b0 * t[0].y() + v.b1 * t[1].y() + v.b2 * t[2].y(),
-              b0 * t[0].z() + v.b1 * t[1].z() + v.b2 * t[2].z()},
-             0);
-  }
-  double hmin = 1e300, hmax = -1e300;
-  for (VertexIndex v : base.vertices()) {
-    const double h = (base.point(v) - CGAL::ORIGIN) * up;
-    hmin = std::min(hmin, h), hmax = std::max(hmax, h);
-  }
-  double area[5] = {0, 0, 0, 0, 0}, bare[5] = {0, 0, 0, 0, 0};
-  auto covered = [&](const Point3& x) { return grid.nearest({x.x(), x.y(), x.z()}, -1, 2 * rad) <= rad; };
-  for (FaceIndex f : base.faces()) {
-    const auto& t = fp[f.idx()];
-    const Point3 c = CGAL::centroid(t[0], t[1], t[2]);
-    int nbare = covered(c) ? 0 : 1;
-    for (int k = 0; k < 3; ++k)
-      nbare += covered(CGAL::centroid(t[k], CGAL::midpoint(t[k], t[(k + 1) % 3]), CGAL::midpoint(t[k], t[(k + 2) % 3]))) ? 0 : 1;
-    const double a = std::sqrt(CGAL::squared_area(t[0], t[1], t[2]));
-    const int band = std::clamp(static_cast<int>(4 * (((c - CGAL::ORIGIN) * up) - hmin) / (hmax - hmin)), 0, 3);
-    area[4] += a, area[band] += a;
-    bare[4] += a * nbare / 4, bare[band] += a * nbare / 4;
-  }
-  json bands = json::array();
-  for (int b = 0; b < 4; ++b) bands.push_back(area[b] > 0 ? bare[b] / area[b] : 0.0);
-  return {{"overall", bare[4] / area[4]}, {"by_height", bands}, {"radius", rad}};
-}
-
 // Edge lengths of the embedded mesh: longest over median.
 double edge_max_over_median(const Mesh& m, double& longest) {
   std::vector<double> len;
@@ -321,6 +287,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   o.embed.stretch.iterations = 20;
   if (const char* e = std::getenv("BENCH_RECENTRE")) o.embed.recentre_caps = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
+  if (const char* e = std::getenv("BENCH_EMBED_RESOLVE")) o.embed.resolve_crossings = std::atoi(e) != 0;
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
   const Swatch& s = run.swatch;
@@ -346,6 +313,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"between_fraction", faces > 0 ? static_cast<double>(er.self_intersections_between) / faces : 0.0},
          {"within_fraction", faces > 0 ? static_cast<double>(er.self_intersections_within) / faces : 0.0},
          {"edge_max_over_median", emax},
+         {"edge_longest", longest},
          {"edge_max_over_swatch", longest / (q.scale * s.mean_edge_length)},
          {"not_expressible", r.elements_not_expressible},
          {"elements_stretched", r.elements_stretched},
@@ -360,6 +328,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"elements_stretched_embedded", er.elements_stretched_embedded},
          {"caps_recentred", er.caps_recentred},
+         {"elements_placed_affine", er.elements_placed_affine},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},
@@ -373,7 +342,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"stretch_before", er.stretch.stretch_before},
          {"stretch_after", er.stretch.stretch_after},
          {"outside_vertices", er.embed.outside},
-         {"bare", bare_area(base, q, 0.5 * spacing * q.scale, Vector3(0, 1, 0))},
+         {"bare", {{"overall", run.bare.overall}, {"by_height", run.bare.by_height}}},
          {"gap", gap_ratio(out, s, q.scale, spacing)},
          {"user_cpu", user_cpu() - cpu0}};
   // Per-stage seconds as the CLI's report has them, with the driver's totals and the rotation search.
@@ -400,6 +369,7 @@ json run_case(const std::string& name, const std::string& outdir) {
       for (const auto& [e, n] : within) sum += n;
       j["lifted_pairs_within"] = sum;
       j["lifted_elements_crossing_themselves"] = within.size();
+      j["lifted_bare"] = output_bare_area(base, lifted, 0.5 * spacing * q.scale, {0, 1, 0}).overall;
     }
     Mesh scene;
     surface_quilt_scene(base, out, scene);

@@ -195,6 +195,12 @@ void write_quilt_outputs(const QuiltArgs& a, const std::vector<std::string>& out
   rep["render"] = a.render;
 }
 
+std::string format_percent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f%%", 100 * fraction);
+  return buf;
+}
+
 // The summary lines on stderr (unless --quiet).
 void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Mesh& out, double seconds) {
   if (a.common.quiet) return;
@@ -204,6 +210,8 @@ void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Me
                (rep.value("scatter_only", false) ? " placed" : " quilted") +
                "; the embedding removed or cut those that crossed or stretched)";
   if (rep.value("scatter_only", false)) elements += ", whole copies of the swatch's few elements";
+  if (rep.contains("bare_fraction") && rep.contains("base_faces"))
+    elements += ", " + format_percent(rep["bare_fraction"].get<double>()) + " of the surface bare";
   std::fprintf(stderr, "quilt: %s, %zu faces (%.1f s) -> %s\n", elements.c_str(),
                static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
   if (!rep.contains("stretch_before")) return;
@@ -404,7 +412,7 @@ nlohmann::json step_quilt(DemoContext& ctx) {
                  {"stretch_before", sr.embedding.stretch.stretch_before},
                  {"stretch_after", sr.embedding.stretch.stretch_after},
                  {"self_intersections", sr.embedding.embed.self_intersecting_pairs},
-                 {"bare_fraction", sr.quilt.bare_fraction},
+                 {"bare_fraction", sr.bare.overall},
                  {"outputs", {"quilt_sphere_chainmail.ply", "quilt_sphere_chainmail.glb", "quilt_sphere_chainmail.png"}}};
   j["seconds"]["sphere"] = t.seconds();
   return j;

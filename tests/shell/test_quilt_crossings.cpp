@@ -933,6 +933,55 @@ TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   EXPECT_LT(bare, 0.03);
 }
 
+// A real swatch's faces that nearly touch (wingnut.obj: pairs 0.0005 of its
+// size apart) were bent into each other by the piecewise-linear shell map, so
+// a third of the scattered nuts crossed themselves more than the swatch and
+// were removed (spot.ply: 109 of 169 left). A whole copy now takes the one
+// affine map that fits the shell map over it (whole_copy_sources): every copy
+// is kept with only the swatch's own crossings, and none dips under the base.
+TEST(SurfaceQuiltingScatter, WholeCopiesAreNotBentIntoThemselves) {
+  Mesh base, nut;
+  make_icosphere(base, 3);
+  read_mesh(test::shared_data("swatches/wingnut.obj"), nut);
+  const Swatch s = make_swatch(nut, SwatchAxis::kAuto);
+  ASSERT_EQ(s.elements.size(), 1u);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.12;
+  SurfaceQuilt q;
+  const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+  ASSERT_TRUE(r.scatter_only);
+  double plane = 1e300;  // the smallest distance of a base face's plane from the centre
+  for (FaceIndex f : base.faces()) {
+    const auto h = base.halfedge(f);
+    const Point3 a = base.point(base.source(h)), b = base.point(base.target(h)), c = base.point(base.target(base.next(h)));
+    Vector3 n = CGAL::cross_product(b - a, c - a);
+    n = n / std::sqrt(n.squared_length());
+    plane = std::min(plane, (a - CGAL::ORIGIN) * n);
+  }
+  auto embed = [&](bool affine, Mesh& out) {
+    EmbedSurfaceQuiltOptions eo;
+    eo.swatch_self_crossings = s.element_self_crossings;
+    if (affine) eo.whole_copy_sources = swatch_element_meshes(s);
+    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+    double lowest = 1e300;
+    for (VertexIndex v : out.vertices()) lowest = std::min(lowest, std::sqrt((out.point(v) - CGAL::ORIGIN).squared_length()));
+    std::cout << "[ whole copies ] affine " << affine << ": " << er.elements << " of " << q.elements << " kept, "
+              << er.elements_placed_affine << " placed affinely, pairs within " << er.self_intersections_within
+              << " between " << er.self_intersections_between << ", lowest vertex at " << lowest << " (face planes from "
+              << plane << ")\n";
+    return std::make_pair(er, lowest);
+  };
+  Mesh bent, whole;
+  const auto [rb, low_bent] = embed(false, bent);
+  const auto [rw, low_whole] = embed(true, whole);
+  EXPECT_LT(rb.elements, static_cast<std::size_t>(q.elements));  // some copies crossed themselves and went
+  EXPECT_EQ(rw.elements, static_cast<std::size_t>(q.elements));
+  EXPECT_EQ(rw.elements_placed_affine, static_cast<std::size_t>(q.elements));
+  EXPECT_EQ(rw.self_intersections_between, 0u);
+  EXPECT_LE(rw.self_intersections_within, s.element_self_crossings * rw.elements);
+  EXPECT_GE(low_whole, plane - 1e-9);
+}
+
 // The copies keep the guidance field's orientation, as a quilted swatch does:
 // on a flat square with the field along +y, every copy of an elongated pebble
 // lies along x (the scatter's quarter turns had laid about half along y).

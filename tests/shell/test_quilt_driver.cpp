@@ -164,6 +164,7 @@ TEST(QuiltDriver, SurfaceDriverIsTheQuiltThenTheEmbeddingColouredAndReportsItsOp
   quilt_surface(base, s, q, qo);
   EmbedSurfaceQuiltOptions eo = o.embed;
   eo.stretch.seed = 7;
+  eo.whole_copy_sources = swatch_element_meshes(s);  // whole compact copies placed affinely
   Mesh by_hand;
   embed_surface_quilt(base, q, by_hand, eo);
   ASSERT_EQ(by_hand.number_of_vertices(), out.number_of_vertices());

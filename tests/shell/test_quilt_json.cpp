@@ -9,6 +9,19 @@
 namespace surftex {
 namespace {
 
+// The surface report's bare area is the output's (after the embedding removed
+// and cut elements); the quilt's own figure before it is reported beside it.
+TEST(QuiltJson, SurfaceBareAreaIsTheOutputs) {
+  QuiltSwatchOnSurfaceResult r;
+  r.quilt.bare_fraction = 0.01;
+  r.bare.overall = 0.03;
+  r.bare.by_height = {0.01, 0.02, 0.05, 0.04};
+  const nlohmann::json j = to_json(r);
+  EXPECT_DOUBLE_EQ(j["bare_fraction"].get<double>(), 0.03);
+  EXPECT_DOUBLE_EQ(j["bare_fraction_quilt"].get<double>(), 0.01);
+  EXPECT_DOUBLE_EQ(j["bare_by_height"][2].get<double>(), 0.05);
+}
+
 TEST(QuiltJson, PlanarAndSurfaceQuiltsShareTheMergeKeys) {
   QuiltResult plane;
   plane.elements = 7;

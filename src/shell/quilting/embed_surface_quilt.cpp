@@ -4,6 +4,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -219,8 +221,10 @@ QuiltVertexMapping map_quilt_vertices(const SurfaceQuilt& quilt, const ShellSpac
 
 /// The quilt's elements as meshes of the mapped positions (each element's
 /// vertices numbered in order of first use).
-std::vector<ElementMesh> quilt_elements(const SurfaceQuilt& quilt, const std::vector<Vec3>& pos) {
+std::vector<ElementMesh> quilt_elements(const SurfaceQuilt& quilt, const std::vector<Vec3>& pos,
+                                       std::vector<std::vector<int>>& quilt_vertex) {
   std::vector<ElementMesh> els(static_cast<std::size_t>(quilt.elements));
+  quilt_vertex.assign(els.size(), {});
   std::vector<int> local(quilt.vertices.size(), -1);
   for (std::size_t f = 0; f < quilt.tris.size(); ++f) {
     ElementMesh& m = els[static_cast<std::size_t>(quilt.tri_element[f])];
@@ -230,12 +234,113 @@ std::vector<ElementMesh> quilt_elements(const SurfaceQuilt& quilt, const std::ve
       if (local[static_cast<std::size_t>(v)] < 0) {
         local[static_cast<std::size_t>(v)] = static_cast<int>(m.points.size());
         m.points.push_back(pos[static_cast<std::size_t>(v)]);
+        quilt_vertex[static_cast<std::size_t>(quilt.tri_element[f])].push_back(v);
       }
       tri[static_cast<std::size_t>(k)] = local[static_cast<std::size_t>(v)];
     }
     m.tris.push_back(tri);
   }
   return els;
+}
+
+/// `m` with its vertices numbered in order of first use by its triangles
+/// (quilt_elements' numbering), so that a whole copy's triangles equal it.
+ElementMesh in_first_use_order(const ElementMesh& m) {
+  std::vector<int> all(m.tris.size());
+  for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<int>(t);
+  return extract_triangles(m, all);
+}
+
+/// The affine map x -> A x + c closest (least squares) to taking each point
+/// of `from` to the same point of `to`; false if `from` spans no volume or the
+/// map turns space inside out (then nothing is moved).
+bool fit_affine(const std::vector<P3>& from, const std::vector<P3>& to, Eigen::Matrix3d& A, Eigen::Vector3d& c) {
+  const std::size_t n = from.size();
+  if (n < 4 || to.size() != n) return false;
+  Eigen::Vector3d mf = Eigen::Vector3d::Zero(), mt = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    mf += Eigen::Vector3d(from[i][0], from[i][1], from[i][2]);
+    mt += Eigen::Vector3d(to[i][0], to[i][1], to[i][2]);
+  }
+  mf /= static_cast<double>(n);
+  mt /= static_cast<double>(n);
+  Eigen::Matrix3d xx = Eigen::Matrix3d::Zero(), yx = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = Eigen::Vector3d(from[i][0], from[i][1], from[i][2]) - mf;
+    const Eigen::Vector3d y = Eigen::Vector3d(to[i][0], to[i][1], to[i][2]) - mt;
+    xx += x * x.transpose();
+    yx += y * x.transpose();
+  }
+  const double tr = xx.trace() / 3;  // flat or degenerate: no volume to fit
+  if (!(tr > 0) || !(xx.determinant() > 1e-18 * tr * tr * tr)) return false;
+  A = yx * xx.inverse();
+  if (!(A.determinant() > 0)) return false;
+  c = mt - A * mf;
+  return true;
+}
+
+/// How far a copy must move along `up` (unit) so that none of its vertices
+/// lies under the plane of the base face its quilt vertex was located on.
+double lift_out_of_base(const ElementMesh& el, const std::vector<int>& qv, const SurfaceQuilt& quilt,
+                        const Mesh& base, const Eigen::Vector3d& up) {
+  double lift = 0;
+  for (std::size_t i = 0; i < el.points.size(); ++i) {
+    const FaceIndex f(static_cast<std::uint32_t>(quilt.vertices[static_cast<std::size_t>(qv[i])].face));
+    const HalfedgeIndex h = base.halfedge(f);
+    const Point3 a = base.point(base.source(h)), b = base.point(base.target(h)), c = base.point(base.target(base.next(h)));
+    const Vector3 nn = CGAL::cross_product(b - a, c - a);
+    const double len = std::sqrt(nn.squared_length());
+    if (!(len > 0)) continue;
+    const Eigen::Vector3d n(nn.x() / len, nn.y() / len, nn.z() / len);
+    const double depth = -n.dot(Eigen::Vector3d(el.points[i][0] - a.x(), el.points[i][1] - a.y(), el.points[i][2] - a.z()));
+    const double along = n.dot(up);
+    if (depth > 0 && along > 0.2) lift = std::max(lift, depth / along);
+  }
+  return lift;
+}
+
+/// Zhou et al. 2006 s.3.2 takes every vertex through the shell map, which is
+/// piecewise linear: faces of a real swatch that nearly touch (wingnut.obj has
+/// pairs 0.0005 of its size apart) or a torus's inner side over a tight bend
+/// are folded into each other by its kinks, and the copy is then removed as
+/// crossing itself (a third of the nuts on spot.ply, 14 of 177 tori on the
+/// bunny). A whole copy of a compact swatch element
+/// (EmbedSurfaceQuiltOptions::whole_copy_sources) instead takes the one affine
+/// map that fits the shell map best over its vertices, lifted so that it does
+/// not dip into the base: it keeps the element's shape (an affine map cannot
+/// make faces cross) and follows the surface where the copy sits. Threads and
+/// cut or merged pieces still bend with the surface. Returns the elements
+/// placed so; `affine[e]` = 1 for them.
+std::size_t place_whole_copies_affinely(const std::vector<ElementMesh>& sources, const std::vector<char>& compact,
+                                        const SurfaceQuilt& quilt, const std::vector<std::vector<int>>& quilt_vertex,
+                                        const Mesh& base, std::vector<ElementMesh>& els, std::vector<char>& affine) {
+  affine.assign(els.size(), 0);
+  if (sources.empty()) return 0;
+  std::vector<ElementMesh> src;
+  for (const ElementMesh& m : sources) src.push_back(in_first_use_order(m));
+  std::size_t placed = 0;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    if (!(e < compact.size() && compact[e])) continue;
+    ElementMesh& el = els[e];
+    for (const ElementMesh& s : src) {
+      if (s.tris.size() != el.tris.size() || s.points.size() != el.points.size() || s.tris != el.tris) continue;
+      Eigen::Matrix3d A;
+      Eigen::Vector3d c;
+      if (!fit_affine(s.points, el.points, A, c)) break;
+      for (std::size_t i = 0; i < el.points.size(); ++i) {
+        const Eigen::Vector3d y = A * Eigen::Vector3d(s.points[i][0], s.points[i][1], s.points[i][2]) + c;
+        el.points[i] = P3{y[0], y[1], y[2]};
+      }
+      const Eigen::Vector3d up = (A * Eigen::Vector3d(0, 0, 1)).normalized();
+      const double lift = lift_out_of_base(el, quilt_vertex[e], quilt, base, up);
+      for (P3& p : el.points)
+        for (int d = 0; d < 3; ++d) p[static_cast<std::size_t>(d)] += lift * up[d];
+      affine[e] = 1;
+      ++placed;
+      break;
+    }
+  }
+  return placed;
 }
 
 /// Counts the clamped locations and the vertices mapped outside the texture
@@ -392,12 +497,20 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   const std::vector<std::array<UV, 3>> face_uv = face_corner_uvs(atlas_mesh, quilt, shell);
   const QuiltVertexMapping vm = map_quilt_vertices(quilt, shell, map, face_uv);
   // Elements as meshes (kFaceElement = element id).
-  std::vector<ElementMesh> els = quilt_elements(quilt, vm.pos);
-  if (opt.recentre_caps)
-    for (ElementMesh& e : els) res.caps_recentred += recentre_fans(e);
+  std::vector<std::vector<int>> quilt_vertex;
+  std::vector<ElementMesh> els = quilt_elements(quilt, vm.pos, quilt_vertex);
+  std::vector<char> affine;
+  res.elements_placed_affine = place_whole_copies_affinely(opt.whole_copy_sources, quilt.element_compact, quilt,
+                                                           quilt_vertex, atlas_mesh, els, affine);
+  if (opt.recentre_caps)  // a whole copy has no cap of ours to recentre
+    for (std::size_t e = 0; e < els.size(); ++e) res.caps_recentred += affine[e] ? 0 : recentre_fans(els[e]);
   mesh_from_elements(els, out);
-  if (opt.measure_outside_shell) {
+  if (opt.measure_outside_shell) {  // the shell map's images; apart, where the affine copies went
     res.outside_shell = measure_outside_shell(vm.pos, shell, map, opt.outside_shell);
+    std::vector<Vec3> placed;
+    for (std::size_t e = 0; e < els.size(); ++e)
+      if (affine[e]) placed.insert(placed.end(), els[e].points.begin(), els[e].points.end());
+    if (!placed.empty()) res.affine_outside_shell = measure_outside_shell(placed, shell, map, opt.outside_shell);
     res.outside_shell_measured = true;
   }
   count_mapping(quilt, vm, res);

@@ -21,6 +21,7 @@
 // Throws: InvalidInputError (bad options), and what the stages throw
 // (TopologyError, SolverError from the atlas and the shell).
 #include <cstddef>
+#include <vector>
 
 #include "geometry/base_mesh_atlas.h"
 #include "geometry/mesh_fwd.h"
@@ -57,6 +58,13 @@ struct EmbedSurfaceQuiltOptions {
   /// (every copy of a swatch element carries the element's); one with more is
   /// resolved as above. quilt_swatch_on_surface sets it; default 0.
   std::size_t swatch_self_crossings = 0;
+  /// The swatch's elements (swatch_element_meshes; quilt_swatch_on_surface
+  /// sets them): a compact element of the quilt with the same triangles as one
+  /// of these (a whole copy, vertices numbered in order of first use) is placed
+  /// by the affine map that best fits the shell map at its vertices (least
+  /// squares), lifted out of the base, not by each vertex's own image
+  /// (place_whole_copies_affinely). Empty (default): every vertex through the map.
+  std::vector<ElementMesh> whole_copy_sources;
   /// The shard bound held again on the embedded elements, mesh units (0 =
   /// none, the default): an element with a longer edge (the shell map
   /// stretches what was within the bound lifted) is removed if compact, else
@@ -100,6 +108,8 @@ struct EmbedSurfaceQuiltResult {
   /// Elements that kept their own crossings (EmbedSurfaceQuiltOptions::swatch_self_crossings),
   /// counted at the last check.
   std::size_t elements_self_crossing_kept = 0;
+  /// Whole copies placed by one affine map (EmbedSurfaceQuiltOptions::whole_copy_sources).
+  std::size_t elements_placed_affine = 0;
   /// Elements with an embedded edge over max_edge, removed or cut.
   std::size_t elements_stretched_embedded = 0;
   /// Cap centres moved by recentre_caps.
@@ -107,9 +117,13 @@ struct EmbedSurfaceQuiltResult {
   /// Elements in `out` (the quilt's, less those the shard bound and the
   /// crossing resolution removed, plus the pieces they cut).
   std::size_t elements = 0;
-  /// Embedded vertices outside the geometric shell (the union of the shell's
-  /// 3D tets; embed_outside_shell.h), with how far; empty unless measured.
+  /// Vertices the shell map put outside the geometric shell (the union of the
+  /// shell's 3D tets; embed_outside_shell.h), with how far; empty unless measured.
   OutsideShellResult outside_shell;
+  /// The same check on the vertices of the copies placed affinely (after
+  /// their lift): above the shell's top is by design (the copy keeps its
+  /// height where the shell is thinner), below it they dip into the base.
+  OutsideShellResult affine_outside_shell;
   bool outside_shell_measured = false;
   double seconds_atlas = 0, seconds_shell = 0, seconds_stretch = 0, seconds_map = 0, seconds_embed = 0;
 };

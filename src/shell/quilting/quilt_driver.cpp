@@ -148,10 +148,13 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   eo.stretch.seed = opt.seed;
   if (eo.max_edge == 0) eo.max_edge = qo.max_edge_stretch * longest_edge_length(r.swatch.mesh) * r.local.scale;
   eo.swatch_self_crossings = r.swatch.element_self_crossings;
+  eo.whole_copy_sources = swatch_element_meshes(r.swatch);
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();
   color_by_element(out, opt.seed);
+  r.bare = output_bare_area(base, out, 0.5 * swatch_element_spacing(r.swatch) * r.local.scale,
+                            qo.up);
   r.base_faces = base.number_of_faces();
   r.faces = out.number_of_faces();
   r.vertices = out.number_of_vertices();

@@ -15,6 +15,7 @@
 #include "geometry/work_budget.h"
 #include "shell/quilting/embed_surface_quilt.h"
 #include "shell/quilting/mesh_quilting.h"
+#include "shell/quilting/quilt_coverage.h"
 #include "shell/quilting/surface_quilting.h"
 #include "shell/swatch.h"
 
@@ -97,6 +98,10 @@ struct QuiltSwatchOnSurfaceResult {
   SurfaceQuilt local;  ///< the quilt in the base's local coordinates (3.1)
   Swatch swatch;
   std::size_t base_faces = 0, faces = 0, vertices = 0;
+  /// The bare area of `out` (output_bare_area, radius half the swatch's
+  /// element spacing, bands along `up`): after the embedding removed and cut
+  /// elements, unlike quilt.bare_fraction (the quilt before it).
+  BareArea bare;
   /// The options the report echoes: relative size, up, field, largest turn.
   SurfaceQuiltOptions::Field field = SurfaceQuiltOptions::Field::kUp;
   std::array<double, 3> up{0, 1, 0};

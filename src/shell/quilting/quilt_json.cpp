@@ -79,6 +79,7 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["crossing_elements_removed_last"] = er.crossing_elements_removed_last;  // still crossing after the trims: removed
   j["elements_stretched_embedded"] = er.elements_stretched_embedded;  // over the shard bound after the shell map
   j["caps_recentred"] = er.caps_recentred;
+  j["elements_placed_affine"] = er.elements_placed_affine;
   j["charts"] = er.atlas.num_charts;
   j["tets"] = er.tets;
   j["shell_height"] = er.shell_height;
@@ -99,6 +100,9 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
     j["outside_shell_above"] = er.outside_shell.above;
     j["outside_shell_side"] = er.outside_shell.side;
     j["outside_shell_max_distance"] = er.outside_shell.max_distance;
+    // The whole copies placed affinely: below the shell = into the base.
+    j["affine_vertices_below_shell"] = er.affine_outside_shell.below;
+    j["affine_vertices_above_shell"] = er.affine_outside_shell.above;
   }
   if (er.embed.checked) {
     j["self_intersections"] = er.embed.self_intersecting_pairs;
@@ -157,6 +161,9 @@ nlohmann::json to_json(const QuiltSwatchOnSurfaceResult& r) {
   j["faces"] = r.faces;
   j["vertices"] = r.vertices;
   j["max_turn_deg"] = r.rotation_max_deg;
+  j["bare_fraction_quilt"] = r.quilt.bare_fraction;  // before the embedding
+  j["bare_fraction"] = r.bare.overall;               // of the output
+  j["bare_by_height"] = r.bare.by_height;
   return j;
 }
 

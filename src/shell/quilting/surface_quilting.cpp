@@ -20,6 +20,7 @@
 #include "geometry/properties.h"
 #include "geometry/timer.h"
 #include "shell/element_clearance.h"
+#include "shell/quilting/foot_grid.h"
 #include "shell/triangle_distance.h"
 
 namespace surftex {
@@ -447,34 +448,6 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
-
-// Points on the base (element vertices' feet) bucketed for "is any within
-// radius" queries (bare-face detection and the scatter fill).
-class FootGrid {
- public:
-  explicit FootGrid(double radius) : rad_(radius) {}
-  void add(const P3& p) { grid_[key(p, 0, 0, 0)].push_back(p); }
-  bool covered(const P3& x) const {
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k) {
-          auto it = grid_.find(key(x, i, j, k));
-          if (it == grid_.end()) continue;
-          for (const P3& q : it->second)
-            if (dot3(sub3(x, q), sub3(x, q)) <= rad_ * rad_) return true;
-        }
-    return false;
-  }
-
- private:
-  long long key(const P3& p, int di, int dj, int dk) const {
-    const long long i = static_cast<long long>(std::floor(p[0] / rad_)) + di, j = static_cast<long long>(std::floor(p[1] / rad_)) + dj,
-                    k = static_cast<long long>(std::floor(p[2] / rad_)) + dk;
-    return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
-  }
-  double rad_;
-  std::unordered_map<long long, std::vector<P3>> grid_;
-};
 
 // Of four sample points of a base face (its centroid and its corner
 // triangles' centroids), how many have no foot within the grid's radius: a
