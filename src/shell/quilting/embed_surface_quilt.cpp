@@ -299,21 +299,33 @@ double lift_out_of_base(const ElementMesh& el, const std::vector<int>& qv, const
   return lift;
 }
 
+/// Whether the element, as the shell map placed it, crosses itself in more
+/// face pairs (exact) than `own`, the swatch element's own crossings.
+bool folded(const ElementMesh& el, std::size_t own) {
+  Mesh m;
+  mesh_from_elements({el}, m);
+  return count_self_intersections(m) > own;
+}
+
 /// Zhou et al. 2006 s.3.2 takes every vertex through the shell map, which is
 /// piecewise linear: faces of a real swatch that nearly touch (wingnut.obj has
 /// pairs 0.0005 of its size apart) or a torus's inner side over a tight bend
 /// are folded into each other by its kinks, and the copy is then removed as
 /// crossing itself (a third of the nuts on spot.ply, 14 of 177 tori on the
 /// bunny). A whole copy of a compact swatch element
-/// (EmbedSurfaceQuiltOptions::whole_copy_sources) instead takes the one affine
-/// map that fits the shell map best over its vertices, lifted so that it does
-/// not dip into the base: it keeps the element's shape (an affine map cannot
-/// make faces cross) and follows the surface where the copy sits. Threads and
-/// cut or merged pieces still bend with the surface. Returns the elements
-/// placed so; `affine[e]` = 1 for them.
+/// (EmbedSurfaceQuiltOptions::whole_copy_sources) that the map folded so
+/// instead takes the one affine map that fits the shell map best over its
+/// vertices, lifted so that it does not dip into the base: it keeps the
+/// element's shape (an affine map cannot make faces cross) and sits where the
+/// copy was. Copies the map did not fold, threads, and cut or merged pieces
+/// bend with the surface. Returns the elements placed so; `whole[e]` = 1 for
+/// whole copies, `affine[e]` = 1 for those placed affinely.
 std::size_t place_whole_copies_affinely(const std::vector<ElementMesh>& sources, const std::vector<char>& compact,
-                                        const SurfaceQuilt& quilt, const std::vector<std::vector<int>>& quilt_vertex,
-                                        const Mesh& base, std::vector<ElementMesh>& els, std::vector<char>& affine) {
+                                        std::size_t own, const SurfaceQuilt& quilt,
+                                        const std::vector<std::vector<int>>& quilt_vertex, const Mesh& base,
+                                        std::vector<ElementMesh>& els, std::vector<char>& whole,
+                                        std::vector<char>& affine) {
+  whole.assign(els.size(), 0);
   affine.assign(els.size(), 0);
   if (sources.empty()) return 0;
   std::vector<ElementMesh> src;
@@ -324,6 +336,8 @@ std::size_t place_whole_copies_affinely(const std::vector<ElementMesh>& sources,
     ElementMesh& el = els[e];
     for (const ElementMesh& s : src) {
       if (s.tris.size() != el.tris.size() || s.points.size() != el.points.size() || s.tris != el.tris) continue;
+      whole[e] = 1;
+      if (!folded(el, own)) break;  // the copy bends with the surface, as in 3.2
       Eigen::Matrix3d A;
       Eigen::Vector3d c;
       if (!fit_affine(s.points, el.points, A, c)) break;
@@ -499,11 +513,12 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   // Elements as meshes (kFaceElement = element id).
   std::vector<std::vector<int>> quilt_vertex;
   std::vector<ElementMesh> els = quilt_elements(quilt, vm.pos, quilt_vertex);
-  std::vector<char> affine;
-  res.elements_placed_affine = place_whole_copies_affinely(opt.whole_copy_sources, quilt.element_compact, quilt,
-                                                           quilt_vertex, atlas_mesh, els, affine);
+  std::vector<char> whole, affine;
+  res.elements_placed_affine =
+      place_whole_copies_affinely(opt.whole_copy_sources, quilt.element_compact, opt.swatch_self_crossings, quilt,
+                                  quilt_vertex, atlas_mesh, els, whole, affine);
   if (opt.recentre_caps)  // a whole copy has no cap of ours to recentre
-    for (std::size_t e = 0; e < els.size(); ++e) res.caps_recentred += affine[e] ? 0 : recentre_fans(els[e]);
+    for (std::size_t e = 0; e < els.size(); ++e) res.caps_recentred += whole[e] ? 0 : recentre_fans(els[e]);
   mesh_from_elements(els, out);
   if (opt.measure_outside_shell) {  // the shell map's images; apart, where the affine copies went
     res.outside_shell = measure_outside_shell(vm.pos, shell, map, opt.outside_shell);
