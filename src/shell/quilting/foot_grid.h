@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "geometry/vec3.h"
 #include "shell/element_mesh.h"
 
 namespace surftex {
@@ -21,10 +22,8 @@ class FootGrid {
         for (int k = -1; k <= 1; ++k) {
           auto it = grid_.find(key(x, i, j, k));
           if (it == grid_.end()) continue;
-          for (const P3& q : it->second) {
-            const double dx = x[0] - q[0], dy = x[1] - q[1], dz = x[2] - q[2];
-            if (dx * dx + dy * dy + dz * dz <= rad_ * rad_) return true;
-          }
+          for (const P3& q : it->second)
+            if (vec3::dot(vec3::sub(x, q), vec3::sub(x, q)) <= rad_ * rad_) return true;
         }
     return false;
   }

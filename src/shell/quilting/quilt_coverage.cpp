@@ -10,31 +10,13 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/vec3.h"
 #include "shell/quilting/foot_grid.h"
 #include "shell/triangle_distance.h"
 
 namespace surftex {
 
 namespace {
-
-ElementMesh base_triangles(const Mesh& base) {
-  ElementMesh m;
-  for (VertexIndex v : base.vertices()) {
-    const Point3& p = base.point(v);
-    m.points.push_back({p.x(), p.y(), p.z()});
-  }
-  for (FaceIndex f : base.faces()) {
-    Tri t{};
-    int k = 0;
-    for (VertexIndex v : base.vertices_around_face(base.halfedge(f))) {
-      if (k == 3) throw InvalidInputError("output_bare_area: the base has a face that is not a triangle");
-      t[static_cast<std::size_t>(k++)] = static_cast<int>(v.idx());
-    }
-    if (k != 3) throw InvalidInputError("output_bare_area: the base has a face that is not a triangle");
-    m.tris.push_back(t);
-  }
-  return m;
-}
 
 // The quilt's vertices' closest points on the base, in parallel (each on its own).
 FootGrid quilt_feet(const ElementMesh& base, const Mesh& quilt, double radius) {
@@ -62,26 +44,22 @@ FootGrid quilt_feet(const ElementMesh& base, const Mesh& quilt, double radius) {
 
 BareArea output_bare_area(const Mesh& base, const Mesh& quilt, double radius, const std::array<double, 3>& up) {
   if (!(radius > 0) || !std::isfinite(radius)) throw InvalidInputError("output_bare_area: radius must be > 0");
-  const ElementMesh b = base_triangles(base);
+  const ElementMesh b = element_mesh_from(base);  // throws for a face that is not a triangle
   const FootGrid feet = quilt_feet(b, quilt, radius);
-  auto height = [&](const P3& p) { return p[0] * up[0] + p[1] * up[1] + p[2] * up[2]; };
+  auto height = [&](const P3& p) { return vec3::dot(p, up); };
   double hmin = 1e300, hmax = -1e300;
   for (const P3& p : b.points) hmin = std::min(hmin, height(p)), hmax = std::max(hmax, height(p));
   double area[5] = {0, 0, 0, 0, 0}, bare[5] = {0, 0, 0, 0, 0};
   for (const Tri& t : b.tris) {
-    const P3 &p0 = b.points[static_cast<std::size_t>(t[0])], &p1 = b.points[static_cast<std::size_t>(t[1])],
-             &p2 = b.points[static_cast<std::size_t>(t[2])];
-    const P3 c{(p0[0] + p1[0] + p2[0]) / 3, (p0[1] + p1[1] + p2[1]) / 3, (p0[2] + p1[2] + p2[2]) / 3};
+    const P3 v[3] = {b.points[static_cast<std::size_t>(t[0])], b.points[static_cast<std::size_t>(t[1])],
+                     b.points[static_cast<std::size_t>(t[2])]};
+    const P3 c{(v[0][0] + v[1][0] + v[2][0]) / 3, (v[0][1] + v[1][1] + v[2][1]) / 3, (v[0][2] + v[1][2] + v[2][2]) / 3};
     int nbare = feet.covered(c) ? 0 : 1;
-    const P3* v[3] = {&p0, &p1, &p2};
     for (int k = 0; k < 3; ++k) {  // corner triangle k's centroid: (4 a + b + c) / 6
-      const P3 &a = *v[k], &q = *v[(k + 1) % 3], &r = *v[(k + 2) % 3];
+      const P3 &a = v[k], &q = v[(k + 1) % 3], &r = v[(k + 2) % 3];
       nbare += feet.covered({(4 * a[0] + q[0] + r[0]) / 6, (4 * a[1] + q[1] + r[1]) / 6, (4 * a[2] + q[2] + r[2]) / 6}) ? 0 : 1;
     }
-    const double ux = p1[0] - p0[0], uy = p1[1] - p0[1], uz = p1[2] - p0[2], vx = p2[0] - p0[0], vy = p2[1] - p0[1],
-                 vz = p2[2] - p0[2];
-    const double a = 0.5 * std::sqrt((uy * vz - uz * vy) * (uy * vz - uz * vy) + (uz * vx - ux * vz) * (uz * vx - ux * vz) +
-                                     (ux * vy - uy * vx) * (ux * vy - uy * vx));
+    const double a = 0.5 * vec3::norm(vec3::cross(vec3::sub(v[1], v[0]), vec3::sub(v[2], v[0])));
     const int band = hmax > hmin ? std::clamp(static_cast<int>(4 * (height(c) - hmin) / (hmax - hmin)), 0, 3) : 0;
     area[4] += a, area[band] += a;
     bare[4] += a * nbare / 4, bare[band] += a * nbare / 4;
