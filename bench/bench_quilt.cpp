@@ -41,7 +41,7 @@
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
-//   resolution after the shell map), BENCH_STRETCH_ITERS (the
+//   resolution after the shell map), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_STRETCH_ITERS (the
 //   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
 //   quilt before the shell map: feet on the base, height along face normals)
 //   and prints its crossings within elements and its bare area (lifted_bare).
@@ -288,6 +288,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_RECENTRE")) o.embed.recentre_caps = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
   if (const char* e = std::getenv("BENCH_EMBED_RESOLVE")) o.embed.resolve_crossings = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_UNTANGLE")) o.embed.untangle_folds = std::atoi(e) != 0;
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
   const Swatch& s = run.swatch;
@@ -328,6 +329,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"elements_stretched_embedded", er.elements_stretched_embedded},
          {"caps_recentred", er.caps_recentred},
+         {"elements_untangled", er.elements_untangled},
          {"elements_placed_affine", er.elements_placed_affine},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},

@@ -12,6 +12,7 @@
 #include "geometry/mesh.h"
 #include "geometry/newell.h"
 #include "geometry/properties.h"
+#include "geometry/self_intersections.h"
 #include "geometry/union_find.h"
 #include "geometry/vec3.h"
 
@@ -388,6 +389,64 @@ std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<Element
     first += static_cast<std::uint32_t>(els[e].tris.size());
   }
   return faces;
+}
+
+}  // namespace surftex
+
+namespace surftex {
+
+std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m) {
+  Mesh mesh;
+  mesh_from_elements({m}, mesh);
+  SelfIntersectionOptions so;
+  so.parallel = false;  // (callers run many elements side by side)
+  return self_intersecting_faces(mesh, so);
+}
+
+namespace {
+// Umbrella steps on the vertices of the flagged triangles and one ring more.
+void smooth_around(ElementMesh& m, const std::vector<char>& faces, int steps) {
+  const std::size_t nv = m.points.size();
+  std::vector<char> region(nv, 0), grown(nv, 0);
+  for (std::size_t t = 0; t < m.tris.size(); ++t)
+    if (faces[t])
+      for (int v : m.tris[t]) region[static_cast<std::size_t>(v)] = 1;
+  for (const Tri& t : m.tris)
+    if (region[static_cast<std::size_t>(t[0])] || region[static_cast<std::size_t>(t[1])] || region[static_cast<std::size_t>(t[2])])
+      for (int v : t) grown[static_cast<std::size_t>(v)] = 1;
+  std::vector<std::vector<int>> nb(nv);
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k)
+      if (grown[static_cast<std::size_t>(t[k])]) {
+        nb[static_cast<std::size_t>(t[k])].push_back(t[(k + 1) % 3]);
+        nb[static_cast<std::size_t>(t[k])].push_back(t[(k + 2) % 3]);
+      }
+  for (int it = 0; it < steps; ++it) {
+    std::vector<P3> next = m.points;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (nb[v].empty()) continue;
+      P3 a{0, 0, 0};
+      for (int u : nb[v]) a = vec3::add(a, m.points[static_cast<std::size_t>(u)]);
+      next[v] = vec3::mul(a, 1.0 / static_cast<double>(nb[v].size()));
+    }
+    m.points.swap(next);
+  }
+}
+}  // namespace
+
+bool smooth_out_crossings(ElementMesh& m, const std::vector<char>& faces, std::size_t own) {
+  if (faces.size() != m.tris.size())
+    throw InvalidInputError("smooth_out_crossings: " + std::to_string(faces.size()) + " flags for " +
+                            std::to_string(m.tris.size()) + " triangles");
+  for (int steps : {4, 16, 64}) {
+    ElementMesh trial = m;
+    smooth_around(trial, faces, steps);
+    if (element_self_crossings(trial).size() <= own) {
+      m = std::move(trial);
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace surftex

@@ -66,6 +66,19 @@ void cap_loop(ElementMesh& m, const std::vector<int>& loop);
 std::size_t recentre_fans(ElementMesh& m, int min_valence = 9, double min_offset = 0.25);
 /// Length of the longest edge; 0 if none.
 double longest_edge_length(const ElementMesh& m);
+/// The pairs of `m`'s triangles that intersect (exact, the rules of
+/// self_intersecting_faces: geometry/self_intersections.h), as triangle
+/// indices, first < second; on one thread. Throws TopologyError for a
+/// non-manifold element (as mesh_from_elements).
+std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m);
+/// A fold of an element untangled (a thread crumpled by the shell map,
+/// decision 102): the vertices of the triangles flagged in `faces` and one
+/// ring of vertices around them are smoothed, every other vertex held
+/// (umbrella steps: each to the mean of its neighbours, all at once), 4, then
+/// 16, then 64 steps from the start, until `m` crosses itself in at most
+/// `own` pairs of triangles. Returns whether it then does; `m` is changed
+/// only if so. Throws InvalidInputError if `faces` is not one flag per triangle.
+bool smooth_out_crossings(ElementMesh& m, const std::vector<char>& faces, std::size_t own);
 /// Unit area-weighted vertex normals (zero for isolated vertices).
 std::vector<P3> vertex_normals(const ElementMesh& m);
 /// Unit face normals (zero for degenerate triangles).

@@ -268,6 +268,33 @@ TEST(EmbedSurfaceQuilt, ThreadsStillCrossingAfterTheTrimRoundsAreRemovedWhole) {
   EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
 }
 
+// Issue 17 item 4 (decision 102, session 37): a thread the shell map folded
+// into itself (here one vertex pushed through the tube's other wall, as a
+// crumpled end is) is smoothed out where it crosses and kept whole, where it
+// was cut into pieces and lost faces.
+TEST(EmbedSurfaceQuilt, AThreadFoldedIntoItselfIsSmoothedOutAndKeptWhole) {
+  Mesh base;
+  SurfaceQuilt q;
+  tube_on_grid(base, q);  // rings of 8 around the tube, z = 0.5 + 0.3 sin(phase)
+  const std::size_t top = 12 * 8 + 2;  // ring 12 (mid-way), phase pi/2: the top of the tube
+  ASSERT_NEAR(q.vertices[top].z, 0.8, 1e-12);
+  q.vertices[top].z = 0.02;  // through the bottom wall (z 0.2 there)
+  EmbedSurfaceQuiltOptions eo = quick_embedding();
+  eo.untangle_folds = false;
+  Mesh out;
+  const EmbedSurfaceQuiltResult cut = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(cut.elements_untangled, 0u);
+  EXPECT_EQ(cut.crossing_elements, 1u);
+  EXPECT_NE(out.number_of_faces(), q.tris.size());  // cut there and capped
+  eo.untangle_folds = true;
+  const EmbedSurfaceQuiltResult smoothed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(smoothed.elements_untangled, 1u);
+  EXPECT_EQ(smoothed.crossing_elements, 0u);
+  EXPECT_EQ(smoothed.embed.self_intersecting_pairs, 0u);
+  EXPECT_EQ(smoothed.elements, 1u);
+  EXPECT_EQ(out.number_of_faces(), q.tris.size());  // whole
+}
+
 // The recheck's faces: a changed element's and those of every element whose
 // box meets its box, in mesh_from_elements's numbering; a far one is left out.
 TEST(ElementMesh, FacesNearChangedElementsAreThoseWhoseBoxesMeet) {

@@ -215,6 +215,59 @@ TEST(ElementCaps, CapCentresPulledToOneEndAreMovedBack) {
   EXPECT_EQ(cone.points[16], apex);
 }
 
+// A fold smoothed out (smooth_out_crossings, decision 102 session 37): a
+// vertex of a thread pushed through the tube's far wall makes it cross
+// itself; smoothing around the crossing faces pulls it back, the triangles
+// and every vertex away from the fold stay. Two tubes through each other as
+// one element cannot be smoothed apart: nothing changes.
+TEST(ElementFolds, ASpikeThroughAThreadIsSmoothedOutAndTheRestHeld) {
+  Mesh cyl;
+  make_cylinder(cyl, 0.1, 3.0, 8, 12);
+  ElementMesh thread = element_mesh_from(cyl);
+  for (P3& p : thread.points) p = {p[2], p[1], p[0]};  // along x
+  ASSERT_TRUE(element_self_crossings(thread).empty());
+  std::size_t spike = 0;  // the side vertex nearest the middle: through to the far wall and beyond
+  for (std::size_t v = 0; v < thread.points.size(); ++v) {
+    const P3& p = thread.points[v];
+    const P3& s = thread.points[spike];
+    if (std::hypot(p[1], p[2]) > 0.09 && std::abs(p[0] - 1.5) + std::abs(p[1] - 0.1) < std::abs(s[0] - 1.5) + std::abs(s[1] - 0.1)) spike = v;
+  }
+  ASSERT_NEAR(std::hypot(thread.points[spike][1], thread.points[spike][2]), 0.1, 1e-9);
+  const ElementMesh before = thread;
+  thread.points[spike][1] = -2.5 * thread.points[spike][1];
+  thread.points[spike][2] = -2.5 * thread.points[spike][2];
+  const auto pairs = element_self_crossings(thread);
+  ASSERT_FALSE(pairs.empty());
+  std::vector<char> faces(thread.tris.size(), 0);
+  for (const auto& fp : pairs) faces[fp[0]] = faces[fp[1]] = 1;
+  ElementMesh smoothed = thread;
+  ASSERT_TRUE(smooth_out_crossings(smoothed, faces, 0));
+  EXPECT_TRUE(element_self_crossings(smoothed).empty());
+  EXPECT_EQ(smoothed.tris, thread.tris);
+  EXPECT_LT(std::hypot(smoothed.points[spike][1], smoothed.points[spike][2]), 0.1);  // back inside the tube's walls
+  std::size_t held = 0;
+  for (std::size_t v = 0; v < thread.points.size(); ++v)
+    if (std::abs(thread.points[v][0] - thread.points[spike][0]) > 0.6) {
+      EXPECT_EQ(smoothed.points[v], before.points[v]);
+      ++held;
+    }
+  EXPECT_GT(held, thread.points.size() / 2);
+  // Two threads through each other, one element: no smoothing parts them.
+  ElementMesh cross = before;
+  const int n = static_cast<int>(before.points.size());
+  for (const P3& p : before.points) cross.points.push_back({1.5 + p[2], p[1], p[0] - 1.5});  // along z, through the middle
+  for (const Tri& t : before.tris) cross.tris.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const auto xp = element_self_crossings(cross);
+  ASSERT_FALSE(xp.empty());
+  std::vector<char> xf(cross.tris.size(), 0);
+  for (const auto& fp : xp) xf[fp[0]] = xf[fp[1]] = 1;
+  const ElementMesh cross_before = cross;
+  EXPECT_FALSE(smooth_out_crossings(cross, xf, 0));
+  EXPECT_EQ(cross.points, cross_before.points);
+  EXPECT_TRUE(smooth_out_crossings(cross, xf, xp.size()));  // its own crossings allowed: nothing to do
+  EXPECT_THROW(smooth_out_crossings(cross, std::vector<char>(3, 0), 0), InvalidInputError);
+}
+
 // Handles of an element (remove_broken_rings' test of a ring cut open): a
 // torus 1, a ball 0, a torus cut open and capped 0 (open, uncapped: still 0),
 // two tori as one element 2, an open cylinder (two border loops) 0.

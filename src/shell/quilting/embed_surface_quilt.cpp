@@ -304,7 +304,7 @@ double lift_out_of_base(const ElementMesh& el, const std::vector<int>& qv, const
 bool folded(const ElementMesh& el, std::size_t own) {
   Mesh m;
   mesh_from_elements({el}, m);
-  return count_self_intersections(m) > own;
+  return count_self_intersections(m) > own;  // (in parallel: the copies are checked one by one)
 }
 
 /// Zhou et al. 2006 s.3.2 takes every vertex through the shell map, which is
@@ -424,6 +424,45 @@ std::vector<FacePair> pairs_to_resolve(const std::vector<FacePair>& pairs, const
   return act;
 }
 
+/// EmbedSurfaceQuiltOptions::untangle_folds on the pairs of the first check:
+/// each element other than a compact one with more pairs within it than
+/// `own` smoothed where it crosses (smooth_out_crossings; side by side, each
+/// element on its own); `out` rebuilt and `pairs` brought up to date (those
+/// of unchanged elements kept, the rest checked again near the smoothed
+/// ones). Returns how many were smoothed out.
+std::size_t untangle_folded_elements(std::vector<FacePair>& pairs, std::size_t own, const std::vector<char>& compact,
+                                     std::vector<ElementMesh>& els, Mesh& out) {
+  std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
+  for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
+  auto element_of = [&](std::uint32_t f) {
+    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
+  };
+  std::map<std::size_t, std::vector<FacePair>> within;
+  for (const FacePair& fp : pairs)
+    if (const std::size_t a = element_of(fp[0]); a == element_of(fp[1])) within[a].push_back(fp);
+  std::vector<std::size_t> todo;
+  for (const auto& [e, ps] : within)
+    if (ps.size() > own && !(e < compact.size() && compact[e])) todo.push_back(e);
+  std::vector<char> smoothed(els.size(), 0);
+  tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t i) {
+    const std::size_t e = todo[i];
+    std::vector<char> faces(els[e].tris.size(), 0);
+    for (const FacePair& fp : within.at(e)) faces[fp[0] - first[e]] = faces[fp[1] - first[e]] = 1;
+    smoothed[e] = smooth_out_crossings(els[e], faces, own) ? 1 : 0;
+  });
+  const std::size_t n = static_cast<std::size_t>(std::count(smoothed.begin(), smoothed.end(), 1));
+  if (n == 0) return 0;
+  mesh_from_elements(els, out);  // (same faces in the same order: only points moved)
+  std::vector<FacePair> now;
+  for (const FacePair& fp : pairs)
+    if (!smoothed[element_of(fp[0])] && !smoothed[element_of(fp[1])]) now.push_back(fp);
+  for (const FacePair& fp : self_intersecting_faces(out, faces_near_changed_elements(els, smoothed))) now.push_back(fp);
+  std::sort(now.begin(), now.end());
+  now.erase(std::unique(now.begin(), now.end()), now.end());
+  pairs.swap(now);
+  return n;
+}
+
 /// Resolution rounds when asked (a cut piece's cap may meet another element),
 /// each reusing the exact check that the count reports; what still crosses
 /// after opt.crossing_trim_rounds is removed whole (removing adds no crossing, so none is
@@ -443,6 +482,8 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
     for (int round = 0; round <= trim_rounds; ++round) {
       pairs = round == 0 ? self_intersecting_faces(out)
                          : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
+      if (round == 0 && opt.untangle_folds)
+        res.elements_untangled = untangle_folded_elements(pairs, opt.swatch_self_crossings, compact, els, out);
       checked = true;
       checked_whole = round == 0;
       const std::vector<FacePair> act =

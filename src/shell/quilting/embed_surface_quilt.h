@@ -51,6 +51,13 @@ struct EmbedSurfaceQuiltOptions {
   /// cut and capped; what still crosses after crossing_trim_rounds such
   /// rounds is removed whole, so none is left). Default true.
   bool resolve_crossings = true;
+  /// Before the first resolution round: an element other than a compact one
+  /// that crosses itself in more pairs than swatch_self_crossings (a thread
+  /// the shell map crumpled where it was squashed in the quilt) is smoothed
+  /// where it crosses until it no longer does (smooth_out_crossings), and
+  /// kept whole; one that still crosses is resolved as below. Default true
+  /// (decision 102, session 37: bunny + weave 2.95% -> 2.15% bare).
+  bool untangle_folds = true;
   /// Rounds that cut and cap crossing threads before the removal; 0..8, default 3.
   int crossing_trim_rounds = 3;
   /// The swatch's own crossings (Swatch::element_self_crossings): an element
@@ -101,6 +108,8 @@ struct EmbedSurfaceQuiltResult {
   /// (what the swatch's elements may already have, and deformation adds) and
   /// faces of two different elements (overlapping elements: a quilting defect).
   std::size_t self_intersections_within = 0, self_intersections_between = 0;
+  /// Elements that crossed themselves and were smoothed out (untangle_folds).
+  std::size_t elements_untangled = 0;
   /// Elements cut or removed by EmbedSurfaceQuiltOptions::resolve_crossings.
   std::size_t crossing_elements = 0;
   /// Of those, removed whole because they still crossed after the trimming rounds.

@@ -79,6 +79,7 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["crossing_elements_removed_last"] = er.crossing_elements_removed_last;  // still crossing after the trims: removed
   j["elements_stretched_embedded"] = er.elements_stretched_embedded;  // over the shard bound after the shell map
   j["caps_recentred"] = er.caps_recentred;
+  j["elements_untangled"] = er.elements_untangled;
   j["elements_placed_affine"] = er.elements_placed_affine;
   j["charts"] = er.atlas.num_charts;
   j["tets"] = er.tets;
