@@ -77,6 +77,8 @@
 #include "geometry/self_intersections.h"
 #include "geometry/timer.h"
 #include "geometry/write_mesh.h"
+#include "geometry/vec3.h"
+#include "shell/quilting/foot_grid.h"
 #include "shell/quilting/quilt_driver.h"
 #include "shell/quilting/quilt_json.h"
 #include "shell/swatch.h"
@@ -95,39 +97,6 @@ double user_cpu() {
   return static_cast<double>(u.ru_utime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec);
 }
 
-// Buckets of points for radius queries.
-class PointGrid {
- public:
-  explicit PointGrid(double cell) : h_(cell) {}
-  void add(const P3& p, int tag) { cells_[key(p, 0, 0, 0)].push_back({p, tag}); }
-  // Smallest distance from p to a point whose tag differs from `not_tag`
-  // (-1: any), searched within one cell; `limit` if none is closer.
-  double nearest(const P3& p, int not_tag, double limit) const {
-    double best = limit * limit;
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k) {
-          auto it = cells_.find(key(p, i, j, k));
-          if (it == cells_.end()) continue;
-          for (const auto& [q, tag] : it->second) {
-            if (tag == not_tag && not_tag >= 0) continue;
-            const double d = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
-            best = std::min(best, d);
-          }
-        }
-    return std::sqrt(best);
-  }
-
- private:
-  long long key(const P3& p, int di, int dj, int dk) const {
-    const long long i = static_cast<long long>(std::floor(p[0] / h_)) + di, j = static_cast<long long>(std::floor(p[1] / h_)) + dj,
-                    k = static_cast<long long>(std::floor(p[2] / h_)) + dk;
-    return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
-  }
-  double h_;
-  std::unordered_map<long long, std::vector<std::pair<P3, int>>> cells_;
-};
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
@@ -137,12 +106,18 @@ double median(std::vector<double> v) {
 // Per element of (points, element id per point): the smallest distance to a
 // point of another element, capped at `limit`.
 std::vector<double> nearest_gaps(const std::vector<P3>& pts, const std::vector<int>& elem, int n, double limit) {
-  PointGrid g(limit);
+  CellGrid<int> g(limit);
   for (std::size_t i = 0; i < pts.size(); ++i) g.add(pts[i], elem[i]);
   std::vector<double> gap(static_cast<std::size_t>(n), limit);
   for (std::size_t i = 0; i < pts.size(); ++i) {
+    double best = gap[static_cast<std::size_t>(elem[i])];
+    best *= best;
+    g.any_near(pts[i], [&](const P3& q, int tag) {
+      if (tag != elem[i]) best = std::min(best, vec3::dot(vec3::sub(pts[i], q), vec3::sub(pts[i], q)));
+      return false;
+    });
     double& e = gap[static_cast<std::size_t>(elem[i])];
-    e = std::min(e, g.nearest(pts[i], elem[i], e));
+    e = std::min(e, std::sqrt(best));
   }
   return gap;
 }

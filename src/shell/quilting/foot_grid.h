@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #pragma once
-// Points on a base mesh (element vertices' feet) bucketed in cells of the
-// query radius, for "is any within radius" queries: the bare-area measure
-// (issue 17 item 4) and the scatter fill.
+// Points bucketed in cubic cells of a query radius, for "what lies within
+// radius" queries: the bare-area measure (issue 17 item 4) and the scatter
+// fill (FootGrid: element vertices' feet on a base mesh), the benchmark's
+// nearest-gap measure (CellGrid of tagged points).
 #include <cmath>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "geometry/vec3.h"
@@ -12,30 +14,50 @@
 
 namespace surftex {
 
-class FootGrid {
+/// Items with a position (`position(item)`) in cells of side `cell`; a query
+/// visits the items of the 27 cells around a point, so every item within
+/// `cell` of it (and some farther).
+template <class Item>
+class CellGrid {
  public:
-  explicit FootGrid(double radius) : rad_(radius) {}
-  void add(const P3& p) { grid_[key(p, 0, 0, 0)].push_back(p); }
-  bool covered(const P3& x) const {
+  explicit CellGrid(double cell) : h_(cell) {}
+  void add(const P3& p, Item item) { cells_[key(p, 0, 0, 0)].push_back({p, std::move(item)}); }
+  /// Calls fn(position, item) for the items of the cells around `p` until it returns true; whether one did.
+  template <class Fn>
+  bool any_near(const P3& p, Fn&& fn) const {
     for (int i = -1; i <= 1; ++i)
       for (int j = -1; j <= 1; ++j)
         for (int k = -1; k <= 1; ++k) {
-          auto it = grid_.find(key(x, i, j, k));
-          if (it == grid_.end()) continue;
-          for (const P3& q : it->second)
-            if (vec3::dot(vec3::sub(x, q), vec3::sub(x, q)) <= rad_ * rad_) return true;
+          auto it = cells_.find(key(p, i, j, k));
+          if (it == cells_.end()) continue;
+          for (const auto& [q, item] : it->second)
+            if (fn(q, item)) return true;
         }
     return false;
   }
 
  private:
   long long key(const P3& p, int di, int dj, int dk) const {
-    const long long i = static_cast<long long>(std::floor(p[0] / rad_)) + di, j = static_cast<long long>(std::floor(p[1] / rad_)) + dj,
-                    k = static_cast<long long>(std::floor(p[2] / rad_)) + dk;
+    const long long i = static_cast<long long>(std::floor(p[0] / h_)) + di, j = static_cast<long long>(std::floor(p[1] / h_)) + dj,
+                    k = static_cast<long long>(std::floor(p[2] / h_)) + dk;
     return (i * 73856093LL) ^ (j * 19349663LL) ^ (k * 83492791LL);
   }
+  double h_;
+  std::unordered_map<long long, std::vector<std::pair<P3, Item>>> cells_;
+};
+
+/// Feet of element vertices: is any within `radius` of a point?
+class FootGrid {
+ public:
+  explicit FootGrid(double radius) : rad_(radius), grid_(radius) {}
+  void add(const P3& p) { grid_.add(p, 0); }
+  bool covered(const P3& x) const {
+    return grid_.any_near(x, [&](const P3& q, char) { return vec3::dot(vec3::sub(x, q), vec3::sub(x, q)) <= rad_ * rad_; });
+  }
+
+ private:
   double rad_;
-  std::unordered_map<long long, std::vector<P3>> grid_;
+  CellGrid<char> grid_;
 };
 
 }  // namespace surftex
