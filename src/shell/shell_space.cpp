@@ -274,26 +274,53 @@ std::size_t unfold_base_layer(const Mesh& base, const std::vector<std::uint8_t>&
 
 /// Offset with local clamping (see the header); where shrinking cannot help,
 /// the base layer is unfolded locally (unfold_base_layer, up to 4 times, the
-/// moved set grown by what is still inverted) and the shrinking resumed.
-/// Throws SolverError when prisms stay inverted.
-void offset_with_clamping(const Mesh& base, std::vector<Vector3>& normal,
-                          const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
-                          ShellSpace& s) {
+/// moved set grown by what is still inverted; with `ring`, by one ring of
+/// neighbours more each time) and the shrinking resumed. Returns the prisms
+/// still inverted.
+std::size_t clamp_and_unfold(const Mesh& base, std::vector<Vector3>& normal,
+                             const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
+                             bool ring, ShellSpace& s) {
   s.vertex_height.assign(base.num_vertices(), s.height);
   std::vector<std::uint8_t> shrunk(base.num_vertices(), 0);
   std::vector<std::uint8_t> bad(base.num_vertices(), 0), unfold(base.num_vertices(), 0);
   std::size_t nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
   for (int attempt = 0; nbad > 0 && attempt < 4; ++attempt) {
     for (std::size_t v = 0; v < bad.size(); ++v) unfold[v] |= bad[v];
+    if (ring) {
+      const std::vector<std::uint8_t> was = unfold;
+      for (VertexIndex v : base.vertices())
+        if (was[v.idx()] && !base.is_isolated(v))
+          for (VertexIndex w : base.vertices_around_target(base.halfedge(v))) unfold[w.idx()] = 1;
+    }
     s.unfolded_vertices = unfold_base_layer(base, unfold, 4 << attempt, s, normal);
     nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
+  }
+  s.clamped_vertices = 0;
+  for (auto x : shrunk) s.clamped_vertices += x;
+  return nbad;
+}
+
+/// clamp_and_unfold; if prisms stay inverted (a scanned or modelled fold
+/// whose neighbours lean over it too: chair.obj's seat corners), again from
+/// the start with the unfolded set grown by a ring each time. Meshes the
+/// first pass succeeds on are unchanged by the second. Throws SolverError
+/// when prisms stay inverted.
+void offset_with_clamping(const Mesh& base, std::vector<Vector3>& normal,
+                          const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
+                          ShellSpace& s) {
+  const std::vector<Vec3> points = s.shell_points;
+  const std::vector<Vector3> normals = normal;
+  std::size_t nbad = clamp_and_unfold(base, normal, face_bottom, opt, false, s);
+  if (nbad > 0) {
+    s.shell_points = points;
+    normal = normals;
+    nbad = clamp_and_unfold(base, normal, face_bottom, opt, true, s);
   }
   if (nbad > 0)
     throw SolverError("shell space: " + std::to_string(nbad) + " prisms still inverted after " +
                       std::to_string(s.shrink_rounds) + " shrink rounds and unfolding " +
                       std::to_string(s.unfolded_vertices) + " base vertices (height " + vstr(s.height) +
                       "; a uv triangle flipped by the atlas, or the surface is too curved for this height)");
-  for (auto x : shrunk) s.clamped_vertices += x;
 }
 }  // namespace
 
