@@ -391,15 +391,11 @@ std::vector<std::uint32_t> faces_near_changed_elements(const std::vector<Element
   return faces;
 }
 
-}  // namespace surftex
-
-namespace surftex {
-
-std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m) {
+std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m, bool parallel) {
   Mesh mesh;
   mesh_from_elements({m}, mesh);
   SelfIntersectionOptions so;
-  so.parallel = false;  // (callers run many elements side by side)
+  so.parallel = parallel;
   return self_intersecting_faces(mesh, so);
 }
 

@@ -68,9 +68,10 @@ std::size_t recentre_fans(ElementMesh& m, int min_valence = 9, double min_offset
 double longest_edge_length(const ElementMesh& m);
 /// The pairs of `m`'s triangles that intersect (exact, the rules of
 /// self_intersecting_faces: geometry/self_intersections.h), as triangle
-/// indices, first < second; on one thread. Throws TopologyError for a
-/// non-manifold element (as mesh_from_elements).
-std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m);
+/// indices, first < second; on one thread unless `parallel` (callers that
+/// check many elements side by side leave it off). Throws TopologyError for
+/// a non-manifold element (as mesh_from_elements).
+std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMesh& m, bool parallel = false);
 /// A fold of an element untangled (a thread crumpled by the shell map,
 /// decision 102): the vertices of the triangles flagged in `faces` and one
 /// ring of vertices around them are smoothed, every other vertex held

@@ -25,6 +25,17 @@
 namespace surftex {
 
 namespace {
+// Where each element's faces lie in mesh_from_elements(els)'s numbering.
+struct ElementFaces {
+  std::vector<std::size_t> first;  // face index of each element's first triangle; one past the last at the end
+  explicit ElementFaces(const std::vector<ElementMesh>& els) : first(els.size() + 1, 0) {
+    for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
+  }
+  std::size_t element_of(std::uint32_t f) const {
+    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
+  }
+};
+
 // Rebuilds `els` (with `compact` and `out`) after some triangles were found
 // bad (bad[e] empty: none in element e): an element without any is kept;
 // one with some is removed if compact or `remove`, else cut there (one ring
@@ -71,18 +82,14 @@ std::size_t cut_or_remove(const std::vector<std::vector<char>>& bad, bool remove
 void resolve_embedded_crossings(const std::vector<FacePair>& pairs, std::vector<char>& compact, bool remove,
                                 double max_edge, std::vector<ElementMesh>& els, Mesh& out,
                                 EmbedSurfaceQuiltResult& res, std::vector<char>& fresh) {
-  std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
-  for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
-  auto element_of = [&](std::uint32_t f) {
-    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
-  };
+  const ElementFaces ef(els);
   std::vector<std::vector<char>> bad(els.size());
   auto mark = [&](std::size_t e, std::uint32_t f) {
     if (bad[e].empty()) bad[e].assign(els[e].tris.size(), 0);
-    bad[e][f - first[e]] = 1;
+    bad[e][f - ef.first[e]] = 1;
   };
   for (const FacePair& p : pairs) {
-    const std::size_t a = element_of(p[0]), b = element_of(p[1]);
+    const std::size_t a = ef.element_of(p[0]), b = ef.element_of(p[1]);
     if (a == b) {
       mark(a, p[0]);
       mark(a, p[1]);
@@ -302,9 +309,7 @@ double lift_out_of_base(const ElementMesh& el, const std::vector<int>& qv, const
 /// Whether the element, as the shell map placed it, crosses itself in more
 /// face pairs (exact) than `own`, the swatch element's own crossings.
 bool folded(const ElementMesh& el, std::size_t own) {
-  Mesh m;
-  mesh_from_elements({el}, m);
-  return count_self_intersections(m) > own;  // (in parallel: the copies are checked one by one)
+  return element_self_crossings(el, true).size() > own;  // (in parallel: the copies are checked one by one)
 }
 
 /// Zhou et al. 2006 s.3.2 takes every vertex through the shell map, which is
@@ -432,14 +437,10 @@ std::vector<FacePair> pairs_to_resolve(const std::vector<FacePair>& pairs, const
 /// ones). Returns how many were smoothed out.
 std::size_t untangle_folded_elements(std::vector<FacePair>& pairs, std::size_t own, const std::vector<char>& compact,
                                      std::vector<ElementMesh>& els, Mesh& out) {
-  std::vector<std::size_t> first(els.size() + 1, 0);  // face index of each element's first triangle
-  for (std::size_t e = 0; e < els.size(); ++e) first[e + 1] = first[e] + els[e].tris.size();
-  auto element_of = [&](std::uint32_t f) {
-    return static_cast<std::size_t>(std::upper_bound(first.begin(), first.end(), static_cast<std::size_t>(f)) - first.begin()) - 1;
-  };
+  const ElementFaces ef(els);
   std::map<std::size_t, std::vector<FacePair>> within;
   for (const FacePair& fp : pairs)
-    if (const std::size_t a = element_of(fp[0]); a == element_of(fp[1])) within[a].push_back(fp);
+    if (const std::size_t a = ef.element_of(fp[0]); a == ef.element_of(fp[1])) within[a].push_back(fp);
   std::vector<std::size_t> todo;
   for (const auto& [e, ps] : within)
     if (ps.size() > own && !(e < compact.size() && compact[e])) todo.push_back(e);
@@ -447,7 +448,7 @@ std::size_t untangle_folded_elements(std::vector<FacePair>& pairs, std::size_t o
   tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t i) {
     const std::size_t e = todo[i];
     std::vector<char> faces(els[e].tris.size(), 0);
-    for (const FacePair& fp : within.at(e)) faces[fp[0] - first[e]] = faces[fp[1] - first[e]] = 1;
+    for (const FacePair& fp : within.at(e)) faces[fp[0] - ef.first[e]] = faces[fp[1] - ef.first[e]] = 1;
     smoothed[e] = smooth_out_crossings(els[e], faces, own) ? 1 : 0;
   });
   const std::size_t n = static_cast<std::size_t>(std::count(smoothed.begin(), smoothed.end(), 1));
@@ -455,7 +456,7 @@ std::size_t untangle_folded_elements(std::vector<FacePair>& pairs, std::size_t o
   mesh_from_elements(els, out);  // (same faces in the same order: only points moved)
   std::vector<FacePair> now;
   for (const FacePair& fp : pairs)
-    if (!smoothed[element_of(fp[0])] && !smoothed[element_of(fp[1])]) now.push_back(fp);
+    if (!smoothed[ef.element_of(fp[0])] && !smoothed[ef.element_of(fp[1])]) now.push_back(fp);
   for (const FacePair& fp : self_intersecting_faces(out, faces_near_changed_elements(els, smoothed))) now.push_back(fp);
   std::sort(now.begin(), now.end());
   now.erase(std::unique(now.begin(), now.end()), now.end());
