@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -111,12 +112,27 @@ P3 closest_barycentric(const P3& p, const P3& a, const P3& b, const P3& c, const
   return {1 - v - w, v, w};
 }
 
+// Unit normal and offset of the plane through a with edges ab, ac; zero when
+// the triangle is a sliver (|ab x ac| under 1e-6 of |ab| |ac|).
+std::array<double, 4> plane_of(const P3& ab, const P3& ac, const P3& a) {
+  const P3 n{ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
+  const double len = std::sqrt(vec3::dot(n, n));
+  if (!(len > 1e-6 * std::sqrt(vec3::dot(ab, ab) * vec3::dot(ac, ac)))) return {0, 0, 0, 0};
+  const P3 u{n[0] / len, n[1] / len, n[2] / len};
+  return {u[0], u[1], u[2], vec3::dot(u, a)};
+}
+
 }  // namespace
 
 struct TriangleDistance::Impl {
   std::vector<std::array<P3, 3>> tris;  // in leaf order
   std::vector<std::array<P3, 2>> edges;  // per triangle in leaf order: b - a, c - a
   std::vector<triangle_distance_detail::Box> boxes;  // per triangle in leaf order
+  // Per triangle in leaf order: unit normal and offset of its plane (n . x = d),
+  // zero for a sliver whose normal rounding cannot be trusted; the plane's
+  // distance is a lower bound of the triangle's.
+  std::vector<std::array<double, 4>> planes;
+  double plane_slack = 0;  // absolute slack of that bound (squared): rounding of n . q
   std::vector<int> original;            // leaf order -> index into mesh.tris
   std::vector<int> leaf;                // index into mesh.tris -> leaf order
   std::vector<triangle_distance_detail::Node> nodes;
@@ -125,8 +141,12 @@ struct TriangleDistance::Impl {
   P3 grid_lo{0, 0, 0};
   double grid_cell = 0;
   int nx = 0, ny = 0, nz = 0;
+  struct CellItem {
+    float bound;  ///< <= the squared distance from any point of the cell to the triangle's box
+    int tri;      ///< leaf order
+  };
   std::vector<std::size_t> cell_start;
-  std::vector<int> cell_items;
+  std::vector<CellItem> cell_items;
 
   /// The cell holding q, or -1 (outside the grid, no grid, not finite).
   long long cell_of(const P3& q) const {
@@ -198,11 +218,17 @@ TriangleDistance::TriangleDistance(const ElementMesh& m) : impl_(std::make_uniqu
   for (int i = 0; i < n; ++i) impl_->leaf[impl_->original[i]] = i;
   impl_->edges.resize(n);
   impl_->boxes.resize(n);
+  impl_->planes.resize(n);
   for (int i = 0; i < n; ++i) {
     const auto& t = impl_->tris[i];
     impl_->edges[i] = {vec3::sub(t[1], t[0]), vec3::sub(t[2], t[0])};
     for (const P3& p : t) impl_->boxes[i].add(p);
+    impl_->planes[i] = plane_of(impl_->edges[i][0], impl_->edges[i][1], t[0]);
   }
+  const auto& all = impl_->nodes[0].box;
+  double extent = 0;
+  for (int k = 0; k < 3; ++k) extent = std::max({extent, std::abs(all.lo[k]), std::abs(all.hi[k])});
+  impl_->plane_slack = (1e-9 * extent) * (1e-9 * extent);
 }
 void TriangleDistance::Impl::triangles_near(const Box& b, double r2, std::vector<int>& out) const {
   int stack[128];
@@ -244,7 +270,7 @@ void TriangleDistance::build_cell_lists(double cell, std::size_t max_cells) {
   for (int k = 0; k < 3; ++k) I.grid_lo[k] = all.lo[k] - 2 * cell;
   I.nx = n[0], I.ny = n[1], I.nz = n[2];
   const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1] * n[2];
-  std::vector<std::vector<int>> lists(cells);
+  std::vector<std::vector<Impl::CellItem>> lists(cells);
   const double half_diag = 0.5 * std::sqrt(3.0) * cell;
   auto fill = [&](std::size_t c) {
     const std::size_t i = c % n[0], j = (c / n[0]) % n[1], k = c / (static_cast<std::size_t>(n[0]) * n[1]);
@@ -253,15 +279,22 @@ void TriangleDistance::build_cell_lists(double cell, std::size_t max_cells) {
     b.hi = {b.lo[0] + cell, b.lo[1] + cell, b.lo[2] + cell};
     const P3 centre{b.lo[0] + 0.5 * cell, b.lo[1] + 0.5 * cell, b.lo[2] + 0.5 * cell};
     const double u = (closest(centre).distance + half_diag) * (1 + 1e-9) + 1e-12 * cell;
-    I.triangles_near(b, u * u, lists[c]);
-    // Nearest to the centre first: a query then meets a near hit early and
-    // skips the rest by their boxes (the hit does not depend on the order:
-    // ties go to the first triangle of the mesh).
-    std::vector<std::pair<double, int>> by_d;
-    by_d.reserve(lists[c].size());
-    for (int t : lists[c]) by_d.push_back({I.boxes[static_cast<std::size_t>(t)].squared_distance(centre), t});
+    std::vector<int> near;
+    I.triangles_near(b, u * u, near);
+    // Ordered by the least squared distance from any point of the cell to the
+    // triangle's box (then nearest to the centre first): a query stops at the
+    // first entry whose bound is past its best hit, every later one being
+    // farther still (the bound is shrunk by 1e-6 so that float rounding never
+    // raises it past the box's own distance).
+    std::vector<std::tuple<double, double, int>> by_d;
+    by_d.reserve(near.size());
+    for (int t : near) {
+      const Box& tb = I.boxes[static_cast<std::size_t>(t)];
+      by_d.emplace_back(tb.squared_distance(b), tb.squared_distance(centre), t);
+    }
     std::sort(by_d.begin(), by_d.end());
-    for (std::size_t m = 0; m < by_d.size(); ++m) lists[c][m] = by_d[m].second;
+    lists[c].reserve(by_d.size());
+    for (const auto& [lb, dc, t] : by_d) lists[c].push_back({static_cast<float>(lb * (1 - 1e-6)), t});
   };
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, 256), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) fill(c);
@@ -293,6 +326,10 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
   auto try_triangle = [&](int i) {
     // A triangle whose box is farther than the best hit can neither win nor tie.
     if (I.boxes[i].squared_distance(q) > best) return;
+    // Nor one whose plane is (with a margin for the rounding of both sides).
+    const auto& pl = I.planes[i];
+    const double pd = pl[0] * q[0] + pl[1] * q[1] + pl[2] * q[2] - pl[3];
+    if (pd * pd > best * (1 + 1e-9) + I.plane_slack) return;
     const auto& t = I.tris[i];
     const P3 b = closest_barycentric(q, t[0], t[1], t[2], I.edges[i][0], I.edges[i][1]);
     P3 x;
@@ -335,7 +372,10 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
     }
   };
   if (const long long c = I.cell_of(q); c >= 0) {  // the cell's list holds the winner and its ties
-    for (std::size_t k = I.cell_start[c]; k < I.cell_start[c + 1]; ++k) try_triangle(I.cell_items[k]);
+    for (std::size_t k = I.cell_start[c]; k < I.cell_start[c + 1]; ++k) {
+      if (I.cell_items[k].bound > best) break;  // this and every later triangle lie farther than the best hit
+      try_triangle(I.cell_items[k].tri);
+    }
   } else {
     // The hint first: a near hit prunes the walk. The winner is the least
     // (distance, index) over all triangles, and no box holding it is ever

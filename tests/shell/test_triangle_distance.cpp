@@ -214,3 +214,31 @@ TEST(TriangleDistance, CellListsGiveTheTreesHits) {
   for (const P3& p : q) differ += !same(soup_tree.closest(p), soup.closest(p));
   EXPECT_EQ(differ, 0);
 }
+
+// A query on a swatch vertex is at distance 0 from every triangle around it:
+// the first of them in the mesh wins, by the tree walk and by the cell lists,
+// whatever bounds skip triangles early (the plane bound keeps a margin for
+// its own rounding: without it the triangles whose plane passes through the
+// vertex up to rounding are skipped and a later one wins).
+TEST(TriangleDistance, AVertexQueryGoesToTheFirstTriangleAroundIt) {
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  std::vector<int> first(s.mesh.points.size(), -1);
+  for (std::size_t t = s.mesh.tris.size(); t-- > 0;)
+    for (int k = 0; k < 3; ++k) first[static_cast<std::size_t>(s.mesh.tris[t][k])] = static_cast<int>(t);
+  const TriangleDistance tree(s.mesh);
+  TriangleDistance cells(s.mesh);
+  cells.build_cell_lists(0.5 * s.mean_edge_length);
+  int wrong_tree = 0, wrong_cells = 0, checked = 0;
+  for (std::size_t v = 0; v < s.mesh.points.size(); ++v) {
+    if (first[v] < 0) continue;
+    ++checked;
+    const auto a = tree.closest(s.mesh.points[v]), b = cells.closest(s.mesh.points[v]);
+    wrong_tree += a.tri != first[v] || a.distance != 0;
+    wrong_cells += b.tri != first[v] || b.distance != 0;
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_EQ(wrong_tree, 0);
+  EXPECT_EQ(wrong_cells, 0);
+}
