@@ -18,6 +18,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "geometry/errors.h"
 #include "geometry/vec3.h"
 
 namespace surftex {
@@ -132,7 +133,7 @@ struct TriangleDistance::Impl {
   // zero for a sliver whose normal rounding cannot be trusted; the plane's
   // distance is a lower bound of the triangle's.
   std::vector<std::array<double, 4>> planes;
-  double plane_slack = 0;  // absolute slack of that bound (squared): rounding of n . q
+  double plane_slack = 0;  // (1e-9 of the largest coordinate)^2: the absolute slack of bounds against rounding
   std::vector<int> original;            // leaf order -> index into mesh.tris
   std::vector<int> leaf;                // index into mesh.tris -> leaf order
   std::vector<triangle_distance_detail::Node> nodes;
@@ -317,10 +318,27 @@ double TriangleDistance::box_squared_distance(const P3& q) const {
 }
 
 TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
+  return closest_below(q, hint, std::numeric_limits<double>::infinity());
+}
+
+TriangleDistance::Hit TriangleDistance::closest_within(const P3& q, double radius, int hint) const {
+  if (!(radius >= 0)) throw InvalidInputError("TriangleDistance::closest_within: radius must be >= 0");
+  // Margins of 1e-9 relative and 1e-9 of the mesh's extent: rounding never
+  // decides against a triangle at the radius, even a radius of 0 (the caller
+  // compares the distance with its radius itself).
+  const double bound = radius * (1 + 1e-9);
+  Hit h = closest_below(q, hint, bound * bound + impl_->plane_slack + 1e-300);
+  if (h.tri < 0) h.distance = std::numeric_limits<double>::infinity();
+  return h;
+}
+
+// The closest triangle among those nearer than sqrt(start) (all: infinity);
+// tri = -1 when there is none.
+TriangleDistance::Hit TriangleDistance::closest_below(const P3& q, int hint, double start) const {
   Hit h;
   const Impl& I = *impl_;
   if (I.tris.empty()) return h;
-  double best = std::numeric_limits<double>::infinity();
+  double best = start;
   int best_i = -1;
   P3 best_bary{1, 0, 0};
   auto try_triangle = [&](int i) {
@@ -337,7 +355,7 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
     const P3 r = vec3::sub(q, x);
     const double d = vec3::dot(r, r);
     // Ties: the triangle first in the mesh (independent of the traversal).
-    if (d < best || (d == best && I.original[i] < I.original[best_i])) {
+    if (d < best || (d == best && best_i >= 0 && I.original[i] < I.original[best_i])) {
       best = d;
       best_i = i;
       best_bary = b;
@@ -384,6 +402,7 @@ TriangleDistance::Hit TriangleDistance::closest(const P3& q, int hint) const {
     if (hint >= 0 && hint < static_cast<int>(I.leaf.size())) try_triangle(I.leaf[static_cast<std::size_t>(hint)]);
     walk_tree();
   }
+  if (best_i < 0 && std::isfinite(start)) return h;  // none nearer than the bound (or q not finite)
   if (best_i < 0) {  // a non-finite query point: no distance compares
     h.tri = I.original[0];
     h.distance = std::numeric_limits<double>::quiet_NaN();

@@ -34,6 +34,12 @@ class TriangleDistance {
   /// from the start (a mesh's vertices in order, a pattern's neighbouring
   /// shifts). The result does not depend on it.
   Hit closest(const P3& q, int hint = -1) const;
+  /// closest(q, hint) when that hit lies within `radius` (>= 0; the same
+  /// triangle, distance, point and barycentrics), else tri = -1 and distance
+  /// infinity; a hit a hair past the radius may still be returned, so callers
+  /// compare the distance themselves. Cheaper: farther boxes are skipped from
+  /// the start. Throws InvalidInputError for a negative or NaN radius.
+  Hit closest_within(const P3& q, double radius, int hint = -1) const;
   /// Adds a grid over the triangles' box (plus a margin of two cells) whose
   /// every cell lists the triangles that can be closest to a point in it; a
   /// query inside reads that list instead of walking the tree, outside it
@@ -47,6 +53,7 @@ class TriangleDistance {
   bool empty() const;
 
  private:
+  Hit closest_below(const P3& q, int hint, double start) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

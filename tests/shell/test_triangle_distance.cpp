@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "geometry/errors.h"
 #include "geometry/mesh.h"
 #include "shell/swatch.h"
 #include "shell/swatch_generators.h"
@@ -241,4 +242,53 @@ TEST(TriangleDistance, AVertexQueryGoesToTheFirstTriangleAroundIt) {
   EXPECT_GT(checked, 1000);
   EXPECT_EQ(wrong_tree, 0);
   EXPECT_EQ(wrong_cells, 0);
+}
+
+// closest_within gives closest's hit whenever that lies within the radius
+// (the same triangle, distance, point and barycentrics), else none; a query
+// on the surface is found at radius 0 (the bound's absolute margin: the
+// computed closest point of a face's centroid is off it by rounding).
+TEST(TriangleDistance, ClosestWithinARadiusIsTheClosestHitOrNone) {
+  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
+    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
+  };
+  Mesh weave;
+  make_weave_swatch(weave);
+  const Swatch s = make_swatch(weave);
+  TriangleDistance cells(s.mesh);
+  cells.build_cell_lists(0.5 * s.mean_edge_length);
+  const TriangleDistance tree(s.mesh);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-0.3, 1.3), r(0.0, 0.6);
+  int within = 0, beyond = 0, wrong = 0;
+  for (int i = 0; i < 3000; ++i) {
+    P3 q;
+    for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
+    const double radius = r(rng);
+    for (const TriangleDistance* td : {&tree, static_cast<const TriangleDistance*>(&cells)}) {
+      const auto all = td->closest(q), near = td->closest_within(q, radius);
+      if (all.distance <= radius) {
+        ++within;
+        wrong += !same(all, near);
+      } else {
+        ++beyond;
+        wrong += near.tri >= 0 && !same(all, near);
+      }
+    }
+  }
+  EXPECT_GT(within, 500);
+  EXPECT_GT(beyond, 500);
+  EXPECT_EQ(wrong, 0);
+  // Face centroids (the merge's coverage queries), at the distance closest
+  // reports for them (0 up to rounding): found.
+  int missed = 0;
+  for (const Tri& t : s.mesh.tris) {
+    P3 c;
+    for (int k = 0; k < 3; ++k) c[k] = (s.mesh.points[t[0]][k] + s.mesh.points[t[1]][k] + s.mesh.points[t[2]][k]) / 3.0;
+    const auto all = tree.closest(c);
+    missed += !same(tree.closest_within(c, 0.0), all) || !same(cells.closest_within(c, all.distance), all);
+  }
+  EXPECT_EQ(missed, 0);
+  EXPECT_THROW(tree.closest_within(s.mesh.points[0], -1.0), InvalidInputError);
+  EXPECT_THROW(tree.closest_within(s.mesh.points[0], std::nan("")), InvalidInputError);
 }

@@ -139,10 +139,12 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
     for (std::size_t g = r.begin(); g < r.end(); ++g) {
       const P3 c = centroid(b, b.tris[g]);
       if (ta.box_squared_distance(c) > far2) continue;
-      const auto q = ta.closest(c, ha);
-      ha = q.tri;
+      // (Only a hit within `match` counts; B's closest point to q is no
+      // farther from q than c, a point of B, is.)
+      const auto q = ta.closest_within(c, match, ha);
+      if (q.tri >= 0) ha = q.tri;
       if (!(q.distance <= match)) continue;
-      const auto back = tb.closest(q.point, hb);
+      const auto back = tb.closest_within(q.point, q.distance, hb);
       hb = back.tri;
       covered[g] = dist(back.point, c) <= round_trip;
     }
@@ -214,7 +216,8 @@ ElementCut cut_with_trees(const ElementMesh& a, const TriangleDistance& ta, Side
       int hint = -1;
       for (int t = r.begin(); t < r.end(); ++t)
         if (!force_keep[t] && !force_del[t])
-          hint = (ch[static_cast<std::size_t>(t)] = tb.closest(centroid(a, a.tris[t]), hint)).tri;
+          if (const auto h = (ch[static_cast<std::size_t>(t)] = tb.closest_within(centroid(a, a.tris[t]), match, hint)); h.tri >= 0)
+            hint = h.tri;
     });
     for (int t = 0; t < nt; ++t) {
       if (force_keep[t] || force_del[t]) continue;
@@ -832,7 +835,7 @@ MergeResult merge_elements(const ElementMesh& a, Side side_a, const ElementMesh&
       for (ElementMesh& e : r.capped_b) {
         std::size_t near = 0;
         for (const P3& p : e.points)
-          if (ta.closest(p).distance <= d) ++near;
+          if (ta.closest_within(p, d).distance <= d) ++near;
         if (4 * near <= e.points.size()) away.push_back(std::move(e));
       }
       r.capped_b = std::move(away);
