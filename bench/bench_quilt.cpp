@@ -309,6 +309,8 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},
+         {"refill_rounds", r.refill_rounds},
+         {"refill_rounds_run", r.refill_rounds_run},
          {"faces_refilled", r.faces_refilled},
          {"scatter_placed", r.scatter_placed},
          {"elements_misshapen", r.elements_misshapen},

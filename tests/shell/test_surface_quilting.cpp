@@ -679,6 +679,30 @@ TEST(SurfaceQuilting, AlignOptionsAreChecked) {
   EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
 }
 
+// SurfaceQuiltOptions::refill_rounds' default comes from the swatch: a
+// swatch of threads (no compact element, no scatter fill after the rounds)
+// gets 6 rounds, one of rings or pebbles 3; a given count is kept, and
+// counts outside [-1, 8] are refused.
+TEST(SurfaceQuilting, RefillRoundsDefaultToSixForThreadsAndThreeForCompactElements) {
+  Mesh base;
+  make_icosphere(base, 2);
+  SurfaceQuilt q;
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.5;
+  const SurfaceQuiltResult threads = quilt_surface(base, weave_4x4(4, 5), q, o);
+  EXPECT_EQ(threads.refill_rounds, 6);
+  EXPECT_LE(threads.refill_rounds_run, 6);
+  const SurfaceQuiltResult rings = quilt_surface(base, tiny_scatter(), q, o);
+  EXPECT_EQ(rings.refill_rounds, 3);
+  EXPECT_LE(rings.refill_rounds_run, 3);
+  o.refill_rounds = 2;
+  EXPECT_EQ(quilt_surface(base, weave_4x4(4, 5), q, o).refill_rounds, 2);
+  for (int bad : {-2, 9}) {
+    o.refill_rounds = bad;
+    EXPECT_THROW(quilt_surface(base, tiny_scatter(), q, o), InvalidInputError);
+  }
+}
+
 }  // namespace
 }  // namespace surftex
 

@@ -61,6 +61,8 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["crossings_resolved"] = r.crossings_resolved;
   j["finish_elements_checked"] = r.finish_elements_checked;
   j["fragments_removed"] = r.fragments_removed;
+  j["refill_rounds"] = r.refill_rounds;
+  j["refill_rounds_run"] = r.refill_rounds_run;
   j["faces_refilled"] = r.faces_refilled;
   j["scatter_placed"] = r.scatter_placed;
   j["scatter_only"] = r.scatter_only;

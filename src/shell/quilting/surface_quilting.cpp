@@ -425,7 +425,7 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.field_smoothing >= 0) || !std::isfinite(o.field_smoothing)) bad("field_smoothing must be >= 0", o.field_smoothing);
   if (!(o.field_min_projection > 0 && o.field_min_projection <= 1))
     bad("field_min_projection must be in (0, 1]", o.field_min_projection);
-  if (o.refill_rounds < 0 || o.refill_rounds > 8) bad("refill_rounds must be in [0, 8]", o.refill_rounds);
+  if (o.refill_rounds < -1 || o.refill_rounds > 8) bad("refill_rounds must be in [-1, 8]", o.refill_rounds);
   if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
@@ -1805,8 +1805,10 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
 void SurfaceQuilter::quilt_and_refill() {
   quilt_unprocessed();
   finish();
-  for (int round = 0; round < opt_.refill_rounds; ++round) {
+  res_.refill_rounds = opt_.refill_rounds >= 0 ? opt_.refill_rounds : compact_.empty() ? 6 : 3;
+  for (int round = 0; round < res_.refill_rounds; ++round) {
     if (refill() == 0) break;
+    ++res_.refill_rounds_run;
     refilling_ = true;
     quilt_unprocessed();
     finish();

@@ -107,8 +107,13 @@ struct SurfaceQuiltOptions {
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
   /// Rounds re-quilting the base faces left bare (no element vertex within half
-  /// the element spacing). In [0, 8]; 0 = none. Default 3.
-  int refill_rounds = 3;
+  /// the element spacing). In [-1, 8]; 0 = none; -1 = from the swatch: 3 when
+  /// it has compact elements (the scatter fill then places them in what stays
+  /// bare; more rounds reopen as many faces as they fill), 6 when it has none
+  /// (threads: the rounds are their only fill and converge; 8 would cover
+  /// more but take bunny5k past its 60 s). Default -1
+  /// (decision 102, session 38).
+  int refill_rounds = -1;
   /// Scatter fill after the refills: per face still bare, up to this many
   /// tries to place one compact swatch element (a ring, a pebble) there
   /// without crossing or stretching (four quarter turns, then moved by up to
@@ -238,6 +243,8 @@ struct SurfaceQuiltResult {
   std::size_t finish_elements_checked = 0;
   /// Output pieces left out for being smaller than a tenth of the swatch's smallest element.
   std::size_t fragments_removed = 0;
+  /// Refill rounds allowed (SurfaceQuiltOptions::refill_rounds, resolved) and run.
+  int refill_rounds = 0, refill_rounds_run = 0;
   /// Base faces reopened by refill_rounds.
   std::size_t faces_refilled = 0;
   /// Single compact elements placed by the scatter fill (scatter_attempts).
