@@ -74,12 +74,21 @@ void expect_matches_brute_force(const ElementMesh& m, const std::vector<P3>& que
   }
 }
 
+// The same hit, bit for bit.
+bool same_hit(const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
+  return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
+}
+
+Swatch weave_swatch() {
+  Mesh weave;
+  make_weave_swatch(weave);
+  return make_swatch(weave);
+}
+
 }  // namespace
 
 TEST(TriangleDistance, MatchesBruteForceOnAWeaveSwatch) {
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   std::mt19937_64 rng(3);
   std::vector<P3> q;
   std::uniform_real_distribution<double> u(-0.3, 1.3);
@@ -132,9 +141,7 @@ TEST(TriangleDistance, EmptyMeshAndTiesAreDefined) {
 
 // A non-finite query point gives a NaN distance, not an index out of range.
 TEST(TriangleDistance, NonFiniteQueryGivesNaN) {
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   const TriangleDistance td(s.mesh);
   const auto h = td.closest({std::nan(""), 0, 0});
   EXPECT_TRUE(std::isnan(h.distance));
@@ -145,24 +152,19 @@ TEST(TriangleDistance, NonFiniteQueryGivesNaN) {
 // The hint (the previous query's triangle) only orders the search: any hint,
 // far, near, out of range or at a tie, gives the hit of no hint, bit for bit.
 TEST(TriangleDistance, AHintNeverChangesTheHit) {
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   const TriangleDistance td(s.mesh);
   const int n = static_cast<int>(s.mesh.tris.size());
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-0.2, 1.2);
-  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
-    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
-  };
   int hint = -1;
   for (int i = 0; i < 300; ++i) {
     P3 q;
     for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
     const auto plain = td.closest(q);
-    EXPECT_TRUE(same(plain, td.closest(q, hint)));            // the previous hit, as the callers pass it
-    EXPECT_TRUE(same(plain, td.closest(q, (i * 7919) % n)));  // any triangle
-    EXPECT_TRUE(same(plain, td.closest(q, n + i)));           // out of range: ignored
+    EXPECT_TRUE(same_hit(plain, td.closest(q, hint)));            // the previous hit, as the callers pass it
+    EXPECT_TRUE(same_hit(plain, td.closest(q, (i * 7919) % n)));  // any triangle
+    EXPECT_TRUE(same_hit(plain, td.closest(q, n + i)));           // out of range: ignored
     hint = plain.tri;
   }
   // Ties: twenty copies of one triangle; hinting a later copy still reports the first.
@@ -177,12 +179,7 @@ TEST(TriangleDistance, AHintNeverChangesTheHit) {
 // the same hits as the tree walk, bit for bit, inside, at the margin and
 // outside the grid, on a swatch and on soups with degenerate triangles.
 TEST(TriangleDistance, CellListsGiveTheTreesHits) {
-  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
-    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
-  };
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   const TriangleDistance tree(s.mesh);
   TriangleDistance cells(s.mesh);
   cells.build_cell_lists(s.mean_edge_length);
@@ -192,10 +189,10 @@ TEST(TriangleDistance, CellListsGiveTheTreesHits) {
   for (int i = 0; i < 2000; ++i) {
     P3 q;
     for (int k = 0; k < 3; ++k) q[k] = s.bbox_min[k] + u(rng) * (s.bbox_max[k] - s.bbox_min[k]);
-    differ += !same(tree.closest(q), cells.closest(q));
+    differ += !same_hit(tree.closest(q), cells.closest(q));
   }
   for (const P3& p : s.mesh.points)
-    differ += !same(tree.closest(p), cells.closest(p));  // on the surface: ties
+    differ += !same_hit(tree.closest(p), cells.closest(p));  // on the surface: ties
   EXPECT_EQ(differ, 0);
   std::normal_distribution<double> g(0, 1);
   ElementMesh m;
@@ -212,7 +209,7 @@ TEST(TriangleDistance, CellListsGiveTheTreesHits) {
   TriangleDistance soup(m);
   soup.build_cell_lists(0.1, 4096);  // coarser than asked: the cell grows to fit 4096 cells
   const TriangleDistance soup_tree(m);
-  for (const P3& p : q) differ += !same(soup_tree.closest(p), soup.closest(p));
+  for (const P3& p : q) differ += !same_hit(soup_tree.closest(p), soup.closest(p));
   EXPECT_EQ(differ, 0);
 }
 
@@ -222,9 +219,7 @@ TEST(TriangleDistance, CellListsGiveTheTreesHits) {
 // its own rounding: without it the triangles whose plane passes through the
 // vertex up to rounding are skipped and a later one wins).
 TEST(TriangleDistance, AVertexQueryGoesToTheFirstTriangleAroundIt) {
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   std::vector<int> first(s.mesh.points.size(), -1);
   for (std::size_t t = s.mesh.tris.size(); t-- > 0;)
     for (int k = 0; k < 3; ++k) first[static_cast<std::size_t>(s.mesh.tris[t][k])] = static_cast<int>(t);
@@ -249,12 +244,7 @@ TEST(TriangleDistance, AVertexQueryGoesToTheFirstTriangleAroundIt) {
 // on the surface is found at radius 0 (the bound's absolute margin: the
 // computed closest point of a face's centroid is off it by rounding).
 TEST(TriangleDistance, ClosestWithinARadiusIsTheClosestHitOrNone) {
-  auto same = [](const TriangleDistance::Hit& a, const TriangleDistance::Hit& b) {
-    return a.tri == b.tri && a.distance == b.distance && a.point == b.point && a.bary == b.bary;
-  };
-  Mesh weave;
-  make_weave_swatch(weave);
-  const Swatch s = make_swatch(weave);
+  const Swatch s = weave_swatch();
   TriangleDistance cells(s.mesh);
   cells.build_cell_lists(0.5 * s.mean_edge_length);
   const TriangleDistance tree(s.mesh);
@@ -269,10 +259,10 @@ TEST(TriangleDistance, ClosestWithinARadiusIsTheClosestHitOrNone) {
       const auto all = td->closest(q), near = td->closest_within(q, radius);
       if (all.distance <= radius) {
         ++within;
-        wrong += !same(all, near);
+        wrong += !same_hit(all, near);
       } else {
         ++beyond;
-        wrong += near.tri >= 0 && !same(all, near);
+        wrong += near.tri >= 0 && !same_hit(all, near);
       }
     }
   }
@@ -286,7 +276,7 @@ TEST(TriangleDistance, ClosestWithinARadiusIsTheClosestHitOrNone) {
     P3 c;
     for (int k = 0; k < 3; ++k) c[k] = (s.mesh.points[t[0]][k] + s.mesh.points[t[1]][k] + s.mesh.points[t[2]][k]) / 3.0;
     const auto all = tree.closest(c);
-    missed += !same(tree.closest_within(c, 0.0), all) || !same(cells.closest_within(c, all.distance), all);
+    missed += !same_hit(tree.closest_within(c, 0.0), all) || !same_hit(cells.closest_within(c, all.distance), all);
   }
   EXPECT_EQ(missed, 0);
   EXPECT_THROW(tree.closest_within(s.mesh.points[0], -1.0), InvalidInputError);
