@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -113,16 +114,27 @@ ProgressCallback terminal_progress(bool quiet) {
   // Never empty: every report is a cancellation point (SIGINT/SIGTERM), also
   // in pipes where nothing is drawn.
   if (quiet || !::isatty(STDERR_FILENO)) return [](std::string_view, double) { throw_if_cancelled(); };
-  auto last = std::make_shared<std::pair<std::string, int>>("", -1);
-  auto mu = std::make_shared<std::mutex>();
-  return [last, mu](std::string_view stage, double fraction) {
+  struct State {
+    std::string stage;
+    int pct = -1;
+    long shown_seconds = -1;
+    std::chrono::steady_clock::time_point start;
+    std::mutex mu;
+  };
+  auto st = std::make_shared<State>();
+  return [st](std::string_view stage, double fraction) {
     throw_if_cancelled();
-    std::lock_guard<std::mutex> lock(*mu);
-    int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
-    if (last->first == stage && last->second == pct) return;
-    last->first = std::string(stage);
-    last->second = pct;
-    std::fprintf(stderr, "\r\033[K%.*s %3d%%", static_cast<int>(stage.size()), stage.data(), pct);
+    std::lock_guard<std::mutex> lock(st->mu);
+    const auto now = std::chrono::steady_clock::now();
+    if (st->stage != stage) st->stage = std::string(stage), st->pct = -1, st->start = now;
+    const int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
+    const double elapsed = std::chrono::duration<double>(now - st->start).count();
+    const long secs = static_cast<long>(elapsed);
+    // Redrawn when the percentage changes or a second passes; 100% once.
+    if (st->pct == pct && (pct >= 100 || st->shown_seconds == secs)) return;
+    st->pct = pct;
+    st->shown_seconds = secs;
+    std::fprintf(stderr, "\r\033[K%s", progress_line(stage, pct, elapsed).c_str());
     if (pct >= 100) std::fputc('\n', stderr);
     std::fflush(stderr);
   };

@@ -55,7 +55,10 @@ void add_common_options(CLI::App& app, CommonOptions& opt);
 std::shared_ptr<void> apply_thread_limit(int threads);
 
 /// A progress callback that draws on stderr when it is a terminal and
-/// !quiet, and does nothing in pipes.
+/// !quiet, and does nothing in pipes. Each line shows the stage, its
+/// percentage, the seconds since the stage began and, once a stage has run
+/// 3 s and is 5% done, the time it has left at its pace so far
+/// (progress_line).
 ProgressCallback terminal_progress(bool quiet);
 
 /// Throws InvalidInputError if `input` does not exist or is not a regular file.

@@ -594,6 +594,8 @@ class SurfaceQuilter {
   std::mt19937_64 rng_;
   std::vector<Element> elements_;
   std::vector<char> processed_;
+  std::string progress_stage_ = "quilt";  // the stage quilt_unprocessed reports, from progress_from_ faces done
+  int progress_from_ = 0;
   std::vector<int> constrained_;
   DiscGrowthState growth_;
   std::vector<int> patch_slot_;
@@ -1373,7 +1375,7 @@ void SurfaceQuilter::mark_processed(const Patch& p, const QuiltGrid& grid, const
 void SurfaceQuilter::quilt_unprocessed() {
   while (done_ < nf_) {
     const int seed = find_seed();
-    report_progress(opt_.progress, "quilt", static_cast<double>(done_) / nf_);
+    report_progress(opt_.progress, progress_stage_, static_cast<double>(done_ - progress_from_) / (nf_ - progress_from_));
     Timer tp;
     Patch p;
     grow_and_flatten(seed, p, opt_.patch_radius * swatch_diag_, cos_max_);
@@ -1395,6 +1397,7 @@ void SurfaceQuilter::quilt_unprocessed() {
     res_.seconds_step += ts.seconds();
     ++res_.steps;
   }
+  report_progress(opt_.progress, progress_stage_, 1.0);
 }
 
 // A location lifted to where the shell puts it, roughly: its foot on the
@@ -1760,6 +1763,7 @@ void SurfaceQuilter::scatter_into_bare() {
     elements_.push_back(std::move(el));
     ++res_.scatter_placed;
   }
+  report_progress(opt_.progress, "scatter", 1.0);
 }
 
 // The output: every live element (fitted into the z range by finish)
@@ -1809,6 +1813,9 @@ void SurfaceQuilter::quilt_and_refill() {
   for (int round = 0; round < res_.refill_rounds; ++round) {
     if (refill() == 0) break;
     ++res_.refill_rounds_run;
+    // (Each round its own progress stage: the faces it reopened, from 0%.)
+    progress_stage_ = "quilt refill " + std::to_string(round + 1) + "/" + std::to_string(res_.refill_rounds);
+    progress_from_ = done_;
     refilling_ = true;
     quilt_unprocessed();
     finish();
@@ -1850,7 +1857,6 @@ SurfaceQuiltResult SurfaceQuilter::run(SurfaceQuilt& out) {
   res_.faces = out.tris.size();
   res_.vertices = out.vertices.size();
   res_.seconds = timer.seconds();
-  report_progress(opt_.progress, "quilt", 1.0);
   return res_;
 }
 
