@@ -126,8 +126,11 @@ ProgressCallback terminal_progress(bool quiet) {
     throw_if_cancelled();
     std::lock_guard<std::mutex> lock(st->mu);
     const auto now = std::chrono::steady_clock::now();
-    if (st->stage != stage) st->stage = std::string(stage), st->pct = -1, st->start = now;
     const int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0 + 0.5);
+    // A new stage, or the same one again after it reached 100% (a scatter
+    // pass after the last): its clock starts now.
+    if (st->stage != stage || (st->pct >= 100 && pct < 100))
+      st->stage = std::string(stage), st->pct = -1, st->start = now;
     const double elapsed = std::chrono::duration<double>(now - st->start).count();
     const long secs = static_cast<long>(elapsed);
     // Redrawn when the percentage changes or a second passes; 100% once.

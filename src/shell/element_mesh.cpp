@@ -400,8 +400,9 @@ std::vector<std::array<std::uint32_t, 2>> element_self_crossings(const ElementMe
 }
 
 namespace {
-// Umbrella steps on the vertices of the flagged triangles and one ring more.
-void smooth_around(ElementMesh& m, const std::vector<char>& faces, int steps) {
+// Neighbours (with repeats, as the triangles list them) of the vertices of
+// the flagged triangles and one ring more; empty for every other vertex.
+std::vector<std::vector<int>> smoothing_neighbours(const ElementMesh& m, const std::vector<char>& faces) {
   const std::size_t nv = m.points.size();
   std::vector<char> region(nv, 0), grown(nv, 0);
   for (std::size_t t = 0; t < m.tris.size(); ++t)
@@ -417,15 +418,20 @@ void smooth_around(ElementMesh& m, const std::vector<char>& faces, int steps) {
         nb[static_cast<std::size_t>(t[k])].push_back(t[(k + 1) % 3]);
         nb[static_cast<std::size_t>(t[k])].push_back(t[(k + 2) % 3]);
       }
+  return nb;
+}
+
+// `steps` umbrella steps (each vertex with neighbours to their mean, all at once).
+void umbrella_steps(std::vector<P3>& points, const std::vector<std::vector<int>>& nb, int steps) {
   for (int it = 0; it < steps; ++it) {
-    std::vector<P3> next = m.points;
-    for (std::size_t v = 0; v < nv; ++v) {
+    std::vector<P3> next = points;
+    for (std::size_t v = 0; v < points.size(); ++v) {
       if (nb[v].empty()) continue;
       P3 a{0, 0, 0};
-      for (int u : nb[v]) a = vec3::add(a, m.points[static_cast<std::size_t>(u)]);
+      for (int u : nb[v]) a = vec3::add(a, points[static_cast<std::size_t>(u)]);
       next[v] = vec3::mul(a, 1.0 / static_cast<double>(nb[v].size()));
     }
-    m.points.swap(next);
+    points.swap(next);
   }
 }
 }  // namespace
@@ -434,9 +440,12 @@ bool smooth_out_crossings(ElementMesh& m, const std::vector<char>& faces, std::s
   if (faces.size() != m.tris.size())
     throw InvalidInputError("smooth_out_crossings: " + std::to_string(faces.size()) + " flags for " +
                             std::to_string(m.tris.size()) + " triangles");
-  for (int steps : {4, 16, 64}) {
-    ElementMesh trial = m;
-    smooth_around(trial, faces, steps);
+  const auto nb = smoothing_neighbours(m, faces);
+  ElementMesh trial = m;
+  int done = 0;
+  for (int steps : {4, 16, 64}) {  // (16 steps from the start are the first 4 and 12 more)
+    umbrella_steps(trial.points, nb, steps - done);
+    done = steps;
     if (element_self_crossings(trial).size() <= own) {
       m = std::move(trial);
       return true;

@@ -133,7 +133,7 @@ struct TriangleDistance::Impl {
   // zero for a sliver whose normal rounding cannot be trusted; the plane's
   // distance is a lower bound of the triangle's.
   std::vector<std::array<double, 4>> planes;
-  double plane_slack = 0;  // (1e-9 of the largest coordinate)^2: the absolute slack of bounds against rounding
+  double rounding_slack = 0;  // (1e-9 of the largest coordinate)^2: the absolute slack of bounds against rounding
   std::vector<int> original;            // leaf order -> index into mesh.tris
   std::vector<int> leaf;                // index into mesh.tris -> leaf order
   std::vector<triangle_distance_detail::Node> nodes;
@@ -229,7 +229,7 @@ TriangleDistance::TriangleDistance(const ElementMesh& m) : impl_(std::make_uniqu
   const auto& all = impl_->nodes[0].box;
   double extent = 0;
   for (int k = 0; k < 3; ++k) extent = std::max({extent, std::abs(all.lo[k]), std::abs(all.hi[k])});
-  impl_->plane_slack = (1e-9 * extent) * (1e-9 * extent);
+  impl_->rounding_slack = (1e-9 * extent) * (1e-9 * extent);
 }
 void TriangleDistance::Impl::triangles_near(const Box& b, double r2, std::vector<int>& out) const {
   int stack[128];
@@ -327,7 +327,7 @@ TriangleDistance::Hit TriangleDistance::closest_within(const P3& q, double radiu
   // decides against a triangle at the radius, even a radius of 0 (the caller
   // compares the distance with its radius itself).
   const double bound = radius * (1 + 1e-9);
-  Hit h = closest_below(q, hint, bound * bound + impl_->plane_slack + 1e-300);
+  Hit h = closest_below(q, hint, bound * bound + impl_->rounding_slack + 1e-300);
   if (h.tri < 0) h.distance = std::numeric_limits<double>::infinity();
   return h;
 }
@@ -347,7 +347,7 @@ TriangleDistance::Hit TriangleDistance::closest_below(const P3& q, int hint, dou
     // Nor one whose plane is (with a margin for the rounding of both sides).
     const auto& pl = I.planes[i];
     const double pd = pl[0] * q[0] + pl[1] * q[1] + pl[2] * q[2] - pl[3];
-    if (pd * pd > best * (1 + 1e-9) + I.plane_slack) return;
+    if (pd * pd > best * (1 + 1e-9) + I.rounding_slack) return;
     const auto& t = I.tris[i];
     const P3 b = closest_barycentric(q, t[0], t[1], t[2], I.edges[i][0], I.edges[i][1]);
     P3 x;
