@@ -39,7 +39,7 @@
 //   BENCH_SCATTER (attempts), BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE,
 //   BENCH_SCATTER_ONLY (scatter_swatch_elements; 0: always quilt), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
-//   BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
+//   BENCH_LIFT_RINGS (lift_crossing_rings), BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
 //   resolution after the shell map), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_STRETCH_ITERS (the
 //   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
@@ -249,6 +249,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_SHAPE")) qo.max_shape_ratio = std::atof(e);
   if (const char* e = std::getenv("BENCH_RINGS")) qo.remove_broken_rings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PIECES")) qo.min_piece_fraction = std::atof(e);
+  if (const char* e = std::getenv("BENCH_LIFT_RINGS")) qo.lift_crossing_rings = std::atoi(e);
   if (const char* e = std::getenv("BENCH_RESOLVE")) qo.resolve_crossings = qo.step.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_TRIM_NEW")) qo.trim_new_to_patch = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_PUSH")) qo.step.push_over_under = std::atoi(e) != 0;
@@ -300,6 +301,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_trimmed", r.stats.crossing_trimmed},
          {"crossing_pushed", r.stats.crossing_pushed},
          {"crossings_resolved", r.crossings_resolved},
+         {"crossings_lifted_clear", r.crossings_lifted_clear},
          {"crossing_elements_embedded", er.crossing_elements},
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"elements_stretched_embedded", er.elements_stretched_embedded},

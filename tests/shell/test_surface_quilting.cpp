@@ -703,6 +703,50 @@ TEST(SurfaceQuilting, RefillRoundsDefaultToSixForThreadsAndThreeForCompactElemen
   }
 }
 
+// Session 39: a chain-mail ring that crosses a neighbour when lifted is moved
+// (along the normal, then aside) where that clears it, instead of removed; on
+// by default only for a swatch whose rings interlink (their boxes overlap),
+// not for separate elements. The kept rings cross nothing: the displaced
+// quilt has no more intersecting pairs between elements than with the moves off.
+TEST(SurfaceQuilting, CrossingChainmailRingsAreMovedClearInsteadOfRemoved) {
+  Mesh base;
+  make_icosphere(base, 2);
+  SurfaceQuiltOptions o;
+  o.relative_size = 0.45;
+  auto between_pairs = [&](const SurfaceQuilt& q) {
+    Mesh displaced;
+    surface_quilt_displaced(base, q, (q.z_max - q.z_min) * q.scale, displaced);
+    auto el = displaced.property_map<FaceIndex, int>(kFaceElement.name).first;
+    std::size_t between = 0;
+    for (const FacePair& fp : self_intersecting_faces(displaced)) between += el[FaceIndex(fp[0])] != el[FaceIndex(fp[1])];
+    return between;
+  };
+  SurfaceQuilt on, off;
+  const SurfaceQuiltResult r_on = quilt_surface(base, tiny_chainmail(), on, o);
+  o.lift_crossing_rings = 0;
+  const SurfaceQuiltResult r_off = quilt_surface(base, tiny_chainmail(), off, o);
+  std::cout << "[ chain mail moves ] crossings " << r_on.crossings_resolved << ", moved clear "
+            << r_on.crossings_lifted_clear << ", elements " << r_on.elements << " (off: " << r_off.elements << ")\n";
+  EXPECT_EQ(r_on.lift_crossing_rings, 1);
+  EXPECT_EQ(r_off.lift_crossing_rings, 0);
+  EXPECT_GT(r_on.crossings_lifted_clear, 0u);
+  EXPECT_EQ(r_off.crossings_lifted_clear, 0u);
+  EXPECT_LE(between_pairs(on), between_pairs(off));
+  o.lift_crossing_rings = -1;
+  ToriOptions to;  // separate tilted rings: no box reaches into another
+  to.tori_x = to.tori_y = 3;
+  to.segments = 12;
+  to.sides = 6;
+  Mesh tori;
+  make_tori_swatch(tori, to);
+  SurfaceQuilt sep;
+  const SurfaceQuiltResult r_sep = quilt_surface(base, make_swatch(tori), sep, o);
+  EXPECT_EQ(r_sep.lift_crossing_rings, 0);
+  EXPECT_EQ(r_sep.crossings_lifted_clear, 0u);
+  o.lift_crossing_rings = 2;
+  EXPECT_THROW(quilt_surface(base, tiny_scatter(), sep, o), InvalidInputError);
+}
+
 }  // namespace
 }  // namespace surftex
 

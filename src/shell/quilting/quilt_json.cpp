@@ -59,6 +59,8 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["small_pieces_removed"] = r.small_pieces_removed;
   j["edge_stretch_max"] = r.edge_stretch_max;
   j["crossings_resolved"] = r.crossings_resolved;
+  j["crossings_lifted_clear"] = r.crossings_lifted_clear;
+  j["lift_crossing_rings"] = r.lift_crossing_rings;
   j["finish_elements_checked"] = r.finish_elements_checked;
   j["fragments_removed"] = r.fragments_removed;
   j["refill_rounds"] = r.refill_rounds;

@@ -426,6 +426,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (!(o.field_min_projection > 0 && o.field_min_projection <= 1))
     bad("field_min_projection must be in (0, 1]", o.field_min_projection);
   if (o.refill_rounds < -1 || o.refill_rounds > 8) bad("refill_rounds must be in [-1, 8]", o.refill_rounds);
+  if (o.lift_crossing_rings < -1 || o.lift_crossing_rings > 1)
+    bad("lift_crossing_rings must be -1, 0 or 1", o.lift_crossing_rings);
   if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
@@ -532,6 +534,21 @@ struct FrameElements {
 // grow_and_flatten, orient, align, express, search_turn, merge, and, after
 // the loop, finish (settle, trim at borders and stretch bound, resolve
 // crossings), refill (bare faces quilted again) and emit.
+// Whether the bounding boxes of two swatch elements overlap: rings that
+// interlink (chain mail) or threads that interweave reach into each other's
+// box; separate rings and pebbles do not.
+bool element_boxes_overlap(const Swatch& sw) {
+  const auto& els = sw.elements;
+  for (std::size_t i = 0; i < els.size(); ++i)
+    for (std::size_t j = i + 1; j < els.size(); ++j) {
+      bool meet = true;
+      for (int d = 0; d < 3; ++d)
+        meet = meet && els[i].bbox_min[d] < els[j].bbox_max[d] && els[j].bbox_min[d] < els[i].bbox_max[d];
+      if (meet) return true;
+    }
+  return false;
+}
+
 class SurfaceQuilter {
  public:
   SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const SurfaceQuiltOptions& opt);
@@ -575,6 +592,7 @@ class SurfaceQuilter {
   void fit_z(Element& el);
   void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
+  bool lift_clear(Element& el, int i, ElementCollider& coll, std::vector<char>& dead);
   void remove_misshapen();
   std::vector<char> bare_faces(bool without_fragments = false) const;  // bare_samples per face
   bool is_fragment(const Element& el) const;
@@ -616,6 +634,7 @@ class SurfaceQuilter {
   double stretch_bound2_ = 0;  // squared (mesh units); 0 = none (settle_and_trim)
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
+  bool lift_rings_ = false;    // lift_crossing_rings, resolved
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   bool scatter_only_ = false;  // few compact elements: placed by the scatter fill alone
   double scatter_clearance_ = 0;  // the scatter's gap to elements already placed (mesh units)
@@ -668,6 +687,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   compact_ = compact_swatch_elements(swatch);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
+  lift_rings_ = opt.lift_crossing_rings < 0 ? !compact_.empty() && element_boxes_overlap(swatch) : opt.lift_crossing_rings > 0;
+  res_.lift_crossing_rings = lift_rings_ ? 1 : 0;
   scatter_only_ = opt.scatter_attempts > 0 && all_compact_ &&
                   compact_.size() <= static_cast<std::size_t>(opt.scatter_swatch_elements);
   scatter_clearance_ = scatter_only_ ? opt.scatter_clearance * std::max(swatch.length(), swatch.width()) * S_
@@ -1544,8 +1565,9 @@ void SurfaceQuilter::resolve_crossings_lifted() {
     const std::vector<char> hit = coll.hits(lifted_els[i], static_cast<int>(i), 0.0, &dead);
     if (std::find(hit.begin(), hit.end(), 1) == hit.end()) continue;
     ++res_.crossings_resolved;
-    dead[i] = 1;
     Element& el = elements_[static_cast<std::size_t>(id[i])];
+    if (el.compact && lift_rings_ && lift_clear(el, static_cast<int>(i), coll, dead)) continue;
+    dead[i] = 1;
     el.alive = false;
     if (el.compact) continue;
     std::vector<char> drop = hit;
@@ -1567,6 +1589,69 @@ void SurfaceQuilter::resolve_crossings_lifted() {
       elements_.push_back(std::move(piece));  // (invalidates el)
     }
   }
+}
+
+// A crossing compact element moved and kept at the first move where it
+// crosses nothing: along the normal (0.1, -0.1, 0.2, -0.2 swatch heights,
+// within the swatch's z range), then along the surface (0.1 and 0.2 of its
+// width in 8 directions; each vertex walked over the base from its foot). In
+// an interlinked swatch (chain mail) a ring that meets a neighbour's tilted
+// ring often clears it a little higher, lower or aside. Its old triangles are
+// retired from the collider, its new ones added.
+bool SurfaceQuilter::lift_clear(Element& el, int i, ElementCollider& coll, std::vector<char>& dead) {
+  auto accept = [&](Element& moved) {
+    const ElementMesh m = lifted_mesh(moved);
+    const std::vector<char> h = coll.hits(m, i, 0.0, &dead);
+    if (std::find(h.begin(), h.end(), 1) != h.end()) return false;
+    el.loc = std::move(moved.loc);
+    dead[static_cast<std::size_t>(i)] = 1;
+    const int nid = static_cast<int>(dead.size());
+    dead.push_back(0);
+    coll.add(m, nid);
+    ++res_.crossings_lifted_clear;
+    return true;
+  };
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  for (const double step : {0.1, -0.1, 0.2, -0.2}) {
+    const double dz = step * swatch_h_;
+    if (lo + dz < swatch_.bbox_min[2] || hi + dz > swatch_.bbox_max[2]) continue;
+    Element moved = el;
+    for (SurfaceQuiltVertex& v : moved.loc) v.z += dz;
+    if (accept(moved)) return true;
+  }
+  // A tangent frame at the element's feet: their mean normal and its extent.
+  P3 n{0, 0, 0}, c{0, 0, 0};
+  std::vector<P3> feet(el.loc.size());
+  for (std::size_t k = 0; k < el.loc.size(); ++k) {
+    feet[k] = base_point(b_, el.loc[k]);
+    for (int d = 0; d < 3; ++d) n[d] += b_.normal[el.loc[k].face][d], c[d] += feet[k][d] / el.loc.size();
+  }
+  double width = 0;
+  for (const P3& f : feet) width = std::max(width, 2 * norm3(sub3(f, c)));
+  if (!(norm3(n) > 0) || !(width > 0)) return false;
+  n = {n[0] / norm3(n), n[1] / norm3(n), n[2] / norm3(n)};
+  P3 e1 = std::abs(n[0]) < 0.9 ? cross3(n, P3{1, 0, 0}) : cross3(n, P3{0, 1, 0});
+  e1 = {e1[0] / norm3(e1), e1[1] / norm3(e1), e1[2] / norm3(e1)};
+  const P3 e2 = cross3(n, e1);
+  for (const double frac : {0.1, 0.2})
+    for (int dir = 0; dir < 8; ++dir) {
+      const double a = dir * kPi / 4, len = frac * width;
+      const P3 t{len * (std::cos(a) * e1[0] + std::sin(a) * e2[0]), len * (std::cos(a) * e1[1] + std::sin(a) * e2[1]),
+                 len * (std::cos(a) * e1[2] + std::sin(a) * e2[2])};
+      Element moved = el;
+      bool ok = true;
+      for (std::size_t k = 0; k < moved.loc.size() && ok; ++k) {
+        SurfaceQuiltVertex& v = moved.loc[k];
+        const P3 q{feet[k][0] + t[0], feet[k][1] + t[1], feet[k][2] + t[2]};
+        const auto w = project_bary(b_, v.face, q);
+        v.b1 = w[1];
+        v.b2 = w[2];
+        ok = settle_location(b_, v);
+      }
+      if (ok && accept(moved)) return true;
+    }
+  return false;
 }
 
 // Finish: compact elements that lost their shape (issue 17 item 2; Zhou

@@ -106,6 +106,14 @@ struct SurfaceQuiltOptions {
   /// After the loop, elements that cross when lifted are resolved exactly (the
   /// later yields), backing up QuiltStepOptions::resolve_crossings. Default true.
   bool resolve_crossings = true;
+  /// A compact element that crosses when lifted is first moved and kept where
+  /// that clears it, instead of removed: along the surface normal (0.1, then
+  /// 0.2 swatch heights, up then down, within the swatch's height range), then
+  /// along the surface (0.1, then 0.2 of its width, 8 directions).
+  /// -1 = from the swatch: on when it has compact elements and its elements
+  /// interlink (two of their bounding boxes overlap: chain mail), off for
+  /// separate ones (tori, pebbles). 0 = off, 1 = on.
+  int lift_crossing_rings = -1;
   /// Rounds re-quilting the base faces left bare (no element vertex within half
   /// the element spacing). In [-1, 8]; 0 = none; -1 = from the swatch: 3 when
   /// it has compact elements (the scatter fill then places them in what stays
@@ -238,6 +246,10 @@ struct SurfaceQuiltResult {
   std::size_t elements_not_expressed = 0;
   /// Elements that crossed an earlier one when lifted and yielded (SurfaceQuiltOptions::resolve_crossings).
   std::size_t crossings_resolved = 0;
+  /// Of those, compact elements kept by a move off the crossing (lift_crossing_rings).
+  std::size_t crossings_lifted_clear = 0;
+  /// SurfaceQuiltOptions::lift_crossing_rings, resolved (0 or 1).
+  int lift_crossing_rings = 0;
   /// Elements the finish tested for crossings, summed over the refill rounds
   /// (a round tests only what changed since the previous finish).
   std::size_t finish_elements_checked = 0;
