@@ -265,6 +265,33 @@ P3 base_point(const Base& b, const SurfaceQuiltVertex& v) {
   return p;
 }
 
+// Area-weighted unit vertex normals of the base (zero at a vertex without area).
+std::vector<P3> vertex_normals(const Base& b) {
+  std::vector<P3> vn(b.pts.size(), P3{0, 0, 0});
+  for (std::size_t f = 0; f < b.faces.size(); ++f)
+    for (int v : b.faces[f])
+      for (int d = 0; d < 3; ++d) vn[v][d] += b.area[f] * b.normal[f][d];
+  for (P3& n : vn) {
+    const double ln = norm3(n);
+    if (ln > 0) n = {n[0] / ln, n[1] / ln, n[2] / ln};
+  }
+  return vn;
+}
+
+// A quilt vertex lifted: its foot plus (z - z0) * scale along the vertex
+// normals interpolated over its face, normalised.
+P3 lift_point(const Base& b, const std::vector<P3>& vn, const SurfaceQuiltVertex& v, double z0, double scale) {
+  const auto& t = b.faces[v.face];
+  const double w[3] = {1 - v.b1 - v.b2, v.b1, v.b2};
+  P3 n{0, 0, 0};
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 3; ++d) n[d] += w[k] * vn[t[k]][d];
+  const double ln = norm3(n);
+  const P3 p = base_point(b, v);
+  const double h = (v.z - z0) * scale / (ln > 0 ? ln : 1);
+  return {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
+}
+
 // Barycentric coordinates of the projection of p on the plane of face f.
 std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
   const auto& t = b.faces[f];
@@ -675,15 +702,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
     field_dir_.resize(static_cast<std::size_t>(nf_));
     for (FaceIndex f : mesh.faces()) field_dir_[f.idx()] = {dirs[f.idx()].x(), dirs[f.idx()].y(), dirs[f.idx()].z()};
   }
-  // Area-weighted vertex normals of the base, for the lifted positions (finish).
-  vertex_normal_.assign(b_.pts.size(), P3{0, 0, 0});
-  for (int f = 0; f < nf_; ++f)
-    for (int v : b_.faces[f])
-      for (int d = 0; d < 3; ++d) vertex_normal_[v][d] += b_.area[f] * b_.normal[f][d];
-  for (P3& n : vertex_normal_) {
-    const double ln = norm3(n);
-    if (ln > 0) n = {n[0] / ln, n[1] / ln, n[2] / ln};
-  }
+  vertex_normal_ = vertex_normals(b_);  // for the lifted positions (finish)
   compact_ = compact_swatch_elements(swatch);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
@@ -1425,15 +1444,7 @@ void SurfaceQuilter::quilt_unprocessed() {
 // base plus its height above the swatch's bottom along the interpolated
 // vertex normal (the shell's offset direction).
 P3 SurfaceQuilter::lifted(const SurfaceQuiltVertex& v) const {
-  const auto& t = b_.faces[v.face];
-  const double w[3] = {1 - v.b1 - v.b2, v.b1, v.b2};
-  P3 n{0, 0, 0};
-  for (int k = 0; k < 3; ++k)
-    for (int d = 0; d < 3; ++d) n[d] += w[k] * vertex_normal_[t[k]][d];
-  const double ln = norm3(n);
-  const P3 p = base_point(b_, v);
-  const double h = (v.z - swatch_.bbox_min[2]) * S_ / (ln > 0 ? ln : 1);
-  return {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
+  return lift_point(b_, vertex_normal_, v, swatch_.bbox_min[2], S_);
 }
 
 namespace {
@@ -2073,6 +2084,17 @@ void surface_quilt_displaced(const Mesh& base, const SurfaceQuilt& q, double hei
     const P3 p = base_point(b, v);
     const double w = (v.z - q.z_min) / dz * height;
     return {p[0] + w * n[0], p[1] + w * n[1], p[2] + w * n[2]};
+  };
+  mesh_from_elements(quilt_elements(q, pos), out);
+}
+
+void surface_quilt_lifted(const Mesh& base, const SurfaceQuilt& q, double z0, Mesh& out) {
+  const Base b = make_base(base);
+  const std::vector<P3> vn = vertex_normals(b);
+  auto pos = [&](const SurfaceQuiltVertex& v) -> P3 {
+    if (v.face < 0 || static_cast<std::size_t>(v.face) >= b.faces.size())
+      throw InvalidInputError("surface_quilt_lifted: face index " + std::to_string(v.face) + " out of range");
+    return lift_point(b, vn, v, z0, q.scale);
   };
   mesh_from_elements(quilt_elements(q, pos), out);
 }

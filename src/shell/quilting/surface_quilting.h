@@ -287,6 +287,7 @@ struct SurfaceQuiltResult {
 /// of zero size).
 double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relative_size);
 
+
 /// The default relative size (the CLI's, when --scale is not given): 0.25,
 /// lowered for swatches of few large compact elements (a single pebble) so
 /// that the median compact element's larger xy side is at most 1/16 of the
@@ -318,5 +319,11 @@ void surface_quilt_to_texture(const Mesh& base, const SurfaceQuilt& quilt, Mesh&
 /// paper's figure 8, left): p = sum b_i x_i + w * height * n_f, n_f the unit
 /// normal of the base face (mesh units). kFaceElement written.
 void surface_quilt_displaced(const Mesh& base, const SurfaceQuilt& quilt, double height, Mesh& out);
+
+/// The quilt as quilt_surface's finish tests it for crossings: each vertex at
+/// (z - z0) * quilt.scale along the base's area-weighted vertex normals,
+/// interpolated over its face and normalised (z0: the swatch's lowest z).
+/// kFaceElement written. Throws InvalidInputError for a face index out of range.
+void surface_quilt_lifted(const Mesh& base, const SurfaceQuilt& quilt, double z0, Mesh& out);
 
 }  // namespace surftex
