@@ -315,6 +315,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"refill_rounds_run", r.refill_rounds_run},
          {"faces_refilled", r.faces_refilled},
          {"scatter_placed", r.scatter_placed},
+         {"scatter_lifted", r.scatter_lifted},
          {"elements_misshapen", r.elements_misshapen},
          {"broken_rings_removed", r.broken_rings_removed},
          {"small_pieces_removed", r.small_pieces_removed},

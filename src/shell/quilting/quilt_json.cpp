@@ -67,6 +67,7 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["refill_rounds_run"] = r.refill_rounds_run;
   j["faces_refilled"] = r.faces_refilled;
   j["scatter_placed"] = r.scatter_placed;
+  j["scatter_lifted"] = r.scatter_lifted;
   j["scatter_only"] = r.scatter_only;
   j["bare_fraction"] = r.bare_fraction;
   j["elements_not_expressible"] = r.elements_not_expressible;

@@ -1797,19 +1797,33 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     if (k < 0) return false;
     el.loc[v] = {p.flat.faces[static_cast<std::size_t>(k)], w[1], w[2], q[2]};
   }
-  const ElementMesh m = lifted_mesh(el);
   const double stretch = scatter_only_ ? opt_.scatter_alone_max_stretch : opt_.scatter_max_stretch;
   const double lim2 = stretch * stretch * S_ * S_;
-  for (const Tri& t : tpl.tris)
-    for (int k = 0; k < 3; ++k) {
-      const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
-      const P3 d1 = sub3(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
-      if (dot3(d1, d1) > lim2 * dot3(d0, d0) || (stretch_bound2_ > 0 && dot3(d1, d1) > stretch_bound2_)) return false;
-    }
-  const std::vector<char> hit = coll.hits(m, -1, scatter_clearance_);
-  if (std::find(hit.begin(), hit.end(), 1) != hit.end()) return false;
-  coll.add(m, static_cast<int>(elements_.size()));
-  return true;
+  // Where it would cross, an interlinked swatch's element is tried a little
+  // higher and lower too (lift_crossing_rings: 0.1, 0.2 swatch heights).
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  const std::vector<double> shifts = lift_rings_ ? std::vector<double>{0, 0.1, -0.1, 0.2, -0.2} : std::vector<double>{0};
+  for (const double step : shifts) {
+    const double dz = step * swatch_h_;
+    if (step != 0 && (lo + dz < swatch_.bbox_min[2] || hi + dz > swatch_.bbox_max[2])) continue;
+    Element at = el;
+    for (SurfaceQuiltVertex& v : at.loc) v.z += dz;
+    const ElementMesh m = lifted_mesh(at);
+    for (const Tri& t : tpl.tris)
+      for (int k = 0; k < 3; ++k) {
+        const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+        const P3 d1 = sub3(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+        if (dot3(d1, d1) > lim2 * dot3(d0, d0) || (stretch_bound2_ > 0 && dot3(d1, d1) > stretch_bound2_)) return false;
+      }
+    const std::vector<char> hit = coll.hits(m, -1, scatter_clearance_);
+    if (std::find(hit.begin(), hit.end(), 1) != hit.end()) continue;
+    coll.add(m, static_cast<int>(elements_.size()));
+    el.loc = std::move(at.loc);
+    if (step != 0) ++res_.scatter_lifted;
+    return true;
+  }
+  return false;
 }
 
 // Scatter fill (issue 17 item 4): the refill rounds quilt bare faces with

@@ -109,7 +109,9 @@ struct SurfaceQuiltOptions {
   /// A compact element that crosses when lifted is first moved and kept where
   /// that clears it, instead of removed: along the surface normal (0.1, then
   /// 0.2 swatch heights, up then down, within the swatch's height range), then
-  /// along the surface (0.1, then 0.2 of its width, 8 directions).
+  /// along the surface (0.1, then 0.2 of its width, 8 directions); the
+  /// scatter fill tries its elements 0.1 and 0.2 swatch heights higher and
+  /// lower where they would cross.
   /// -1 = from the swatch: on when it has compact elements and its elements
   /// interlink (two of their bounding boxes overlap: chain mail), off for
   /// separate ones (tori, pebbles). 0 = off, 1 = on.
@@ -248,6 +250,9 @@ struct SurfaceQuiltResult {
   std::size_t crossings_resolved = 0;
   /// Of those, compact elements kept by a move off the crossing (lift_crossing_rings).
   std::size_t crossings_lifted_clear = 0;
+  /// Of scatter_placed, elements placed higher or lower than the swatch has
+  /// them (lift_crossing_rings).
+  std::size_t scatter_lifted = 0;
   /// SurfaceQuiltOptions::lift_crossing_rings, resolved (0 or 1).
   int lift_crossing_rings = 0;
   /// Elements the finish tested for crossings, summed over the refill rounds
