@@ -704,7 +704,8 @@ TEST(SurfaceQuilting, RefillRoundsDefaultToSixForThreadsAndThreeForCompactElemen
 }
 
 // Session 39: a chain-mail ring that crosses a neighbour when lifted is moved
-// (along the normal, then aside) where that clears it, instead of removed; on
+// (along the normal, then aside) where that clears it, instead of removed, and
+// the scatter fill tries its rings higher and lower where they would cross; on
 // by default only for a swatch whose rings interlink (their boxes overlap),
 // not for separate elements. The kept rings cross nothing: the quilt lifted as
 // the finish tests it has no face pair intersecting between elements.
@@ -727,11 +728,17 @@ TEST(SurfaceQuilting, CrossingChainmailRingsAreMovedClearInsteadOfRemoved) {
   o.lift_crossing_rings = 0;
   const SurfaceQuiltResult r_off = quilt_surface(base, sw, off, o);
   std::cout << "[ chain mail moves ] crossings " << r_on.crossings_resolved << ", moved clear "
-            << r_on.crossings_lifted_clear << ", elements " << r_on.elements << " (off: " << r_off.elements << ")\n";
+            << r_on.crossings_lifted_clear << ", scattered " << r_on.scatter_placed << " (" << r_on.scatter_lifted
+            << " lifted), elements " << r_on.elements << " (off: " << r_off.elements << ", scattered "
+            << r_off.scatter_placed << ")\n";
   EXPECT_EQ(r_on.lift_crossing_rings, 1);
   EXPECT_EQ(r_off.lift_crossing_rings, 0);
   EXPECT_GT(r_on.crossings_lifted_clear, 0u);
   EXPECT_EQ(r_off.crossings_lifted_clear, 0u);
+  // The scatter fill places rings a little higher or lower where they would cross.
+  EXPECT_GT(r_on.scatter_lifted, 0u);
+  EXPECT_EQ(r_off.scatter_lifted, 0u);
+  EXPECT_GT(r_on.scatter_placed, r_off.scatter_placed);
   EXPECT_EQ(between_pairs(on), 0u);
   EXPECT_EQ(between_pairs(off), 0u);
   o.lift_crossing_rings = -1;
