@@ -557,10 +557,6 @@ struct FrameElements {
   std::vector<Partial> partial;
 };
 
-// The staged driver of quilt_surface (see the header): find_seed,
-// grow_and_flatten, orient, align, express, search_turn, merge, and, after
-// the loop, finish (settle, trim at borders and stretch bound, resolve
-// crossings), refill (bare faces quilted again) and emit.
 // Whether the bounding boxes of two swatch elements overlap: rings that
 // interlink (chain mail) or threads that interweave reach into each other's
 // box; separate rings and pebbles do not.
@@ -576,6 +572,10 @@ bool element_boxes_overlap(const Swatch& sw) {
   return false;
 }
 
+// The staged driver of quilt_surface (see the header): find_seed,
+// grow_and_flatten, orient, align, express, search_turn, merge, and, after
+// the loop, finish (settle, trim at borders and stretch bound, resolve
+// crossings), refill (bare faces quilted again) and emit.
 class SurfaceQuilter {
  public:
   SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const SurfaceQuiltOptions& opt);

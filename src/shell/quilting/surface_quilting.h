@@ -8,7 +8,8 @@
 // max_area_distortion), orient (guidance field onto the swatch's +y, swatch z
 // along the base normal), align and search_turn (our additions), express,
 // merge (quilt_step.h, 2.4-2.7); then finish (border trim, shards, misshapen
-// and broken compact elements, crossings), refill bare faces, scatter whole
+// and broken compact elements, crossings: an interlinked swatch's crossing
+// rings moved clear first), refill bare faces, scatter whole
 // compact elements into what stays bare, emit. surface_quilt_to_texture maps the quilt into the
 // atlas's (u, v, w) for embed_in_shell (3.2). The stages in detail and the
 // figures behind the defaults: docs/decisions/100-102-quilt-*.md.
