@@ -292,6 +292,13 @@ P3 lift_point(const Base& b, const std::vector<P3>& vn, const SurfaceQuiltVertex
   return {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
 }
 
+// The lowest and highest z of the locations.
+std::pair<double, double> z_extent(const std::vector<SurfaceQuiltVertex>& loc) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SurfaceQuiltVertex& v : loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  return {lo, hi};
+}
+
 // Barycentric coordinates of the projection of p on the plane of face f.
 std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
   const auto& t = b.faces[f];
@@ -617,6 +624,7 @@ class SurfaceQuilter {
   bool place_scatter_element(const Patch& p, const PatchLocator& loc, const ElementMesh& tpl, int quarter, const V2& offset,
                              ElementCollider& coll, Element& el);
   void fit_z(Element& el);
+  std::vector<double> z_lifts(const Element& el) const;
   void settle_and_trim(std::size_t from);
   void resolve_crossings_lifted();
   bool lift_clear(Element& el, int i, ElementCollider& coll, std::vector<char>& dead);
@@ -1466,8 +1474,7 @@ void grow_drop(const std::vector<Tri>& tris, std::size_t nv, std::vector<char>& 
 // deformations and stitches of sections 2.6-2.7 move vertices a little past it.
 void SurfaceQuilter::fit_z(Element& el) {
   const double lim_lo = swatch_.bbox_min[2] - opt_.max_z_growth * swatch_h_, lim_hi = swatch_.bbox_max[2] + opt_.max_z_growth * swatch_h_;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  const auto [lo, hi] = z_extent(el.loc);
   if (!(lo < lim_lo || hi > lim_hi)) return;
   ++res_.z_fitted_elements;
   res_.z_fitted_vertices += el.loc.size();
@@ -1602,6 +1609,19 @@ void SurfaceQuilter::resolve_crossings_lifted() {
   }
 }
 
+// The height changes (swatch units) an interlinked swatch's element is tried
+// at where it crosses (lift_crossing_rings): 0.1, -0.1, 0.2, -0.2 swatch
+// heights, those that keep it within the swatch's z range.
+std::vector<double> SurfaceQuilter::z_lifts(const Element& el) const {
+  const auto [lo, hi] = z_extent(el.loc);
+  std::vector<double> out;
+  for (const double step : {0.1, -0.1, 0.2, -0.2}) {
+    const double dz = step * swatch_h_;
+    if (lo + dz >= swatch_.bbox_min[2] && hi + dz <= swatch_.bbox_max[2]) out.push_back(dz);
+  }
+  return out;
+}
+
 // A crossing compact element moved and kept at the first move where it
 // crosses nothing: along the normal (0.1, -0.1, 0.2, -0.2 swatch heights,
 // within the swatch's z range), then along the surface (0.1 and 0.2 of its
@@ -1622,11 +1642,7 @@ bool SurfaceQuilter::lift_clear(Element& el, int i, ElementCollider& coll, std::
     ++res_.crossings_lifted_clear;
     return true;
   };
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
-  for (const double step : {0.1, -0.1, 0.2, -0.2}) {
-    const double dz = step * swatch_h_;
-    if (lo + dz < swatch_.bbox_min[2] || hi + dz > swatch_.bbox_max[2]) continue;
+  for (const double dz : z_lifts(el)) {
     Element moved = el;
     for (SurfaceQuiltVertex& v : moved.loc) v.z += dz;
     if (accept(moved)) return true;
@@ -1800,13 +1816,11 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
   const double stretch = scatter_only_ ? opt_.scatter_alone_max_stretch : opt_.scatter_max_stretch;
   const double lim2 = stretch * stretch * S_ * S_;
   // Where it would cross, an interlinked swatch's element is tried a little
-  // higher and lower too (lift_crossing_rings: 0.1, 0.2 swatch heights).
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const SurfaceQuiltVertex& v : el.loc) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
-  const std::vector<double> shifts = lift_rings_ ? std::vector<double>{0, 0.1, -0.1, 0.2, -0.2} : std::vector<double>{0};
-  for (const double step : shifts) {
-    const double dz = step * swatch_h_;
-    if (step != 0 && (lo + dz < swatch_.bbox_min[2] || hi + dz > swatch_.bbox_max[2])) continue;
+  // higher and lower too (z_lifts).
+  std::vector<double> shifts{0};
+  if (lift_rings_)
+    for (const double dz : z_lifts(el)) shifts.push_back(dz);
+  for (const double dz : shifts) {
     Element at = el;
     for (SurfaceQuiltVertex& v : at.loc) v.z += dz;
     const ElementMesh m = lifted_mesh(at);
@@ -1820,7 +1834,7 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     if (std::find(hit.begin(), hit.end(), 1) != hit.end()) continue;
     coll.add(m, static_cast<int>(elements_.size()));
     el.loc = std::move(at.loc);
-    if (step != 0) ++res_.scatter_lifted;
+    if (dz != 0) ++res_.scatter_lifted;
     return true;
   }
   return false;

@@ -293,7 +293,6 @@ struct SurfaceQuiltResult {
 /// of zero size).
 double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relative_size);
 
-
 /// The default relative size (the CLI's, when --scale is not given): 0.25,
 /// lowered for swatches of few large compact elements (a single pebble) so
 /// that the median compact element's larger xy side is at most 1/16 of the
