@@ -42,6 +42,7 @@ struct PatchArgs {
   int patch_res = 128, max_faces = 200, window = 11, preselect = 0, rotations = 64,
       exemplar_size = 0;
   double max_angle = 30.0, bump = 2.0, coherence = ElOptions{}.coherence;
+  double min_widths = PatchSynthesisOptions{}.min_exemplar_widths;
   bool patch_res_given = false;  ///< --patch-res on the command line: refused, not lowered, when the atlas cannot hold it
   CommonOptions common;
 };
@@ -186,6 +187,7 @@ int run(const PatchArgs& a) {
   po.flatten.resolution = a.patch_res;
   po.flatten.margin = std::max(2, a.patch_res / 32);
   po.fit_resolution = !a.patch_res_given;
+  po.min_exemplar_widths = a.min_widths;
   po.order = a.order == "curvature" ? PatchOrder::Curvature : PatchOrder::Random;
   po.el.window = a.window;
   po.el.preselect = a.preselect;
@@ -196,13 +198,20 @@ int run(const PatchArgs& a) {
   po.seed = a.common.seed;
   po.progress = terminal_progress(a.common.quiet);
   check_budget(estimate_patches(mesh.number_of_faces(), ex[0].width, ex[0].height, static_cast<int>(ex.size()),
-                                a.patch_res, a.max_faces, a.window, a.rotations, a.search == "exhaustive"),
+                                a.patch_res, a.max_faces, a.window, a.rotations, a.search == "exhaustive",
+                                a.patch_res_given ? 0.0 : a.min_widths),
                a.common);
   nlohmann::json rep = run_pipeline(mesh, ex, to, a.outdir, maps);
+  if (rep.contains("patch_resolution_raised_from") && !a.common.quiet)
+    std::fprintf(stderr, "note: %d texels a side showed %.2f exemplar widths across the mesh's longest side: raised "
+                         "to %d for at least %g (--min-widths; --patch-res to choose)\n",
+                 a.patch_res, rep["exemplar_widths"]["at_patch_resolution"].get<double>(),
+                 rep.value("patch_resolution_requested", rep["patch_resolution"].get<int>()), a.min_widths);
   if (rep.contains("patch_resolution_requested") && !a.common.quiet)
     std::fprintf(stderr, "note: %d patches at %d texels a side do not fit one %d px atlas: %d texels a side used "
                          "(--patch-res to choose; --max-patch-faces for fewer, larger patches)\n",
-                 rep["patches"].get<int>(), a.patch_res, po.atlas.max_size, rep["patch_resolution"].get<int>());
+                 rep["patches"].get<int>(), rep["patch_resolution_requested"].get<int>(), po.atlas.max_size,
+                 rep["patch_resolution"].get<int>());
   rep["mesh"] = a.mesh;
   rep["input_mesh"] = to_json(loaded);
   rep["exemplar"] = a.exemplar;
@@ -255,6 +264,12 @@ SubcommandRegistrar reg{
                       "not fit one 4096 px atlas; given: refused then, before any synthesis)")
            ->check(CLI::Range(16, 1024))
            ->each([a](const std::string&) { a->patch_res_given = true; });
+       app.add_option("--min-widths", a->min_widths,
+                      "Texture scale floor: when the patch resolution would show fewer than this many exemplar "
+                      "widths across the mesh's longest bounding-box side (a large exemplar on a small or coarse "
+                      "mesh: every texel magnified), the resolution is raised until it shows them, as far as one "
+                      "4096 px atlas holds; 0..1000, 0 = off; not with --patch-res (default 1)")
+           ->check(CLI::Range(0.0, 1000.0));
        app.add_option("--max-angle", a->max_angle,
                       "Largest angle between a triangle normal and its patch's reference normal, "
                       "degrees, 1..89 (default 30)")

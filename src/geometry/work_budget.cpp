@@ -122,11 +122,13 @@ void exemplar(WorkEstimate& e, int w, int h, int max_side) {
 }
 
 WorkEstimate estimate_patches(std::size_t faces, int exemplar_width, int exemplar_height, int exemplars, int patch_res,
-                              int max_patch_faces, int window, int rotations, bool exhaustive_search) {
+                              int max_patch_faces, int window, int rotations, bool exhaustive_search,
+                              double min_exemplar_widths) {
   const double exemplar_pixels = static_cast<double>(exemplar_width) * exemplar_height;
   const double F = static_cast<double>(faces);
-  const double res2 = static_cast<double>(patch_res) * patch_res;
   const double patches = F / std::max(1, max_patch_faces) * 1.6 + 8;  // greedy patches are smaller than the cap
+  const double floor_px = std::min(4096.0 * 4096.0, 12.0 * std::pow(min_exemplar_widths * exemplar_width, 2.0));
+  const double res2 = std::max(static_cast<double>(patch_res) * patch_res, floor_px / patches);
   const double ex = static_cast<double>(exemplar_pixels) * std::max(1, exemplars);
   WorkEstimate e;
   e.what = "patches on " + std::to_string(faces) + " faces";

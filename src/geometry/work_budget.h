@@ -51,8 +51,13 @@ std::string format_seconds(double s);
 std::string check_work_budget(const WorkEstimate& e);
 
 // The estimates, one per subcommand. Sizes are counts (faces, pixels).
+/// estimate_patches: min_exemplar_widths > 0 (PatchSynthesisOptions) may raise
+/// the rasters up to about 12 (widths x exemplar width)^2 pixels in all (a
+/// closed surface's area over its longest side squared is at most about 6,
+/// the square rasters about twice their patches), never past one 4096^2 atlas.
 WorkEstimate estimate_patches(std::size_t faces, int exemplar_width, int exemplar_height, int exemplars, int patch_res,
-                              int max_patch_faces, int window, int rotations, bool exhaustive_search = false);
+                              int max_patch_faces, int window, int rotations, bool exhaustive_search = false,
+                              double min_exemplar_widths = 0);
 WorkEstimate estimate_subdiv(std::size_t faces, int exemplar_width, int exemplar_height, int levels, int atlas);
 WorkEstimate estimate_material_map(std::size_t faces, std::size_t tile_bytes, int render_size, int atlas_size);
 WorkEstimate estimate_material_tile(int size, int layers, int keys, int key_width, int key_height);

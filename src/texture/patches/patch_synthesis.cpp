@@ -47,6 +47,8 @@ void validate(const Mesh& mesh, const std::vector<Image>& ex, const PatchSynthes
   }
   if (o.field == PatchField::Constant && vec(o.constant_vector).squared_length() == 0)
     bad("constant_vector is zero");
+  if (!(o.min_exemplar_widths >= 0 && o.min_exemplar_widths <= 1000))
+    bad("min_exemplar_widths " + std::to_string(o.min_exemplar_widths) + " outside 0..1000");
   if (!(o.constraint_fraction > 0 && o.constraint_fraction <= 1))
     bad("constraint_fraction " + std::to_string(o.constraint_fraction) + " outside (0, 1]");
   if (o.multi != MultiTexture::None && ex.size() < 2)
@@ -633,15 +635,55 @@ void fill_boundary_pixels(PatchSynthesisResult& res, const PatchFaces& pf, int C
 }  // namespace
 
 namespace {
-// Step 3 with the atlas check (see PatchSynthesisOptions::atlas): the rasters
-// at flatten.resolution, or lowered by eighths until one atlas holds them.
+// The mesh's longest bounding-box side.
+double longest_side(const Mesh& mesh) {
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    const double c[3] = {p.x(), p.y(), p.z()};
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], c[d]), hi[d] = std::max(hi[d], c[d]);
+  }
+  return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+}
+
+// PatchSynthesisOptions::min_exemplar_widths: the flattening options whose
+// texel shows `widths` exemplar widths across `longest` where `flat` (at `fo`)
+// shows fewer: the raster's inside (resolution less both margins) grows by the
+// missing factor, the margin keeps its share of the side.
+FlattenOptions raised_for_widths(const FlattenOptions& fo, const FlattenResult& flat, double longest, int ex_width,
+                                 double widths) {
+  const double shown = longest / (flat.texel * ex_width);
+  if (!(shown > 0) || shown >= widths) return fo;
+  const double f = widths / shown;
+  FlattenOptions up = fo;
+  up.margin = std::max(fo.margin, static_cast<int>(std::ceil(fo.margin * f)));
+  const double inside = std::ceil((fo.resolution - 2 * fo.margin) * f);
+  up.resolution = static_cast<int>(std::min(4096.0, inside + 2 * up.margin));
+  up.margin = std::min(up.margin, up.resolution / 4);
+  return up;
+}
+
+// Step 3 with the texture-scale floor and the atlas check (see
+// PatchSynthesisOptions::atlas): the rasters at flatten.resolution (raised for
+// min_exemplar_widths), or lowered by eighths until one atlas holds them.
 FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& seeds, const PatchSynthesisOptions& opt,
-                                   int& resolution) {
+                                   int ex_width, PatchSynthesisResult& res) {
   FlattenOptions fo = opt.flatten;
+  FlattenResult flat = flatten_patches(mesh, seeds, fo);
+  const double longest = longest_side(mesh);
+  res.exemplar_widths_partition = longest / (flat.texel * ex_width);
+  if (opt.fit_resolution && opt.min_exemplar_widths > 0) {
+    const FlattenOptions up = raised_for_widths(fo, flat, longest, ex_width, opt.min_exemplar_widths);
+    if (up.resolution != fo.resolution) {
+      fo = up;
+      flat = flatten_patches(mesh, seeds, fo);
+    }
+  }
+  res.resolution_wanted = fo.resolution;
   for (;;) {
-    FlattenResult flat = flatten_patches(mesh, seeds, fo);
     if (!opt.check_atlas || patch_rasters_fit(flat, opt.atlas)) {
-      resolution = fo.resolution;
+      res.resolution = fo.resolution;
+      res.exemplar_widths = longest / (flat.texel * ex_width);
       return flat;
     }
     const int lower = std::max(16, fo.resolution * 7 / 8);
@@ -651,6 +693,7 @@ FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& see
                               std::to_string(opt.atlas.max_size) + " px atlas: lower --patch-res or raise "
                               "--max-patch-faces (fewer, larger patches)");
     fo.resolution = lower;
+    flat = flatten_patches(mesh, seeds, fo);
   }
 }
 }  // namespace
@@ -680,7 +723,7 @@ PatchSynthesisResult synthesize_patches(Mesh& mesh, const std::vector<Image>& ex
   // 3. Flatten and rasterise (3.2).
   t.reset();
   report_progress(opt.progress, "flatten", 0.0);
-  res.flat = flatten_to_fit_atlas(mesh, seeds, opt, res.resolution);
+  res.flat = flatten_to_fit_atlas(mesh, seeds, opt, exemplars[0].width, res);
   res.seconds_flatten = t.seconds();
   const PatchFaces faces = index_patch_faces(res.flat.patches, mesh.num_faces());
   for (int id : opt.resynthesize)

@@ -67,6 +67,13 @@ struct PatchSynthesisOptions {
   PatchAtlasOptions atlas;
   bool check_atlas = true;
   bool fit_resolution = true;
+  /// Texture scale floor (ours): with fit_resolution, when the patches'
+  /// common texel would show fewer than this many widths of exemplar 0
+  /// across the mesh's longest bounding-box side, flatten.resolution (and the
+  /// margin with it) is raised so that it shows them (then lowered again only
+  /// if one atlas cannot hold the rasters). subdiv's --texel-size Nx counts
+  /// in the same terms. >= 0, 0 = off. Default 1.
+  double min_exemplar_widths = 1.0;
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< stages "partition", "field", "flatten", "synthesis"
 };
@@ -81,7 +88,13 @@ struct PatchSynthesisResult {
   std::vector<std::vector<ElSource>> sources;
   std::vector<int> order;        ///< patch ids in synthesis order (main pass)
   int split_patches = 0;         ///< patches split because their projection overlapped
-  int resolution = 0;            ///< texels per patch side used (flatten.resolution unless lowered to fit the atlas)
+  int resolution = 0;            ///< texels per patch side used (flatten.resolution unless raised or lowered)
+  /// flatten.resolution, or the resolution min_exemplar_widths raised it to
+  /// (before any lowering to fit the atlas).
+  int resolution_wanted = 0;
+  /// Widths of exemplar 0 across the mesh's longest bounding-box side at
+  /// flatten.resolution's texel, and at the texel used.
+  double exemplar_widths_partition = 0, exemplar_widths = 0;
   std::size_t texels = 0;        ///< pixels synthesised (main pass + resynthesis)
   std::size_t seeded = 0;        ///< of which seeded by random patches
   std::size_t known_boundary = 0;  ///< Known boundary pixels given to the synthesis

@@ -47,10 +47,11 @@ PatchTextureResult synthesize_patch_texture(Mesh& mesh, const std::vector<Image>
   Timer total;
   PatchTextureResult r;
   r.bump = o.bump;
-  r.requested_resolution = o.synthesis.flatten.resolution;
+  r.synthesis_options_resolution = o.synthesis.flatten.resolution;
   const std::clock_t c0 = std::clock();
   r.synthesis = synthesize_patches(mesh, exemplars, o.synthesis);  // step 1
   r.patch_resolution = r.synthesis.resolution;
+  r.requested_resolution = r.synthesis.resolution_wanted;
   r.cpu_seconds_synthesis = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   Timer t;
   pack_atlases(mesh, exemplars, maps, o, r);  // steps 2-3
@@ -80,6 +81,10 @@ nlohmann::json to_json(const PatchTextureResult& t) {
   j["patch_resolution"] = t.patch_resolution;
   if (t.patch_resolution != t.requested_resolution)  // lowered to fit one atlas
     j["patch_resolution_requested"] = t.requested_resolution;
+  if (r.resolution_wanted != t.synthesis_options_resolution)  // raised for the texture-scale floor
+    j["patch_resolution_raised_from"] = t.synthesis_options_resolution;
+  j["exemplar_widths"] = {{"across_longest_side", r.exemplar_widths},
+                          {"at_patch_resolution", r.exemplar_widths_partition}};
   j["texel_size"] = r.flat.texel;
   j["dropped_boundary_triangles"] = r.flat.dropped_boundary;
   j["texels_synthesized"] = r.texels;

@@ -52,7 +52,8 @@ struct PatchTextureResult {
   bool height_from_exemplar = false, normal_from_exemplar = false;
   double bump = 0;
   int patch_resolution = 0;         ///< texels per patch side used
-  int requested_resolution = 0;     ///< the options' (larger when lowered to fit one atlas)
+  int requested_resolution = 0;     ///< the options', or raised for the texture-scale floor (larger when lowered to fit one atlas)
+  int synthesis_options_resolution = 0;  ///< the options' flatten.resolution
   SeamRatioResult seam;
   double seam_step_texels = 0;
   nlohmann::json fidelity;          ///< atlas_fidelity_report (null without `fidelity`)
