@@ -110,6 +110,17 @@ TEST(PatchTexture, TextureScaleFloorShowsAWholeExemplarAcrossAnyMesh) {
     std::printf("scale %g: resolution 16 -> %d, widths %.3f -> %.3f\n", scale, r.patch_resolution,
                 widths_shown(m_off, r_off, ex.width), widths_shown(m, r, ex.width));
   }
+  // Raised past what one atlas holds: lowered again by eighths, not refused.
+  Mesh small;
+  make_icosphere(small, 1);
+  PatchTextureOptions tight = small_options();
+  tight.fidelity = false;
+  tight.synthesis.min_exemplar_widths = 1;
+  tight.synthesis.atlas.max_size = 128;
+  const PatchTextureResult r_tight = synthesize_patch_texture(small, {ex}, {}, tight);
+  EXPECT_GT(r_tight.synthesis.resolution_wanted, r_tight.patch_resolution);
+  EXPECT_GT(r_tight.patch_resolution, 16);
+  EXPECT_EQ(to_json(r_tight)["patch_resolution_requested"], r_tight.synthesis.resolution_wanted);
   PatchTextureOptions bad = small_options();
   bad.synthesis.min_exemplar_widths = -1;
   Mesh m;

@@ -687,11 +687,16 @@ FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& see
       return flat;
     }
     const int lower = std::max(16, fo.resolution * 7 / 8);
-    if (!opt.fit_resolution || lower == fo.resolution || fo.margin > lower / 4)
+    // A raised margin comes down with the resolution, to the options' own.
+    const FlattenOptions& given = opt.flatten;
+    const int margin = std::min(
+        fo.margin, std::max(given.margin, static_cast<int>(std::lround(given.margin * double(lower) / given.resolution))));
+    if (!opt.fit_resolution || lower == fo.resolution || margin > lower / 4)
       throw InvalidInputError("synthesize_patches: " + std::to_string(flat.patches.size()) + " patches of " +
                               std::to_string(fo.resolution) + " texels a side do not fit one " +
                               std::to_string(opt.atlas.max_size) + " px atlas: lower --patch-res or raise "
                               "--max-patch-faces (fewer, larger patches)");
+    fo.margin = margin;
     fo.resolution = lower;
     flat = flatten_patches(mesh, seeds, fo);
   }
