@@ -19,6 +19,7 @@
 #include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "geometry/timer.h"
+#include "geometry/vec3.h"
 #include "shell/element_clearance.h"
 #include "shell/quilting/foot_grid.h"
 #include "shell/triangle_distance.h"
@@ -31,12 +32,6 @@ using V2 = std::array<double, 2>;
 // nearest patch face for the element to be expressed in the patch frame.
 constexpr double kFrameCos = 0.5;
 
-P3 sub3(const P3& a, const P3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot3(const P3& a, const P3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-P3 cross3(const P3& a, const P3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm3(const P3& a) { return std::sqrt(dot3(a, a)); }
 double area2(const V2& a, const V2& b, const V2& c) {
   return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
 }
@@ -94,8 +89,8 @@ Base make_base(const Mesh& m) {
     const auto& t = b.faces[f];
     const P3 &a = b.pts[t[0]], &c1 = b.pts[t[1]], &c2 = b.pts[t[2]];
     b.centroid[f] = {(a[0] + c1[0] + c2[0]) / 3, (a[1] + c1[1] + c2[1]) / 3, (a[2] + c1[2] + c2[2]) / 3};
-    P3 n = cross3(sub3(c1, a), sub3(c2, a));
-    const double l = norm3(n);
+    P3 n = vec3::cross(vec3::sub(c1, a), vec3::sub(c2, a));
+    const double l = vec3::norm(n);
     b.area[f] = 0.5 * l;
     b.normal[f] = l > 0 ? P3{n[0] / l, n[1] / l, n[2] / l} : P3{0, 0, 0};
     for (int v : t) vf[v].push_back(static_cast<int>(f));
@@ -272,7 +267,7 @@ std::vector<P3> vertex_normals(const Base& b) {
     for (int v : b.faces[f])
       for (int d = 0; d < 3; ++d) vn[v][d] += b.area[f] * b.normal[f][d];
   for (P3& n : vn) {
-    const double ln = norm3(n);
+    const double ln = vec3::norm(n);
     if (ln > 0) n = {n[0] / ln, n[1] / ln, n[2] / ln};
   }
   return vn;
@@ -286,7 +281,7 @@ P3 lift_point(const Base& b, const std::vector<P3>& vn, const SurfaceQuiltVertex
   P3 n{0, 0, 0};
   for (int k = 0; k < 3; ++k)
     for (int d = 0; d < 3; ++d) n[d] += w[k] * vn[t[k]][d];
-  const double ln = norm3(n);
+  const double ln = vec3::norm(n);
   const P3 p = base_point(b, v);
   const double h = (v.z - z0) * scale / (ln > 0 ? ln : 1);
   return {p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]};
@@ -302,10 +297,10 @@ std::pair<double, double> z_extent(const std::vector<SurfaceQuiltVertex>& loc) {
 // Barycentric coordinates of the projection of p on the plane of face f.
 std::array<double, 3> project_bary(const Base& b, int f, const P3& p) {
   const auto& t = b.faces[f];
-  const P3 e1 = sub3(b.pts[t[1]], b.pts[t[0]]), e2 = sub3(b.pts[t[2]], b.pts[t[0]]), dp = sub3(p, b.pts[t[0]]);
-  const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2), det = g11 * g22 - g12 * g12;
+  const P3 e1 = vec3::sub(b.pts[t[1]], b.pts[t[0]]), e2 = vec3::sub(b.pts[t[2]], b.pts[t[0]]), dp = vec3::sub(p, b.pts[t[0]]);
+  const double g11 = vec3::dot(e1, e1), g12 = vec3::dot(e1, e2), g22 = vec3::dot(e2, e2), det = g11 * g22 - g12 * g12;
   if (!(det > 0)) return {1.0 / 3, 1.0 / 3, 1.0 / 3};
-  const double r1 = dot3(dp, e1), r2 = dot3(dp, e2);
+  const double r1 = vec3::dot(dp, e1), r2 = vec3::dot(dp, e2);
   const double w1 = (r1 * g22 - r2 * g12) / det, w2 = (g11 * r2 - g12 * r1) / det;
   return {1 - w1 - w2, w1, w2};
 }
@@ -400,16 +395,16 @@ void trim_element(const Base& b, const std::vector<Tri>& tris, const std::vector
       for (int v : l) q.push_back(lifted(pl[static_cast<std::size_t>(v)]));
       for (std::size_t i = 0; i < q.size() && ok; ++i)
         for (std::size_t j = i + 1; j < q.size(); ++j)
-          if (dot3(sub3(q[i], q[j]), sub3(q[i], q[j])) > cap_max * cap_max) {
+          if (vec3::dot(vec3::sub(q[i], q[j]), vec3::sub(q[i], q[j])) > cap_max * cap_max) {
             ok = false;
             break;
           }
       // The cap's edges (from the loop's first vertex) obey the stretch limit too.
       for (std::size_t i = 2; i + 1 < l.size() && ok && max_edge2 > 0; ++i) {
         const SurfaceQuiltVertex &v0 = pl[static_cast<std::size_t>(l[0])], &v1 = pl[static_cast<std::size_t>(l[i])];
-        const P3 d = sub3(base_point(b, v0), base_point(b, v1));
+        const P3 d = vec3::sub(base_point(b, v0), base_point(b, v1));
         const double dz = (v0.z - v1.z) * scale;
-        if (dot3(d, d) + dz * dz > max_edge2) ok = false;
+        if (vec3::dot(d, d) + dz * dz > max_edge2) ok = false;
       }
       if (!ok) break;
     }
@@ -481,7 +476,7 @@ void check_options(const SurfaceQuiltOptions& o) {
     bad("scatter_alone_max_stretch must be in [1, 10]", o.scatter_alone_max_stretch);
   if (!(o.scatter_clearance >= 0 && o.scatter_clearance <= 1))
     bad("scatter_clearance must be in [0, 1]", o.scatter_clearance);
-  if (o.field == SurfaceQuiltOptions::Field::kUp && !(norm3(o.up) > 0) )
+  if (o.field == SurfaceQuiltOptions::Field::kUp && !(vec3::norm(o.up) > 0) )
     throw InvalidInputError("quilt_surface: the up vector must be non-zero");
 }
 
@@ -512,7 +507,7 @@ double spread13(const std::vector<P3>& pts) {
   for (const P3& d : dirs) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const P3& q : pts) {
-      const double t = dot3(q, d);
+      const double t = vec3::dot(q, d);
       lo = std::min(lo, t), hi = std::max(hi, t);
     }
     if (hi > lo) best = std::max(best, hi - lo);
@@ -698,7 +693,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   swatch_h_ = swatch.bbox_max[2] - swatch.bbox_min[2];
   cos_max_ = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
   scatter_cos_max_ = std::cos(opt.scatter_max_normal_angle_deg * kPi / 180.0);
-  const double l = norm3(opt.up);
+  const double l = vec3::norm(opt.up);
   if (l > 0) up_ = {opt.up[0] / l, opt.up[1] / l, opt.up[2] / l};
   if (opt.field == SurfaceQuiltOptions::Field::kUp && opt.smooth_field) {
     // The smooth guidance field: a 4-symmetric direction per base face interpolated from the projected up.
@@ -771,8 +766,8 @@ void SurfaceQuilter::grow_and_flatten(int seed, Patch& p, double radius, double 
   for (int attempt = 0; attempt < 9; ++attempt) {
     const double r2 = p.R * p.R;
     auto accept = [&](int f) {
-      const P3 d = sub3(b_.centroid[f], c0);
-      return dot3(d, d) <= r2 && dot3(b_.normal[f], n0) >= cos_max;
+      const P3 d = vec3::sub(b_.centroid[f], c0);
+      return vec3::dot(d, d) <= r2 && vec3::dot(b_.normal[f], n0) >= cos_max;
     };
     const std::vector<int> faces = grow_disc_chart(mesh_, seed, accept, static_cast<std::size_t>(opt_.max_patch_faces), growth_);
     ok = flatten_patch(mesh_, b_, faces, p.flat, err);
@@ -806,15 +801,15 @@ void SurfaceQuilter::orient(Patch& p) {
   const P3& n = b_.normal[seed];
   P3 d{0, 0, 0};
   if (opt_.field == SurfaceQuiltOptions::Field::kUp) {
-    const double un = dot3(up_, n);
+    const double un = vec3::dot(up_, n);
     d = {up_[0] - un * n[0], up_[1] - un * n[1], up_[2] - un * n[2]};
-    if (norm3(d) >= 0.2) p.up_at_seed = d;
+    if (vec3::norm(d) >= 0.2) p.up_at_seed = d;
   }
-  const double dl = norm3(d);
+  const double dl = vec3::norm(d);
   const bool smooth = !field_dir_.empty();
   if (smooth) {
     const P3& f0 = field_dir_[static_cast<std::size_t>(seed)];
-    const P3 f1 = cross3(n, f0);
+    const P3 f1 = vec3::cross(n, f0);
     P3 ref = d;
     if (!(dl >= 0.2)) {
       ref = {0, 0, 0};
@@ -824,7 +819,7 @@ void SurfaceQuilter::orient(Patch& p) {
     const std::array<P3, 4> cand{f0, f1, P3{-f0[0], -f0[1], -f0[2]}, P3{-f1[0], -f1[1], -f1[2]}};
     int best_c = 0;
     for (int k = 1; k < 4; ++k)
-      if (dot3(cand[k], ref) > dot3(cand[best_c], ref)) best_c = k;
+      if (vec3::dot(cand[k], ref) > vec3::dot(cand[best_c], ref)) best_c = k;
     d = cand[static_cast<std::size_t>(best_c)];
     p.guide_at_seed = d;
   } else if (dl >= 0.2) {
@@ -836,21 +831,21 @@ void SurfaceQuilter::orient(Patch& p) {
     P3 t{0, 0, 0};
     for (int f : flat.faces) {
       const P3& g = face_dir_[static_cast<std::size_t>(f)];
-      const double gn = dot3(g, n);
+      const double gn = vec3::dot(g, n);
       for (int k = 0; k < 3; ++k) t[k] += b_.area[f] * (g[k] - gn * n[k]);
     }
-    if (norm3(t) > 0) {
+    if (vec3::norm(t) > 0) {
       d = t;
       ++res_.patches_transported;
     } else if (dl <= 0.2) {
       d = {0, 0, 0};  // no neighbour yet and no usable field: LSCM orientation
     }
   }
-  if (norm3(d) > 0) {
+  if (vec3::norm(d) > 0) {
     // d = alpha e1 + beta e2 in the seed triangle, mapped to uv, turned onto +y.
-    const P3 e1 = sub3(b_.pts[st[1]], b_.pts[st[0]]), e2 = sub3(b_.pts[st[2]], b_.pts[st[0]]);
-    const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2);
-    const double r1 = dot3(d, e1), r2 = dot3(d, e2), det = g11 * g22 - g12 * g12;
+    const P3 e1 = vec3::sub(b_.pts[st[1]], b_.pts[st[0]]), e2 = vec3::sub(b_.pts[st[2]], b_.pts[st[0]]);
+    const double g11 = vec3::dot(e1, e1), g12 = vec3::dot(e1, e2), g22 = vec3::dot(e2, e2);
+    const double r1 = vec3::dot(d, e1), r2 = vec3::dot(d, e2), det = g11 * g22 - g12 * g12;
     if (det > 0) {
       const double al = (r1 * g22 - r2 * g12) / det, be = (g11 * r2 - g12 * r1) / det;
       const V2 du{al * (q1[0] - q0[0]) + be * (q2[0] - q0[0]), al * (q1[1] - q0[1]) + be * (q2[1] - q0[1])};
@@ -867,8 +862,8 @@ void SurfaceQuilter::orient(Patch& p) {
     const double rad = (p.r + 0.5) * c_ * S_ * std::sqrt(2.0);
     double a3 = 0, a2 = 0;
     for (int f : flat.faces) {
-      const P3 dd = sub3(b_.centroid[f], b_.centroid[seed]);
-      if (f != seed && dot3(dd, dd) > rad * rad) continue;
+      const P3 dd = vec3::sub(b_.centroid[f], b_.centroid[seed]);
+      if (f != seed && vec3::dot(dd, dd) > rad * rad) continue;
       const auto& t = b_.faces[f];
       a3 += b_.area[f];
       a2 += std::abs(area2(flat.uv[flat.local[t[0]]], flat.uv[flat.local[t[1]]], flat.uv[flat.local[t[2]]]));
@@ -902,12 +897,12 @@ void SurfaceQuilter::align(Patch& p) {
       const double w = b_.area[f] * std::exp(-(cx * cx + cy * cy) / (2 * sigma * sigma));
       wall += w;
       const P3& g = face_dir_[static_cast<std::size_t>(f)];
-      if (!(norm3(g) > 0)) continue;
+      if (!(vec3::norm(g) > 0)) continue;
       // g = al e1 + be e2 (least squares in the face's plane) -> uv = al (u1 - u0) + be (u2 - u0).
-      const P3 e1 = sub3(b_.pts[t[1]], b_.pts[t[0]]), e2 = sub3(b_.pts[t[2]], b_.pts[t[0]]);
-      const double g11 = dot3(e1, e1), g12 = dot3(e1, e2), g22 = dot3(e2, e2), det = g11 * g22 - g12 * g12;
+      const P3 e1 = vec3::sub(b_.pts[t[1]], b_.pts[t[0]]), e2 = vec3::sub(b_.pts[t[2]], b_.pts[t[0]]);
+      const double g11 = vec3::dot(e1, e1), g12 = vec3::dot(e1, e2), g22 = vec3::dot(e2, e2), det = g11 * g22 - g12 * g12;
       if (!(det > 0)) continue;
-      const double r1 = dot3(g, e1), r2 = dot3(g, e2);
+      const double r1 = vec3::dot(g, e1), r2 = vec3::dot(g, e2);
       const double al = (r1 * g22 - r2 * g12) / det, be = (g11 * r2 - g12 * r1) / det;
       const double dx = al * (u1[0] - u0[0]) + be * (u2[0] - u0[0]), dy = al * (u1[1] - u0[1]) + be * (u2[1] - u0[1]);
       if (!(std::hypot(dx, dy) > 0)) continue;
@@ -920,7 +915,7 @@ void SurfaceQuilter::align(Patch& p) {
     // Only with enough overlap near the seed, and old directions that agree.
     if (wall > 0 && wsum >= opt_.align_min_overlap * wall && std::hypot(sc, ss) >= 0.3 * wsum) {
       double turn0 = std::atan2(ss, sc) / 4;
-      if (norm3(p.guide_at_seed) > 0 && opt_.field == SurfaceQuiltOptions::Field::kUp) {
+      if (vec3::norm(p.guide_at_seed) > 0 && opt_.field == SurfaceQuiltOptions::Field::kUp) {
         const double lim = opt_.align_field_max_deg * kPi / 180.0;  // bounded relative to the field
         if (std::abs(turn0) > lim) ++res_.patches_align_bounded;
         turn0 = std::clamp(turn0, -lim, lim);
@@ -999,8 +994,8 @@ int SurfaceQuilter::nearest_patch_face(const Patch& p, int f, std::unordered_map
   double bd = 1e300;
   int bk = 0;
   for (std::size_t q = 0; q < p.flat.faces.size(); ++q) {
-    const P3 dd = sub3(b_.centroid[p.flat.faces[q]], b_.centroid[f]);
-    const double d2 = dot3(dd, dd);
+    const P3 dd = vec3::sub(b_.centroid[p.flat.faces[q]], b_.centroid[f]);
+    const double d2 = vec3::dot(dd, dd);
     if (d2 < bd) bd = d2, bk = static_cast<int>(q);
   }
   return cache.emplace(f, bk).first->second;
@@ -1050,8 +1045,8 @@ FrameElements SurfaceQuilter::express(const Patch& p) {
       const auto& lv = el.loc[v];
       if (patch_slot_[lv.face] >= 0) continue;
       const int g = p.flat.faces[static_cast<std::size_t>(nearest_patch_face(p, lv.face, near))];
-      const P3 d = sub3(base_point(b_, lv), b_.centroid[g]);
-      if (dot3(b_.normal[g], b_.normal[lv.face]) < kFrameCos || dot3(d, d) > 4 * p.R * p.R) ex[v] = 0, all_ex = false;
+      const P3 d = vec3::sub(base_point(b_, lv), b_.centroid[g]);
+      if (vec3::dot(b_.normal[g], b_.normal[lv.face]) < kFrameCos || vec3::dot(d, d) > 4 * p.R * p.R) ex[v] = 0, all_ex = false;
     }
     FrameElements::Partial part;
     if (!all_ex) {
@@ -1178,19 +1173,19 @@ void SurfaceQuilter::drift(const Patch& p) {
   const double det = m11 * m22 - m12 * m21;
   if (det == 0) return;
   const double a1 = -m12 / det, a2 = m11 / det;  // M^-1 (0, 1)
-  const P3 e1 = sub3(b_.pts[st[1]], b_.pts[st[0]]), e2 = sub3(b_.pts[st[2]], b_.pts[st[0]]);
+  const P3 e1 = vec3::sub(b_.pts[st[1]], b_.pts[st[0]]), e2 = vec3::sub(b_.pts[st[2]], b_.pts[st[0]]);
   const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
-  if (!(norm3(v) > 0)) return;
+  if (!(vec3::norm(v) > 0)) return;
   auto folded = [&](const P3& g) {
-    const double cosang = std::clamp(dot3(v, g) / (norm3(v) * norm3(g)), -1.0, 1.0);
+    const double cosang = std::clamp(vec3::dot(v, g) / (vec3::norm(v) * vec3::norm(g)), -1.0, 1.0);
     const double a = std::fmod(std::acos(cosang) * 180.0 / kPi, 90.0);
     return std::min(a, 90.0 - a);
   };
-  if (norm3(p.guide_at_seed) > 0) {
+  if (vec3::norm(p.guide_at_seed) > 0) {
     res_.drift_deg_sum += folded(p.guide_at_seed);
     ++res_.drift_count;
   }
-  if (norm3(p.up_at_seed) > 0) {
+  if (vec3::norm(p.up_at_seed) > 0) {
     res_.drift_up_deg_sum += folded(p.up_at_seed);
     ++res_.drift_up_count;
   }
@@ -1387,7 +1382,7 @@ void SurfaceQuilter::mark_processed(const Patch& p, const QuiltGrid& grid, const
     const int f = p.flat.faces[k];
     P3& g = face_dir_[static_cast<std::size_t>(f)];
     if (!processed_[f]) continue;
-    const bool old_dir = norm3(g) > 0;
+    const bool old_dir = vec3::norm(g) > 0;
     if (old_dir && !in_footprint(k)) continue;
     // 3D = p0 + E M^-1 (uv - q0), E = [e1 e2], M = [q1 - q0, q2 - q0]; direction of (0, 1).
     const auto& tk = p.ftris[k];
@@ -1396,12 +1391,12 @@ void SurfaceQuilter::mark_processed(const Patch& p, const QuiltGrid& grid, const
     if (det == 0) continue;
     const double a1 = -m12 / det, a2 = m11 / det;
     const auto& tri = b_.faces[f];
-    const P3 e1 = sub3(b_.pts[tri[1]], b_.pts[tri[0]]), e2 = sub3(b_.pts[tri[2]], b_.pts[tri[0]]);
+    const P3 e1 = vec3::sub(b_.pts[tri[1]], b_.pts[tri[0]]), e2 = vec3::sub(b_.pts[tri[2]], b_.pts[tri[0]]);
     const P3 v{a1 * e1[0] + a2 * e2[0], a1 * e1[1] + a2 * e2[1], a1 * e1[2] + a2 * e2[2]};
-    const double l = norm3(v);
+    const double l = vec3::norm(v);
     if (!(l > 0)) continue;
     if (old_dir) {  // the jump against the earlier placement, folded by a quarter turn
-      const double cosang = std::clamp(dot3(v, g) / l, -1.0, 1.0);
+      const double cosang = std::clamp(vec3::dot(v, g) / l, -1.0, 1.0);
       double a = std::fmod(std::acos(cosang) * 180.0 / kPi, 90.0);
       a = std::min(a, 90.0 - a);
       res_.overlap_turn_sum += b_.area[f] * a;
@@ -1527,7 +1522,7 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
       const Tri& tr = el.mesh.tris[t];
       if (too_far && (past_v[tr[0]] || past_v[tr[1]] || past_v[tr[2]])) drop[t] = 1, any_past = true;
       for (int k = 0; k < 3 && opt_.max_edge_stretch > 0; ++k) {
-        const double len = norm3(sub3(lp[tr[k]], lp[tr[(k + 1) % 3]]));
+        const double len = vec3::norm(vec3::sub(lp[tr[k]], lp[tr[(k + 1) % 3]]));
         if (len > bound) drop[t] = 1, any_stretched = true;
       }
     }
@@ -1655,12 +1650,12 @@ bool SurfaceQuilter::lift_clear(Element& el, int i, ElementCollider& coll, std::
     for (int d = 0; d < 3; ++d) n[d] += b_.normal[el.loc[k].face][d], c[d] += feet[k][d] / el.loc.size();
   }
   double width = 0;
-  for (const P3& f : feet) width = std::max(width, 2 * norm3(sub3(f, c)));
-  if (!(norm3(n) > 0) || !(width > 0)) return false;
-  n = {n[0] / norm3(n), n[1] / norm3(n), n[2] / norm3(n)};
-  P3 e1 = std::abs(n[0]) < 0.9 ? cross3(n, P3{1, 0, 0}) : cross3(n, P3{0, 1, 0});
-  e1 = {e1[0] / norm3(e1), e1[1] / norm3(e1), e1[2] / norm3(e1)};
-  const P3 e2 = cross3(n, e1);
+  for (const P3& f : feet) width = std::max(width, 2 * vec3::norm(vec3::sub(f, c)));
+  if (!(vec3::norm(n) > 0) || !(width > 0)) return false;
+  n = {n[0] / vec3::norm(n), n[1] / vec3::norm(n), n[2] / vec3::norm(n)};
+  P3 e1 = std::abs(n[0]) < 0.9 ? vec3::cross(n, P3{1, 0, 0}) : vec3::cross(n, P3{0, 1, 0});
+  e1 = {e1[0] / vec3::norm(e1), e1[1] / vec3::norm(e1), e1[2] / vec3::norm(e1)};
+  const P3 e2 = vec3::cross(n, e1);
   for (const double frac : {0.1, 0.2})
     for (int dir = 0; dir < 8; ++dir) {
       const double a = dir * kPi / 4, len = frac * width;
@@ -1826,9 +1821,9 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
     const ElementMesh m = lifted_mesh(at);
     for (const Tri& t : tpl.tris)
       for (int k = 0; k < 3; ++k) {
-        const P3 d0 = sub3(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
-        const P3 d1 = sub3(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
-        if (dot3(d1, d1) > lim2 * dot3(d0, d0) || (stretch_bound2_ > 0 && dot3(d1, d1) > stretch_bound2_)) return false;
+        const P3 d0 = vec3::sub(tpl.points[static_cast<std::size_t>(t[k])], tpl.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+        const P3 d1 = vec3::sub(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+        if (vec3::dot(d1, d1) > lim2 * vec3::dot(d0, d0) || (stretch_bound2_ > 0 && vec3::dot(d1, d1) > stretch_bound2_)) return false;
       }
     const std::vector<char> hit = coll.hits(m, -1, scatter_clearance_);
     if (std::find(hit.begin(), hit.end(), 1) != hit.end()) continue;
@@ -1924,7 +1919,7 @@ void SurfaceQuilter::emit(SurfaceQuilt& out) {
   double longest = 0;
   for (const Tri& t : out.tris)
     for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, norm3(sub3(lifted(out.vertices[static_cast<std::size_t>(t[k])]),
+      longest = std::max(longest, vec3::norm(vec3::sub(lifted(out.vertices[static_cast<std::size_t>(t[k])]),
                                              lifted(out.vertices[static_cast<std::size_t>(t[(k + 1) % 3])]))));
   res_.edge_stretch_max = max_edge > 0 ? longest / (max_edge * S_) : 0;
 }
@@ -1993,7 +1988,7 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
     const P3 q{p.x(), p.y(), p.z()};
     for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
   }
-  const double diag = base.is_empty() ? 0.0 : norm3(sub3(hi, lo));
+  const double diag = base.is_empty() ? 0.0 : vec3::norm(vec3::sub(hi, lo));
   return relative_size * diag / std::max(swatch.length(), swatch.width());
 }
 
