@@ -673,7 +673,21 @@ FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& see
   const double longest = longest_side(mesh);
   res.exemplar_widths_partition = longest / (flat.texel * ex_width);
   if (opt.fit_resolution && opt.min_exemplar_widths > 0) {
-    const FlattenOptions up = raised_for_widths(fo, flat, longest, ex_width, opt.min_exemplar_widths);
+    FlattenOptions up = raised_for_widths(fo, flat, longest, ex_width, opt.min_exemplar_widths);
+    // Never rasterise more than one atlas could hold: the windows' area grows
+    // with the square of the resolution (a 2048 px exemplar on a coarse mesh
+    // would otherwise ask for gigabytes of rasters before the atlas check).
+    double windows = 0;
+    for (const FlatPatch& p : flat.patches) windows += static_cast<double>(p.bw) * p.bh;
+    const double atlas = static_cast<double>(opt.atlas.max_size) * opt.atlas.max_size;
+    if (windows > 0 && up.resolution > fo.resolution) {
+      const int cap = static_cast<int>(std::floor(fo.resolution * std::sqrt(atlas / windows)));
+      if (up.resolution > cap) {
+        up.margin = std::max(fo.margin, static_cast<int>(std::lround(up.margin * double(cap) / up.resolution)));
+        up.resolution = std::max(fo.resolution, cap);
+        up.margin = std::min(up.margin, up.resolution / 4);
+      }
+    }
     if (up.resolution != fo.resolution) {
       fo = up;
       flat = flatten_patches(mesh, seeds, fo);
