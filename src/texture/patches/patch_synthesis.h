@@ -7,7 +7,10 @@
 // 2. a direction field (4): Constant (projected "up"), Kmax / Kmin (signed
 //    curvature), KmaxAbs / KminAbs (unsigned) or None; principal directions
 //    smoothed from the top `constraint_fraction` anisotropic faces;
-// 3. each patch flattened with rotated neighbour triangles, rasterised (3.2);
+// 3. each patch flattened with rotated neighbour triangles, rasterised (3.2)
+//    at one texel for all: the resolution's, raised (ours) when it would show
+//    fewer than min_exemplar_widths exemplar widths across the mesh
+//    (decision 211), lowered if one atlas cannot hold the rasters;
 // 4. patches visited in Random or Curvature order (4);
 // 5. each synthesised by two-pass Efros-Leung (3.3), already synthesised
 //    neighbours as Known pixels, oriented per pixel (3.3.2);
