@@ -231,10 +231,12 @@ int run(const PatchArgs& a) {
                     make_report(a.common, "patches", rep, files).dump(2) + "\n", true);
   write_report(a.common, "patches", rep, files);
   if (!a.common.quiet)
-    std::printf("%s: %d patches, %zu texels in %.2f s (%.0f texels/s), seam ratio %.3f\n",
-                a.outdir.c_str(), rep["patches"].get<int>(), rep["texels_synthesized"].get<std::size_t>(),
-                rep["seconds"]["synthesis"].get<double>(), rep["texels_per_second"].get<double>(),
-                rep["seam"]["ratio"].get<double>());
+    std::printf("%s: %d patches at %d texels a side (%.2f exemplar widths across), %zu texels in %.2f s (%.0f "
+                "texels/s), seam ratio %.3f\n",
+                a.outdir.c_str(), rep["patches"].get<int>(), rep["patch_resolution"].get<int>(),
+                rep["exemplar_widths"]["across_longest_side"].get<double>(),
+                rep["texels_synthesized"].get<std::size_t>(), rep["seconds"]["synthesis"].get<double>(),
+                rep["texels_per_second"].get<double>(), rep["seam"]["ratio"].get<double>());
   return 0;
 }
 
@@ -260,8 +262,10 @@ SubcommandRegistrar reg{
                       "2003, Fig. 11); none: no orientation, for isotropic textures (default up)")
            ->check(CLI::IsMember({"up", "kmax", "kmin", "kmax-abs", "kmin-abs", "none"}));
        app.add_option("--patch-res", a->patch_res,
-                      "Texels per patch side, 16..1024 (default 128, lowered by eighths when the patches would "
-                      "not fit one 4096 px atlas; given: refused then, before any synthesis)")
+                      "Texels per patch side, 16..1024: with the largest patch's extent it sets the texture's "
+                      "scale (default 128, raised when that would show fewer than --min-widths exemplar widths "
+                      "across the mesh, lowered by eighths when the patches would not fit one 4096 px atlas; "
+                      "given: kept as given, refused before any synthesis when the atlas cannot hold it)")
            ->check(CLI::Range(16, 1024))
            ->each([a](const std::string&) { a->patch_res_given = true; });
        app.add_option("--min-widths", a->min_widths,
