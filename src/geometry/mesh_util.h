@@ -42,6 +42,17 @@ inline std::array<VertexIndex, 3> face_vertices(const Mesh& mesh, FaceIndex f) {
   return {mesh.target(h), mesh.target(mesh.next(h)), mesh.target(mesh.prev(h))};
 }
 
+// The longest side of the mesh's axis-aligned bounding box (the unit in which
+// subdiv and patches count exemplar widths across the object).
+inline double longest_bbox_side(const Mesh& mesh) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], p[i]), hi[i] = std::max(hi[i], p[i]);
+  }
+  return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+}
+
 inline double face_area(const Mesh& mesh, FaceIndex f) {
   const auto v = face_vertices(mesh, f);
   const Vector3 c =

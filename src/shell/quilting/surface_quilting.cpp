@@ -1652,9 +1652,11 @@ bool SurfaceQuilter::lift_clear(Element& el, int i, ElementCollider& coll, std::
   double width = 0;
   for (const P3& f : feet) width = std::max(width, 2 * vec3::norm(vec3::sub(f, c)));
   if (!(vec3::norm(n) > 0) || !(width > 0)) return false;
-  n = {n[0] / vec3::norm(n), n[1] / vec3::norm(n), n[2] / vec3::norm(n)};
+  const double ln = vec3::norm(n);
+  n = {n[0] / ln, n[1] / ln, n[2] / ln};
   P3 e1 = std::abs(n[0]) < 0.9 ? vec3::cross(n, P3{1, 0, 0}) : vec3::cross(n, P3{0, 1, 0});
-  e1 = {e1[0] / vec3::norm(e1), e1[1] / vec3::norm(e1), e1[2] / vec3::norm(e1)};
+  const double le = vec3::norm(e1);
+  e1 = {e1[0] / le, e1[1] / le, e1[2] / le};
   const P3 e2 = vec3::cross(n, e1);
   for (const double frac : {0.1, 0.2})
     for (int dir = 0; dir < 8; ++dir) {

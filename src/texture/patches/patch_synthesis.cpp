@@ -635,23 +635,15 @@ void fill_boundary_pixels(PatchSynthesisResult& res, const PatchFaces& pf, int C
 }  // namespace
 
 namespace {
-// The mesh's longest bounding-box side.
-double longest_side(const Mesh& mesh) {
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (VertexIndex v : mesh.vertices()) {
-    const Point3& p = mesh.point(v);
-    const double c[3] = {p.x(), p.y(), p.z()};
-    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], c[d]), hi[d] = std::max(hi[d], c[d]);
-  }
-  return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-}
-
 // PatchSynthesisOptions::min_exemplar_widths: the flattening options whose
 // texel shows `widths` exemplar widths across `longest` where `flat` (at `fo`)
 // shows fewer: the raster's inside (resolution less both margins) grows by the
-// missing factor, the margin keeps its share of the side.
+// missing factor, the margin keeps its share of the side. Never more than
+// one atlas of atlas_side could hold: the raster windows' area grows with the
+// square of the resolution (a 2048 px exemplar on a coarse mesh would
+// otherwise ask for gigabytes of rasters before the atlas check).
 FlattenOptions raised_for_widths(const FlattenOptions& fo, const FlattenResult& flat, double longest, int ex_width,
-                                 double widths) {
+                                 double widths, int atlas_side) {
   const double shown = longest / (flat.texel * ex_width);
   if (!(shown > 0) || shown >= widths) return fo;
   const double f = widths / shown;
@@ -660,6 +652,16 @@ FlattenOptions raised_for_widths(const FlattenOptions& fo, const FlattenResult& 
   const double inside = std::ceil((fo.resolution - 2 * fo.margin) * f);
   up.resolution = static_cast<int>(std::min(4096.0, inside + 2 * up.margin));
   up.margin = std::min(up.margin, up.resolution / 4);
+  double windows = 0;
+  for (const FlatPatch& p : flat.patches) windows += static_cast<double>(p.bw) * p.bh;
+  if (!(windows > 0) || up.resolution <= fo.resolution) return up;
+  const double atlas = static_cast<double>(atlas_side) * atlas_side;
+  const int cap = static_cast<int>(std::floor(fo.resolution * std::sqrt(atlas / windows)));
+  if (up.resolution > cap) {
+    up.margin = std::max(fo.margin, static_cast<int>(std::lround(up.margin * double(cap) / up.resolution)));
+    up.resolution = std::max(fo.resolution, cap);
+    up.margin = std::min(up.margin, up.resolution / 4);
+  }
   return up;
 }
 
@@ -670,24 +672,11 @@ FlattenResult flatten_to_fit_atlas(const Mesh& mesh, const std::vector<int>& see
                                    int ex_width, PatchSynthesisResult& res) {
   FlattenOptions fo = opt.flatten;
   FlattenResult flat = flatten_patches(mesh, seeds, fo);
-  const double longest = longest_side(mesh);
+  const double longest = longest_bbox_side(mesh);
   res.exemplar_widths_partition = longest / (flat.texel * ex_width);
   if (opt.fit_resolution && opt.min_exemplar_widths > 0) {
-    FlattenOptions up = raised_for_widths(fo, flat, longest, ex_width, opt.min_exemplar_widths);
-    // Never rasterise more than one atlas could hold: the windows' area grows
-    // with the square of the resolution (a 2048 px exemplar on a coarse mesh
-    // would otherwise ask for gigabytes of rasters before the atlas check).
-    double windows = 0;
-    for (const FlatPatch& p : flat.patches) windows += static_cast<double>(p.bw) * p.bh;
-    const double atlas = static_cast<double>(opt.atlas.max_size) * opt.atlas.max_size;
-    if (windows > 0 && up.resolution > fo.resolution) {
-      const int cap = static_cast<int>(std::floor(fo.resolution * std::sqrt(atlas / windows)));
-      if (up.resolution > cap) {
-        up.margin = std::max(fo.margin, static_cast<int>(std::lround(up.margin * double(cap) / up.resolution)));
-        up.resolution = std::max(fo.resolution, cap);
-        up.margin = std::min(up.margin, up.resolution / 4);
-      }
-    }
+    const FlattenOptions up =
+        raised_for_widths(fo, flat, longest, ex_width, opt.min_exemplar_widths, opt.atlas.max_size);
     if (up.resolution != fo.resolution) {
       fo = up;
       flat = flatten_patches(mesh, seeds, fo);

@@ -23,6 +23,7 @@
 #include "texture/subdivision/adaptive_sqrt2_subdivide.h"
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/mesh_util.h"
 #include "geometry/properties.h"
 #include "texture/subdivision/sqrt2_subdivide.h"
 #include "geometry/polygon_util.h"
@@ -67,12 +68,7 @@ struct MeshFigures {
 
 MeshFigures mesh_figures(const Mesh& mesh) {
   MeshFigures f;
-  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (VertexIndex v : mesh.vertices()) {
-    const Point3& p = mesh.point(v);
-    for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], p[i]), hi[i] = std::max(hi[i], p[i]);
-  }
-  f.longest = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  f.longest = longest_bbox_side(mesh);
   for (FaceIndex fc : mesh.faces()) f.area += polygon_area(mesh, fc);
   double s = 0;
   for (EdgeIndex e : mesh.edges())
