@@ -41,7 +41,8 @@
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_LIFT_RINGS (lift_crossing_rings), BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
-//   resolution after the shell map), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_STRETCH_ITERS (the
+//   resolution after the shell map), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_EDGE_MEDIANS (the
+//   embedding's max_edge_over_median; 0 = none), BENCH_RELAX=0 (stretched elements cut, not relaxed), BENCH_STRETCH_ITERS (the
 //   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
 //   quilt before the shell map: feet on the base, height along face normals)
 //   and prints its crossings within elements and its bare area (lifted_bare).
@@ -265,6 +266,8 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
   if (const char* e = std::getenv("BENCH_EMBED_RESOLVE")) o.embed.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_UNTANGLE")) o.embed.untangle_folds = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_EDGE_MEDIANS")) o.embed.max_edge_over_median = std::atof(e);
+  if (const char* e = std::getenv("BENCH_RELAX")) o.embed.relax_stretched = std::atoi(e) != 0;
   Mesh out;
   const QuiltSwatchOnSurfaceResult run = quilt_swatch_on_surface(base, make_named_swatch(kind), out, o);
   const Swatch& s = run.swatch;
@@ -305,6 +308,9 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"crossing_elements_embedded", er.crossing_elements},
          {"crossing_elements_removed_last", er.crossing_elements_removed_last},
          {"elements_stretched_embedded", er.elements_stretched_embedded},
+         {"embedded_edge_bound", er.embedded_edge_bound},
+         {"embedded_median_edge", er.embedded_median_edge},
+         {"elements_relaxed_embedded", er.elements_relaxed_embedded},
          {"caps_recentred", er.caps_recentred},
          {"elements_untangled", er.elements_untangled},
          {"elements_placed_affine", er.elements_placed_affine},

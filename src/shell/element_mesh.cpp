@@ -248,6 +248,19 @@ double longest_edge_length(const ElementMesh& m) {
   return std::sqrt(l2);
 }
 
+double median_edge_length(const ElementMesh& m) {
+  std::vector<double> l2;
+  l2.reserve(3 * m.tris.size());
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) {
+      const P3 &a = m.points[static_cast<std::size_t>(t[k])], &b = m.points[static_cast<std::size_t>(t[(k + 1) % 3])];
+      l2.push_back((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+    }
+  if (l2.empty()) return 0;
+  std::nth_element(l2.begin(), l2.begin() + static_cast<std::ptrdiff_t>(l2.size() / 2), l2.end());
+  return std::sqrt(l2[l2.size() / 2]);
+}
+
 std::vector<P3> face_normals(const ElementMesh& m) {
   std::vector<P3> n(m.tris.size(), P3{0, 0, 0});
   for (std::size_t i = 0; i < m.tris.size(); ++i) {

@@ -175,14 +175,15 @@ namespace {
 // A closed tube (thread) of 8 x 24 vertices from a to b (xy, at height zc),
 // radius rxy across in the plane and rz in height, capped, added to q as one
 // element located on the grid `base` (faces found by their barycentrics).
+// gap > 0: its second half moved on by gap along a -> b (one stretched step).
 void add_tube(SurfaceQuilt& q, const Mesh& base, std::array<double, 2> a, std::array<double, 2> b, double zc, double rxy,
-              double rz) {
+              double rz, double gap = 0) {
   ElementMesh t;
   const int nu = 8, nv = 24;
   const double dx = b[0] - a[0], dy = b[1] - a[1], len = std::hypot(dx, dy);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
-      const double s = static_cast<double>(j) / (nv - 1), ph = 2 * M_PI * i / nu;
+      const double s = static_cast<double>(j) / (nv - 1) + (2 * j >= nv ? gap / len : 0), ph = 2 * M_PI * i / nu;
       const double side = rxy * std::cos(ph);
       t.points.push_back({a[0] + s * dx - side * dy / len, a[1] + s * dy + side * dx / len, zc + rz * std::sin(ph)});
     }
@@ -349,6 +350,7 @@ TEST(EmbedSurfaceQuilt, TheShardBoundHoldsOnTheEmbeddedElements) {
   EXPECT_EQ(whole.elements_stretched_embedded, 0u);
   const double longest = longest_edge_length(element_mesh_from(out));
   ASSERT_EQ(out.number_of_faces(), q.tris.size());
+  eo.relax_stretched = false;  // the cut and the removal (relaxation: the next test)
   eo.max_edge = 0.99 * longest;
   const EmbedSurfaceQuiltResult cut = embed_surface_quilt(base, q, out, eo);
   EXPECT_EQ(cut.elements_stretched_embedded, 1u);
@@ -359,6 +361,53 @@ TEST(EmbedSurfaceQuilt, TheShardBoundHoldsOnTheEmbeddedElements) {
   EXPECT_EQ(removed.elements_stretched_embedded, 1u);
   EXPECT_EQ(out.number_of_faces(), 0u);
   eo.max_edge = -1;
+  EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
+}
+
+// Issue 17 item 2's bound in the output's own terms (decision 102, session 41):
+// an edge over 4 median edges of the embedded elements is a shard however the
+// swatch's edges compare, and a thread over it is first relaxed (its long
+// edges shortened, the excess spread along it) and kept whole; cut without
+// the relaxation; left as it is without the bound.
+TEST(EmbedSurfaceQuilt, AThreadStretchedPastFourMedianEdgesIsRelaxedWithinThemAndKeptWhole) {
+  Mesh base;
+  make_grid(base, 6, 6, 1.0, 1.0);
+  SurfaceQuilt q;
+  q.scale = 0.2;
+  q.z_min = 0;
+  q.z_max = 1;
+  add_tube(q, base, {0.1, 0.5}, {0.7, 0.5}, 0.5, 0.06, 0.3, 0.2);  // one step 0.23 long, the others 0.026
+  EmbedSurfaceQuiltOptions eo = quick_embedding();
+  eo.max_edge = 10;  // a shard bound nothing passes: the median's is tighter
+  eo.max_edge_over_median = 0;
+  Mesh out;
+  const EmbedSurfaceQuiltResult as_is = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(as_is.embedded_edge_bound, 10.0);
+  const double median = median_edge_length(element_mesh_from(out));
+  const double longest = longest_edge_length(element_mesh_from(out));
+  ASSERT_GT(longest, 4 * median);  // the stretched step
+  eo.max_edge_over_median = 4;
+  eo.relax_stretched = false;
+  const EmbedSurfaceQuiltResult cut = embed_surface_quilt(base, q, out, eo);
+  EXPECT_NEAR(cut.embedded_edge_bound, 4 * cut.embedded_median_edge, 1e-12);
+  EXPECT_NEAR(cut.embedded_median_edge, median, 0.02 * median);
+  EXPECT_EQ(cut.elements_stretched_embedded, 1u);
+  EXPECT_EQ(cut.elements_relaxed_embedded, 0u);
+  EXPECT_NE(out.number_of_faces(), q.tris.size());
+  EXPECT_LE(longest_edge_length(element_mesh_from(out)), cut.embedded_edge_bound);
+  eo.relax_stretched = true;
+  const EmbedSurfaceQuiltResult relaxed = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(relaxed.elements_relaxed_embedded, 1u);
+  EXPECT_EQ(relaxed.elements_stretched_embedded, 0u);
+  EXPECT_EQ(relaxed.embed.self_intersecting_pairs, 0u);
+  EXPECT_EQ(out.number_of_faces(), q.tris.size());  // whole
+  EXPECT_LE(longest_edge_length(element_mesh_from(out)), relaxed.embedded_edge_bound);
+  EXPECT_GT(longest_edge_length(element_mesh_from(out)), 0.9 * relaxed.embedded_edge_bound);  // shortened, not shrunk
+  eo.min_edge_bound = 1.1 * longest;  // a swatch with edges that long: the bound stays above them
+  const EmbedSurfaceQuiltResult floor = embed_surface_quilt(base, q, out, eo);
+  EXPECT_EQ(floor.embedded_edge_bound, eo.min_edge_bound);
+  EXPECT_EQ(floor.elements_relaxed_embedded + floor.elements_stretched_embedded, 0u);
+  eo.max_edge_over_median = -1;
   EXPECT_THROW(embed_surface_quilt(base, q, out, eo), InvalidInputError);
 }
 

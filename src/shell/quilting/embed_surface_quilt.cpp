@@ -383,18 +383,66 @@ void count_mapping(const SurfaceQuilt& quilt, const QuiltVertexMapping& vm, Embe
   }
 }
 
+/// An element's edges over `bound` shortened by moving their ends, not cut
+/// (issue 17 item 1's "moved by the deformation"): position-based relaxation,
+/// every edge held to its own length but those over the bound to 0.95 of it,
+/// so the excess spreads to their shorter neighbours (a thread gives along its
+/// length). Returns true, with `m` relaxed, when no edge is over the bound
+/// after `iterations` sweeps; false (m unchanged) otherwise. The crossings are
+/// checked after this, exactly, as for every embedded element.
+bool relax_stretched_edges(ElementMesh& m, double bound, int iterations) {
+  std::vector<std::array<int, 2>> edges;
+  for (const Tri& t : m.tris)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b) edges.push_back({a, b});  // a closed element has every edge both ways
+    }
+  auto length = [](const P3& a, const P3& b) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  };
+  std::vector<double> rest(edges.size());
+  for (std::size_t i = 0; i < edges.size(); ++i)
+    rest[i] = std::min(length(m.points[edges[i][0]], m.points[edges[i][1]]), 0.95 * bound);
+  std::vector<P3> p = m.points;
+  for (int it = 0; it < iterations; ++it) {
+    double longest = 0;
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      P3 &a = p[edges[i][0]], &b = p[edges[i][1]];
+      const double l = length(a, b);
+      longest = std::max(longest, l);
+      if (!(l > 0)) continue;
+      const double f = 0.5 * (l - rest[i]) / l;
+      for (int c = 0; c < 3; ++c) {
+        const double d = f * (b[c] - a[c]);
+        a[c] += d, b[c] -= d;
+      }
+    }
+    if (longest <= bound) break;
+  }
+  for (const auto& e : edges)
+    if (length(p[e[0]], p[e[1]]) > bound) return false;
+  m.points.swap(p);
+  return true;
+}
+
 /// The shard bound held on the embedded elements (EmbedSurfaceQuiltOptions::
 /// max_edge): triangles with a longer edge are cut out of threads (with one
 /// ring, the pieces capped; a piece whose cap is over the bound too is left
 /// out) and compact elements with one are removed.
 /// `compact` follows `els`; `out` is rebuilt if anything changed.
-void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::vector<ElementMesh>& els, Mesh& out,
-                            EmbedSurfaceQuiltResult& res) {
+void remove_embedded_shards(double max_edge, bool relax, std::vector<char>& compact, std::vector<ElementMesh>& els,
+                            Mesh& out, EmbedSurfaceQuiltResult& res) {
   if (!(max_edge > 0)) return;
   const double lim2 = max_edge * max_edge;
   std::vector<std::vector<char>> bad(els.size());  // per element: its triangles with a longer edge (empty: none)
   bool changed = false;
   for (std::size_t e = 0; e < els.size(); ++e) {
+    if (longest_edge_length(els[e]) <= max_edge) continue;
+    if (relax && relax_stretched_edges(els[e], max_edge, 50)) {
+      ++res.elements_relaxed_embedded;
+      changed = true;
+      continue;
+    }
     const ElementMesh& m = els[e];
     for (std::size_t t = 0; t < m.tris.size(); ++t)
       for (int k = 0; k < 3; ++k) {
@@ -406,7 +454,8 @@ void remove_embedded_shards(double max_edge, std::vector<char>& compact, std::ve
         break;
       }
   }
-  if (changed) res.elements_stretched_embedded += cut_or_remove(bad, false, max_edge, compact, els, out);
+  if (!changed) return;
+  res.elements_stretched_embedded += cut_or_remove(bad, false, max_edge, compact, els, out);
 }
 
 /// The pairs to resolve: those between two elements, and those within an
@@ -526,6 +575,11 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     throw InvalidInputError("embed_surface_quilt: shell_height must be > 0 (" + std::to_string(opt.shell_height) + ")");
   if (!(opt.max_edge >= 0) || !std::isfinite(opt.max_edge))
     throw InvalidInputError("embed_surface_quilt: max_edge must be >= 0 (" + std::to_string(opt.max_edge) + ")");
+  if (!(opt.min_edge_bound >= 0) || !std::isfinite(opt.min_edge_bound))
+    throw InvalidInputError("embed_surface_quilt: min_edge_bound must be >= 0 (" + std::to_string(opt.min_edge_bound) + ")");
+  if (!(opt.max_edge_over_median >= 0) || !std::isfinite(opt.max_edge_over_median))
+    throw InvalidInputError("embed_surface_quilt: max_edge_over_median must be >= 0 (" +
+                            std::to_string(opt.max_edge_over_median) + ")");
   if (opt.crossing_trim_rounds < 0 || opt.crossing_trim_rounds > 8)
     throw InvalidInputError("embed_surface_quilt: crossing_trim_rounds must be in 0..8 (" +
                             std::to_string(opt.crossing_trim_rounds) + ")");
@@ -572,8 +626,22 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   }
   count_mapping(quilt, vm, res);
   std::vector<char> compact = quilt.element_compact;
-  remove_embedded_shards(opt.max_edge, compact, els, out, res);
-  resolve_and_count_crossings(compact, opt, els, out, res);
+  res.embedded_edge_bound = opt.max_edge;
+  if (opt.max_edge > 0 && opt.max_edge_over_median > 0) {
+    ElementMesh all;  // the elements as one mesh for the median
+    for (const ElementMesh& m : els) {
+      const int base = static_cast<int>(all.points.size());
+      all.points.insert(all.points.end(), m.points.begin(), m.points.end());
+      for (const Tri& t : m.tris) all.tris.push_back({t[0] + base, t[1] + base, t[2] + base});
+    }
+    res.embedded_median_edge = median_edge_length(all);
+    const double b = std::max(opt.max_edge_over_median * res.embedded_median_edge, opt.min_edge_bound);
+    if (b > 0) res.embedded_edge_bound = std::min(res.embedded_edge_bound, b);
+  }
+  remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
+  EmbedSurfaceQuiltOptions ro = opt;
+  ro.max_edge = res.embedded_edge_bound;  // the crossings' cut pieces are held to it too
+  resolve_and_count_crossings(compact, ro, els, out, res);
   res.elements = els.size();
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);

@@ -80,6 +80,20 @@ struct EmbedSurfaceQuiltOptions {
   /// sets SurfaceQuiltOptions::max_edge_stretch times the swatch's longest
   /// edge, scaled.
   double max_edge = 0;
+  /// The shard bound also in the output's own terms (issue 17's shard: an
+  /// element edge longer than 4 median edges of the output): when max_edge
+  /// > 0, the embedded elements' median edge times this where that is lower,
+  /// but not below min_edge_bound (a swatch whose own longest edge is many
+  /// median edges, a CAD part, keeps its elements). 0 = none. Default 4
+  /// (decision 102, session 41).
+  double max_edge_over_median = 4.0;
+  /// The floor of that bound, mesh units; quilt_swatch_on_surface sets 1.5
+  /// times the swatch's longest edge, scaled. Default 0.
+  double min_edge_bound = 0;
+  /// An element over the bound is first relaxed (its long edges shortened by
+  /// moving their ends, the excess spread to its shorter edges) and kept when
+  /// that brings it within; cut or removed otherwise. Default true.
+  bool relax_stretched = true;
   /// Cap centres moved back to the middle of their caps (recentre_fans) on the
   /// embedded elements, before the shard bound and the crossings. Default true.
   bool recentre_caps = true;
@@ -121,6 +135,11 @@ struct EmbedSurfaceQuiltResult {
   std::size_t elements_placed_affine = 0;
   /// Elements with an embedded edge over max_edge, removed or cut.
   std::size_t elements_stretched_embedded = 0;
+  /// The bound held on the embedded elements: max_edge, or max_edge_over_median
+  /// median edges when that is lower (mesh units; 0 = none), and that median.
+  double embedded_edge_bound = 0, embedded_median_edge = 0;
+  /// Elements over the bound brought within it by relax_stretched (not cut).
+  std::size_t elements_relaxed_embedded = 0;
   /// Cap centres moved by recentre_caps.
   std::size_t caps_recentred = 0;
   /// Elements in `out` (the quilt's, less those the shard bound and the

@@ -146,7 +146,9 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                             " (the swatch may be too large for the mesh: lower --scale)");
   EmbedSurfaceQuiltOptions eo = opt.embed;
   eo.stretch.seed = opt.seed;
-  if (eo.max_edge == 0) eo.max_edge = qo.max_edge_stretch * longest_edge_length(r.swatch.mesh) * r.local.scale;
+  const double swatch_longest = longest_edge_length(r.swatch.mesh) * r.local.scale;
+  if (eo.max_edge == 0) eo.max_edge = qo.max_edge_stretch * swatch_longest;
+  if (eo.min_edge_bound == 0) eo.min_edge_bound = 1.5 * swatch_longest;
   eo.swatch_self_crossings = r.swatch.element_self_crossings;
   eo.whole_copy_sources = swatch_element_meshes(r.swatch);
   t.reset();

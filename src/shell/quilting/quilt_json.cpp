@@ -83,6 +83,9 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["crossing_elements_embedded"] = er.crossing_elements;  // cut or removed after the embedding
   j["crossing_elements_removed_last"] = er.crossing_elements_removed_last;  // still crossing after the trims: removed
   j["elements_stretched_embedded"] = er.elements_stretched_embedded;  // over the shard bound after the shell map
+  j["embedded_edge_bound"] = er.embedded_edge_bound;    // that bound, mesh units (decision 102, session 41)
+  j["embedded_median_edge"] = er.embedded_median_edge;
+  j["elements_relaxed_embedded"] = er.elements_relaxed_embedded;  // brought within it by moving, not cut
   j["caps_recentred"] = er.caps_recentred;
   j["elements_untangled"] = er.elements_untangled;
   j["elements_placed_affine"] = er.elements_placed_affine;
