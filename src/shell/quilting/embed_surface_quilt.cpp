@@ -458,6 +458,28 @@ void remove_embedded_shards(double max_edge, bool relax, std::vector<char>& comp
   res.elements_stretched_embedded += cut_or_remove(bad, false, max_edge, compact, els, out);
 }
 
+/// The shard bound on the embedded elements (EmbedSurfaceQuiltOptions::
+/// max_edge, max_edge_over_median, min_edge_bound); `median` gets their
+/// median edge when that is used.
+double embedded_edge_bound(const EmbedSurfaceQuiltOptions& opt, const std::vector<ElementMesh>& els, double& median) {
+  if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) return opt.max_edge;
+  ElementMesh all;  // the elements as one mesh
+  for (const ElementMesh& m : els) {
+    const int first = static_cast<int>(all.points.size());
+    all.points.insert(all.points.end(), m.points.begin(), m.points.end());
+    for (const Tri& t : m.tris) all.tris.push_back({t[0] + first, t[1] + first, t[2] + first});
+  }
+  median = median_edge_length(all);
+  const double b = std::max(opt.max_edge_over_median * median, opt.min_edge_bound);
+  return b > 0 ? std::min(opt.max_edge, b) : opt.max_edge;
+}
+
+double longest_edge_length(const std::vector<ElementMesh>& els) {
+  double l = 0;
+  for (const ElementMesh& m : els) l = std::max(l, longest_edge_length(m));
+  return l;
+}
+
 /// The pairs to resolve: those between two elements, and those within an
 /// element that has more than `own` of them (at most `own` are the swatch
 /// element's own crossings, which the copy keeps); `kept` = elements keeping theirs.
@@ -533,7 +555,7 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
       pairs = round == 0 ? self_intersecting_faces(out)
                          : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
       if (round == 0 && opt.untangle_folds)
-        res.elements_untangled = untangle_folded_elements(pairs, opt.swatch_self_crossings, compact, els, out);
+        res.elements_untangled += untangle_folded_elements(pairs, opt.swatch_self_crossings, compact, els, out);
       checked = true;
       checked_whole = round == 0;
       const std::vector<FacePair> act =
@@ -626,22 +648,18 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   }
   count_mapping(quilt, vm, res);
   std::vector<char> compact = quilt.element_compact;
-  res.embedded_edge_bound = opt.max_edge;
-  if (opt.max_edge > 0 && opt.max_edge_over_median > 0) {
-    ElementMesh all;  // the elements as one mesh for the median
-    for (const ElementMesh& m : els) {
-      const int base = static_cast<int>(all.points.size());
-      all.points.insert(all.points.end(), m.points.begin(), m.points.end());
-      for (const Tri& t : m.tris) all.tris.push_back({t[0] + base, t[1] + base, t[2] + base});
-    }
-    res.embedded_median_edge = median_edge_length(all);
-    const double b = std::max(opt.max_edge_over_median * res.embedded_median_edge, opt.min_edge_bound);
-    if (b > 0) res.embedded_edge_bound = std::min(res.embedded_edge_bound, b);
+  // The shard bound, then the crossings; as removing elements moves the
+  // median, again on the final elements while one is over its bound.
+  for (int pass = 0; pass < 3; ++pass) {
+    res.embedded_edge_bound = embedded_edge_bound(opt, els, res.embedded_median_edge);
+    if (pass > 0 && longest_edge_length(els) <= res.embedded_edge_bound) break;
+    remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
+    EmbedSurfaceQuiltOptions ro = opt;
+    ro.max_edge = res.embedded_edge_bound;  // the crossings' cut pieces are held to it too
+    res.self_intersections_within = res.self_intersections_between = 0;
+    resolve_and_count_crossings(compact, ro, els, out, res);
+    if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;
   }
-  remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
-  EmbedSurfaceQuiltOptions ro = opt;
-  ro.max_edge = res.embedded_edge_bound;  // the crossings' cut pieces are held to it too
-  resolve_and_count_crossings(compact, ro, els, out, res);
   res.elements = els.size();
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);
