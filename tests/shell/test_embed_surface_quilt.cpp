@@ -222,13 +222,13 @@ void add_tube(SurfaceQuilt& q, const Mesh& base, std::array<double, 2> a, std::a
 }
 
 // A 6 x 6 grid over the unit square and a quilt of one thread across it along x
-// (scale 0.2, z in [0, 1]).
-void tube_on_grid(Mesh& base, SurfaceQuilt& q) {
+// (scale 0.2, z in [0, 1]), from x0 to x1, its second half moved on by `gap`.
+void tube_on_grid(Mesh& base, SurfaceQuilt& q, double x0 = 0.1, double x1 = 0.9, double gap = 0) {
   make_grid(base, 6, 6, 1.0, 1.0);
   q.scale = 0.2;
   q.z_min = 0;
   q.z_max = 1;
-  add_tube(q, base, {0.1, 0.5}, {0.9, 0.5}, 0.5, 0.06, 0.3);
+  add_tube(q, base, {x0, 0.5}, {x1, 0.5}, 0.5, 0.06, 0.3, gap);
 }
 
 EmbedSurfaceQuiltOptions quick_embedding() {
@@ -371,12 +371,8 @@ TEST(EmbedSurfaceQuilt, TheShardBoundHoldsOnTheEmbeddedElements) {
 // the relaxation; left as it is without the bound.
 TEST(EmbedSurfaceQuilt, AThreadStretchedPastFourMedianEdgesIsRelaxedWithinThemAndKeptWhole) {
   Mesh base;
-  make_grid(base, 6, 6, 1.0, 1.0);
   SurfaceQuilt q;
-  q.scale = 0.2;
-  q.z_min = 0;
-  q.z_max = 1;
-  add_tube(q, base, {0.1, 0.5}, {0.7, 0.5}, 0.5, 0.06, 0.3, 0.2);  // one step 0.23 long, the others 0.026
+  tube_on_grid(base, q, 0.1, 0.7, 0.2);  // one step 0.23 long, the others 0.026
   EmbedSurfaceQuiltOptions eo = quick_embedding();
   eo.max_edge = 10;  // a shard bound nothing passes: the median's is tighter
   eo.max_edge_over_median = 0;
