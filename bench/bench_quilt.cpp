@@ -35,7 +35,7 @@
 //   the stretch bound at 12), for before/after tables.
 //   Environment overrides for experiments (each sets one option of
 //   SurfaceQuiltOptions / QuiltSwatchOnSurfaceOptions; unset = the default):
-//   BENCH_SEED, BENCH_RELATIVE_SIZE, BENCH_MAX_EDGE_STRETCH, BENCH_REFILL_ROUNDS,
+//   BENCH_SEED, BENCH_RELATIVE_SIZE, BENCH_MAX_EDGE_STRETCH, BENCH_THREAD_STRETCH, BENCH_REFILL_ROUNDS,
 //   BENCH_SCATTER (attempts), BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE,
 //   BENCH_SCATTER_ONLY (scatter_swatch_elements; 0: always quilt), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
@@ -243,6 +243,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   // BENCH_CLEARANCE in swatch units (negative = automatic), BENCH_SEED the run's seed (default 1).
   if (const char* e = std::getenv("BENCH_RELATIVE_SIZE")) qo.relative_size = std::atof(e);
   if (const char* e = std::getenv("BENCH_MAX_EDGE_STRETCH")) qo.max_edge_stretch = std::atof(e);
+  if (const char* e = std::getenv("BENCH_THREAD_STRETCH")) qo.max_thread_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER")) qo.scatter_attempts = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_STRETCH")) qo.scatter_max_stretch = std::atof(e);

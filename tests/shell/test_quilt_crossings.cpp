@@ -745,6 +745,7 @@ TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.4;
     o.max_edge_stretch = bound;
+    o.max_thread_stretch = 0;  // the threads' bound: max_edge_stretch's
     SurfaceQuilt q;
     const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
     std::cout << "[ rim ] bound " << bound << ": edge stretch max " << r.edge_stretch_max << ", stretched "

@@ -391,12 +391,14 @@ void count_mapping(const SurfaceQuilt& quilt, const QuiltVertexMapping& vm, Embe
 /// after `iterations` sweeps; false (m unchanged) otherwise. The crossings are
 /// checked after this, exactly, as for every embedded element.
 bool relax_stretched_edges(ElementMesh& m, double bound, int iterations) {
-  std::vector<std::array<int, 2>> edges;
+  std::vector<std::array<int, 2>> edges;  // each undirected edge once (an open element's border too)
   for (const Tri& t : m.tris)
     for (int k = 0; k < 3; ++k) {
       const int a = t[k], b = t[(k + 1) % 3];
-      if (a < b) edges.push_back({a, b});  // a closed element has every edge both ways
+      edges.push_back({std::min(a, b), std::max(a, b)});
     }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   auto length = [](const P3& a, const P3& b) {
     return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
   };
@@ -656,6 +658,7 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
     EmbedSurfaceQuiltOptions ro = opt;
     ro.max_edge = res.embedded_edge_bound;  // the crossings' cut pieces are held to it too
+    ro.untangle_folds = opt.untangle_folds && pass == 0;  // its smoothing may stretch: not again
     res.self_intersections_within = res.self_intersections_between = 0;
     resolve_and_count_crossings(compact, ro, els, out, res);
     if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;

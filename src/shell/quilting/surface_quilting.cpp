@@ -440,6 +440,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.subpatch_radius < 0) bad("subpatch_radius must be >= 0", o.subpatch_radius);
   if (!(o.max_past_border >= 0 && o.max_past_border <= 1)) bad("max_past_border must be in [0, 1]", o.max_past_border);
   if (!(o.max_edge_stretch >= 0) || !std::isfinite(o.max_edge_stretch)) bad("max_edge_stretch must be >= 0", o.max_edge_stretch);
+  if (!(o.max_thread_stretch >= 0) || !std::isfinite(o.max_thread_stretch))
+    bad("max_thread_stretch must be >= 0", o.max_thread_stretch);
   if (!(o.max_z_growth >= 0 && o.max_z_growth <= 10)) bad("max_z_growth must be in [0, 10]", o.max_z_growth);
   if (!(o.transport_below >= 0 && o.transport_below <= 1)) bad("transport_below must be in [0, 1]", o.transport_below);
   if (!(o.rotation_max_deg >= 0 && o.rotation_max_deg <= 90)) bad("rotation_max_deg must be in [0, 90]", o.rotation_max_deg);
@@ -662,6 +664,7 @@ class SurfaceQuilter {
   int done_ = 0;
   bool refilling_ = false;
   double stretch_bound2_ = 0;  // squared (mesh units); 0 = none (settle_and_trim)
+  double thread_bound2_ = 0;   // the same for threads (max_thread_stretch)
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool lift_rings_ = false;    // lift_crossing_rings, resolved
@@ -1491,6 +1494,8 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
   const double max_edge = longest_edge_length(swatch_.mesh);
   const double bound = opt_.max_edge_stretch * max_edge * S_, cap_max = 2 * swatch_h_ * S_;
   stretch_bound2_ = opt_.max_edge_stretch > 0 ? bound * bound : 0.0;
+  const double thread_bound = (opt_.max_thread_stretch > 0 ? opt_.max_thread_stretch : opt_.max_edge_stretch) * max_edge * S_;
+  thread_bound2_ = thread_bound * thread_bound;
   // (The pieces appended are checked in turn: a cap's edges, lifted along
   // the vertex normals, may pass the bound where they diverge, at a rim.)
   for (std::size_t e = from; e < elements_.size(); ++e) {
@@ -1521,9 +1526,10 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
     for (std::size_t t = 0; t < el.mesh.tris.size(); ++t) {
       const Tri& tr = el.mesh.tris[t];
       if (too_far && (past_v[tr[0]] || past_v[tr[1]] || past_v[tr[2]])) drop[t] = 1, any_past = true;
-      for (int k = 0; k < 3 && opt_.max_edge_stretch > 0; ++k) {
+      const double b = el.compact ? bound : thread_bound;
+      for (int k = 0; k < 3 && b > 0; ++k) {
         const double len = vec3::norm(vec3::sub(lp[tr[k]], lp[tr[(k + 1) % 3]]));
-        if (len > bound) drop[t] = 1, any_stretched = true;
+        if (len > b) drop[t] = 1, any_stretched = true;
       }
     }
     if (!any_past && !any_stretched) continue;
@@ -1534,7 +1540,8 @@ void SurfaceQuilter::settle_and_trim(std::size_t from) {
     }
     if (any_stretched) grow_drop(el.mesh.tris, el.loc.size(), drop, 1);
     std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>> pieces;
-    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, any_stretched ? bound * bound : 0.0, pieces);
+    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, any_stretched ? thread_bound2_ : 0.0,
+                 pieces);
     el.alive = false;
     if (pieces.empty()) {
       if (any_past && !any_stretched) ++res_.elements_past_border;
@@ -1586,7 +1593,7 @@ void SurfaceQuilter::resolve_crossings_lifted() {
     std::vector<char> drop = hit;
     grow_drop(el.mesh.tris, el.loc.size(), drop, opt_.step.trim_rings);
     std::vector<std::pair<std::vector<Tri>, std::vector<SurfaceQuiltVertex>>> pieces;
-    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, stretch_bound2_, pieces);
+    trim_element(b_, el.mesh.tris, el.loc, drop, S_, swatch_.bbox_min[2], cap_max, thread_bound2_, pieces);
     for (auto& [tris, locs] : pieces) {
       ElementMesh m;
       m.tris = tris;

@@ -79,6 +79,13 @@ struct SurfaceQuiltOptions {
   /// longer, lifted, than this many swatch longest edges is cut out (threads) or
   /// its element removed, then refilled. >= 0, 0 = none. Default 3.
   double max_edge_stretch = 3.0;
+  /// The same bound for threads (elements that are not compact: weaves), in
+  /// swatch longest edges; 0 = max_edge_stretch. Looser: a thread is cut
+  /// where it passes, and the cut loses cover that only the refill rounds
+  /// give back (on thin parts they do not), while the embedding relaxes what
+  /// stays over its 4 median edges (EmbedSurfaceQuiltOptions::
+  /// max_edge_over_median). >= 0. Default 4 (decision 102, session 41).
+  double max_thread_stretch = 4.0;
   /// Shape bound for compact elements (rings, pebbles): one that, lifted,
   /// spreads wider than this many times the swatch's largest compact element
   /// (merged with a neighbour, or deformed) is removed, then refilled. >= 0,
