@@ -427,10 +427,11 @@ bool relax_stretched_edges(ElementMesh& m, double bound, int iterations) {
   return true;
 }
 
-/// The shard bound held on the embedded elements (EmbedSurfaceQuiltOptions::
-/// max_edge): triangles with a longer edge are cut out of threads (with one
-/// ring, the pieces capped; a piece whose cap is over the bound too is left
-/// out) and compact elements with one are removed.
+/// The shard bound held on the embedded elements (embedded_edge_bound): an
+/// element with a longer edge is relaxed within it when `relax` can
+/// (relax_stretched_edges); otherwise its triangles with a longer edge are
+/// cut out of threads (with one ring, the pieces capped; a piece whose cap is
+/// over the bound too is left out) and compact elements with one are removed.
 /// `compact` follows `els`; `out` is rebuilt if anything changed.
 void remove_embedded_shards(double max_edge, bool relax, std::vector<char>& compact, std::vector<ElementMesh>& els,
                             Mesh& out, EmbedSurfaceQuiltResult& res) {
