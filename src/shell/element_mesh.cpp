@@ -248,17 +248,43 @@ double longest_edge_length(const ElementMesh& m) {
   return std::sqrt(l2);
 }
 
-double median_edge_length(const ElementMesh& m) {
-  std::vector<double> l2;
-  l2.reserve(3 * m.tris.size());
+double longest_edge_length(const std::vector<ElementMesh>& els) {
+  double l = 0;
+  for (const ElementMesh& m : els) l = std::max(l, longest_edge_length(m));
+  return l;
+}
+
+namespace {
+// Squared length of every triangle side of `m`, appended to `l2`.
+void append_side_lengths2(const ElementMesh& m, std::vector<double>& l2) {
   for (const Tri& t : m.tris)
     for (int k = 0; k < 3; ++k) {
-      const P3 &a = m.points[static_cast<std::size_t>(t[k])], &b = m.points[static_cast<std::size_t>(t[(k + 1) % 3])];
-      l2.push_back((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+      const P3 d = vec3::sub(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
+      l2.push_back(vec3::dot(d, d));
     }
+}
+
+double median_length(std::vector<double>& l2) {
   if (l2.empty()) return 0;
   std::nth_element(l2.begin(), l2.begin() + static_cast<std::ptrdiff_t>(l2.size() / 2), l2.end());
   return std::sqrt(l2[l2.size() / 2]);
+}
+}  // namespace
+
+double median_edge_length(const ElementMesh& m) {
+  std::vector<double> l2;
+  l2.reserve(3 * m.tris.size());
+  append_side_lengths2(m, l2);
+  return median_length(l2);
+}
+
+double median_edge_length(const std::vector<ElementMesh>& els) {
+  std::size_t n = 0;
+  for (const ElementMesh& m : els) n += 3 * m.tris.size();
+  std::vector<double> l2;
+  l2.reserve(n);
+  for (const ElementMesh& m : els) append_side_lengths2(m, l2);
+  return median_length(l2);
 }
 
 std::vector<P3> face_normals(const ElementMesh& m) {

@@ -66,9 +66,13 @@ void cap_loop(ElementMesh& m, const std::vector<int>& loop);
 std::size_t recentre_fans(ElementMesh& m, int min_valence = 9, double min_offset = 0.25);
 /// Length of the longest edge; 0 if none.
 double longest_edge_length(const ElementMesh& m);
+/// The longest over several elements; 0 if none.
+double longest_edge_length(const std::vector<ElementMesh>& els);
 /// Median length over the triangles' sides (an edge of two triangles counted
-/// twice, as every edge of a closed element is); 0 if none.
+/// twice, as every edge of a closed element is); 0 if none. Over several
+/// elements: of all their sides together.
 double median_edge_length(const ElementMesh& m);
+double median_edge_length(const std::vector<ElementMesh>& els);
 /// The pairs of `m`'s triangles that intersect (exact, the rules of
 /// self_intersecting_faces: geometry/self_intersections.h), as triangle
 /// indices, first < second; on one thread unless `parallel` (callers that

@@ -18,6 +18,7 @@
 #include "geometry/self_intersections.h"
 #include "shell/element_clearance.h"
 #include "geometry/timer.h"
+#include "geometry/vec3.h"
 #include "shell/element_mesh.h"
 #include "shell/shell_map.h"
 #include "shell/shell_space.h"
@@ -399,9 +400,7 @@ bool relax_stretched_edges(ElementMesh& m, double bound, int iterations) {
     }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  auto length = [](const P3& a, const P3& b) {
-    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
-  };
+  auto length = [](const P3& a, const P3& b) { return vec3::norm(vec3::sub(a, b)); };
   std::vector<double> rest(edges.size());
   for (std::size_t i = 0; i < edges.size(); ++i)
     rest[i] = std::min(length(m.points[edges[i][0]], m.points[edges[i][1]]), 0.95 * bound);
@@ -466,21 +465,9 @@ void remove_embedded_shards(double max_edge, bool relax, std::vector<char>& comp
 /// median edge when that is used.
 double embedded_edge_bound(const EmbedSurfaceQuiltOptions& opt, const std::vector<ElementMesh>& els, double& median) {
   if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) return opt.max_edge;
-  ElementMesh all;  // the elements as one mesh
-  for (const ElementMesh& m : els) {
-    const int first = static_cast<int>(all.points.size());
-    all.points.insert(all.points.end(), m.points.begin(), m.points.end());
-    for (const Tri& t : m.tris) all.tris.push_back({t[0] + first, t[1] + first, t[2] + first});
-  }
-  median = median_edge_length(all);
+  median = median_edge_length(els);
   const double b = std::max(opt.max_edge_over_median * median, opt.min_edge_bound);
   return b > 0 ? std::min(opt.max_edge, b) : opt.max_edge;
-}
-
-double longest_edge_length(const std::vector<ElementMesh>& els) {
-  double l = 0;
-  for (const ElementMesh& m : els) l = std::max(l, longest_edge_length(m));
-  return l;
 }
 
 /// The pairs to resolve: those between two elements, and those within an
@@ -542,9 +529,10 @@ std::size_t untangle_folded_elements(std::vector<FacePair>& pairs, std::size_t o
 /// each reusing the exact check that the count reports; what still crosses
 /// after opt.crossing_trim_rounds is removed whole (removing adds no crossing, so none is
 /// left); then the self-intersecting face pairs counted, within and between
-/// elements.
-void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQuiltOptions& opt,
-                                 std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+/// elements. Cut pieces with an edge over `max_edge` (> 0) are left out;
+/// `untangle`: folded threads smoothed out first (untangle_folded_elements).
+void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQuiltOptions& opt, double max_edge,
+                                 bool untangle, std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
   std::vector<FacePair> pairs;
   bool checked = false, checked_whole = false;
   // After a resolution round: its cut pieces. Every pair of the round's check
@@ -557,14 +545,14 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
     for (int round = 0; round <= trim_rounds; ++round) {
       pairs = round == 0 ? self_intersecting_faces(out)
                          : self_intersecting_faces(out, faces_near_changed_elements(els, fresh));
-      if (round == 0 && opt.untangle_folds)
+      if (round == 0 && untangle)
         res.elements_untangled += untangle_folded_elements(pairs, opt.swatch_self_crossings, compact, els, out);
       checked = true;
       checked_whole = round == 0;
       const std::vector<FacePair> act =
           pairs_to_resolve(pairs, out, opt.swatch_self_crossings, res.elements_self_crossing_kept);
       if (act.empty()) break;
-      resolve_embedded_crossings(act, compact, round == trim_rounds, opt.max_edge, els, out, res, fresh);
+      resolve_embedded_crossings(act, compact, round == trim_rounds, max_edge, els, out, res, fresh);
       checked = false;
     }
   }
@@ -657,11 +645,10 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     res.embedded_edge_bound = embedded_edge_bound(opt, els, res.embedded_median_edge);
     if (pass > 0 && longest_edge_length(els) <= res.embedded_edge_bound) break;
     remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
-    EmbedSurfaceQuiltOptions ro = opt;
-    ro.max_edge = res.embedded_edge_bound;  // the crossings' cut pieces are held to it too
-    ro.untangle_folds = opt.untangle_folds && pass == 0;  // its smoothing may stretch: not again
     res.self_intersections_within = res.self_intersections_between = 0;
-    resolve_and_count_crossings(compact, ro, els, out, res);
+    // The crossings' cut pieces are held to the bound too; the untangling's
+    // smoothing may stretch, so it runs in the first pass only.
+    resolve_and_count_crossings(compact, opt, res.embedded_edge_bound, opt.untangle_folds && pass == 0, els, out, res);
     if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;
   }
   res.elements = els.size();
