@@ -10,11 +10,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <sstream>
 #include <unordered_map>
 
 #include "geometry/errors.h"
@@ -118,12 +121,23 @@ bool parse_uint64(std::string_view tok, std::uint64_t& v) {
   return r.ec == std::errc() && r.ptr == tok.data() + tok.size();
 }
 
+/// Refuses a NaN or infinite coordinate, and one beyond the float range
+/// (3.4e38): outputs store float32 positions, and a larger one overflows the
+/// geometry's products to infinity (CGAL's exact fallback then converts an
+/// infinite double to GMP, which raises SIGFPE; fuzz_off found it).
 void check_finite(const std::string& path, const std::string& where, const std::array<double, 3>& p) {
-  for (double c : p)
+  auto text = [](double c) {
+    std::ostringstream v;
+    v << c;
+    return v.str();
+  };
+  const std::string at = " (" + text(p[0]) + ", " + text(p[1]) + ", " + text(p[2]) + ")";
+  for (double c : p) {
     if (!std::isfinite(c))
-      fail_input(path, where, "coordinate is " + std::string(std::isnan(c) ? "NaN" : "infinite") +
-                                  " (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ", " +
-                                  std::to_string(p[2]) + ")");
+      fail_input(path, where, "coordinate is " + std::string(std::isnan(c) ? "NaN" : "infinite") + at);
+    if (std::abs(c) > double(std::numeric_limits<float>::max()))
+      fail_input(path, where, "coordinate " + text(c) + " is beyond the float range (3.4e38)" + at);
+  }
 }
 
 std::size_t PositionHash::operator()(const std::array<double, 3>& p) const noexcept {

@@ -577,7 +577,7 @@ TEST(ReadMeshHostile, AnImageGivenAsAMeshIsNamedAsSuch) {
 
 TEST(ReadMeshHostile, NanAndInfCoordinatesAreInvalidInput) {
   auto d = test::temp_dir("rm");
-  for (std::string bad : {"nan", "inf", "-inf", "1e999"}) {
+  for (std::string bad : {"nan", "inf", "-inf", "1e999", "1e300", "-3.5e38"}) {
     SCOPED_TRACE(bad);
     std::string off = "OFF\n3 1 0\n0 0 0\n1 " + bad + " 0\n0 1 0\n3 0 1 2\n";
     auto msg = expect_throw<InvalidInputError>([&] { read_polygon_soup(write_file(d, "n.off", off)); });
@@ -593,6 +593,10 @@ TEST(ReadMeshHostile, NanAndInfCoordinatesAreInvalidInput) {
     stl.replace(stl.find("vertex 1 0 0"), 12, "vertex 1 " + bad + " 0");
     expect_throw<InvalidInputError>([&] { read_polygon_soup(write_file(d, "n.stl", stl)); });
   }
+  // The largest float is still a coordinate.
+  EXPECT_EQ(read_polygon_soup(write_file(d, "f.off", "OFF\n3 1 0\n0 0 0\n3.4e38 0 0\n0 -3.4e38 0\n3 0 1 2\n"))
+                .points.size(),
+            3u);
   // Binary: a NaN float in a binary PLY and a binary STL.
   std::string ply = tet_ply("binary_little_endian");
   std::size_t body = ply.find("end_header\n") + 11;
