@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <iterator>
@@ -170,7 +171,13 @@ bool triangle_hits(const ElementMesh& m, const Tri& tr, const std::vector<char>&
 }
 }  // namespace
 
-std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead) const {
+// hits() and any_hit(): each vertex and each triangle tested on its own (the
+// trees are only read), in parallel; the answer does not depend on the thread
+// count. With `first`, triangles after a hit is known are skipped (their
+// entries left 0; only "any" is then meaningful: which triangles were tested
+// depends on the threads, the answer does not).
+std::vector<char> ElementCollider::collide(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead,
+                                           bool first) const {
   auto counts = [&](int tag) {
     if (tag == skip && skip >= 0) return false;
     return !(dead && tag >= 0 && static_cast<std::size_t>(tag) < dead->size() && (*dead)[static_cast<std::size_t>(tag)]);
@@ -179,8 +186,6 @@ std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double c
     for (int v : tr)
       if (v < 0 || static_cast<std::size_t>(v) >= m.points.size())
         throw InvalidInputError("ElementCollider::hits: vertex index " + std::to_string(v) + " out of range");
-  // Each vertex and each triangle is tested on its own (the trees are only
-  // read), in parallel; the answer does not depend on the thread count.
   std::vector<char> hit(m.tris.size(), 0);
   std::vector<char> near(m.points.size(), 0);
   if (clearance > 0 && skip < 0 && !dead)
@@ -194,10 +199,24 @@ std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double c
           }
         }
     });
+  std::atomic<bool> found{false};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.tris.size(), 32), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t < r.end(); ++t) hit[t] = triangle_hits(m, m.tris[t], near, skip, dead, counts, impl_->batches) ? 1 : 0;
+    for (std::size_t t = r.begin(); t < r.end(); ++t) {
+      if (first && found.load(std::memory_order_relaxed)) return;
+      hit[t] = triangle_hits(m, m.tris[t], near, skip, dead, counts, impl_->batches) ? 1 : 0;
+      if (hit[t]) found.store(true, std::memory_order_relaxed);
+    }
   });
   return hit;
+}
+
+std::vector<char> ElementCollider::hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead) const {
+  return collide(m, skip, clearance, dead, false);
+}
+
+bool ElementCollider::any_hit(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead) const {
+  const std::vector<char> hit = collide(m, skip, clearance, dead, true);
+  return std::find(hit.begin(), hit.end(), 1) != hit.end();
 }
 
 std::vector<ElementMesh> trim_and_cap(const ElementMesh& m, const std::vector<char>& drop, int rings, std::size_t min_faces) {

@@ -29,6 +29,9 @@ class ElementCollider {
   /// element than `skip` (-1: none), or (clearance > 0, no skip) a corner lies
   /// within `clearance` of one; elements in `dead` are ignored.
   std::vector<char> hits(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead = nullptr) const;
+  /// Whether any triangle of `m` hits (as hits() would mark one), stopping
+  /// at the first: for the tests that only accept or reject a placement.
+  bool any_hit(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead = nullptr) const;
   /// Smallest distance from any of `points` to a triangle of the collider, or `limit` if none is closer.
   double nearest_distance(const std::vector<P3>& points, double limit) const;
   /// Adds the triangles of `m`, tagged `id` (so that later queries see it).
@@ -36,6 +39,7 @@ class ElementCollider {
   bool empty() const;
 
  private:
+  std::vector<char> collide(const ElementMesh& m, int skip, double clearance, const std::vector<char>* dead, bool first) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

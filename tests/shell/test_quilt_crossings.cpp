@@ -69,6 +69,11 @@ TEST(ElementClearance, CrossingTubesHitDisjointOnesDoNotClearanceCounts) {
   EXPECT_FALSE(any(two.hits(d, 1, 0.0, &dead)));
   EXPECT_NEAR(smallest_element_gap({a, c}, 10.0), 0.4, 0.05);
   EXPECT_EQ(smallest_element_gap({a, d}, 10.0), 0.0);
+  // any_hit (stops at the first hit) answers as hits() does.
+  for (const auto& [m, clearance] : std::vector<std::pair<ElementMesh, double>>{{b, 0.0}, {c, 0.35}, {c, 0.45}, {d, 0.0}})
+    EXPECT_EQ(coll.any_hit(m, -1, clearance), any(coll.hits(m, -1, clearance))) << clearance;
+  EXPECT_TRUE(two.any_hit(d, 1, 0.0));
+  EXPECT_FALSE(two.any_hit(d, 1, 0.0, &dead));
 }
 
 // The collider restricted to a box (quilt_step's resolve_crossings: the new
@@ -511,6 +516,37 @@ TEST(SurfaceQuiltingCoverage, ScatterFillCoversTheHolesLeftByRemovedElements) {
     EXPECT_LT(ron.bare_fraction, 0.6 * roff.bare_fraction) << kind;
     EXPECT_EQ(eon.self_intersections_between, 0u) << kind;
   }
+}
+
+// The scatter fill tries every face with a bare sample point, not only the
+// faces the refill rounds reopen (two or more): the measure counts each bare
+// point as a quarter of its face, and with two the chain mail's gaps of one
+// bare point per face were never tried.
+TEST(SurfaceQuiltingCoverage, ScatterFillTriesFacesWithOneBarePoint) {
+  Mesh base;
+  make_icosphere(base, 3);
+  const Swatch s = test::small_chainmail_swatch();
+  auto run = [&](int bare_samples) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.3;
+    o.scatter_bare_samples = bare_samples;
+    SurfaceQuilt q;
+    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+    EmbedSurfaceQuiltOptions eo;
+    eo.stretch.iterations = 4;
+    eo.measure_outside_shell = false;
+    Mesh out;
+    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+    std::cout << "[ sphere chainmail ] scatter from " << bare_samples << " bare points: placed " << r.scatter_placed
+              << ", bare " << r.bare_fraction << ", pairs " << er.self_intersections_between << "\n";
+    return std::make_pair(r, er);
+  };
+  const auto [r2, e2] = run(2);
+  const auto [r1, e1] = run(SurfaceQuiltOptions{}.scatter_bare_samples);
+  EXPECT_EQ(SurfaceQuiltOptions{}.scatter_bare_samples, 1);
+  EXPECT_GT(r1.scatter_placed, r2.scatter_placed);
+  EXPECT_LT(r1.bare_fraction, r2.bare_fraction);
+  EXPECT_EQ(e1.self_intersections_between, 0u);
 }
 
 // The reported bare area is the output's (issue 17 item 4): a quarter of a

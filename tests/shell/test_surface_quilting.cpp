@@ -267,6 +267,11 @@ TEST(SurfaceQuilting, RejectsBadInput) {
   o = {};
   o.up = {0, 0, 0};
   EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError);
+  for (int samples : {0, 5}) {
+    o = {};
+    o.scatter_bare_samples = samples;
+    EXPECT_THROW(quilt_surface(base, sw, q, o), InvalidInputError) << samples;
+  }
   Mesh empty;
   EXPECT_THROW(quilt_surface(empty, sw, q, {}), InvalidInputError);
   // No atlas on the base: texture coordinates cannot be made.

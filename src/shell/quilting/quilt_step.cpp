@@ -209,8 +209,7 @@ std::vector<ElementMesh> resolve_crossings(const std::vector<ElementMesh>& eleme
     if (!compact && opt.push_over_under) {  // over or under the crossing threads, if that clears them
       ElementMesh pushed = m;
       if (push_over_under(pushed, hit, elements, alive, opt.clearance)) {
-        const std::vector<char> h2 = old.hits(pushed, -1, opt.clearance);
-        if (std::find(h2.begin(), h2.end(), 1) == h2.end()) {
+        if (!old.any_hit(pushed, -1, opt.clearance)) {
           ++stats.crossing_pushed;
           old.add(pushed, -2);
           keep.push_back(std::move(pushed));
@@ -223,8 +222,7 @@ std::vector<ElementMesh> resolve_crossings(const std::vector<ElementMesh>& eleme
     // A piece is kept only if it is clear of the others itself (its cap may reach them).
     std::size_t kept = 0;
     for (ElementMesh& p : pieces) {
-      const std::vector<char> h2 = old.hits(p, -1, opt.clearance);
-      if (std::find(h2.begin(), h2.end(), 1) != h2.end()) continue;
+      if (old.any_hit(p, -1, opt.clearance)) continue;
       old.add(p, -2);
       keep.push_back(std::move(p));
       ++kept;

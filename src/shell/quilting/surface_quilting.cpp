@@ -461,6 +461,8 @@ void check_options(const SurfaceQuiltOptions& o) {
     bad("lift_crossing_rings must be -1, 0 or 1", o.lift_crossing_rings);
   if (!(o.max_shape_ratio >= 0) || !std::isfinite(o.max_shape_ratio)) bad("max_shape_ratio must be >= 0", o.max_shape_ratio);
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
+  if (o.scatter_bare_samples < 1 || o.scatter_bare_samples > 4)
+    bad("scatter_bare_samples must be in [1, 4]", o.scatter_bare_samples);
   if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
     bad("min_piece_fraction must be in [0, 1]", o.min_piece_fraction);
   if (!(o.blob_loop_gap >= 0) || !std::isfinite(o.blob_loop_gap))
@@ -485,7 +487,8 @@ void check_options(const SurfaceQuiltOptions& o) {
 // Of four sample points of a base face (its centroid and its corner
 // triangles' centroids), how many have no foot within the grid's radius: a
 // quarter of the face's area each in the bare area; the face is bare (to be
-// refilled or scattered into) if two or more are.
+// refilled) if two or more are; the scatter fill tries faces with
+// scatter_bare_samples of them.
 int bare_samples(const Base& b, int f, const FootGrid& feet) {
   const auto& t = b.faces[f];
   int nbare = feet.covered(b.centroid[f]) ? 0 : 1;
@@ -496,7 +499,6 @@ int bare_samples(const Base& b, int f, const FootGrid& feet) {
   }
   return nbare;
 }
-bool face_is_bare(const Base& b, int f, const FootGrid& feet) { return bare_samples(b, f, feet) >= 2; }
 
 // The largest extent of `pts` along 13 directions (the axes, the face and
 // the body diagonals of a cube): the diameter within about 10%, whatever the
@@ -1598,8 +1600,7 @@ void SurfaceQuilter::resolve_crossings_lifted() {
       ElementMesh m;
       m.tris = tris;
       for (const auto& v : locs) m.points.push_back(lifted(v));
-      const std::vector<char> h2 = coll.hits(m, -1, 0.0, &dead);
-      if (std::find(h2.begin(), h2.end(), 1) != h2.end()) continue;
+      if (coll.any_hit(m, -1, 0.0, &dead)) continue;
       const int nid = static_cast<int>(dead.size());
       dead.push_back(0);
       coll.add(m, nid);
@@ -1634,8 +1635,7 @@ std::vector<double> SurfaceQuilter::z_lifts(const Element& el) const {
 bool SurfaceQuilter::lift_clear(Element& el, int i, ElementCollider& coll, std::vector<char>& dead) {
   auto accept = [&](Element& moved) {
     const ElementMesh m = lifted_mesh(moved);
-    const std::vector<char> h = coll.hits(m, i, 0.0, &dead);
-    if (std::find(h.begin(), h.end(), 1) != h.end()) return false;
+    if (coll.any_hit(m, i, 0.0, &dead)) return false;
     el.loc = std::move(moved.loc);
     dead[static_cast<std::size_t>(i)] = 1;
     const int nid = static_cast<int>(dead.size());
@@ -1834,8 +1834,7 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
         const P3 d1 = vec3::sub(m.points[static_cast<std::size_t>(t[k])], m.points[static_cast<std::size_t>(t[(k + 1) % 3])]);
         if (vec3::dot(d1, d1) > lim2 * vec3::dot(d0, d0) || (stretch_bound2_ > 0 && vec3::dot(d1, d1) > stretch_bound2_)) return false;
       }
-    const std::vector<char> hit = coll.hits(m, -1, scatter_clearance_);
-    if (std::find(hit.begin(), hit.end(), 1) != hit.end()) continue;
+    if (coll.any_hit(m, -1, scatter_clearance_)) continue;
     coll.add(m, static_cast<int>(elements_.size()));
     el.loc = std::move(at.loc);
     if (dz != 0) ++res_.scatter_lifted;
@@ -1847,15 +1846,18 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // Scatter fill (issue 17 item 4): the refill rounds quilt bare faces with
 // whole swatch patches, whose compact elements then cross their neighbours
 // and are removed again, so holes of about one element stay. Here each face
-// still bare gets, on a small patch around it (flattened and oriented as a
-// quilting patch, section 3.1), one of the swatch's compact elements at a
-// time: tried in four quarter turns at the face (a swatch scattered alone: in
+// with a bare point (scatter_bare_samples) gets, on a small patch around it
+// (flattened and oriented as a quilting patch, section 3.1), one of the
+// swatch's compact elements at a time: tried in four quarter turns at the face (a swatch scattered alone: in
 // the field's orientation only), then moved by up to half the element spacing,
 // and kept where it fits (place_scatter_element). Threads (weaves) are not
 // scattered: a cut thread is no element.
 void SurfaceQuilter::scatter_into_bare() {
   const std::vector<ElementMesh>& tpl = compact_;
   if (tpl.empty()) return;
+  // Scattered alone, copies go where the face is bare (two points): started
+  // at faces with one, they packed worse (bunny + rock_1: 0.18% -> 0.75% bare).
+  const int min_bare = scatter_only_ ? 2 : opt_.scatter_bare_samples;
   double reach = 0;  // the largest template's xy radius (swatch units)
   for (const ElementMesh& m : tpl)
     for (const P3& q : m.points) reach = std::max(reach, std::hypot(q[0], q[1]));
@@ -1868,7 +1870,7 @@ void SurfaceQuilter::scatter_into_bare() {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int f = 0; f < nf_; ++f) {
     if (f % 256 == 0) report_progress(opt_.progress, "scatter", static_cast<double>(f) / nf_);
-    if (!face_is_bare(b_, f, feet)) continue;
+    if (bare_samples(b_, f, feet) < min_bare) continue;
     Patch p;
     grow_and_flatten(f, p, 2 * reach * S_, scatter_cos_max_);
     orient(p);
