@@ -35,7 +35,7 @@ namespace quilt_command {  // named: the unity build joins these files
 struct QuiltArgs {
   std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto";
   bool no_render = false, no_check = false, no_align = false, smooth_field = false;
-  double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0;
+  double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0, split_edges = 2.5;
   std::vector<double> up{0, 1, 0};
   int subpatch = 0, stretch_iterations = 20;
   CommonOptions common;
@@ -147,6 +147,7 @@ QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
   o.align_field_max_deg = a.align_bound;
   o.smooth_field = a.smooth_field;
   o.progress = terminal_progress(a.common.quiet);
+  d.split_edges_over_median = a.split_edges;
   d.embed.shell_height = a.shell_height;
   d.embed.stretch.iterations = a.stretch_iterations;
   d.embed.check_self_intersections = !a.no_check;
@@ -296,6 +297,21 @@ SubcommandRegistrar reg_quilt{
                       "Shell thickness in scaled swatch heights, > 0 (default 1); clamped locally where the "
                       "shell would fold")
            ->check(number_above(0, true));
+       app.add_option("--split-edges", a->split_edges,
+                      "Split the swatch's edges longer than this many of its median edges before quilting, so "
+                      "that the shell map bends them with the surface (a CAD part's long flat edges); 0 = never, "
+                      "else >= 1.5 (default 2.5)")
+           ->check(CLI::Validator(
+               [](std::string& v) {
+                 double x = 0;
+                 try {
+                   x = std::stod(v);
+                 } catch (...) {
+                   return std::string("not a number: " + v);
+                 }
+                 return x == 0 || (x >= 1.5 && x <= 1e6) ? std::string() : std::string("must be 0 or in [1.5, 1e6]");
+               },
+               "0 or >= 1.5"));
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));

@@ -339,10 +339,22 @@ TEST(CmdQuiltHostile, ZeroOrNegativeShellHeightIsRefused) {
   EXPECT_EQ(entries(dir), (std::set<std::string>{"base.off"}));
 }
 
+TEST(CmdQuiltHostile, SplitEdgesBelowOneAndAHalfMediansIsRefused) {
+  const std::string dir = test::temp_dir("qh-split");
+  const std::string base = write_icosahedron(dir);
+  for (const char* v : {"1", "-2", "inf"}) {
+    SCOPED_TRACE(v);
+    expect_refused(test::run_surftex("quilt " + q(base) + " chainmail -o " + q(dir + "/s.obj") + " --split-edges " + v +
+                                     kFast),
+                   "--split-edges");
+  }
+  EXPECT_EQ(entries(dir), (std::set<std::string>{"base.off"}));
+}
+
 TEST(CmdQuiltHostile, NaNParametersAreRefusedBeforeQuilting) {
   const std::string dir = test::temp_dir("qh-nan-opts");
   const std::string base = write_icosahedron(dir);
-  for (const char* opt : {"--shell-height", "--scale"}) {
+  for (const char* opt : {"--shell-height", "--scale", "--split-edges"}) {
     SCOPED_TRACE(opt);
     expect_refused(test::run_surftex("quilt " + q(base) + " chainmail -o " + q(dir + "/s.obj") + " " + opt + " nan" +
                                      kFast),

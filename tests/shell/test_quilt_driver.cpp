@@ -7,9 +7,11 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
@@ -190,6 +192,77 @@ TEST(QuiltDriver, SurfaceDriverIsTheQuiltThenTheEmbeddingColouredAndReportsItsOp
   surface_quilt_scene(base, out, scene);
   EXPECT_EQ(scene.number_of_faces(), base.number_of_faces() + out.number_of_faces());
   EXPECT_EQ(find(scene, kVertexColor).first[VertexIndex(0)], (Color3f{0.72f, 0.72f, 0.75f}));
+}
+
+// A CAD-like part: a thin disc, its caps fans of long radial edges (about 8
+// of its median edges) around a finely segmented rim.
+Mesh fan_capped_disc(int n = 64, double radius = 1.0, double height = 0.1) {
+  Mesh m;
+  std::vector<VertexIndex> top, bottom;
+  const VertexIndex ct = m.add_vertex(Point3(0, 0, height)), cb = m.add_vertex(Point3(0, 0, 0));
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    top.push_back(m.add_vertex(Point3(radius * std::cos(a), radius * std::sin(a), height)));
+    bottom.push_back(m.add_vertex(Point3(radius * std::cos(a), radius * std::sin(a), 0)));
+  }
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    m.add_face(ct, top[i], top[j]);
+    m.add_face(cb, bottom[j], bottom[i]);
+    m.add_face(bottom[i], bottom[j], top[j]);
+    m.add_face(bottom[i], top[j], top[i]);
+  }
+  return m;
+}
+
+// The longest over the median edge of a mesh.
+double longest_over_median_edge(const Mesh& m) {
+  std::vector<double> len;
+  for (auto e : m.edges())
+    len.push_back(std::sqrt(CGAL::squared_distance(m.point(m.source(m.halfedge(e))), m.point(m.target(m.halfedge(e))))));
+  std::sort(len.begin(), len.end());
+  return len.back() / len[len.size() / 2];
+}
+
+// Issue 17 item 2 on a real swatch's long edges: a swatch whose edges span
+// many of its median edges is split (flat, the shape kept) before quilting,
+// so the output's longest edge stays within 4 of its median edges; without
+// the split its copies keep their 8-median radial edges.
+TEST(QuiltDriver, LongSwatchEdgesAreSplitSoTheOutputKeepsTheShardBound) {
+  Mesh base;
+  make_icosphere(base, 2);
+  const Mesh disc = fan_capped_disc();
+  ASSERT_GT(longest_over_median_edge(disc), 6.0);
+  auto run = [&](double split) {
+    QuiltSwatchOnSurfaceOptions o;
+    o.split_edges_over_median = split;
+    o.quilt.relative_size = 0.3;
+    o.embed.stretch.iterations = 2;
+    o.embed.check_self_intersections = false;
+    Mesh out;
+    const QuiltSwatchOnSurfaceResult r = quilt_swatch_on_surface(base, disc, out, o);
+    const double ratio = longest_over_median_edge(out);
+    std::cout << "[ disc ] split at " << split << ": " << r.swatch_vertices_split << " vertices added, "
+              << r.quilt.elements << " elements, output longest / median edge " << ratio << "\n";
+    EXPECT_GT(r.quilt.elements, 5);
+    return std::make_pair(r, ratio);
+  };
+  const auto [r0, ratio0] = run(0);
+  EXPECT_EQ(r0.swatch_vertices_split, 0u);
+  EXPECT_GT(ratio0, 4.0);
+  const auto [r1, ratio1] = run(QuiltSwatchOnSurfaceOptions{}.split_edges_over_median);
+  EXPECT_GT(r1.swatch_vertices_split, 0u);
+  EXPECT_LE(ratio1, 4.0);
+  EXPECT_EQ(to_json(r1)["swatch_vertices_split"], r1.swatch_vertices_split);
+  // A swatch without long edges is left as it is.
+  Mesh out;
+  QuiltSwatchOnSurfaceOptions o;
+  o.quilt.relative_size = 0.45;
+  o.embed.stretch.iterations = 1;
+  o.embed.check_self_intersections = false;
+  EXPECT_EQ(quilt_swatch_on_surface(base, small_chainmail_mesh(), out, o).swatch_vertices_split, 0u);
+  o.split_edges_over_median = 1.2;
+  EXPECT_THROW(quilt_swatch_on_surface(base, disc, out, o), InvalidInputError);
 }
 
 TEST(QuiltDriver, SurfaceDriverRefusesAScaleAbove10AndOversizedRunsBeforeQuilting) {

@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/quilting/quilt_driver.h"
 
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <vector>
 #include <map>
 #include <string>
 #include <tuple>
@@ -120,12 +124,46 @@ void check_surface_quilt_size(const Mesh& base, const Swatch& s, const SurfaceQu
     check_work(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())));
 }
 
+// The swatch's edges split (PMP::split_long_edges: midpoints on the edge,
+// faces kept triangles and flat) until none is longer than `medians` of its
+// median edge, the median taken again after each round (splitting adds short
+// edges); at most 8 rounds. Returns the vertices added.
+std::size_t split_long_swatch_edges(Mesh& m, double medians) {
+  const std::size_t before = m.number_of_vertices();
+  for (int round = 0; round < 8; ++round) {
+    std::vector<double> len;
+    len.reserve(m.number_of_edges());
+    for (auto e : m.edges()) len.push_back(std::sqrt(CGAL::squared_distance(m.point(m.source(m.halfedge(e))),
+                                                                            m.point(m.target(m.halfedge(e))))));
+    if (len.empty()) break;
+    const double longest = *std::max_element(len.begin(), len.end());
+    std::nth_element(len.begin(), len.begin() + static_cast<std::ptrdiff_t>(len.size() / 2), len.end());
+    const double bound = medians * len[len.size() / 2];
+    if (!(bound > 0) || longest <= bound) break;
+    std::vector<EdgeIndex> long_edges;
+    for (auto e : m.edges())
+      if (CGAL::squared_distance(m.point(m.source(m.halfedge(e))), m.point(m.target(m.halfedge(e)))) > bound * bound)
+        long_edges.push_back(e);
+    CGAL::Polygon_mesh_processing::split_long_edges(long_edges, bound, m);
+  }
+  return m.number_of_vertices() - before;
+}
+
 }  // namespace
 
 QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh& swatch_mesh, Mesh& out,
                                                    const QuiltSwatchOnSurfaceOptions& opt) {
   QuiltSwatchOnSurfaceResult r;
-  r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
+  if (!(opt.split_edges_over_median == 0 || opt.split_edges_over_median >= 1.5))
+    throw InvalidInputError("quilt: split_edges_over_median must be 0 (never) or at least 1.5, got " +
+                            std::to_string(opt.split_edges_over_median));
+  if (opt.split_edges_over_median > 0) {
+    Mesh fine = swatch_mesh;
+    r.swatch_vertices_split = split_long_swatch_edges(fine, opt.split_edges_over_median);
+    r.swatch = make_swatch(fine, opt.swatch_up);
+  } else {
+    r.swatch = make_swatch(swatch_mesh, opt.swatch_up);
+  }
   // Before the estimate and any work: a flat swatch gives a shell of no
   // thickness (embed_surface_quilt would refuse it after the quilting).
   if (!(r.swatch.height() > 0))
