@@ -488,6 +488,23 @@ TEST(SurfaceQuiltingCrossings, RefillRoundsRecheckOnlyChangedElements) {
 // single compact elements, which neither cross nor come near their
 // neighbours: the bare fraction falls while the embedded quilt keeps 0
 // intersecting pairs.
+// The swatch quilted at 0.3 over `base` with `o` (its size set here) and
+// embedded; the scatter fill's figures printed under `label`.
+std::pair<SurfaceQuiltResult, EmbedSurfaceQuiltResult> quilt_and_embed(const Mesh& base, const Swatch& s,
+                                                                       SurfaceQuiltOptions o, const std::string& label) {
+  o.relative_size = 0.3;
+  SurfaceQuilt q;
+  const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
+  EmbedSurfaceQuiltOptions eo;
+  eo.stretch.iterations = 4;
+  eo.measure_outside_shell = false;
+  Mesh out;
+  const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
+  std::cout << "[ " << label << " ] " << r.elements << " elements, scatter placed " << r.scatter_placed << ", bare "
+            << r.bare_fraction << ", pairs " << er.self_intersections_between << "\n";
+  return {r, er};
+}
+
 TEST(SurfaceQuiltingCoverage, ScatterFillCoversTheHolesLeftByRemovedElements) {
   for (const char* kind : {"tori", "chainmail"}) {
     Mesh base;
@@ -495,18 +512,8 @@ TEST(SurfaceQuiltingCoverage, ScatterFillCoversTheHolesLeftByRemovedElements) {
     const Swatch s = std::string(kind) == "tori" ? small_tori(3) : test::small_chainmail_swatch();
     auto run = [&](int attempts) {
       SurfaceQuiltOptions o;
-      o.relative_size = 0.3;
       o.scatter_attempts = attempts;
-      SurfaceQuilt q;
-      const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-      EmbedSurfaceQuiltOptions eo;
-      eo.stretch.iterations = 4;
-      eo.measure_outside_shell = false;
-      Mesh out;
-      const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-      std::cout << "[ sphere " << kind << " ] scatter " << attempts << ": " << r.elements << " elements, placed "
-                << r.scatter_placed << ", bare " << r.bare_fraction << ", pairs " << er.self_intersections_between << "\n";
-      return std::make_pair(r, er);
+      return quilt_and_embed(base, s, o, std::string("sphere ") + kind + ", scatter " + std::to_string(attempts));
     };
     const auto [roff, eoff] = run(0);
     const auto [ron, eon] = run(SurfaceQuiltOptions{}.scatter_attempts);
@@ -528,18 +535,8 @@ TEST(SurfaceQuiltingCoverage, ScatterFillTriesFacesWithOneBarePoint) {
   const Swatch s = test::small_chainmail_swatch();
   auto run = [&](int bare_samples) {
     SurfaceQuiltOptions o;
-    o.relative_size = 0.3;
     o.scatter_bare_samples = bare_samples;
-    SurfaceQuilt q;
-    const SurfaceQuiltResult r = quilt_surface(base, s, q, o);
-    EmbedSurfaceQuiltOptions eo;
-    eo.stretch.iterations = 4;
-    eo.measure_outside_shell = false;
-    Mesh out;
-    const EmbedSurfaceQuiltResult er = embed_surface_quilt(base, q, out, eo);
-    std::cout << "[ sphere chainmail ] scatter from " << bare_samples << " bare points: placed " << r.scatter_placed
-              << ", bare " << r.bare_fraction << ", pairs " << er.self_intersections_between << "\n";
-    return std::make_pair(r, er);
+    return quilt_and_embed(base, s, o, "sphere chainmail, scatter from " + std::to_string(bare_samples) + " bare points");
   };
   const auto [r2, e2] = run(2);
   const auto [r1, e1] = run(SurfaceQuiltOptions{}.scatter_bare_samples);
