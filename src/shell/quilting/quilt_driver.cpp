@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <vector>
 #include <map>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
