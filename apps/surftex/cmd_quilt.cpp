@@ -300,18 +300,8 @@ SubcommandRegistrar reg_quilt{
        app.add_option("--split-edges", a->split_edges,
                       "Split the swatch's edges longer than this many of its median edges before quilting, so "
                       "that the shell map bends them with the surface (a CAD part's long flat edges); 0 = never, "
-                      "else >= 1.5 (default 2.5)")
-           ->check(CLI::Validator(
-               [](std::string& v) {
-                 double x = 0;
-                 try {
-                   x = std::stod(v);
-                 } catch (...) {
-                   return std::string("not a number: " + v);
-                 }
-                 return x == 0 || (x >= 1.5 && x <= 1e6) ? std::string() : std::string("must be 0 or in [1.5, 1e6]");
-               },
-               "0 or >= 1.5"));
+                      "else 1.5..1e6 (default 2.5)")
+           ->check(zero_or_between(1.5, 1e6, "never"));
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));

@@ -82,6 +82,20 @@ CLI::Validator zero_or_range(long long lo, long long hi, const std::string& zero
       "0 or " + std::to_string(lo) + ".." + std::to_string(hi));
 }
 
+CLI::Validator zero_or_between(double lo, double hi, const std::string& zero_means) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g..%g", lo, hi);
+  const std::string want = "0 (" + zero_means + ") or " + buf;
+  return CLI::Validator(
+      [lo, hi, want](std::string& in) -> std::string {
+        double v = 0;
+        if (!parse_whole_number(in, v)) return "must be " + want + " (got '" + in + "')";
+        if (v != 0 && !(v >= lo && v <= hi)) return "must be " + want + " (got " + in + ")";
+        return "";
+      },
+      std::string("0 or ") + buf);
+}
+
 void add_common_options(CLI::App& app, CommonOptions& opt) {
   app.add_option("--seed", opt.seed,
                  "Seed for every random choice; the same input and seed give the same output "

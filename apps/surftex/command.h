@@ -42,6 +42,10 @@ CLI::Validator number_above(double lo, bool strict);
 /// message reads "must be 0 (from the vertices) or 64..8192 (got 10)".
 CLI::Validator zero_or_range(long long lo, long long hi, const std::string& zero_means);
 
+/// A CLI11 check: 0 (meaning `zero_means`) or a number in lo..hi; the
+/// message reads "must be 0 (never) or 1.5..1e+06 (got 1)".
+CLI::Validator zero_or_between(double lo, double hi, const std::string& zero_means);
+
 /// A CLI11 check: a whole unsigned 64-bit integer ("18446744073709551616"
 /// and "-1" are refused, not saturated or wrapped).
 CLI::Validator whole_unsigned_64();

@@ -1848,9 +1848,10 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // and are removed again, so holes of about one element stay. Here each face
 // with a bare point (scatter_bare_samples) gets, on a small patch around it
 // (flattened and oriented as a quilting patch, section 3.1), one of the
-// swatch's compact elements at a time: tried in four quarter turns at the face (a swatch scattered alone: in
-// the field's orientation only), then moved by up to half the element spacing,
-// and kept where it fits (place_scatter_element). Threads (weaves) are not
+// swatch's compact elements at a time: tried in four quarter turns at the
+// face (a swatch scattered alone: in the field's orientation only), then
+// moved by up to half the element spacing, and kept where it fits
+// (place_scatter_element). Threads (weaves) are not
 // scattered: a cut thread is no element.
 void SurfaceQuilter::scatter_into_bare() {
   const std::vector<ElementMesh>& tpl = compact_;
