@@ -247,6 +247,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_REFILL_ROUNDS")) qo.refill_rounds = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER")) qo.scatter_attempts = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_BARE")) qo.scatter_bare_samples = std::atoi(e);
+  if (const char* e = std::getenv("BENCH_THREAD_PARTS")) qo.scatter_thread_parts = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_STRETCH")) qo.scatter_max_stretch = std::atof(e);
   if (const char* e = std::getenv("BENCH_SCATTER_CONE")) qo.scatter_max_normal_angle_deg = std::atof(e);
   if (const char* e = std::getenv("BENCH_SHAPE")) qo.max_shape_ratio = std::atof(e);

@@ -477,6 +477,7 @@ TEST(SurfaceQuilting, RefusedInputThreadsKeepTheirCutPartSoNoStripIsLeftBare) {
   SurfaceQuiltOptions o;
   o.relative_size = 0.45;
   o.up = {0.0, 0.6, 0.8};  // a helix field: many refused stitches
+  o.scatter_thread_parts = 0;  // (the scatter fill's thread pieces would cover the bare strips measured here)
   // Runs: refused inputs dropped whole (their cut parts not kept); the
   // defaults (cut parts kept, elements trimmed at the open ends); and the
   // elements past the open ends removed whole (trim_at_border off, the state
@@ -836,6 +837,7 @@ TEST(SurfaceQuilting, NewElementsOffThePatchKeepTheirPartOnItClosed) {
   o.relative_size = 0.45;
   o.up = {0.0, 0.6, 0.8};
   o.refill_rounds = 0;  // (the refill rounds trim new elements whatever the option says)
+  o.scatter_thread_parts = 0;  // (nor would the scatter fill's thread pieces leave the dropped space alone)
   SurfaceQuiltResult r[2];
   std::size_t faces[2] = {0, 0};
   for (int trim = 0; trim < 2; ++trim) {

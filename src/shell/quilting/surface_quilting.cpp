@@ -463,6 +463,8 @@ void check_options(const SurfaceQuiltOptions& o) {
   if (o.scatter_attempts < 0 || o.scatter_attempts > 64) bad("scatter_attempts must be in [0, 64]", o.scatter_attempts);
   if (o.scatter_bare_samples < 1 || o.scatter_bare_samples > 4)
     bad("scatter_bare_samples must be in [1, 4]", o.scatter_bare_samples);
+  if (o.scatter_thread_parts < 0 || o.scatter_thread_parts > 16)
+    bad("scatter_thread_parts must be in [0, 16]", o.scatter_thread_parts);
   if (!(o.min_piece_fraction >= 0 && o.min_piece_fraction <= 1))
     bad("min_piece_fraction must be in [0, 1]", o.min_piece_fraction);
   if (!(o.blob_loop_gap >= 0) || !std::isfinite(o.blob_loop_gap))
@@ -670,6 +672,7 @@ class SurfaceQuilter {
   std::vector<ElementMesh> compact_;  // compact_swatch_elements: what the scatter places
   double compact_spread_ = 0;  // the largest compact swatch element's spread13 (swatch units; 0 = none)
   bool lift_rings_ = false;    // lift_crossing_rings, resolved
+  std::vector<ElementMesh> thread_pieces_;  // the scatter fill's templates without compact elements
   bool all_compact_ = false;   // every swatch element is compact (so must every output element be)
   bool scatter_only_ = false;  // few compact elements: placed by the scatter fill alone
   double scatter_clearance_ = 0;  // the scatter's gap to elements already placed (mesh units)
@@ -712,6 +715,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   }
   vertex_normal_ = vertex_normals(b_);  // for the lifted positions (finish)
   compact_ = compact_swatch_elements(swatch);
+  if (compact_.empty() && opt.scatter_thread_parts > 0) thread_pieces_ = thread_scatter_pieces(swatch, opt.scatter_thread_parts);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   lift_rings_ = opt.lift_crossing_rings < 0 ? !compact_.empty() && element_boxes_overlap(swatch) : opt.lift_crossing_rings > 0;
@@ -1851,10 +1855,11 @@ bool SurfaceQuilter::place_scatter_element(const Patch& p, const PatchLocator& l
 // swatch's compact elements at a time: tried in four quarter turns at the
 // face (a swatch scattered alone: in the field's orientation only), then
 // moved by up to half the element spacing, and kept where it fits
-// (place_scatter_element). Threads (weaves) are not
-// scattered: a cut thread is no element.
+// (place_scatter_element). A swatch of threads alone (a weave) scatters
+// pieces of its threads (thread_pieces_): where a fin or a lobe is too small
+// for whole threads, the quilting's trimmed threads leave it bare.
 void SurfaceQuilter::scatter_into_bare() {
-  const std::vector<ElementMesh>& tpl = compact_;
+  const std::vector<ElementMesh>& tpl = compact_.empty() ? thread_pieces_ : compact_;
   if (tpl.empty()) return;
   // Scattered alone, copies go where the face is bare (two points): started
   // at faces with one, they packed worse (bunny + rock_1: 0.18% -> 0.75% bare).
@@ -2016,6 +2021,56 @@ double longest_thread(const Swatch& s) {
   return longest;
 }
 }  // namespace
+
+namespace {
+// The triangles of `m` whose three vertices have coordinate `axis` in
+// [w0, w1], with their vertices renumbered.
+ElementMesh slab_of(const ElementMesh& m, int axis, double w0, double w1) {
+  ElementMesh piece;
+  std::vector<int> id(m.points.size(), -1);
+  for (const Tri& t : m.tris) {
+    bool inside = true;
+    for (int v : t) inside = inside && m.points[static_cast<std::size_t>(v)][axis] >= w0 && m.points[static_cast<std::size_t>(v)][axis] <= w1;
+    if (!inside) continue;
+    Tri nt;
+    for (int k = 0; k < 3; ++k) {
+      int& i = id[static_cast<std::size_t>(t[k])];
+      if (i < 0) i = static_cast<int>(piece.points.size()), piece.points.push_back(m.points[static_cast<std::size_t>(t[k])]);
+      nt[k] = i;
+    }
+    piece.tris.push_back(nt);
+  }
+  return piece;
+}
+}  // namespace
+
+std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts) {
+  std::vector<ElementMesh> out;
+  if (parts < 1) return out;
+  for (const ElementMesh& m : swatch_element_meshes(swatch)) {
+    if (m.points.empty() || is_compact_element(m)) continue;
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
+    const double len = (hi[axis] - lo[axis]) / parts;
+    for (int k = 0; k < parts; ++k) {
+      ElementMesh piece = slab_of(m, axis, lo[axis] + k * len, lo[axis] + (k + 1) * len);
+      std::vector<std::vector<int>> loops;
+      if (piece.tris.size() < 8 || !boundary_loops(piece, loops)) continue;
+      for (const std::vector<int>& loop : loops)
+        if (loop.size() >= 3) cap_loop(piece, loop);
+      double cx = 0, cy = 0;
+      for (const P3& q : piece.points) cx += q[0], cy += q[1];
+      cx /= static_cast<double>(piece.points.size());
+      cy /= static_cast<double>(piece.points.size());
+      for (P3& q : piece.points) q[0] -= cx, q[1] -= cy;
+      out.push_back(std::move(piece));
+    }
+  }
+  return out;
+}
 
 double default_surface_quilt_size(const Swatch& swatch) {
   constexpr double kSize = 0.25, kElementSize = 1.0 / 16, kElementHeight = 1.0 / 32, kThreadLength = 1.0 / 8;

@@ -133,7 +133,8 @@ struct SurfaceQuiltOptions {
   /// (decision 102, session 38).
   int refill_rounds = -1;
   /// Scatter fill after the refills: per face still bare, up to this many
-  /// tries to place one compact swatch element (a ring, a pebble) there
+  /// tries to place one compact swatch element (a ring, a pebble; for a
+  /// weave a piece of a thread, scatter_thread_parts) there
   /// without crossing or stretching (four quarter turns, then moved by up to
   /// half the element spacing). In [0, 64]; 0 = none. Default 64: the chain
   /// mail's gaps are about a ring wide, and a ring finds its way into one in
@@ -146,6 +147,13 @@ struct SurfaceQuiltOptions {
   /// never tried (koala + chain mail 2.13% -> 1.36% bare; decision 102,
   /// session 42). A swatch scattered alone keeps 2.
   int scatter_bare_samples = 1;
+  /// A swatch with no compact element (a weave): the scatter fill places
+  /// pieces of its threads instead, each thread cut into this many pieces
+  /// along its length, the cuts capped (thread_scatter_pieces). In [0, 16];
+  /// 0 = threads are not scattered. Default 4: a fish's fins, too small for
+  /// whole threads, stayed bare (fish_blub + weave 6.9% -> 2.1% bare;
+  /// decision 102, session 43).
+  int scatter_thread_parts = 4;
   /// The scatter fill's stretch bound: no lifted edge of a scattered element
   /// longer than this many times its swatch length (a ring bent over a leg or
   /// an ear stretches on its outside). In [1, 10]. Default 2 (1.5 left the
@@ -322,6 +330,13 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 /// the diagonal in length: on curved ground a longer thread runs past the
 /// patch that can express it and is cut into pieces (decision 102).
 double default_surface_quilt_size(const Swatch& swatch);
+
+/// The scatter fill's templates for a swatch of threads: each element that
+/// is not compact cut, along the longer side of its xy box, into `parts`
+/// pieces of equal length (the triangles wholly inside each), each cut loop
+/// closed (cap_loop) and the piece centred in xy. Pieces of fewer than 8
+/// triangles or with a border that is not simple loops are left out.
+std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
 /// scaled swatch's xy area (0 when the swatch has no area).
