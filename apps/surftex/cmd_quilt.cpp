@@ -37,7 +37,7 @@ struct QuiltArgs {
   bool no_render = false, no_check = false, no_align = false, smooth_field = false;
   double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0, split_edges = 2.5;
   std::vector<double> up{0, 1, 0};
-  int subpatch = 0, stretch_iterations = 20;
+  int subpatch = 0, stretch_iterations = 20, thread_pieces = 4;
   CommonOptions common;
 };
 
@@ -146,6 +146,7 @@ QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
   o.align_to_overlap = !a.no_align;
   o.align_field_max_deg = a.align_bound;
   o.smooth_field = a.smooth_field;
+  o.scatter_thread_parts = a.thread_pieces;
   o.progress = terminal_progress(a.common.quiet);
   d.split_edges_over_median = a.split_edges;
   d.embed.shell_height = a.shell_height;
@@ -302,6 +303,11 @@ SubcommandRegistrar reg_quilt{
                       "that the shell map bends them with the surface (a CAD part's long flat edges); 0 = never, "
                       "else 1.5..1e6 (default 2.5)")
            ->check(zero_or_between(1.5, 1e6, "never"));
+       app.add_option("--thread-pieces", a->thread_pieces,
+                      "On a mesh, for a swatch with no compact element (a weave): what stays bare after the "
+                      "quilting is filled with pieces of its threads, each thread cut into this many; 0 = no "
+                      "pieces (0..16, default 4)")
+           ->check(CLI::Range(0, 16));
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));

@@ -86,6 +86,32 @@ TEST(CmdQuilt, SphereWritesSiblingsAndReportsStretchAndSelfIntersections) {
   EXPECT_EQ(m.number_of_faces(), j["faces"].get<std::size_t>());
 }
 
+// --thread-pieces reaches the scatter fill: a weave on a flat lens, whose
+// rim cuts the threads, gets thread pieces in what stays bare by default and
+// none with 0.
+TEST(CmdQuilt, ThreadPiecesFillBareSpotsOfAWeaveAndZeroTurnsThemOff) {
+  const std::string dir = test::temp_dir("quilt-thread-pieces");
+  Mesh base;
+  make_icosphere(base, 3);
+  for (VertexIndex v : base.vertices()) {
+    const Point3 p = base.point(v);
+    base.point(v) = Point3(p.x(), p.y(), 0.08 * p.z());
+  }
+  write_mesh(dir + "/lens.off", base);
+  auto run = [&](const std::string& extra, const std::string& tag) {
+    const test::RunResult r = test::run_surftex("quilt '" + dir + "/lens.off' weave -o '" + dir + "/" + tag +
+                                                ".obj' --scale 0.6 --no-render --stretch-iterations 0 --no-check "
+                                                "--quiet --report '" + dir + "/" + tag + ".json'" + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_json(dir + "/" + tag + ".json");
+  };
+  const nlohmann::json off = run(" --thread-pieces 0", "off");
+  const nlohmann::json on = run("", "on");
+  EXPECT_EQ(off["scatter_placed"].get<std::size_t>(), 0u);
+  EXPECT_GT(on["scatter_placed"].get<std::size_t>(), 0u);
+  EXPECT_LT(on["bare_fraction"].get<double>(), off["bare_fraction"].get<double>());
+}
+
 TEST(CmdQuilt, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = test::temp_dir("quilt-bad");
   // Unknown swatch file.

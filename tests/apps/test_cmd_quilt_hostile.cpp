@@ -351,6 +351,18 @@ TEST(CmdQuiltHostile, SplitEdgesBelowOneAndAHalfMediansIsRefused) {
   EXPECT_EQ(entries(dir), (std::set<std::string>{"base.off"}));
 }
 
+TEST(CmdQuiltHostile, ThreadPiecesOutsideZeroToSixteenAreRefused) {
+  const std::string dir = test::temp_dir("qh-thread-pieces");
+  const std::string base = write_icosahedron(dir);
+  for (const char* v : {"17", "-1", "2.5", "nan"}) {
+    SCOPED_TRACE(v);
+    expect_refused(test::run_surftex("quilt " + q(base) + " weave -o " + q(dir + "/s.obj") + " --thread-pieces " + v +
+                                     kFast),
+                   "--thread-pieces");
+  }
+  EXPECT_EQ(entries(dir), (std::set<std::string>{"base.off"}));
+}
+
 TEST(CmdQuiltHostile, NaNParametersAreRefusedBeforeQuilting) {
   const std::string dir = test::temp_dir("qh-nan-opts");
   const std::string base = write_icosahedron(dir);
