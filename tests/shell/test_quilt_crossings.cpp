@@ -570,7 +570,14 @@ TEST(SurfaceQuiltingScatter, ThreadPiecesAreClosedAndAPartOfAThreadLong) {
     for (int d = 0; d < 2; ++d) EXPECT_NEAR(mean[d] / static_cast<double>(m.points.size()), 0.0, 1e-9);
   }
   EXPECT_TRUE(thread_scatter_pieces(s, 0).empty());
-  EXPECT_TRUE(thread_scatter_pieces(small_tori(3), 4).empty());  // rings are compact
+  EXPECT_TRUE(thread_scatter_pieces(small_tori(3), 4).empty());  // rings lying flat are compact
+  // Standing chain-mail rings are not compact, but arcs of a ring would be
+  // the broken rings the finish removes: none.
+  const Swatch chain = test::small_chainmail_swatch();
+  std::size_t standing = 0;
+  for (const ElementMesh& m : swatch_element_meshes(chain)) standing += !is_compact_element(m);
+  EXPECT_GT(standing, 0u);
+  EXPECT_TRUE(thread_scatter_pieces(chain, 4).empty());
 }
 
 // Threads longer than a thin part is wide are cut where its patches end and

@@ -2048,7 +2048,8 @@ std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts) 
   std::vector<ElementMesh> out;
   if (parts < 1) return out;
   for (const ElementMesh& m : swatch_element_meshes(swatch)) {
-    if (m.points.empty() || is_compact_element(m)) continue;
+    // (A ring cut into arcs is the broken ring remove_broken_elements removes.)
+    if (m.points.empty() || is_compact_element(m) || element_genus(m.tris) > 0) continue;
     double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     double hi[2] = {-lo[0], -lo[1]};
     for (const P3& q : m.points)

@@ -332,7 +332,7 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 double default_surface_quilt_size(const Swatch& swatch);
 
 /// The scatter fill's templates for a swatch of threads: each element that
-/// is not compact cut, along the longer side of its xy box, into `parts`
+/// is neither compact nor a ring (no handle) cut, along the longer side of its xy box, into `parts`
 /// pieces of equal length (the triangles wholly inside each), each cut loop
 /// closed (cap_loop) and the piece centred in xy. Pieces of fewer than 8
 /// triangles or with a border that is not simple loops are left out.
