@@ -524,15 +524,20 @@ double spread13(const std::vector<P3>& pts) {
 // The swatch's compact elements (rings, pebbles: is_compact_element), each
 // moved so that its xy centroid is the origin (swatch units, z kept): what
 // the scatter fill places one at a time.
+// `m` moved so that the mean of its vertices' xy is the origin (z kept).
+void centre_xy(ElementMesh& m) {
+  double cx = 0, cy = 0;
+  for (const P3& q : m.points) cx += q[0], cy += q[1];
+  cx /= static_cast<double>(m.points.size());
+  cy /= static_cast<double>(m.points.size());
+  for (P3& q : m.points) q[0] -= cx, q[1] -= cy;
+}
+
 std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
   std::vector<ElementMesh> out;
   for (ElementMesh& m : swatch_element_meshes(s)) {
     if (m.points.empty() || !is_compact_element(m)) continue;
-    double cx = 0, cy = 0;
-    for (const P3& q : m.points) cx += q[0], cy += q[1];
-    cx /= static_cast<double>(m.points.size());
-    cy /= static_cast<double>(m.points.size());
-    for (P3& q : m.points) q[0] -= cx, q[1] -= cy;
+    centre_xy(m);
     out.push_back(std::move(m));
   }
   return out;
@@ -715,7 +720,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   }
   vertex_normal_ = vertex_normals(b_);  // for the lifted positions (finish)
   compact_ = compact_swatch_elements(swatch);
-  if (compact_.empty() && opt.scatter_thread_parts > 0) thread_pieces_ = thread_scatter_pieces(swatch, opt.scatter_thread_parts);
+  if (compact_.empty() && opt.scatter_attempts > 0 && opt.scatter_thread_parts > 0)
+    thread_pieces_ = thread_scatter_pieces(swatch, opt.scatter_thread_parts);
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   lift_rings_ = opt.lift_crossing_rings < 0 ? !compact_.empty() && element_boxes_overlap(swatch) : opt.lift_crossing_rings > 0;
@@ -2022,52 +2028,31 @@ double longest_thread(const Swatch& s) {
 }
 }  // namespace
 
-namespace {
-// The triangles of `m` whose three vertices have coordinate `axis` in
-// [w0, w1], with their vertices renumbered.
-ElementMesh slab_of(const ElementMesh& m, int axis, double w0, double w1) {
-  ElementMesh piece;
-  std::vector<int> id(m.points.size(), -1);
-  for (const Tri& t : m.tris) {
-    bool inside = true;
-    for (int v : t) inside = inside && m.points[static_cast<std::size_t>(v)][axis] >= w0 && m.points[static_cast<std::size_t>(v)][axis] <= w1;
-    if (!inside) continue;
-    Tri nt;
-    for (int k = 0; k < 3; ++k) {
-      int& i = id[static_cast<std::size_t>(t[k])];
-      if (i < 0) i = static_cast<int>(piece.points.size()), piece.points.push_back(m.points[static_cast<std::size_t>(t[k])]);
-      nt[k] = i;
-    }
-    piece.tris.push_back(nt);
-  }
-  return piece;
-}
-}  // namespace
-
 std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts) {
   std::vector<ElementMesh> out;
   if (parts < 1) return out;
-  for (const ElementMesh& m : swatch_element_meshes(swatch)) {
+  const std::vector<ElementMesh> meshes = swatch_element_meshes(swatch);
+  for (std::size_t e = 0; e < meshes.size() && e < swatch.elements.size(); ++e) {
+    const ElementMesh& m = meshes[e];
+    const SwatchElement& el = swatch.elements[e];
+    const double side[2] = {el.bbox_max[0] - el.bbox_min[0], el.bbox_max[1] - el.bbox_min[1]};
     // (A ring cut into arcs is the broken ring remove_broken_elements removes.)
-    if (m.points.empty() || is_compact_element(m) || element_genus(m.tris) > 0) continue;
-    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    double hi[2] = {-lo[0], -lo[1]};
-    for (const P3& q : m.points)
-      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
-    const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
-    const double len = (hi[axis] - lo[axis]) / parts;
+    if (m.points.empty() || is_compact_extent(side[0], side[1]) || element_genus(m.tris) > 0) continue;
+    const int axis = side[0] >= side[1] ? 0 : 1;
+    const double len = side[axis] / parts;
     for (int k = 0; k < parts; ++k) {
-      ElementMesh piece = slab_of(m, axis, lo[axis] + k * len, lo[axis] + (k + 1) * len);
-      std::vector<std::vector<int>> loops;
-      if (piece.tris.size() < 8 || !boundary_loops(piece, loops)) continue;
-      for (const std::vector<int>& loop : loops)
-        if (loop.size() >= 3) cap_loop(piece, loop);
-      double cx = 0, cy = 0;
-      for (const P3& q : piece.points) cx += q[0], cy += q[1];
-      cx /= static_cast<double>(piece.points.size());
-      cy /= static_cast<double>(piece.points.size());
-      for (P3& q : piece.points) q[0] -= cx, q[1] -= cy;
-      out.push_back(std::move(piece));
+      // The slab [w0, w1] along the thread: every triangle with a vertex outside it dropped.
+      const double w0 = el.bbox_min[axis] + k * len, w1 = w0 + len;
+      std::vector<char> drop(m.tris.size(), 0);
+      for (std::size_t t = 0; t < m.tris.size(); ++t)
+        for (int v : m.tris[t]) {
+          const double x = m.points[static_cast<std::size_t>(v)][axis];
+          drop[t] = drop[t] || x < w0 || x > w1;
+        }
+      for (ElementMesh& piece : trim_and_cap(m, drop, 0, 8)) {
+        centre_xy(piece);
+        out.push_back(std::move(piece));
+      }
     }
   }
   return out;

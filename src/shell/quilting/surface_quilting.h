@@ -332,10 +332,11 @@ double surface_quilt_scale(const Mesh& base, const Swatch& swatch, double relati
 double default_surface_quilt_size(const Swatch& swatch);
 
 /// The scatter fill's templates for a swatch of threads: each element that
-/// is neither compact nor a ring (no handle) cut, along the longer side of its xy box, into `parts`
-/// pieces of equal length (the triangles wholly inside each), each cut loop
-/// closed (cap_loop) and the piece centred in xy. Pieces of fewer than 8
-/// triangles or with a border that is not simple loops are left out.
+/// is neither compact nor a ring (no handle) cut, along the longer side of
+/// its xy box, into `parts` pieces of equal length (the triangles wholly
+/// inside each, capped by trim_and_cap, which leaves out pieces of fewer
+/// than 8 triangles or not closed after capping, and open elements), each
+/// piece centred in xy.
 std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
