@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "shell/shell_space.h"
 #include "shell/swatch.h"
@@ -42,6 +43,29 @@ inline Mesh small_chainmail_mesh(std::uint64_t seed = 1, int segments = 12, int 
 /// The same as a swatch.
 inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, int sides = 6) {
   return make_swatch(small_chainmail_mesh(seed, segments, sides));
+}
+
+/// A 4 x 4 thread weave (generator defaults otherwise, e.g. WeaveOptions::spacing).
+inline Swatch weave_4x4(int segments_per_spacing, int sides) {
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = segments_per_spacing;
+  wo.sides = sides;
+  Mesh wm;
+  make_weave_swatch(wm, wo);
+  return make_swatch(wm);
+}
+
+/// An icosphere of `subdivisions` squashed to 0.08 along z: a lens, two
+/// nearly flat faces meeting at a sharp rim.
+inline Mesh flat_lens(int subdivisions) {
+  Mesh base;
+  make_icosphere(base, subdivisions);
+  for (VertexIndex v : base.vertices()) {
+    const Point3 p = base.point(v);
+    base.point(v) = Point3(p.x(), p.y(), 0.08 * p.z());
+  }
+  return base;
 }
 
 /// A small generated scatter swatch for fast tests.

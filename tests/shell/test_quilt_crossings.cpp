@@ -549,13 +549,7 @@ TEST(SurfaceQuiltingCoverage, ScatterFillTriesFacesWithOneBarePoint) {
 // A weave has no compact element to scatter: its threads are cut into
 // pieces (scatter_thread_parts) along their length, each closed by caps.
 TEST(SurfaceQuiltingScatter, ThreadPiecesAreClosedAndAPartOfAThreadLong) {
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 5;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch s = make_swatch(wm);
+  const Swatch s = test::weave_4x4(6, 5);
   double longest = 0;  // the threads' length: their boxes' larger xy side
   for (const SwatchElement& e : s.elements)
     longest = std::max({longest, e.bbox_max[0] - e.bbox_min[0], e.bbox_max[1] - e.bbox_min[1]});
@@ -586,19 +580,8 @@ TEST(SurfaceQuiltingScatter, ThreadPiecesAreClosedAndAPartOfAThreadLong) {
 // trimmed threads leave on this fin are what the scatter fill sees: it puts
 // thread pieces there (2.2% -> 0.02% bare), crossing nothing.
 TEST(SurfaceQuiltingCoverage, ThreadPiecesFillWhereWholeThreadsDoNotFit) {
-  Mesh base;
-  make_icosphere(base, 3);
-  for (VertexIndex v : base.vertices()) {
-    const Point3 p = base.point(v);
-    base.point(v) = Point3(p.x(), p.y(), 0.08 * p.z());  // a fin: two flat faces meeting at a sharp rim
-  }
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 5;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch s = make_swatch(wm);
+  const Mesh base = test::flat_lens(3);  // a fin: two flat faces meeting at a sharp rim
+  const Swatch s = test::weave_4x4(6, 5);
   auto run = [&](int parts) {
     SurfaceQuiltOptions o;
     o.scatter_thread_parts = parts;
@@ -836,19 +819,8 @@ TEST(SurfaceQuiltingUpright, ElementsOfAYThinSwatchStandOnTheNormalOfAYUpMesh) {
 // stretched into shards; with the bound none is longer than max_edge_stretch
 // swatch edges (lifted), and the space is refilled.
 TEST(SurfaceQuiltingShards, NoElementStretchesPastTheBoundOnARim) {
-  Mesh base;
-  make_icosphere(base, 2);
-  for (VertexIndex v : base.vertices()) {
-    const Point3 p = base.point(v);
-    base.point(v) = Point3(p.x(), p.y(), 0.08 * p.z());  // a lens: two faces meeting at a sharp rim
-  }
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 5;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch s = make_swatch(wm);
+  const Mesh base = test::flat_lens(2);  // a lens: two faces meeting at a sharp rim
+  const Swatch s = test::weave_4x4(6, 5);
   auto run = [&](double bound) {
     SurfaceQuiltOptions o;
     o.relative_size = 0.4;

@@ -29,16 +29,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 Swatch tiny_chainmail(std::uint64_t seed = 1) { return test::small_chainmail_swatch(seed, 10, 5); }
 Swatch tiny_scatter(std::uint64_t seed = 1) { return test::small_scatter_swatch(seed); }
-// A 4 x 4 thread weave (generator defaults otherwise, e.g. WeaveOptions::spacing).
-Swatch weave_4x4(int segments_per_spacing, int sides) {
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = segments_per_spacing;
-  wo.sides = sides;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  return make_swatch(wm);
-}
+using test::weave_4x4;
 
 // Fraction of elements (connected components) of `m` that are closed and consistently oriented.
 double closed_fraction(const Mesh& m, int* count = nullptr) {
