@@ -41,7 +41,8 @@
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_LIFT_RINGS (lift_crossing_rings), BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
-//   resolution after the shell map), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_EDGE_MEDIANS (the
+//   resolution after the shell map), BENCH_EMBED_FILL=0 (no fill of the embedded quilt's bare faces;
+//   BENCH_FILL_ATTEMPTS, BENCH_FILL_CONE its tries and normal cone), BENCH_UNTANGLE=0 (folded threads cut, not smoothed out), BENCH_EDGE_MEDIANS (the
 //   embedding's max_edge_over_median; 0 = none), BENCH_RELAX=0 (stretched elements cut, not relaxed), BENCH_STRETCH_ITERS (the
 //   shell map's sweeps); BENCH_LIFTED=1 also writes DIR/<case>_lifted.glb (the
 //   quilt before the shell map: feet on the base, height along face normals)
@@ -269,6 +270,9 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_STRETCH_ITERS")) o.embed.stretch.iterations = std::atoi(e);
   if (const char* e = std::getenv("BENCH_EMBED_RESOLVE")) o.embed.resolve_crossings = std::atoi(e) != 0;
   if (const char* e = std::getenv("BENCH_UNTANGLE")) o.embed.untangle_folds = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_EMBED_FILL")) o.fill_embedded = std::atoi(e) != 0;
+  if (const char* e = std::getenv("BENCH_FILL_ATTEMPTS")) o.embed.fill.attempts = std::atoi(e);
+  if (const char* e = std::getenv("BENCH_FILL_CONE")) o.embed.fill.max_normal_angle_deg = std::atof(e);
   if (const char* e = std::getenv("BENCH_EDGE_MEDIANS")) o.embed.max_edge_over_median = std::atof(e);
   if (const char* e = std::getenv("BENCH_RELAX")) o.embed.relax_stretched = std::atoi(e) != 0;
   Mesh out;
@@ -317,6 +321,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"caps_recentred", er.caps_recentred},
          {"elements_untangled", er.elements_untangled},
          {"elements_placed_affine", er.elements_placed_affine},
+         {"fill_placed", er.fill.placed},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},

@@ -305,8 +305,9 @@ SubcommandRegistrar reg_quilt{
            ->check(zero_or_between(1.5, 1e6, "never"));
        app.add_option("--thread-pieces", a->thread_pieces,
                       "On a mesh, for a swatch with no compact element (a weave): what stays bare after the "
-                      "quilting is filled with pieces of its threads, each thread cut into this many; 0 = no "
-                      "pieces (0..16, default 4)")
+                      "quilting, and again after the embedding (threads the shell map folds over a sharp rim "
+                      "are cut there), is filled with pieces of its threads, each thread cut into this many; "
+                      "0 = no pieces (0..16, default 4)")
            ->check(CLI::Range(0, 16));
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")

@@ -379,5 +379,35 @@ TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
   EXPECT_THROW(load_or_generate_swatch("/nonexistent/swatch.obj", 1), Error);
 }
 
+// Issue 17 item 4 after the embedding: on a fin (a flat lens, sharp rim),
+// the shell map folds threads over the rim and the embedding cuts them,
+// leaving bare what the quilt covered. The fill puts thread pieces there
+// (EmbedSurfaceQuiltOptions::fill), crossing nothing; fill_embedded off, the
+// output keeps the bare spots.
+TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
+  const Mesh base = test::flat_lens(3);
+  WeaveOptions wo;
+  wo.threads_x = wo.threads_y = 4;
+  wo.segments_per_spacing = 6;
+  wo.sides = 5;
+  Mesh weave;
+  make_weave_swatch(weave, wo);
+  auto run = [&](bool fill) {
+    QuiltSwatchOnSurfaceOptions o;
+    o.quilt.relative_size = 0.6;
+    o.embed.stretch.iterations = 2;
+    o.fill_embedded = fill;
+    Mesh out;
+    return quilt_swatch_on_surface(base, weave, out, o);
+  };
+  const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
+  EXPECT_EQ(off.embedding.fill.placed, 0u);
+  EXPECT_GT(on.embedding.fill.placed, 0u);
+  EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
+  EXPECT_EQ(on.embedding.self_intersections_between, off.embedding.self_intersections_between);
+  EXPECT_EQ(on.embedding.self_intersections_within, off.embedding.self_intersections_within);
+  EXPECT_EQ(on.embedding.elements, off.embedding.elements + on.embedding.fill.placed);
+}
+
 }  // namespace
 }  // namespace surftex

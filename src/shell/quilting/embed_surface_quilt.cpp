@@ -577,6 +577,30 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
     res.embed.checked = true;
   }
 }
+// EmbedSurfaceQuiltOptions::fill: pieces into the bare faces; the crossings
+// that involve them (none by construction, but the count stays exact) added
+// to the counts.
+void fill_and_count(const Mesh& base, const EmbedSurfaceQuiltOptions& opt, std::vector<char>& compact,
+                    std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+  EmbeddedFillOptions fo = opt.fill;
+  const double b = res.embedded_edge_bound;
+  if (b > 0) fo.max_edge = fo.max_edge > 0 ? std::min(fo.max_edge, b) : b;
+  const std::size_t before = els.size();
+  res.fill = fill_embedded_bare(element_mesh_from(base), els, fo);
+  if (res.fill.placed == 0) return;
+  compact.resize(els.size(), 0);
+  mesh_from_elements(els, out);
+  if (!opt.check_self_intersections) return;
+  std::vector<char> fresh(els.size(), 0);
+  std::fill(fresh.begin() + static_cast<std::ptrdiff_t>(before), fresh.end(), 1);
+  const ElementFaces ef(els);
+  for (const FacePair& fp : self_intersecting_faces(out, faces_near_changed_elements(els, fresh))) {
+    const std::size_t a = ef.element_of(fp[0]), c = ef.element_of(fp[1]);
+    if (a < before && c < before) continue;  // counted before the fill
+    ++res.embed.self_intersecting_pairs;
+    ++(a == c ? res.self_intersections_within : res.self_intersections_between);
+  }
+}
 }  // namespace
 
 /// Zhou et al. 2006 s.3: the base mesh charted, its shell space built and
@@ -651,6 +675,7 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
     resolve_and_count_crossings(compact, opt, res.embedded_edge_bound, opt.untangle_folds && pass == 0, els, out, res);
     if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;
   }
+  if (!opt.fill.templates.empty()) fill_and_count(base, opt, compact, els, out, res);
   res.elements = els.size();
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);

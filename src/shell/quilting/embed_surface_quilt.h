@@ -29,6 +29,7 @@
 #include "shell/embed_in_shell.h"
 #include "shell/embed_outside_shell.h"
 #include "shell/shell_stretch.h"
+#include "shell/quilting/embedded_fill.h"
 #include "shell/quilting/surface_quilting.h"
 
 namespace surftex {
@@ -97,6 +98,11 @@ struct EmbedSurfaceQuiltOptions {
   /// Cap centres moved back to the middle of their caps (recentre_fans) on the
   /// embedded elements, before the shard bound and the crossings. Default true.
   bool recentre_caps = true;
+  /// Last: pieces placed into what the output leaves bare (embedded_fill.h;
+  /// no templates, the default: none). quilt_swatch_on_surface sets the
+  /// templates (embedded_fill_templates), scale, heights and radius; the
+  /// shard bound is held to embedded_edge_bound too.
+  EmbeddedFillOptions fill;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;
   OutsideShellOptions outside_shell;
@@ -142,8 +148,10 @@ struct EmbedSurfaceQuiltResult {
   std::size_t elements_relaxed_embedded = 0;
   /// Cap centres moved by recentre_caps.
   std::size_t caps_recentred = 0;
+  /// The fill of the embedded quilt's bare faces (EmbedSurfaceQuiltOptions::fill).
+  EmbeddedFillResult fill;
   /// Elements in `out` (the quilt's, less those the shard bound and the
-  /// crossing resolution removed, plus the pieces they cut).
+  /// crossing resolution removed, plus the pieces they cut and the fill's).
   std::size_t elements = 0;
   /// Vertices the shell map put outside the geometric shell (the union of the
   /// shell's 3D tets; embed_outside_shell.h), with how far; empty unless measured.

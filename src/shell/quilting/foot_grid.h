@@ -60,4 +60,18 @@ class FootGrid {
   CellGrid<char> grid_;
 };
 
+/// A triangle's four sample points (its centroid and its corner triangles'
+/// centroids, (4 a + b + c) / 6), each standing for a quarter of its area:
+/// how many have no foot within the grid's radius (0..4). The bare-area
+/// measure and the scatter fills count bare area with it.
+inline int bare_samples_of(const P3& a, const P3& b, const P3& c, const FootGrid& feet) {
+  int n = feet.covered({(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3}) ? 0 : 1;
+  const P3* v[3] = {&a, &b, &c};
+  for (int k = 0; k < 3; ++k) {
+    const P3 &p = *v[k], &q = *v[(k + 1) % 3], &r = *v[(k + 2) % 3];
+    n += feet.covered({(4 * p[0] + q[0] + r[0]) / 6, (4 * p[1] + q[1] + r[1]) / 6, (4 * p[2] + q[2] + r[2]) / 6}) ? 0 : 1;
+  }
+  return n;
+}
+
 }  // namespace surftex

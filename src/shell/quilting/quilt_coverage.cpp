@@ -54,11 +54,7 @@ BareArea output_bare_area(const Mesh& base, const Mesh& quilt, double radius, co
     const P3 v[3] = {b.points[static_cast<std::size_t>(t[0])], b.points[static_cast<std::size_t>(t[1])],
                      b.points[static_cast<std::size_t>(t[2])]};
     const P3 c{(v[0][0] + v[1][0] + v[2][0]) / 3, (v[0][1] + v[1][1] + v[2][1]) / 3, (v[0][2] + v[1][2] + v[2][2]) / 3};
-    int nbare = feet.covered(c) ? 0 : 1;
-    for (int k = 0; k < 3; ++k) {  // corner triangle k's centroid: (4 a + b + c) / 6
-      const P3 &a = v[k], &q = v[(k + 1) % 3], &r = v[(k + 2) % 3];
-      nbare += feet.covered({(4 * a[0] + q[0] + r[0]) / 6, (4 * a[1] + q[1] + r[1]) / 6, (4 * a[2] + q[2] + r[2]) / 6}) ? 0 : 1;
-    }
+    const int nbare = bare_samples_of(v[0], v[1], v[2], feet);
     const double a = 0.5 * vec3::norm(vec3::cross(vec3::sub(v[1], v[0]), vec3::sub(v[2], v[0])));
     const int band = hmax > hmin ? std::clamp(static_cast<int>(4 * (height(c) - hmin) / (hmax - hmin)), 0, 3) : 0;
     area[4] += a, area[band] += a;

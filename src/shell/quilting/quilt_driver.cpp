@@ -189,12 +189,19 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   if (eo.min_edge_bound == 0) eo.min_edge_bound = 1.5 * swatch_longest;
   eo.swatch_self_crossings = r.swatch.element_self_crossings;
   eo.whole_copy_sources = swatch_element_meshes(r.swatch);
+  const double bare_radius = 0.5 * swatch_element_spacing(r.swatch) * r.local.scale;
+  if (opt.fill_embedded && eo.fill.templates.empty()) eo.fill.templates = embedded_fill_templates(r.swatch, qo);
+  eo.fill.scale = r.local.scale;
+  eo.fill.z0 = r.swatch.bbox_min[2];
+  eo.fill.radius = bare_radius;
+  eo.fill.max_stretch = qo.scatter_max_stretch;
+  eo.fill.own_crossings = r.swatch.element_self_crossings;
+  eo.fill.seed = opt.seed;
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();
   color_by_element(out, opt.seed);
-  r.bare = output_bare_area(base, out, 0.5 * swatch_element_spacing(r.swatch) * r.local.scale,
-                            qo.up);
+  r.bare = output_bare_area(base, out, bare_radius, qo.up);
   r.base_faces = base.number_of_faces();
   r.faces = out.number_of_faces();
   r.vertices = out.number_of_vertices();

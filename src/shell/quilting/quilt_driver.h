@@ -98,6 +98,10 @@ struct QuiltSwatchOnSurfaceOptions {
   /// floor (1.5 swatch longest edges) then stays under 4 medians; the
   /// generated swatches and the rocks (1.3-2.0) are untouched.
   double split_edges_over_median = 2.5;
+  /// Fill what the embedded quilt leaves bare with pieces of the swatch's
+  /// threads (EmbedSurfaceQuiltOptions::fill, embedded_fill_templates: a
+  /// swatch with no compact element). Default true (decision 102, session 44).
+  bool fill_embedded = true;
 };
 
 struct QuiltSwatchOnSurfaceResult {

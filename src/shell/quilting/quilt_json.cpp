@@ -89,6 +89,8 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["caps_recentred"] = er.caps_recentred;
   j["elements_untangled"] = er.elements_untangled;
   j["elements_placed_affine"] = er.elements_placed_affine;
+  j["fill_faces_tried"] = er.fill.faces_tried;  // bare faces after the embedding (decision 102, session 44)
+  j["fill_placed"] = er.fill.placed;            // thread pieces placed there
   j["charts"] = er.atlas.num_charts;
   j["tets"] = er.tets;
   j["shell_height"] = er.shell_height;

@@ -493,13 +493,7 @@ void check_options(const SurfaceQuiltOptions& o) {
 // scatter_bare_samples of them.
 int bare_samples(const Base& b, int f, const FootGrid& feet) {
   const auto& t = b.faces[f];
-  int nbare = feet.covered(b.centroid[f]) ? 0 : 1;
-  for (int k = 0; k < 3; ++k) {
-    const P3 &a = b.pts[t[k]], &b1 = b.pts[t[(k + 1) % 3]], &b2 = b.pts[t[(k + 2) % 3]];
-    const P3 s{(4 * a[0] + b1[0] + b2[0]) / 6, (4 * a[1] + b1[1] + b2[1]) / 6, (4 * a[2] + b1[2] + b2[2]) / 6};
-    nbare += feet.covered(s) ? 0 : 1;
-  }
-  return nbare;
+  return bare_samples_of(b.pts[t[0]], b.pts[t[1]], b.pts[t[2]], feet);
 }
 
 // The largest extent of `pts` along 13 directions (the axes, the face and
@@ -2027,6 +2021,11 @@ double longest_thread(const Swatch& s) {
   return longest;
 }
 }  // namespace
+
+std::vector<ElementMesh> embedded_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
+  if (opt.scatter_attempts <= 0 || !compact_swatch_elements(swatch).empty()) return {};
+  return thread_scatter_pieces(swatch, opt.scatter_thread_parts);
+}
 
 std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts) {
   std::vector<ElementMesh> out;

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#pragma once
+// The scatter fill once more, on the embedded quilt (issue 17 item 4): the
+// embedding (Zhou et al. 2006 s.3.2) cuts threads that the shell map folds
+// over a sharp rim, which the quilt's lifted approximation did not see, and
+// leaves bare what they covered. Here templates (pieces of the swatch's
+// threads) are placed into what the output leaves bare, in mesh space: each
+// template vertex's planar position on the face's tangent plane is projected
+// to its closest point on the base and lifted along the interpolated vertex
+// normal by its swatch height, as the quilt lifts its vertices. A placement
+// is kept only if it stays on one side of the surface (every foot's face
+// within a normal cone of the face), no edge is stretched past the bounds,
+// it crosses no element (exact, ElementCollider) and not itself beyond the
+// swatch's own crossings: so it adds no crossing and no shard.
+//
+// Orientation: a piece runs along the nearest embedded element's long axis
+// (the weave's threads near it), or a quarter turn of it.
+// Reads: the base (triangles), the elements. Writes: appends to `els`.
+// Deterministic for a seed (faces in order, one generator).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "shell/element_mesh.h"
+
+namespace surftex {
+
+struct EmbeddedFillOptions {
+  /// What is placed: swatch units, centred in xy (thread_scatter_pieces). Empty: nothing.
+  std::vector<ElementMesh> templates;
+  double scale = 0;   ///< mesh units per swatch unit (> 0 when templates are given)
+  double z0 = 0;      ///< the swatch z that lies on the base
+  double radius = 0;  ///< bare radius, mesh units (the bare-area measure's, > 0)
+  int attempts = 16;  ///< tries per bare face (quarter turns, then moved), 1..64
+  /// No placed edge longer than max_stretch times its template edge, scaled, nor than max_edge (> 0).
+  double max_stretch = 2.0, max_edge = 0;
+  /// Every foot's face normal within this angle of the bare face's (deg).
+  double max_normal_angle_deg = 60.0;
+  /// Self-intersecting pairs a placed piece may keep (the swatch's own).
+  std::size_t own_crossings = 0;
+  std::uint64_t seed = 1;
+};
+
+struct EmbeddedFillResult {
+  std::size_t faces_tried = 0;  ///< base faces with a bare sample point
+  std::size_t placed = 0;       ///< pieces appended
+};
+
+/// See the header comment. Throws InvalidInputError for bad options.
+EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<ElementMesh>& els,
+                                      const EmbeddedFillOptions& opt);
+
+}  // namespace surftex

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The fill of the embedded quilt's bare faces (shell/quilting/embedded_fill.h).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "geometry/errors.h"
+#include "geometry/mesh.h"
+#include "geometry/self_intersections.h"
+#include "shell/element_mesh.h"
+#include "shell/quilting/embedded_fill.h"
+#include "shell/quilting/quilt_coverage.h"
+#include "shell/quilting/surface_quilting.h"
+#include "shell/swatch.h"
+#include "shell/triangle_distance.h"
+#include "shell_test_util.h"
+
+namespace surftex {
+namespace {
+
+// A weave's thread pieces, scaled so that one is `piece` mesh units long.
+EmbeddedFillOptions weave_fill(double piece) {
+  const Swatch s = test::weave_4x4(6, 5);
+  EmbeddedFillOptions o;
+  o.templates = thread_scatter_pieces(s, 4);
+  double longest = 0;
+  for (const ElementMesh& m : o.templates) {
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const P3& q : m.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], q[d]), hi[d] = std::max(hi[d], q[d]);
+    longest = std::max({longest, hi[0] - lo[0], hi[1] - lo[1]});
+  }
+  o.scale = piece / longest;
+  o.z0 = s.bbox_min[2];
+  o.radius = 0.5 * swatch_element_spacing(s) * o.scale;
+  return o;
+}
+
+double bare(const Mesh& base, const std::vector<ElementMesh>& els, double radius) {
+  Mesh out;
+  mesh_from_elements(els, out);
+  return output_bare_area(base, out, radius, {0, 0, 1}).overall;
+}
+
+// A fin: two flat faces meeting at a sharp rim, with nothing on it. The fill
+// covers it with thread pieces that cross nothing, stay over the face they
+// were placed on (none wraps the rim onto the other face) and stand within
+// the shell's height above it.
+TEST(EmbeddedFill, CoversABareFinWithoutCrossingsOrPiecesOverItsRim) {
+  const Mesh base = test::flat_lens(3);
+  const ElementMesh b = element_mesh_from(base);
+  const EmbeddedFillOptions o = weave_fill(0.3);
+  std::vector<ElementMesh> els;
+  ASSERT_DOUBLE_EQ(bare(base, els, o.radius), 1.0);
+  const EmbeddedFillResult r = fill_embedded_bare(b, els, o);
+  EXPECT_GT(r.placed, 20u);
+  EXPECT_EQ(els.size(), r.placed);
+  EXPECT_LT(bare(base, els, o.radius), 0.2);
+  Mesh out;
+  mesh_from_elements(els, out);
+  EXPECT_TRUE(self_intersecting_faces(out).empty());
+  double zmax = 0;
+  for (const ElementMesh& t : o.templates)
+    for (const P3& q : t.points) zmax = std::max(zmax, (q[2] - o.z0) * o.scale);
+  for (const ElementMesh& m : els) {
+    std::size_t above = 0;
+    for (const P3& p : m.points) above += p[2] > 0;
+    EXPECT_TRUE(above == 0 || above == m.points.size()) << above << " of " << m.points.size() << " above the rim";
+    EXPECT_TRUE(is_closed_oriented(m));
+  }
+  // Each vertex within the shell: no farther from the lens than its height.
+  const TriangleDistance lens(b);
+  for (const ElementMesh& m : els)
+    for (const P3& p : m.points) EXPECT_LE(lens.closest(p).distance, 1.02 * zmax + 1e-9);
+}
+
+// What is covered gets nothing: with the fin's upper face covered by a
+// sheet of elements, pieces go to the lower face only, crossing none of it;
+// and the same seed places the same pieces.
+TEST(EmbeddedFill, LeavesCoveredFacesAloneAndRepeatsForASeed) {
+  const Mesh base = test::flat_lens(3);
+  const ElementMesh b = element_mesh_from(base);
+  const EmbeddedFillOptions o = weave_fill(0.3);
+  ElementMesh sheet;  // the upper faces, lifted by half the radius
+  std::vector<int> index(b.points.size(), -1);
+  for (const Tri& t : b.tris) {
+    if (b.points[static_cast<std::size_t>(t[0])][2] <= 0 || b.points[static_cast<std::size_t>(t[1])][2] <= 0 ||
+        b.points[static_cast<std::size_t>(t[2])][2] <= 0)
+      continue;
+    Tri n{};
+    for (int k = 0; k < 3; ++k) {
+      int& i = index[static_cast<std::size_t>(t[k])];
+      if (i < 0) {
+        i = static_cast<int>(sheet.points.size());
+        P3 p = b.points[static_cast<std::size_t>(t[k])];
+        p[2] += 0.5 * o.radius;
+        sheet.points.push_back(p);
+      }
+      n[k] = i;
+    }
+    sheet.tris.push_back(n);
+  }
+  std::vector<ElementMesh> els{sheet}, again{sheet};
+  const EmbeddedFillResult r = fill_embedded_bare(b, els, o);
+  EXPECT_GT(r.placed, 5u);
+  for (std::size_t e = 1; e < els.size(); ++e)
+    for (const P3& p : els[e].points) EXPECT_LT(p[2], 0.0);
+  Mesh out;
+  mesh_from_elements(els, out);
+  EXPECT_TRUE(self_intersecting_faces(out).empty());
+  fill_embedded_bare(b, again, o);
+  ASSERT_EQ(again.size(), els.size());
+  for (std::size_t e = 0; e < els.size(); ++e) EXPECT_EQ(again[e].points, els[e].points);
+}
+
+TEST(EmbeddedFill, RefusesImpossibleOptions) {
+  const ElementMesh b = element_mesh_from(test::flat_lens(1));
+  std::vector<ElementMesh> els;
+  auto refused = [&](auto&& edit) {
+    EmbeddedFillOptions o = weave_fill(0.3);
+    edit(o);
+    EXPECT_THROW(fill_embedded_bare(b, els, o), InvalidInputError);
+  };
+  refused([](EmbeddedFillOptions& o) { o.radius = 0; });
+  refused([](EmbeddedFillOptions& o) { o.scale = -1; });
+  refused([](EmbeddedFillOptions& o) { o.attempts = 0; });
+  refused([](EmbeddedFillOptions& o) { o.max_stretch = 0.5; });
+  refused([](EmbeddedFillOptions& o) { o.max_normal_angle_deg = std::nan(""); });
+  EmbeddedFillOptions none;  // no templates: nothing to do, nothing checked
+  EXPECT_EQ(fill_embedded_bare(b, els, none).placed, 0u);
+  EXPECT_TRUE(els.empty());
+}
+
+}  // namespace
+}  // namespace surftex
