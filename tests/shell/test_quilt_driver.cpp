@@ -383,7 +383,8 @@ TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
 // the shell map folds threads over the rim and the embedding cuts them,
 // leaving bare what the quilt covered. The fill puts thread pieces there
 // (EmbedSurfaceQuiltOptions::fill), crossing nothing; fill_embedded off, the
-// output keeps the bare spots.
+// output keeps the bare spots. With the fill, the quilt's refill rounds for
+// threads are three, not six.
 TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
   const Mesh base = test::flat_lens(3);
   WeaveOptions wo;
@@ -403,10 +404,13 @@ TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
   const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
   EXPECT_EQ(off.embedding.fill.placed, 0u);
   EXPECT_GT(on.embedding.fill.placed, 0u);
+  EXPECT_EQ(off.quilt.refill_rounds, 6);
+  EXPECT_EQ(on.quilt.refill_rounds, kRefillRoundsBeforeEmbeddedFill);
+  EXPECT_EQ(kRefillRoundsBeforeEmbeddedFill, 3);
   EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
-  EXPECT_EQ(on.embedding.self_intersections_between, off.embedding.self_intersections_between);
-  EXPECT_EQ(on.embedding.self_intersections_within, off.embedding.self_intersections_within);
-  EXPECT_EQ(on.embedding.elements, off.embedding.elements + on.embedding.fill.placed);
+  EXPECT_TRUE(on.embedding.embed.checked);
+  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
+  EXPECT_EQ(on.embedding.self_intersections_within, 0u);
 }
 
 }  // namespace

@@ -175,6 +175,11 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   if (!(qo.relative_size > 0)) qo.relative_size = default_surface_quilt_size(r.swatch);
   check_surface_quilt_size(base, r.swatch, qo, opt.check_work);
   qo.seed = opt.seed;
+  // A swatch of threads gets six refill rounds in the quilt (its only fill
+  // there); filled again after the embedding, three do (decision 102, session 44).
+  std::vector<ElementMesh> fill_templates;
+  if (opt.fill_embedded) fill_templates = embedded_fill_templates(r.swatch, qo);
+  if (qo.refill_rounds < 0 && !fill_templates.empty()) qo.refill_rounds = kRefillRoundsBeforeEmbeddedFill;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);
   r.seconds_quilt = t.seconds();
@@ -190,7 +195,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   eo.swatch_self_crossings = r.swatch.element_self_crossings;
   eo.whole_copy_sources = swatch_element_meshes(r.swatch);
   const double bare_radius = 0.5 * swatch_element_spacing(r.swatch) * r.local.scale;
-  if (opt.fill_embedded && eo.fill.templates.empty()) eo.fill.templates = embedded_fill_templates(r.swatch, qo);
+  if (eo.fill.templates.empty()) eo.fill.templates = std::move(fill_templates);
   eo.fill.scale = r.local.scale;
   eo.fill.z0 = r.swatch.bbox_min[2];
   eo.fill.radius = bare_radius;

@@ -100,9 +100,15 @@ struct QuiltSwatchOnSurfaceOptions {
   double split_edges_over_median = 2.5;
   /// Fill what the embedded quilt leaves bare with pieces of the swatch's
   /// threads (EmbedSurfaceQuiltOptions::fill, embedded_fill_templates: a
-  /// swatch with no compact element). Default true (decision 102, session 44).
+  /// swatch with no compact element). The quilt's refill rounds, left to the
+  /// swatch (SurfaceQuiltOptions::refill_rounds -1), are then
+  /// kRefillRoundsBeforeEmbeddedFill instead of six. Default true (decision
+  /// 102, session 44).
   bool fill_embedded = true;
 };
+
+/// The refill rounds of a swatch of threads that the embedding's fill follows.
+inline constexpr int kRefillRoundsBeforeEmbeddedFill = 3;
 
 struct QuiltSwatchOnSurfaceResult {
   SurfaceQuiltResult quilt;

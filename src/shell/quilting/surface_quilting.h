@@ -130,7 +130,9 @@ struct SurfaceQuiltOptions {
   /// bare; more rounds reopen as many faces as they fill), 6 when it has none
   /// (threads: the rounds are their only fill and converge; 8 would cover
   /// more but take bunny5k past its 60 s). Default -1
-  /// (decision 102, session 38).
+  /// (decision 102, session 38). quilt_swatch_on_surface, which fills a
+  /// thread swatch's bare spots again after the embedding, sets 3
+  /// (kRefillRoundsBeforeEmbeddedFill, session 44).
   int refill_rounds = -1;
   /// Scatter fill after the refills: per face still bare, up to this many
   /// tries to place one compact swatch element (a ring, a pebble; for a
