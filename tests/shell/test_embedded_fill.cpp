@@ -7,6 +7,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/primitive_meshes.h"
 #include "geometry/self_intersections.h"
 #include "shell/element_mesh.h"
 #include "shell/quilting/embedded_fill.h"
@@ -112,6 +113,39 @@ TEST(EmbeddedFill, LeavesCoveredFacesAloneAndRepeatsForASeed) {
   fill_embedded_bare(b, again, o);
   ASSERT_EQ(again.size(), els.size());
   for (std::size_t e = 0; e < els.size(); ++e) EXPECT_EQ(again[e].points, els[e].points);
+}
+
+// An open mesh: a piece placed near the border would have its overhanging
+// part projected onto the border (squashed into a line, its edges shorter,
+// none stretched). On a flat square every piece kept is its template moved
+// rigidly: the same area, scaled.
+TEST(EmbeddedFill, PiecesOverAnOpenBorderAreNotSquashedOntoIt) {
+  Mesh square;
+  make_grid(square, 24, 24);
+  const ElementMesh b = element_mesh_from(square);
+  const EmbeddedFillOptions o = weave_fill(0.25);
+  std::vector<ElementMesh> els;
+  const EmbeddedFillResult r = fill_embedded_bare(b, els, o);
+  EXPECT_GT(r.placed, 10u);
+  auto area = [](const ElementMesh& m) {
+    double a = 0;
+    for (const Tri& t : m.tris) {
+      const P3 &p = m.points[static_cast<std::size_t>(t[0])], &q = m.points[static_cast<std::size_t>(t[1])],
+               &w = m.points[static_cast<std::size_t>(t[2])];
+      const P3 u{q[0] - p[0], q[1] - p[1], q[2] - p[2]}, v{w[0] - p[0], w[1] - p[1], w[2] - p[2]};
+      a += 0.5 * std::sqrt(std::pow(u[1] * v[2] - u[2] * v[1], 2) + std::pow(u[2] * v[0] - u[0] * v[2], 2) +
+                           std::pow(u[0] * v[1] - u[1] * v[0], 2));
+    }
+    return a;
+  };
+  std::size_t squashed = 0;
+  for (const ElementMesh& m : els) {
+    bool rigid = false;
+    for (const ElementMesh& t : o.templates)
+      rigid = rigid || (t.tris == m.tris && std::abs(area(m) - o.scale * o.scale * area(t)) <= 1e-6 * area(m));
+    squashed += !rigid;
+  }
+  EXPECT_EQ(squashed, 0u) << "of " << els.size();
 }
 
 TEST(EmbeddedFill, RefusesImpossibleOptions) {

@@ -109,7 +109,8 @@ P3 local_direction(const FillState& s, const P3& c, const P3& n, const P3& edge)
 
 // One placement of `tpl` at `c` in the frame (e1, e2, n): the planar points
 // projected to the base and lifted; false when a foot's face leaves the
-// normal cone or an edge is over its bound. `feet` gets the feet.
+// normal cone, a point lies beside its foot rather than over it (past an
+// open border) or an edge is over its bound. `feet` gets the feet.
 bool place(const FillState& s, const EmbeddedFillOptions& o, const ElementMesh& tpl, const P3& c, const P3& e1,
            const P3& e2, const P3& n, double cos_max, ElementMesh& m, std::vector<P3>& feet) {
   m.tris = tpl.tris;
@@ -120,7 +121,14 @@ bool place(const FillState& s, const EmbeddedFillOptions& o, const ElementMesh& 
     const P3& q = tpl.points[v];
     const P3 x = vec3::add(c, vec3::add(vec3::mul(e1, o.scale * q[0]), vec3::mul(e2, o.scale * q[1])));
     const TriangleDistance::Hit h = s.tree.closest(x, hint);
-    if (h.tri < 0 || vec3::dot(s.fn[static_cast<std::size_t>(h.tri)], n) < cos_max) return false;
+    if (h.tri < 0) return false;
+    const P3& fn = s.fn[static_cast<std::size_t>(h.tri)];
+    if (vec3::dot(fn, n) < cos_max) return false;
+    // Over the surface, the point lies off it along the normal; past an open
+    // border (or a rim) it lies beside its foot, and would be squashed onto it.
+    const P3 d = vec3::sub(x, h.point);
+    const double along = vec3::dot(d, fn);
+    if (vec3::norm(vec3::sub(d, vec3::mul(fn, along))) > std::max(1e-9 * o.radius, std::abs(along))) return false;
     hint = h.tri;
     const Tri& t = s.base.tris[static_cast<std::size_t>(h.tri)];
     P3 nv{0, 0, 0};

@@ -9,7 +9,8 @@
 // to its closest point on the base and lifted along the interpolated vertex
 // normal by its swatch height, as the quilt lifts its vertices. A placement
 // is kept only if it stays on one side of the surface (every foot's face
-// within a normal cone of the face), no edge is stretched past the bounds,
+// within a normal cone of the face) and over it (each point off its foot
+// along the normal more than beside it: not past an open border), no edge is stretched past the bounds,
 // it crosses no element (exact, ElementCollider) and not itself beyond the
 // swatch's own crossings: so it adds no crossing and no shard.
 //
