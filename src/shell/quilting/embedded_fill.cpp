@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "shell/quilting/embedded_fill.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -14,6 +11,7 @@
 #include "geometry/vec3.h"
 #include "shell/element_clearance.h"
 #include "shell/quilting/foot_grid.h"
+#include "shell/quilting/quilt_coverage.h"
 #include "shell/triangle_distance.h"
 
 namespace surftex {
@@ -32,24 +30,6 @@ void check_options(const EmbeddedFillOptions& o) {
   if (!(o.max_stretch >= 1) || !std::isfinite(o.max_stretch)) bad("max_stretch must be >= 1");
   if (!(o.max_edge >= 0) || !std::isfinite(o.max_edge)) bad("max_edge must be >= 0");
   if (!(o.max_normal_angle_deg > 0 && o.max_normal_angle_deg <= 180)) bad("max_normal_angle_deg must be in (0, 180]");
-}
-
-// The feet (closest base points) of every element vertex, in a grid of the bare radius.
-FootGrid feet_of(const TriangleDistance& tree, const std::vector<ElementMesh>& els, double radius) {
-  std::vector<P3> pts;
-  for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
-  std::vector<P3> feet(pts.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pts.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-    int hint = -1;
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const TriangleDistance::Hit h = tree.closest(pts[i], hint);
-      feet[i] = h.point;
-      hint = h.tri;
-    }
-  });
-  FootGrid grid(radius);
-  for (const P3& p : feet) grid.add(p);
-  return grid;
 }
 
 // An element's long axis: the principal direction of its points (power
@@ -158,7 +138,9 @@ EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<Eleme
   if (opt.templates.empty() || base.tris.empty()) return res;
   FillState s(base, opt.radius);
   for (std::size_t e = 0; e < els.size(); ++e) s.add_element(els[e], static_cast<int>(e));
-  FootGrid feet = feet_of(s.tree, els, opt.radius);
+  std::vector<P3> pts;
+  for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
+  FootGrid feet = feet_on_base(s.tree, pts, opt.radius);
   ElementCollider coll(els, {});
   std::mt19937_64 rng(opt.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

@@ -16,21 +16,12 @@
 
 namespace surftex {
 
-namespace {
-
-// The quilt's vertices' closest points on the base, in parallel (each on its own).
-FootGrid quilt_feet(const ElementMesh& base, const Mesh& quilt, double radius) {
-  std::vector<P3> pts;
-  for (VertexIndex v : quilt.vertices()) {
-    const Point3& p = quilt.point(v);
-    pts.push_back({p.x(), p.y(), p.z()});
-  }
-  std::vector<P3> feet(pts.size());
-  const TriangleDistance tree(base);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pts.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+FootGrid feet_on_base(const TriangleDistance& base, const std::vector<P3>& points, double radius) {
+  std::vector<P3> feet(points.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     int hint = -1;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const TriangleDistance::Hit h = tree.closest(pts[i], hint);
+      const TriangleDistance::Hit h = base.closest(points[i], hint);
       feet[i] = h.point;
       hint = h.tri;
     }
@@ -40,12 +31,15 @@ FootGrid quilt_feet(const ElementMesh& base, const Mesh& quilt, double radius) {
   return grid;
 }
 
-}  // namespace
-
 BareArea output_bare_area(const Mesh& base, const Mesh& quilt, double radius, const std::array<double, 3>& up) {
   if (!(radius > 0) || !std::isfinite(radius)) throw InvalidInputError("output_bare_area: radius must be > 0");
   const ElementMesh b = element_mesh_from(base);  // throws for a face that is not a triangle
-  const FootGrid feet = quilt_feet(b, quilt, radius);
+  std::vector<P3> pts;
+  for (VertexIndex v : quilt.vertices()) {
+    const Point3& p = quilt.point(v);
+    pts.push_back({p.x(), p.y(), p.z()});
+  }
+  const FootGrid feet = feet_on_base(TriangleDistance(b), pts, radius);
   auto height = [&](const P3& p) { return vec3::dot(p, up); };
   double hmin = 1e300, hmax = -1e300;
   for (const P3& p : b.points) hmin = std::min(hmin, height(p)), hmax = std::max(hmax, height(p));
