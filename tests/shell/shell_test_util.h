@@ -45,16 +45,19 @@ inline Swatch small_chainmail_swatch(std::uint64_t seed = 1, int segments = 12, 
   return make_swatch(small_chainmail_mesh(seed, segments, sides));
 }
 
-/// A 4 x 4 thread weave (generator defaults otherwise, e.g. WeaveOptions::spacing).
-inline Swatch weave_4x4(int segments_per_spacing, int sides) {
+/// A 4 x 4 thread weave mesh (generator defaults otherwise, e.g. WeaveOptions::spacing).
+inline Mesh weave_4x4_mesh(int segments_per_spacing, int sides) {
   WeaveOptions wo;
   wo.threads_x = wo.threads_y = 4;
   wo.segments_per_spacing = segments_per_spacing;
   wo.sides = sides;
   Mesh wm;
   make_weave_swatch(wm, wo);
-  return make_swatch(wm);
+  return wm;
 }
+
+/// The same as a swatch.
+inline Swatch weave_4x4(int segments_per_spacing, int sides) { return make_swatch(weave_4x4_mesh(segments_per_spacing, sides)); }
 
 /// An icosphere of `subdivisions` squashed to 0.08 along z: a lens, two
 /// nearly flat faces meeting at a sharp rim.

@@ -387,12 +387,7 @@ TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
 // threads are three, not six.
 TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
   const Mesh base = test::flat_lens(3);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 5;
-  Mesh weave;
-  make_weave_swatch(weave, wo);
+  const Mesh weave = test::weave_4x4_mesh(6, 5);
   auto run = [&](bool fill) {
     QuiltSwatchOnSurfaceOptions o;
     o.quilt.relative_size = 0.6;

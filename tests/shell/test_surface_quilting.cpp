@@ -609,13 +609,7 @@ namespace {
 TEST(SurfaceQuilting, HelixFieldCylinderWeaveOverlapAlignedPlacementsJumpLess) {
   Mesh base;
   make_cylinder(base, 1.0, 2.0, test::sanitized() ? 20 : 30, test::sanitized() ? 8 : 12);
-  WeaveOptions wo;
-  wo.threads_x = wo.threads_y = 4;
-  wo.segments_per_spacing = 6;
-  wo.sides = 6;
-  Mesh wm;
-  make_weave_swatch(wm, wo);
-  const Swatch sw = make_swatch(wm);
+  const Swatch sw = weave_4x4(6, 6);
   SurfaceQuiltOptions o;
   o.relative_size = test::sanitized() ? 0.45 : 0.35;
   o.up = {0.0, 0.6, 0.8};  // a helix field
