@@ -164,9 +164,11 @@ EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<Eleme
       // Quarter turns at the centroid first, then moved by up to a radius.
       const P3 e1 = (k & 1) ? vec3::cross(n, d) : d, e1s = (k & 2) ? vec3::mul(e1, -1.0) : e1;
       const P3 e2 = vec3::cross(n, e1s);
-      const P3 at = k < 4 ? c
-                          : vec3::add(c, vec3::add(vec3::mul(e1s, opt.radius * unit(rng)),
-                                                   vec3::mul(e2, opt.radius * unit(rng))));
+      P3 at = c;
+      if (k >= 4) {  // (the draws named, so their order is fixed: a call's arguments have none)
+        const double along_e2 = unit(rng), along_e1 = unit(rng);
+        at = vec3::add(c, vec3::add(vec3::mul(e1s, opt.radius * along_e1), vec3::mul(e2, opt.radius * along_e2)));
+      }
       if (!place(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
       if (coll.any_hit(m, -1, 0)) continue;
       if (element_self_crossings(m, false).size() > opt.own_crossings) continue;

@@ -178,7 +178,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   // A swatch of threads gets six refill rounds in the quilt (its only fill
   // there); filled again after the embedding, three do (decision 102, session 44).
   std::vector<ElementMesh> fill_templates;
-  if (opt.fill_embedded) fill_templates = embedded_fill_templates(r.swatch, qo);
+  if (opt.fill_embedded) fill_templates = thread_fill_templates(r.swatch, qo);
   if (qo.refill_rounds < 0 && !fill_templates.empty()) qo.refill_rounds = kRefillRoundsBeforeEmbeddedFill;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);

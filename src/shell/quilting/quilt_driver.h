@@ -99,7 +99,7 @@ struct QuiltSwatchOnSurfaceOptions {
   /// generated swatches and the rocks (1.3-2.0) are untouched.
   double split_edges_over_median = 2.5;
   /// Fill what the embedded quilt leaves bare with pieces of the swatch's
-  /// threads (EmbedSurfaceQuiltOptions::fill, embedded_fill_templates: a
+  /// threads (EmbedSurfaceQuiltOptions::fill, thread_fill_templates: a
   /// swatch with no compact element). The quilt's refill rounds, left to the
   /// swatch (SurfaceQuiltOptions::refill_rounds -1), are then
   /// kRefillRoundsBeforeEmbeddedFill instead of six. Default true (decision

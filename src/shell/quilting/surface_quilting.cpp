@@ -515,9 +515,6 @@ double spread13(const std::vector<P3>& pts) {
   return best;
 }
 
-// The swatch's compact elements (rings, pebbles: is_compact_element), each
-// moved so that its xy centroid is the origin (swatch units, z kept): what
-// the scatter fill places one at a time.
 // `m` moved so that the mean of its vertices' xy is the origin (z kept).
 void centre_xy(ElementMesh& m) {
   double cx = 0, cy = 0;
@@ -527,6 +524,9 @@ void centre_xy(ElementMesh& m) {
   for (P3& q : m.points) q[0] -= cx, q[1] -= cy;
 }
 
+// The swatch's compact elements (rings, pebbles: is_compact_element), each
+// moved so that its xy centroid is the origin (swatch units, z kept): what
+// the scatter fill places one at a time.
 std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
   std::vector<ElementMesh> out;
   for (ElementMesh& m : swatch_element_meshes(s)) {
@@ -714,8 +714,7 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   }
   vertex_normal_ = vertex_normals(b_);  // for the lifted positions (finish)
   compact_ = compact_swatch_elements(swatch);
-  if (compact_.empty() && opt.scatter_attempts > 0 && opt.scatter_thread_parts > 0)
-    thread_pieces_ = thread_scatter_pieces(swatch, opt.scatter_thread_parts);
+  thread_pieces_ = thread_fill_templates(swatch, opt);  // (none with compact elements)
   for (const ElementMesh& m : compact_) compact_spread_ = std::max(compact_spread_, spread13(m.points));
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   lift_rings_ = opt.lift_crossing_rings < 0 ? !compact_.empty() && element_boxes_overlap(swatch) : opt.lift_crossing_rings > 0;
@@ -2022,7 +2021,7 @@ double longest_thread(const Swatch& s) {
 }
 }  // namespace
 
-std::vector<ElementMesh> embedded_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
+std::vector<ElementMesh> thread_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
   if (opt.scatter_attempts <= 0 || !compact_swatch_elements(swatch).empty()) return {};
   return thread_scatter_pieces(swatch, opt.scatter_thread_parts);
 }

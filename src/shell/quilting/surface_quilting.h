@@ -341,12 +341,13 @@ double default_surface_quilt_size(const Swatch& swatch);
 /// piece centred in xy.
 std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts);
 
-/// What the scatter fill places once more on the embedded quilt
-/// (embedded_fill.h): the thread pieces when the swatch has no compact
-/// element and the scatter fill runs (scatter_attempts, scatter_thread_parts
-/// > 0), else none (compact elements are placed whole, affinely, by the
-/// embedding, which a fill in mesh space would not do).
-std::vector<ElementMesh> embedded_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt);
+/// The thread pieces both scatter fills place, the quilt's and the embedded
+/// quilt's (embedded_fill.h): thread_scatter_pieces when the swatch has no
+/// compact element and the scatter fill runs (scatter_attempts,
+/// scatter_thread_parts > 0), else none (the quilt's scatter places compact
+/// elements; the embedding places them whole, affinely, which a fill in mesh
+/// space would not do).
+std::vector<ElementMesh> thread_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
 /// scaled swatch's xy area (0 when the swatch has no area).
