@@ -304,9 +304,10 @@ SubcommandRegistrar reg_quilt{
                       "else 1.5..1e6 (default 2.5)")
            ->check(zero_or_between(1.5, 1e6, "never"));
        app.add_option("--thread-pieces", a->thread_pieces,
-                      "On a mesh, for a swatch with no compact element (a weave): what stays bare after the "
-                      "quilting, and again after the embedding (threads the shell map folds over a sharp rim "
-                      "are cut there), is filled with pieces of its threads, each thread cut into this many; "
+                      "On a mesh, what stays bare after the quilting, and again after the embedding (threads "
+                      "the shell map folds over a sharp rim are cut there), is filled: with whole copies of the "
+                      "swatch's compact elements (rings, tubes, pebbles; rigid, resting on the surface), or for a "
+                      "swatch with none (a weave) with pieces of its threads, each thread cut into this many; "
                       "0 = no pieces (0..16, default 4)")
            ->check(CLI::Range(0, 16));
        app.add_option("--stretch-iterations", a->stretch_iterations,

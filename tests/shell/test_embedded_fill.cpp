@@ -9,6 +9,7 @@
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/self_intersections.h"
+#include "shell/element_clearance.h"
 #include "shell/element_mesh.h"
 #include "shell/quilting/embedded_fill.h"
 #include "shell/quilting/quilt_coverage.h"
@@ -146,6 +147,68 @@ TEST(EmbeddedFill, PiecesOverAnOpenBorderAreNotSquashedOntoIt) {
     squashed += !rigid;
   }
   EXPECT_EQ(squashed, 0u) << "of " << els.size();
+}
+
+// A ring (a torus lying flat, 0.2 across) as the one template of a rigid fill.
+EmbeddedFillOptions ring_fill() {
+  Mesh torus;
+  make_torus(torus, 0.07, 0.03, 16, 8);
+  EmbeddedFillOptions o;
+  o.templates = {element_mesh_from(torus)};
+  o.scale = 1;
+  o.z0 = -0.03;
+  o.radius = 0.1;
+  o.rigid = true;
+  o.max_float = 0.06;  // the ring's height
+  o.clearance = 0.02;
+  return o;
+}
+
+double distance(const P3& a, const P3& b) { return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]); }
+
+// A thin part (a horn: an ellipsoid 0.5 across, 3 long) and compact elements:
+// each goes whole (the same distances between its vertices as the template),
+// resting on the surface without crossing it, no vertex floating more than
+// max_float over its height, and the clearance kept between copies. Bent
+// over the horn, as thread pieces are, a ring would not keep its shape.
+TEST(EmbeddedFill, CompactElementsGoWholeOntoAThinPart) {
+  Mesh horn;
+  make_ellipsoid(horn, 0.25, 0.25, 1.5, 4);
+  const ElementMesh b = element_mesh_from(horn);
+  const EmbeddedFillOptions o = ring_fill();
+  std::vector<ElementMesh> els;
+  const EmbeddedFillResult r = fill_embedded_bare(b, els, o);
+  EXPECT_GT(r.placed, 20u);
+  EXPECT_LT(bare(horn, els, o.radius), 0.25);
+  const ElementMesh& t = o.templates[0];
+  double worst = 0;
+  for (const ElementMesh& m : els)
+    for (std::size_t v = 1; v < t.points.size(); v += 7)
+      for (std::size_t w = 0; w < v; w += 5)
+        worst = std::max(worst, std::abs(distance(m.points[v], m.points[w]) - distance(t.points[v], t.points[w])));
+  EXPECT_LT(worst, 1e-9) << "a copy is not rigid";
+  Mesh scene = horn, ring;
+  mesh_from_elements(els, ring);
+  scene.join(ring);
+  EXPECT_TRUE(self_intersecting_faces(scene).empty());
+  const TriangleDistance surface(b);
+  for (const ElementMesh& m : els)
+    for (std::size_t v = 0; v < m.points.size(); ++v)
+      EXPECT_LE(surface.closest(m.points[v]).distance, (t.points[v][2] - o.z0) + o.max_float + 1e-3 * o.radius);
+  EXPECT_GE(smallest_element_gap(els, 1.0), o.clearance * (1 - 1e-9));
+}
+
+// The rigid fill's own options: turns 1 or 4, no negative float or clearance.
+TEST(EmbeddedFill, RefusesImpossibleRigidOptions) {
+  const ElementMesh b = element_mesh_from(test::flat_lens(1));
+  std::vector<ElementMesh> els;
+  for (auto edit : {+[](EmbeddedFillOptions& o) { o.turns = 2; }, +[](EmbeddedFillOptions& o) { o.max_float = -1; },
+                    +[](EmbeddedFillOptions& o) { o.clearance = std::nan(""); },
+                    +[](EmbeddedFillOptions& o) { o.up = {0, std::nan(""), 0}; }}) {
+    EmbeddedFillOptions o = ring_fill();
+    edit(o);
+    EXPECT_THROW(fill_embedded_bare(b, els, o), InvalidInputError);
+  }
 }
 
 TEST(EmbeddedFill, RefusesImpossibleOptions) {

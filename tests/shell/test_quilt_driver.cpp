@@ -408,5 +408,32 @@ TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
   EXPECT_EQ(on.embedding.self_intersections_within, 0u);
 }
 
+// A swatch of compact elements (one ring, placed by the scatter alone) on a
+// horn: what the quilt and the embedding leave bare gets whole rings, rigid,
+// crossing nothing.
+TEST(QuiltDriver, CompactElementsFillWhatTheEmbeddingLeftBare) {
+  Mesh horn, ring;
+  make_ellipsoid(horn, 0.25, 0.25, 1.5, 3);
+  make_torus(ring, 0.35, 0.15, 16, 8);
+  auto run = [&](bool fill) {
+    QuiltSwatchOnSurfaceOptions o;
+    o.quilt.up = {0, 0, 1};
+    o.quilt.relative_size = 0.2;  // rings about as wide as the horn
+    o.embed.stretch.iterations = 2;
+    o.fill_embedded = fill;
+    Mesh out;
+    return quilt_swatch_on_surface(horn, ring, out, o);
+  };
+  const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
+  EXPECT_TRUE(on.quilt.scatter_only);
+  EXPECT_EQ(off.embedding.fill.placed, 0u);
+  EXPECT_GT(on.embedding.fill.placed, 0u);
+  EXPECT_GT(off.bare.overall, 0.01);
+  EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
+  EXPECT_TRUE(on.embedding.embed.checked);
+  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
+  EXPECT_EQ(on.embedding.self_intersections_within, 0u);
+}
+
 }  // namespace
 }  // namespace surftex

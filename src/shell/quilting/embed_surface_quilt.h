@@ -100,8 +100,9 @@ struct EmbedSurfaceQuiltOptions {
   bool recentre_caps = true;
   /// Last: pieces placed into what the output leaves bare (embedded_fill.h;
   /// no templates, the default: none). quilt_swatch_on_surface sets the
-  /// templates (thread_fill_templates), scale, heights and radius; the
-  /// shard bound is held to embedded_edge_bound too.
+  /// templates (compact_swatch_elements placed rigidly, else
+  /// thread_fill_templates), scale, heights and radius; the shard bound is
+  /// held to embedded_edge_bound too.
   EmbeddedFillOptions fill;
   /// Check every embedded vertex against the geometric shell (embed_outside_shell.h).
   bool measure_outside_shell = true;

@@ -30,6 +30,11 @@ void check_options(const EmbeddedFillOptions& o) {
   if (!(o.max_stretch >= 1) || !std::isfinite(o.max_stretch)) bad("max_stretch must be >= 1");
   if (!(o.max_edge >= 0) || !std::isfinite(o.max_edge)) bad("max_edge must be >= 0");
   if (!(o.max_normal_angle_deg > 0 && o.max_normal_angle_deg <= 180)) bad("max_normal_angle_deg must be in (0, 180]");
+  if (!(o.max_float >= 0) || !std::isfinite(o.max_float)) bad("max_float must be >= 0");
+  if (!(o.clearance >= 0) || !std::isfinite(o.clearance)) bad("clearance must be >= 0");
+  if (o.turns != 1 && o.turns != 4) bad("turns must be 1 or 4");
+  for (double u : o.up)
+    if (!std::isfinite(u)) bad("up must be finite");
 }
 
 // An element's long axis: the principal direction of its points (power
@@ -69,9 +74,9 @@ struct FillState {
   }
 };
 
-// The tangent direction at `c` (normal n) of the nearest element's long axis
-// within about two radii, or of the face's first edge.
-P3 local_direction(const FillState& s, const P3& c, const P3& n, const P3& edge) {
+// The tangent direction at `c` (normal n) of `up`, else of the nearest
+// element's long axis within about two radii, else of the face's first edge.
+P3 local_direction(const FillState& s, const P3& c, const P3& n, const P3& edge, const P3& up) {
   double best = std::numeric_limits<double>::infinity();
   int id = -1;
   s.near.any_near(c, [&](const P3& q, int e) {
@@ -79,7 +84,7 @@ P3 local_direction(const FillState& s, const P3& c, const P3& n, const P3& edge)
     if (d < best) best = d, id = e;
     return false;
   });
-  for (const P3& a : {id >= 0 ? s.axis[static_cast<std::size_t>(id)] : edge, edge}) {
+  for (const P3& a : {up, id >= 0 ? s.axis[static_cast<std::size_t>(id)] : edge, edge}) {
     const P3 t = vec3::sub(a, vec3::mul(n, vec3::dot(a, n)));
     const double l = vec3::norm(t);
     if (l > 1e-6 * vec3::norm(a)) return vec3::mul(t, 1.0 / l);
@@ -129,6 +134,45 @@ bool place(const FillState& s, const EmbeddedFillOptions& o, const ElementMesh& 
   return true;
 }
 
+// One rigid copy of `tpl` at `c` in the frame (e1, e2, n), rested on the
+// base: lifted along n until no vertex lies below its height over the base
+// (measured to its closest point); false when a foot's face leaves the normal
+// cone, a vertex lies beside its foot (past an open border) or floats more
+// than max_float over its height. `feet` gets the feet.
+bool place_rigid(const FillState& s, const EmbeddedFillOptions& o, const ElementMesh& tpl, const P3& c, const P3& e1,
+                 const P3& e2, const P3& n, double cos_max, ElementMesh& m, std::vector<P3>& feet) {
+  m.tris = tpl.tris;
+  m.points.resize(tpl.points.size());
+  feet.resize(tpl.points.size());
+  const double eps = 1e-3 * o.radius;  // off the base, so that resting on it is no crossing
+  double rest = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    int hint = -1;
+    double sink = 0;
+    for (std::size_t v = 0; v < tpl.points.size(); ++v) {
+      const P3& q = tpl.points[v];
+      const double height = (q[2] - o.z0) * o.scale;
+      const P3 x = vec3::add(c, vec3::add(vec3::add(vec3::mul(e1, o.scale * q[0]), vec3::mul(e2, o.scale * q[1])),
+                                          vec3::mul(n, height + rest)));
+      const TriangleDistance::Hit h = s.tree.closest(x, hint);
+      if (h.tri < 0) return false;
+      hint = h.tri;
+      const P3& fn = s.fn[static_cast<std::size_t>(h.tri)];
+      const P3 d = vec3::sub(x, h.point);
+      const double along = vec3::dot(d, fn);
+      sink = std::max(sink, height + eps - along);
+      if (pass == 0) continue;
+      if (vec3::dot(fn, n) < cos_max) return false;
+      if (vec3::norm(vec3::sub(d, vec3::mul(fn, along))) > std::max(1e-9 * o.radius, std::abs(along))) return false;
+      if (along - height > o.max_float + eps) return false;
+      feet[v] = h.point;
+      m.points[v] = x;
+    }
+    rest += std::max(0.0, sink);
+  }
+  return true;
+}
+
 }  // namespace
 
 EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<ElementMesh>& els,
@@ -142,6 +186,8 @@ EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<Eleme
   for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
   FootGrid feet = feet_on_base(s.tree, pts, opt.radius);
   ElementCollider coll(els, {});
+  // Rigid copies must not cross the base either (exact, as between elements).
+  const ElementCollider base_coll = opt.rigid ? ElementCollider({base}, {}) : ElementCollider({}, {});
   std::mt19937_64 rng(opt.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const double cos_max = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
@@ -156,22 +202,28 @@ EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<Eleme
     if (!(vec3::norm(n) > 0)) continue;
     ++res.faces_tried;
     const P3 c{(a[0] + b[0] + c2[0]) / 3, (a[1] + b[1] + c2[1]) / 3, (a[2] + b[2] + c2[2]) / 3};
-    const P3 d = local_direction(s, c, n, vec3::sub(b, a));
+    const P3 d = local_direction(s, c, n, vec3::sub(b, a), opt.up);
     if (!(vec3::norm(d) > 0)) continue;
     bool ok = false;
     for (int k = 0; k < opt.attempts && !ok; ++k) {
       const ElementMesh& tpl = opt.templates[static_cast<std::size_t>(rng() % opt.templates.size())];
       // Quarter turns at the centroid first, then moved by up to a radius.
-      const P3 e1 = (k & 1) ? vec3::cross(n, d) : d, e1s = (k & 2) ? vec3::mul(e1, -1.0) : e1;
+      const int turn = opt.turns == 1 ? 0 : k & 3;
+      const P3 e1 = (turn & 1) ? vec3::cross(n, d) : d, e1s = (turn & 2) ? vec3::mul(e1, -1.0) : e1;
       const P3 e2 = vec3::cross(n, e1s);
       P3 at = c;
-      if (k >= 4) {  // (the draws named, so their order is fixed: a call's arguments have none)
+      if (k >= opt.turns) {  // (the draws named, so their order is fixed: a call's arguments have none)
         const double along_e2 = unit(rng), along_e1 = unit(rng);
         at = vec3::add(c, vec3::add(vec3::mul(e1s, opt.radius * along_e1), vec3::mul(e2, opt.radius * along_e2)));
       }
-      if (!place(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
-      if (coll.any_hit(m, -1, 0)) continue;
-      if (element_self_crossings(m, false).size() > opt.own_crossings) continue;
+      if (opt.rigid) {
+        if (!place_rigid(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
+        if (base_coll.any_hit(m, -1, 0) || coll.any_hit(m, -1, opt.clearance)) continue;
+      } else {
+        if (!place(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
+        if (coll.any_hit(m, -1, opt.clearance)) continue;
+        if (element_self_crossings(m, false).size() > opt.own_crossings) continue;
+      }
       ok = true;
     }
     if (!ok) continue;

@@ -15,7 +15,15 @@
 // swatch's own crossings: so it adds no crossing and no shard.
 //
 // Orientation: a piece runs along the nearest embedded element's long axis
-// (the weave's threads near it), or a quarter turn of it.
+// (the weave's threads near it), or a quarter turn of it; given an up
+// direction, along its projection (the quilt's guidance field, unsmoothed).
+//
+// Compact elements (rings, tubes, pebbles: `rigid`) are placed whole, as the
+// embedding places them (affinely, not bent): a rigid copy in the face's
+// tangent frame, rested on the base (lifted until no vertex lies below its
+// height over the base), kept only if no vertex floats more than max_float
+// over its height, it crosses neither the base nor an element (exact), and
+// keeps `clearance` to every element (the quilt scatter's gap).
 // Reads: the base (triangles), the elements. Writes: appends to `els`.
 // Deterministic for a seed (faces in order, one generator).
 #include <cstddef>
@@ -39,6 +47,16 @@ struct EmbeddedFillOptions {
   double max_normal_angle_deg = 60.0;
   /// Self-intersecting pairs a placed piece may keep (the swatch's own).
   std::size_t own_crossings = 0;
+  /// Whole rigid copies (compact elements) instead of pieces bent over the base.
+  bool rigid = false;
+  /// Rigid copies: how far a vertex may float over its height above the base (mesh units, >= 0).
+  double max_float = 0;
+  /// Gap kept to every element (mesh units, >= 0; 0: only no crossing).
+  double clearance = 0;
+  /// Quarter turns tried before the copy is moved: 4, or 1 (the direction only).
+  int turns = 4;
+  /// Non-zero: pieces run along its projection on the face (else the nearest element's axis).
+  P3 up{0, 0, 0};
   std::uint64_t seed = 1;
 };
 

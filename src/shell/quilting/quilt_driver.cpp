@@ -149,6 +149,20 @@ std::size_t split_long_swatch_edges(Mesh& m, double medians) {
   return m.number_of_vertices() - before;
 }
 
+// Compact elements placed whole by the embedded fill, as the quilt's scatter
+// places them: its gap kept to every element; a swatch scattered alone in the
+// guidance field's orientation (the up field's, unsmoothed) only; resting on
+// the base, floating at most the shell's height over where the shell would
+// hold it (its bottom stays in the shell; decision 102, session 45).
+void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scale, EmbeddedFillOptions& f) {
+  f.rigid = true;
+  f.clearance = scatter_gap(sw, qo) * scale;
+  f.max_float = sw.height() * scale;
+  if (!scattered_alone(sw, qo)) return;
+  f.turns = 1;
+  if (qo.field == SurfaceQuiltOptions::Field::kUp) f.up = qo.up;
+}
+
 }  // namespace
 
 QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh& swatch_mesh, Mesh& out,
@@ -175,11 +189,15 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   if (!(qo.relative_size > 0)) qo.relative_size = default_surface_quilt_size(r.swatch);
   check_surface_quilt_size(base, r.swatch, qo, opt.check_work);
   qo.seed = opt.seed;
-  // A swatch of threads gets six refill rounds in the quilt (its only fill
-  // there); filled again after the embedding, three do (decision 102, session 44).
+  // The embedded fill places the swatch's compact elements whole, else
+  // pieces of its threads. A swatch of threads gets six refill rounds in the
+  // quilt (its only fill there); filled again after the embedding, three do
+  // (decision 102, session 44).
   std::vector<ElementMesh> fill_templates;
-  if (opt.fill_embedded) fill_templates = thread_fill_templates(r.swatch, qo);
-  if (qo.refill_rounds < 0 && !fill_templates.empty()) qo.refill_rounds = kRefillRoundsBeforeEmbeddedFill;
+  const bool fill_rigid = opt.fill_embedded && qo.scatter_attempts > 0 && !compact_swatch_elements(r.swatch).empty();
+  if (fill_rigid) fill_templates = compact_swatch_elements(r.swatch);
+  else if (opt.fill_embedded) fill_templates = thread_fill_templates(r.swatch, qo);
+  if (qo.refill_rounds < 0 && !fill_rigid && !fill_templates.empty()) qo.refill_rounds = kRefillRoundsBeforeEmbeddedFill;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);
   r.seconds_quilt = t.seconds();
@@ -202,6 +220,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
   eo.fill.max_stretch = qo.scatter_max_stretch;
   eo.fill.own_crossings = r.swatch.element_self_crossings;
   eo.fill.seed = opt.seed;
+  if (fill_rigid) set_rigid_fill(r.swatch, qo, r.local.scale, eo.fill);
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();

@@ -98,12 +98,13 @@ struct QuiltSwatchOnSurfaceOptions {
   /// floor (1.5 swatch longest edges) then stays under 4 medians; the
   /// generated swatches and the rocks (1.3-2.0) are untouched.
   double split_edges_over_median = 2.5;
-  /// Fill what the embedded quilt leaves bare with pieces of the swatch's
-  /// threads (EmbedSurfaceQuiltOptions::fill, thread_fill_templates: a
-  /// swatch with no compact element). The quilt's refill rounds, left to the
-  /// swatch (SurfaceQuiltOptions::refill_rounds -1), are then
-  /// kRefillRoundsBeforeEmbeddedFill instead of six. Default true (decision
-  /// 102, session 44).
+  /// Fill what the embedded quilt leaves bare (EmbedSurfaceQuiltOptions::fill):
+  /// with whole rigid copies of the swatch's compact elements (rings, tubes,
+  /// pebbles; the quilt scatter's gap kept, a swatch scattered alone in the up
+  /// field's orientation; decision 102, session 45), else with pieces of its
+  /// threads (thread_fill_templates); then the quilt's refill rounds, left
+  /// to the swatch (SurfaceQuiltOptions::refill_rounds -1), are
+  /// kRefillRoundsBeforeEmbeddedFill instead of six. Default true (session 44).
   bool fill_embedded = true;
 };
 

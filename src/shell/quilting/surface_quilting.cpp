@@ -524,19 +524,6 @@ void centre_xy(ElementMesh& m) {
   for (P3& q : m.points) q[0] -= cx, q[1] -= cy;
 }
 
-// The swatch's compact elements (rings, pebbles: is_compact_element), each
-// moved so that its xy centroid is the origin (swatch units, z kept): what
-// the scatter fill places one at a time.
-std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
-  std::vector<ElementMesh> out;
-  for (ElementMesh& m : swatch_element_meshes(s)) {
-    if (m.points.empty() || !is_compact_element(m)) continue;
-    centre_xy(m);
-    out.push_back(std::move(m));
-  }
-  return out;
-}
-
 // One surface patch of the loop (steps 2-5 of the header).
 struct Patch {
   int seed = -1;
@@ -719,10 +706,8 @@ SurfaceQuilter::SurfaceQuilter(const Mesh& mesh, const Swatch& swatch, const Sur
   all_compact_ = !compact_.empty() && compact_.size() == swatch.elements.size();
   lift_rings_ = opt.lift_crossing_rings < 0 ? !compact_.empty() && element_boxes_overlap(swatch) : opt.lift_crossing_rings > 0;
   res_.lift_crossing_rings = lift_rings_ ? 1 : 0;
-  scatter_only_ = opt.scatter_attempts > 0 && all_compact_ &&
-                  compact_.size() <= static_cast<std::size_t>(opt.scatter_swatch_elements);
-  scatter_clearance_ = scatter_only_ ? opt.scatter_clearance * std::max(swatch.length(), swatch.width()) * S_
-                                     : 0.5 * swatch.min_gap * S_;
+  scatter_only_ = scattered_alone(swatch, opt);
+  scatter_clearance_ = scatter_gap(swatch, opt) * S_;
   ring_handles_ = compact_.empty() ? 0 : std::numeric_limits<int>::max();
   int most_handles = 0;
   for (const ElementMesh& m : compact_) {
@@ -2020,6 +2005,27 @@ double longest_thread(const Swatch& s) {
   return longest;
 }
 }  // namespace
+
+std::vector<ElementMesh> compact_swatch_elements(const Swatch& s) {
+  std::vector<ElementMesh> out;
+  for (ElementMesh& m : swatch_element_meshes(s)) {
+    if (m.points.empty() || !is_compact_element(m)) continue;
+    centre_xy(m);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+bool scattered_alone(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
+  const std::vector<ElementMesh> compact = compact_swatch_elements(swatch);
+  return opt.scatter_attempts > 0 && !compact.empty() && compact.size() == swatch.elements.size() &&
+         compact.size() <= static_cast<std::size_t>(opt.scatter_swatch_elements);
+}
+
+double scatter_gap(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
+  return scattered_alone(swatch, opt) ? opt.scatter_clearance * std::max(swatch.length(), swatch.width())
+                                      : 0.5 * swatch.min_gap;
+}
 
 std::vector<ElementMesh> thread_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt) {
   if (opt.scatter_attempts <= 0 || !compact_swatch_elements(swatch).empty()) return {};

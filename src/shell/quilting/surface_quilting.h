@@ -341,12 +341,25 @@ double default_surface_quilt_size(const Swatch& swatch);
 /// piece centred in xy.
 std::vector<ElementMesh> thread_scatter_pieces(const Swatch& swatch, int parts);
 
+/// The swatch's compact elements (rings, pebbles: is_compact_element), each
+/// moved so that its xy centroid is the origin (swatch units, z kept): what
+/// the scatter fills place one at a time.
+std::vector<ElementMesh> compact_swatch_elements(const Swatch& swatch);
+
+/// Whether the swatch is placed by the scatter fill alone, not quilted: at
+/// most scatter_swatch_elements elements, all compact, and the fill on.
+bool scattered_alone(const Swatch& swatch, const SurfaceQuiltOptions& opt);
+
+/// The scatter fill's gap to elements already placed (swatch units):
+/// scatter_clearance of the swatch's larger side for a swatch scattered
+/// alone, else half the swatch's smallest gap between elements.
+double scatter_gap(const Swatch& swatch, const SurfaceQuiltOptions& opt);
+
 /// The thread pieces both scatter fills place, the quilt's and the embedded
 /// quilt's (embedded_fill.h): thread_scatter_pieces when the swatch has no
 /// compact element and the scatter fill runs (scatter_attempts,
-/// scatter_thread_parts > 0), else none (the quilt's scatter places compact
-/// elements; the embedding places them whole, affinely, which a fill in mesh
-/// space would not do).
+/// scatter_thread_parts > 0), else none (both scatter fills place a swatch's
+/// compact elements themselves, whole: compact_swatch_elements).
 std::vector<ElementMesh> thread_fill_templates(const Swatch& swatch, const SurfaceQuiltOptions& opt);
 
 /// Swatch copies needed to cover `base` at that scale: the base's area over the
