@@ -273,18 +273,18 @@ std::size_t unfold_base_layer(const Mesh& base, const std::vector<std::uint8_t>&
 }
 
 /// Offset with local clamping (see the header); where shrinking cannot help,
-/// the base layer is unfolded locally (unfold_base_layer, up to 4 times, the
-/// moved set grown by what is still inverted; with `ring`, by one ring of
-/// neighbours more each time) and the shrinking resumed. Returns the prisms
-/// still inverted.
+/// the base layer is unfolded locally (unfold_base_layer, up to `attempts`
+/// times with 4, 8, ... 128 passes, the moved set grown by what is still
+/// inverted; with `ring`, by one ring of neighbours more each time) and the
+/// shrinking resumed. Returns the prisms still inverted.
 std::size_t clamp_and_unfold(const Mesh& base, std::vector<Vector3>& normal,
                              const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
-                             bool ring, ShellSpace& s) {
+                             bool ring, int attempts, ShellSpace& s) {
   s.vertex_height.assign(base.num_vertices(), s.height);
   std::vector<std::uint8_t> shrunk(base.num_vertices(), 0);
   std::vector<std::uint8_t> bad(base.num_vertices(), 0), unfold(base.num_vertices(), 0);
   std::size_t nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
-  for (int attempt = 0; nbad > 0 && attempt < 4; ++attempt) {
+  for (int attempt = 0; nbad > 0 && attempt < attempts; ++attempt) {
     for (std::size_t v = 0; v < bad.size(); ++v) unfold[v] |= bad[v];
     if (ring) {
       const std::vector<std::uint8_t> was = unfold;
@@ -292,7 +292,7 @@ std::size_t clamp_and_unfold(const Mesh& base, std::vector<Vector3>& normal,
         if (was[v.idx()] && !base.is_isolated(v))
           for (VertexIndex w : base.vertices_around_target(base.halfedge(v))) unfold[w.idx()] = 1;
     }
-    s.unfolded_vertices = unfold_base_layer(base, unfold, 4 << attempt, s, normal);
+    s.unfolded_vertices = unfold_base_layer(base, unfold, 4 << std::min(attempt, 5), s, normal);
     nbad = shrink_inverted_prisms(normal, face_bottom, opt, s, shrunk, bad);
   }
   s.clamped_vertices = 0;
@@ -302,19 +302,26 @@ std::size_t clamp_and_unfold(const Mesh& base, std::vector<Vector3>& normal,
 
 /// clamp_and_unfold; if prisms stay inverted (a scanned or modelled fold
 /// whose neighbours lean over it too: chair.obj's seat corners), again from
-/// the start with the unfolded set grown by a ring each time. Meshes the
-/// first pass succeeds on are unchanged by the second. Throws SolverError
-/// when prisms stay inverted.
+/// the start with the unfolded set grown by a ring each time; if still, a
+/// third time with the set grown by what stays inverted only, but up to 16
+/// times (dragon_25k.off's 30 folded vertices, no offset direction positive
+/// on all their faces: 9 times). Meshes a pass succeeds on are unchanged by
+/// the later ones. Throws SolverError when prisms stay inverted.
 void offset_with_clamping(const Mesh& base, std::vector<Vector3>& normal,
                           const std::vector<std::array<int, 3>>& face_bottom, const ShellSpaceOptions& opt,
                           ShellSpace& s) {
   const std::vector<Vec3> points = s.shell_points;
   const std::vector<Vector3> normals = normal;
-  std::size_t nbad = clamp_and_unfold(base, normal, face_bottom, opt, false, s);
+  std::size_t nbad = clamp_and_unfold(base, normal, face_bottom, opt, false, 4, s);
   if (nbad > 0) {
     s.shell_points = points;
     normal = normals;
-    nbad = clamp_and_unfold(base, normal, face_bottom, opt, true, s);
+    nbad = clamp_and_unfold(base, normal, face_bottom, opt, true, 4, s);
+  }
+  if (nbad > 0) {
+    s.shell_points = points;
+    normal = normals;
+    nbad = clamp_and_unfold(base, normal, face_bottom, opt, false, 16, s);
   }
   if (nbad > 0)
     throw SolverError("shell space: " + std::to_string(nbad) + " prisms still inverted after " +

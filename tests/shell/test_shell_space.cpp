@@ -235,6 +235,27 @@ TEST(ShellSpace, FoldsWhoseNeighboursLeanOverThemAreUnfoldedWithARingMore) {
   EXPECT_LT(s.unfolded_vertices, m.number_of_vertices() / 10);  // still local
 }
 
+// dragon_25k.off (a decimated scan): 30 vertices whose faces no offset
+// direction makes all positive, folds the first two passes leave 56 prisms
+// of (`surftex quilt dragon_25k.off rock_1.obj` was refused with them); the
+// third, unfolding up to 16 times, leaves none, still locally.
+TEST(ShellSpace, ManyFoldsOfAScanAreUnfoldedByMoreRounds) {
+  Mesh m;
+  load_input_mesh(test::shared_data("meshes/dragon_25k.off"), m);
+  BaseMeshAtlasOptions ao;
+  ao.max_normal_angle_deg = 30.0;  // the quilt embedding's atlas
+  compute_base_mesh_atlas(m, ao);
+  ShellSpaceOptions opt;
+  opt.height = 0.073960;
+  opt.relative_height = false;
+  const ShellSpace s = build_shell_space(m, opt);
+  auto [ns, nt] = count_not_positive(s);
+  EXPECT_EQ(ns, 0u);
+  EXPECT_EQ(nt, 0u);
+  EXPECT_GT(s.unfolded_vertices, 30u);
+  EXPECT_LT(s.unfolded_vertices, m.number_of_vertices() / 20);  // still local
+}
+
 TEST(ShellSpace, RefusesMissingAtlasAndBadOptions) {
   Mesh m;
   make_grid(m, 2, 2);
