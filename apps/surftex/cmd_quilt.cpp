@@ -204,6 +204,23 @@ std::string format_percent(double fraction) {
 }
 
 // The summary lines on stderr (unless --quiet).
+// Over 4% of a height band bare (issue 17's goal): parts thinner than the
+// elements, which stay whole, are left bare; a smaller --scale is the remedy.
+void print_thin_parts_note(const nlohmann::json& rep) {
+  if (!rep.contains("bare_by_height") || !rep.contains("scale")) return;
+  static const char* kBand[4] = {"lowest", "second", "third", "highest"};
+  const std::vector<double> bands = rep["bare_by_height"].get<std::vector<double>>();
+  std::size_t worst = 0;
+  for (std::size_t b = 1; b < bands.size() && b < 4; ++b)
+    if (bands[b] > bands[worst]) worst = b;
+  if (bands.empty() || !(bands[worst] > 0.04)) return;
+  std::fprintf(stderr,
+               "note: %s of the %s quarter of the mesh's height (along --up) is bare: parts thinner than the "
+               "swatch's elements (at --scale %g) are not covered, as elements stay whole; a smaller --scale "
+               "places smaller elements there\n",
+               format_percent(bands[worst]).c_str(), kBand[worst], rep["scale"].get<double>());
+}
+
 void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Mesh& out, double seconds) {
   if (a.common.quiet) return;
   std::string elements = std::to_string(rep["elements"].get<int>()) + " elements";
@@ -216,6 +233,7 @@ void print_quilt_summary(const QuiltArgs& a, const nlohmann::json& rep, const Me
     elements += ", " + format_percent(rep["bare_fraction"].get<double>()) + " of the surface bare";
   std::fprintf(stderr, "quilt: %s, %zu faces (%.1f s) -> %s\n", elements.c_str(),
                static_cast<std::size_t>(out.number_of_faces()), seconds, a.output.c_str());
+  print_thin_parts_note(rep);
   if (!rep.contains("stretch_before")) return;
   const auto& si = rep["self_intersections"];
   std::string what = "not checked (--no-check)";

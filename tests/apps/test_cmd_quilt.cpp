@@ -112,6 +112,35 @@ TEST(CmdQuilt, ThreadPiecesFillBareSpotsOfAWeaveAndZeroTurnsThemOff) {
   EXPECT_LT(on["bare_fraction"].get<double>(), off["bare_fraction"].get<double>());
 }
 
+// Rings wider than a horn: its tips stay bare, and the summary says why and
+// what to do (a smaller --scale); at the default scale the horn is covered
+// and nothing is said.
+TEST(CmdQuilt, ThinPartsLeftBareAreNamedWithTheScaleToLower) {
+  const std::string dir = test::temp_dir("quilt-thin-parts");
+  Mesh horn, ring;
+  make_ellipsoid(horn, 0.25, 0.25, 1.5, 2);
+  make_torus(ring, 0.35, 0.12, 16, 6);
+  write_mesh(dir + "/horn.off", horn);
+  write_mesh(dir + "/ring.off", ring);
+  auto run = [&](const std::string& scale, const std::string& tag) {
+    const test::RunResult r = test::run_surftex("quilt '" + dir + "/horn.off' '" + dir + "/ring.off' -o '" + dir + "/" +
+                                                tag + ".obj' --up 0 0 1 --scale " + scale +
+                                                " --stretch-iterations 2 --no-check --no-render --report '" + dir +
+                                                "/" + tag + ".json'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return std::make_pair(r.err, read_json(dir + "/" + tag + ".json"));
+  };
+  const auto [wide_err, wide] = run("0.3", "wide");
+  double worst = 0;
+  for (const auto& b : wide["bare_by_height"]) worst = std::max(worst, b.get<double>());
+  EXPECT_GT(worst, 0.04);
+  for (const char* w : {"parts thinner than", "quarter of the mesh's height", "--scale 0.3", "smaller --scale"})
+    EXPECT_NE(wide_err.find(w), std::string::npos) << w << " in " << wide_err;
+  const auto [fine_err, fine] = run("0", "fine");
+  for (const auto& b : fine["bare_by_height"]) EXPECT_LE(b.get<double>(), 0.04);
+  EXPECT_EQ(fine_err.find("parts thinner than"), std::string::npos) << fine_err;
+}
+
 TEST(CmdQuilt, BadInputExitsTwoAndWritesNothing) {
   const std::string dir = test::temp_dir("quilt-bad");
   // Unknown swatch file.

@@ -435,5 +435,30 @@ TEST(QuiltDriver, CompactElementsFillWhatTheEmbeddingLeftBare) {
   EXPECT_EQ(on.embedding.self_intersections_within, 0u);
 }
 
+// A box of twelve triangles and a swatch scattered alone: the fills place
+// one copy per base face, so without the base's long edges split most of each
+// side stays bare; split (the surface unchanged) it is covered.
+TEST(QuiltDriver, LongBaseEdgesAreSplitForASwatchScatteredAlone) {
+  Mesh box, ring;
+  make_cube(box, 1.0);
+  make_torus(ring, 0.35, 0.15, 16, 8);
+  auto run = [&](bool split) {
+    QuiltSwatchOnSurfaceOptions o;
+    o.quilt.relative_size = 0.08;
+    o.embed.stretch.iterations = 2;
+    o.split_base_edges = split;
+    Mesh out;
+    return quilt_swatch_on_surface(box, ring, out, o);
+  };
+  const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
+  EXPECT_EQ(off.base_vertices_split, 0u);
+  EXPECT_EQ(off.base_faces, 12u);
+  EXPECT_GT(on.base_vertices_split, 20u);
+  EXPECT_EQ(on.base_faces, box.number_of_faces() + 2 * on.base_vertices_split);  // closed: 2 faces per vertex
+  EXPECT_GT(off.bare.overall, 0.2);
+  EXPECT_LT(on.bare.overall, 0.05);
+  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
+}
+
 }  // namespace
 }  // namespace surftex

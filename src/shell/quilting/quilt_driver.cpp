@@ -128,6 +128,15 @@ void check_surface_quilt_size(const Mesh& base, const Swatch& s, const SurfaceQu
 // faces kept triangles and flat) until none is longer than `medians` of its
 // median edge, the median taken again after each round (splitting adds short
 // edges); at most 8 rounds. Returns the vertices added.
+// The edges of `m` longer than `bound`.
+std::vector<EdgeIndex> edges_longer_than(const Mesh& m, double bound) {
+  std::vector<EdgeIndex> out;
+  for (auto e : m.edges())
+    if (CGAL::squared_distance(m.point(m.source(m.halfedge(e))), m.point(m.target(m.halfedge(e)))) > bound * bound)
+      out.push_back(e);
+  return out;
+}
+
 std::size_t split_long_swatch_edges(Mesh& m, double medians) {
   const std::size_t before = m.number_of_vertices();
   for (int round = 0; round < 8; ++round) {
@@ -165,7 +174,19 @@ void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scal
 
 }  // namespace
 
-QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh& swatch_mesh, Mesh& out,
+std::size_t split_long_base_edges(const Mesh& base, double bound, Mesh& fine) {
+  if (!(bound > 0) || edges_longer_than(base, bound).empty()) return 0;
+  fine = base;
+  // (The faces split get new edges, which may be long too: again, at most 8 rounds.)
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<EdgeIndex> long_edges = edges_longer_than(fine, bound);
+    if (long_edges.empty()) break;
+    CGAL::Polygon_mesh_processing::split_long_edges(long_edges, bound, fine);
+  }
+  return fine.number_of_vertices() - base.number_of_vertices();
+}
+
+QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& input_base, const Mesh& swatch_mesh, Mesh& out,
                                                    const QuiltSwatchOnSurfaceOptions& opt) {
   QuiltSwatchOnSurfaceResult r;
   if (!(opt.split_edges_over_median == 0 || opt.split_edges_over_median >= 1.5))
@@ -187,7 +208,18 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& base, const Mesh&
                             "a flat swatch quilts a plane (--plane WxH)");
   SurfaceQuiltOptions qo = opt.quilt;
   if (!(qo.relative_size > 0)) qo.relative_size = default_surface_quilt_size(r.swatch);
-  check_surface_quilt_size(base, r.swatch, qo, opt.check_work);
+  check_surface_quilt_size(input_base, r.swatch, qo, opt.check_work);
+  // A swatch scattered alone: base faces wider than its element spacing
+  // split (the surface unchanged), as both fills try one place per face and
+  // the bare measure samples four points per face: a chair leg's long
+  // triangles stayed bare (decision 102, session 45). Quilted swatches cover
+  // faces by patches and are left alone.
+  Mesh fine_base;
+  if (opt.split_base_edges && scattered_alone(r.swatch, qo)) {
+    const double spacing = swatch_element_spacing(r.swatch) * surface_quilt_scale(input_base, r.swatch, qo.relative_size);
+    r.base_vertices_split = split_long_base_edges(input_base, spacing, fine_base);
+  }
+  const Mesh& base = r.base_vertices_split > 0 ? fine_base : input_base;
   qo.seed = opt.seed;
   // The embedded fill places the swatch's compact elements whole, else
   // pieces of its threads. A swatch of threads gets six refill rounds in the

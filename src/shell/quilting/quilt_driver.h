@@ -106,7 +106,17 @@ struct QuiltSwatchOnSurfaceOptions {
   /// to the swatch (SurfaceQuiltOptions::refill_rounds -1), are
   /// kRefillRoundsBeforeEmbeddedFill instead of six. Default true (session 44).
   bool fill_embedded = true;
+  /// For a swatch scattered alone (scattered_alone): split the base's edges
+  /// longer than its element spacing (scaled) before quilting
+  /// (split_long_base_edges): the fills try one place per base face. Default
+  /// true (decision 102, session 45).
+  bool split_base_edges = true;
 };
+
+/// The base with its edges longer than `bound` split (PMP::split_long_edges,
+/// midpoints: the surface unchanged), in `fine`; returns the vertices added
+/// (0: none was longer, `fine` untouched).
+std::size_t split_long_base_edges(const Mesh& base, double bound, Mesh& fine);
 
 /// The refill rounds of a swatch of threads that the embedding's fill follows.
 inline constexpr int kRefillRoundsBeforeEmbeddedFill = 3;
@@ -128,6 +138,7 @@ struct QuiltSwatchOnSurfaceResult {
   double seconds_quilt = 0, seconds_embed = 0;  ///< the two stages, wall clock
   /// Vertices added to the swatch by split_edges_over_median.
   std::size_t swatch_vertices_split = 0;
+  std::size_t base_vertices_split = 0;  ///< split_base_edges: vertices added to the base
 };
 
 /// Surface mesh quilting (section 3.1) of `swatch_mesh` over `base` (a

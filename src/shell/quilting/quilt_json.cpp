@@ -167,6 +167,7 @@ nlohmann::json to_json(const QuiltSwatchOnSurfaceResult& r) {
   j["swatch_components"] = r.swatch.components;  // more than elements: crossing components joined
   j["swatch_up"] = axis_name(r.swatch.up_axis);
   j["swatch_vertices_split"] = r.swatch_vertices_split;
+  j["base_vertices_split"] = r.base_vertices_split;
   j["up"] = r.up;
   j["scale"] = r.relative_size;
   j["field"] = r.field == SurfaceQuiltOptions::Field::kUp ? "up" : "none";
