@@ -38,6 +38,7 @@
 //   BENCH_SEED, BENCH_RELATIVE_SIZE, BENCH_MAX_EDGE_STRETCH, BENCH_THREAD_STRETCH, BENCH_REFILL_ROUNDS,
 //   BENCH_SCATTER (attempts), BENCH_SCATTER_STRETCH, BENCH_SCATTER_CONE,
 //   BENCH_SCATTER_ONLY (scatter_swatch_elements; 0: always quilt), BENCH_SCATTER_PASSES, BENCH_SCATTER_CLEARANCE,
+//   BENCH_SCATTER_SKIP (scatter_skip_near_failed),
 //   BENCH_SHAPE, BENCH_RINGS, BENCH_PIECES, BENCH_LOOP_GAP (blob_loop_gap),
 //   BENCH_LIFT_RINGS (lift_crossing_rings), BENCH_RESOLVE, BENCH_TRIM_NEW, BENCH_PUSH, BENCH_CLEARANCE, BENCH_KEEP_CUT,
 //   BENCH_RECENTRE (the embedding's recentre_caps), BENCH_EMBED_RESOLVE=0 (no crossing
@@ -264,6 +265,7 @@ json run_case(const std::string& name, const std::string& outdir) {
   if (const char* e = std::getenv("BENCH_SCATTER_ONLY")) qo.scatter_swatch_elements = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_PASSES")) qo.scatter_passes = std::atoi(e);
   if (const char* e = std::getenv("BENCH_SCATTER_CLEARANCE")) qo.scatter_clearance = std::atof(e);
+  if (const char* e = std::getenv("BENCH_SCATTER_SKIP")) qo.scatter_skip_near_failed = std::atof(e);
   if (const char* e = std::getenv("BENCH_SEED")) o.seed = std::strtoull(e, nullptr, 10);
   o.embed.stretch.iterations = 20;
   if (const char* e = std::getenv("BENCH_RECENTRE")) o.embed.recentre_caps = std::atoi(e) != 0;

@@ -1067,6 +1067,34 @@ TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   EXPECT_LT(bare, 0.03);
 }
 
+// A face next to one whose tries all failed is not tried again in the same
+// pass (each try flattens a patch): fewer faces tried, the sphere still
+// covered; with the option at 0 every bare face is tried.
+TEST(SurfaceQuiltingScatter, FacesNextToAFailedOneAreNotTriedAgain) {
+  Mesh base, rock;
+  make_icosphere(base, 5);
+  read_mesh(test::shared_data("swatches/rock_1.obj"), rock);
+  const Swatch s = make_swatch(rock);
+  auto run = [&](double skip) {
+    SurfaceQuiltOptions o;
+    o.relative_size = 0.08;
+    o.scatter_skip_near_failed = skip;
+    SurfaceQuilt q;
+    Mesh out;
+    return quilt_displaced(base, s, o, q, out);
+  };
+  const SurfaceQuiltResult all = run(0), skipping = run(SurfaceQuiltOptions{}.scatter_skip_near_failed);
+  EXPECT_EQ(all.scatter_faces_skipped, 0u);
+  EXPECT_GT(skipping.scatter_faces_skipped, 0u);
+  EXPECT_LT(skipping.scatter_faces_tried, all.scatter_faces_tried);
+  EXPECT_GT(skipping.scatter_placed, all.scatter_placed * 9 / 10);
+  EXPECT_LT(skipping.bare_fraction, 0.03);
+  SurfaceQuiltOptions bad;
+  bad.scatter_skip_near_failed = 1.5;
+  SurfaceQuilt q;
+  EXPECT_THROW(quilt_surface(base, s, q, bad), InvalidInputError);
+}
+
 // A real swatch's faces that nearly touch (wingnut.obj: pairs 0.0005 of its
 // size apart) were bent into each other by the piecewise-linear shell map, so
 // a third of the scattered nuts crossed themselves more than the swatch and

@@ -67,6 +67,8 @@ void add_placement(const SurfaceQuiltResult& r, nlohmann::json& j) {
   j["refill_rounds_run"] = r.refill_rounds_run;
   j["faces_refilled"] = r.faces_refilled;
   j["scatter_placed"] = r.scatter_placed;
+  j["scatter_faces_tried"] = r.scatter_faces_tried;
+  j["scatter_faces_skipped"] = r.scatter_faces_skipped;
   j["scatter_lifted"] = r.scatter_lifted;
   j["scatter_only"] = r.scatter_only;
   j["bare_fraction"] = r.bare_fraction;

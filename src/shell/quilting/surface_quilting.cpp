@@ -480,6 +480,8 @@ void check_options(const SurfaceQuiltOptions& o) {
     bad("scatter_alone_attempts must be in [1, 64]", o.scatter_alone_attempts);
   if (!(o.scatter_alone_max_stretch >= 1 && o.scatter_alone_max_stretch <= 10))
     bad("scatter_alone_max_stretch must be in [1, 10]", o.scatter_alone_max_stretch);
+  if (!(o.scatter_skip_near_failed >= 0 && o.scatter_skip_near_failed <= 1))
+    bad("scatter_skip_near_failed must be in [0, 1]", o.scatter_skip_near_failed);
   if (!(o.scatter_clearance >= 0 && o.scatter_clearance <= 1))
     bad("scatter_clearance must be in [0, 1]", o.scatter_clearance);
   if (o.field == SurfaceQuiltOptions::Field::kUp && !(vec3::norm(o.up) > 0) )
@@ -1858,9 +1860,25 @@ void SurfaceQuilter::scatter_into_bare() {
   FootGrid feet = element_feet();
   const double jitter = 0.5 * swatch_element_spacing(swatch_);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  // Faces whose tries all failed: a face next to one (its centroid within
+  // scatter_skip_near_failed of the jitter) is not tried in this pass.
+  const double skip = opt_.scatter_skip_near_failed * jitter * S_;
+  CellGrid<int> failed(skip > 0 ? skip : 1.0);
+  auto near_failed = [&](int f) {
+    const P3& c = b_.centroid[f];
+    return skip > 0 && failed.any_near(c, [&](const P3& q, int) {
+      const P3 d = vec3::sub(q, c);
+      return vec3::dot(d, d) < skip * skip;
+    });
+  };
   for (int f = 0; f < nf_; ++f) {
     if (f % 256 == 0) report_progress(opt_.progress, "scatter", static_cast<double>(f) / nf_);
     if (bare_samples(b_, f, feet) < min_bare) continue;
+    if (near_failed(f)) {
+      ++res_.scatter_faces_skipped;
+      continue;
+    }
+    ++res_.scatter_faces_tried;
     Patch p;
     grow_and_flatten(f, p, 2 * reach * S_, scatter_cos_max_);
     orient(p);
@@ -1878,7 +1896,10 @@ void SurfaceQuilter::scatter_into_bare() {
       placed = place_scatter_element(p, loc, t, scatter_only_ ? 0 : a, off, coll, el);
     }
     for (int g : p.flat.faces) patch_slot_[g] = -1;
-    if (!placed) continue;
+    if (!placed) {
+      if (skip > 0) failed.add(b_.centroid[f], f);
+      continue;
+    }
     for (const auto& v : el.loc) feet.add(base_point(b_, v));
     elements_.push_back(std::move(el));
     ++res_.scatter_placed;
