@@ -1067,9 +1067,9 @@ TEST(SurfaceQuiltingScatter, OneElementSwatchIsPlacedAsWholeCopies) {
   EXPECT_LT(bare, 0.03);
 }
 
-// A face next to one whose tries all failed is not tried again in the same
-// pass (each try flattens a patch): fewer faces tried, the sphere still
-// covered; with the option at 0 every bare face is tried.
+// With scatter_skip_near_failed, a face next to one whose tries all failed is
+// not tried again in the same pass (each try flattens a patch): fewer faces
+// tried, the sphere still covered; at 0 (the default) every bare face is tried.
 TEST(SurfaceQuiltingScatter, FacesNextToAFailedOneAreNotTriedAgain) {
   Mesh base, rock;
   make_icosphere(base, 5);
@@ -1083,7 +1083,8 @@ TEST(SurfaceQuiltingScatter, FacesNextToAFailedOneAreNotTriedAgain) {
     Mesh out;
     return quilt_displaced(base, s, o, q, out);
   };
-  const SurfaceQuiltResult all = run(0), skipping = run(SurfaceQuiltOptions{}.scatter_skip_near_failed);
+  EXPECT_EQ(SurfaceQuiltOptions{}.scatter_skip_near_failed, 0.0);  // off by default (coverage first)
+  const SurfaceQuiltResult all = run(0), skipping = run(0.25);
   EXPECT_EQ(all.scatter_faces_skipped, 0u);
   EXPECT_GT(skipping.scatter_faces_skipped, 0u);
   EXPECT_LT(skipping.scatter_faces_tried, all.scatter_faces_tried);
