@@ -379,6 +379,17 @@ TEST(QuiltDriver, GeneratedSwatchesByNameAndSeed) {
   EXPECT_THROW(load_or_generate_swatch("/nonexistent/swatch.obj", 1), Error);
 }
 
+// The embedded fill off and on: nothing placed without it; with it, pieces
+// placed, the bare area under half, and no crossing.
+void expect_the_fill_covers(const QuiltSwatchOnSurfaceResult& off, const QuiltSwatchOnSurfaceResult& on) {
+  EXPECT_EQ(off.embedding.fill.placed, 0u);
+  EXPECT_GT(on.embedding.fill.placed, 0u);
+  EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
+  EXPECT_TRUE(on.embedding.embed.checked);
+  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
+  EXPECT_EQ(on.embedding.self_intersections_within, 0u);
+}
+
 // Issue 17 item 4 after the embedding: on a fin (a flat lens, sharp rim),
 // the shell map folds threads over the rim and the embedding cuts them,
 // leaving bare what the quilt covered. The fill puts thread pieces there
@@ -397,15 +408,10 @@ TEST(QuiltDriver, ThreadPiecesFillWhatTheEmbeddingLeftBare) {
     return quilt_swatch_on_surface(base, weave, out, o);
   };
   const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
-  EXPECT_EQ(off.embedding.fill.placed, 0u);
-  EXPECT_GT(on.embedding.fill.placed, 0u);
+  expect_the_fill_covers(off, on);
   EXPECT_EQ(off.quilt.refill_rounds, 6);
   EXPECT_EQ(on.quilt.refill_rounds, kRefillRoundsBeforeEmbeddedFill);
   EXPECT_EQ(kRefillRoundsBeforeEmbeddedFill, 3);
-  EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
-  EXPECT_TRUE(on.embedding.embed.checked);
-  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
-  EXPECT_EQ(on.embedding.self_intersections_within, 0u);
 }
 
 // A swatch of compact elements (one ring, placed by the scatter alone) on a
@@ -426,13 +432,8 @@ TEST(QuiltDriver, CompactElementsFillWhatTheEmbeddingLeftBare) {
   };
   const QuiltSwatchOnSurfaceResult off = run(false), on = run(true);
   EXPECT_TRUE(on.quilt.scatter_only);
-  EXPECT_EQ(off.embedding.fill.placed, 0u);
-  EXPECT_GT(on.embedding.fill.placed, 0u);
   EXPECT_GT(off.bare.overall, 0.01);
-  EXPECT_LT(on.bare.overall, 0.5 * off.bare.overall);
-  EXPECT_TRUE(on.embedding.embed.checked);
-  EXPECT_EQ(on.embedding.self_intersections_between, 0u);
-  EXPECT_EQ(on.embedding.self_intersections_within, 0u);
+  expect_the_fill_covers(off, on);
 }
 
 // A box of twelve triangles and a swatch scattered alone: the fills place

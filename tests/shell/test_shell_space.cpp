@@ -6,6 +6,7 @@
 
 #include <map>
 #include <random>
+#include <string>
 
 #include "geometry/base_mesh_atlas.h"
 #include "geometry/errors.h"
@@ -213,6 +214,26 @@ TEST(ShellSpace, FoldedFacesAreUnfoldedInTheBottomLayerInsteadOfFailing) {
   EXPECT_EQ(build_shell_space(m, opt).unfolded_vertices, 0u);
 }
 
+namespace {
+// The shell `surftex quilt` builds over a mesh of ../shared/data (`m` gets
+// it, loaded and charted by the embedding's atlas) at an absolute height;
+// every tet must be positive in both spaces.
+ShellSpace quilt_shell_of(const std::string& mesh, double height, Mesh& m) {
+  load_input_mesh(test::shared_data("meshes/" + mesh), m);
+  BaseMeshAtlasOptions ao;
+  ao.max_normal_angle_deg = 30.0;  // the quilt embedding's atlas
+  compute_base_mesh_atlas(m, ao);
+  ShellSpaceOptions opt;
+  opt.height = height;
+  opt.relative_height = false;
+  ShellSpace s = build_shell_space(m, opt);
+  auto [ns, nt] = count_not_positive(s);
+  EXPECT_EQ(ns, 0u) << mesh;
+  EXPECT_EQ(nt, 0u) << mesh;
+  return s;
+}
+}  // namespace
+
 // A real mesh whose folds the unfolding alone could not undo: chair.obj (a
 // modelled chair: seat corners where neighbouring faces lean over a fold) at
 // the height `surftex quilt chair.obj rock_2.obj` gives its shell (3.03).
@@ -220,17 +241,7 @@ TEST(ShellSpace, FoldedFacesAreUnfoldedInTheBottomLayerInsteadOfFailing) {
 // set by a ring each time, leaves none (was: refused with inverted prisms).
 TEST(ShellSpace, FoldsWhoseNeighboursLeanOverThemAreUnfoldedWithARingMore) {
   Mesh m;
-  load_input_mesh(test::shared_data("meshes/chair.obj"), m);
-  BaseMeshAtlasOptions ao;
-  ao.max_normal_angle_deg = 30.0;  // the quilt embedding's atlas
-  compute_base_mesh_atlas(m, ao);
-  ShellSpaceOptions opt;
-  opt.height = 3.026546;
-  opt.relative_height = false;
-  const ShellSpace s = build_shell_space(m, opt);
-  auto [ns, nt] = count_not_positive(s);
-  EXPECT_EQ(ns, 0u);
-  EXPECT_EQ(nt, 0u);
+  const ShellSpace s = quilt_shell_of("chair.obj", 3.026546, m);
   EXPECT_GT(s.unfolded_vertices, 34u);  // more than the first pass's 34
   EXPECT_LT(s.unfolded_vertices, m.number_of_vertices() / 10);  // still local
 }
@@ -241,17 +252,7 @@ TEST(ShellSpace, FoldsWhoseNeighboursLeanOverThemAreUnfoldedWithARingMore) {
 // third, unfolding up to 16 times, leaves none, still locally.
 TEST(ShellSpace, ManyFoldsOfAScanAreUnfoldedByMoreRounds) {
   Mesh m;
-  load_input_mesh(test::shared_data("meshes/dragon_25k.off"), m);
-  BaseMeshAtlasOptions ao;
-  ao.max_normal_angle_deg = 30.0;  // the quilt embedding's atlas
-  compute_base_mesh_atlas(m, ao);
-  ShellSpaceOptions opt;
-  opt.height = 0.073960;
-  opt.relative_height = false;
-  const ShellSpace s = build_shell_space(m, opt);
-  auto [ns, nt] = count_not_positive(s);
-  EXPECT_EQ(ns, 0u);
-  EXPECT_EQ(nt, 0u);
+  const ShellSpace s = quilt_shell_of("dragon_25k.off", 0.073960, m);
   EXPECT_GT(s.unfolded_vertices, 30u);
   EXPECT_LT(s.unfolded_vertices, m.number_of_vertices() / 20);  // still local
 }

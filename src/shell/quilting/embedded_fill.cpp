@@ -92,6 +92,18 @@ P3 local_direction(const FillState& s, const P3& c, const P3& n, const P3& edge,
   return {0, 0, 0};
 }
 
+// Template point q's offset in the plane spanned by (e1, e2), scaled.
+P3 planar_offset(const EmbeddedFillOptions& o, const P3& q, const P3& e1, const P3& e2) {
+  return vec3::add(vec3::mul(e1, o.scale * q[0]), vec3::mul(e2, o.scale * q[1]));
+}
+
+// Whether a point `d` off its foot (`along` the foot face's normal fn) lies
+// beside it more than over it: past an open border (or a rim), where it
+// would be squashed onto the border.
+bool beside_foot(const EmbeddedFillOptions& o, const P3& d, const P3& fn, double along) {
+  return vec3::norm(vec3::sub(d, vec3::mul(fn, along))) > std::max(1e-9 * o.radius, std::abs(along));
+}
+
 // One placement of `tpl` at `c` in the frame (e1, e2, n): the planar points
 // projected to the base and lifted; false when a foot's face leaves the
 // normal cone, a point lies beside its foot rather than over it (past an
@@ -104,16 +116,13 @@ bool place(const FillState& s, const EmbeddedFillOptions& o, const ElementMesh& 
   int hint = -1;
   for (std::size_t v = 0; v < tpl.points.size(); ++v) {
     const P3& q = tpl.points[v];
-    const P3 x = vec3::add(c, vec3::add(vec3::mul(e1, o.scale * q[0]), vec3::mul(e2, o.scale * q[1])));
+    const P3 x = vec3::add(c, planar_offset(o, q, e1, e2));
     const TriangleDistance::Hit h = s.tree.closest(x, hint);
     if (h.tri < 0) return false;
     const P3& fn = s.fn[static_cast<std::size_t>(h.tri)];
     if (vec3::dot(fn, n) < cos_max) return false;
-    // Over the surface, the point lies off it along the normal; past an open
-    // border (or a rim) it lies beside its foot, and would be squashed onto it.
     const P3 d = vec3::sub(x, h.point);
-    const double along = vec3::dot(d, fn);
-    if (vec3::norm(vec3::sub(d, vec3::mul(fn, along))) > std::max(1e-9 * o.radius, std::abs(along))) return false;
+    if (beside_foot(o, d, fn, vec3::dot(d, fn))) return false;
     hint = h.tri;
     const Tri& t = s.base.tris[static_cast<std::size_t>(h.tri)];
     P3 nv{0, 0, 0};
@@ -152,8 +161,7 @@ bool place_rigid(const FillState& s, const EmbeddedFillOptions& o, const Element
     for (std::size_t v = 0; v < tpl.points.size(); ++v) {
       const P3& q = tpl.points[v];
       const double height = (q[2] - o.z0) * o.scale;
-      const P3 x = vec3::add(c, vec3::add(vec3::add(vec3::mul(e1, o.scale * q[0]), vec3::mul(e2, o.scale * q[1])),
-                                          vec3::mul(n, height + rest)));
+      const P3 x = vec3::add(c, vec3::add(planar_offset(o, q, e1, e2), vec3::mul(n, height + rest)));
       const TriangleDistance::Hit h = s.tree.closest(x, hint);
       if (h.tri < 0) return false;
       hint = h.tri;
@@ -163,7 +171,7 @@ bool place_rigid(const FillState& s, const EmbeddedFillOptions& o, const Element
       sink = std::max(sink, height + eps - along);
       if (pass == 0) continue;
       if (vec3::dot(fn, n) < cos_max) return false;
-      if (vec3::norm(vec3::sub(d, vec3::mul(fn, along))) > std::max(1e-9 * o.radius, std::abs(along))) return false;
+      if (beside_foot(o, d, fn, along)) return false;
       if (along - height > o.max_float + eps) return false;
       feet[v] = h.point;
       m.points[v] = x;

@@ -10,9 +10,10 @@
 // normal by its swatch height, as the quilt lifts its vertices. A placement
 // is kept only if it stays on one side of the surface (every foot's face
 // within a normal cone of the face) and over it (each point off its foot
-// along the normal more than beside it: not past an open border), no edge is stretched past the bounds,
-// it crosses no element (exact, ElementCollider) and not itself beyond the
-// swatch's own crossings: so it adds no crossing and no shard.
+// along the normal more than beside it: not past an open border), no edge is
+// stretched past the bounds, it crosses no element (exact, ElementCollider)
+// and not itself beyond the swatch's own crossings: so it adds no crossing
+// and no shard.
 //
 // Orientation: a piece runs along the nearest embedded element's long axis
 // (the weave's threads near it), or a quarter turn of it; given an up

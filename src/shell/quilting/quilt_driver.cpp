@@ -124,10 +124,6 @@ void check_surface_quilt_size(const Mesh& base, const Swatch& s, const SurfaceQu
     check_work(estimate_quilt(base.number_of_faces(), placements * static_cast<double>(s.mesh.tris.size())));
 }
 
-// The swatch's edges split (PMP::split_long_edges: midpoints on the edge,
-// faces kept triangles and flat) until none is longer than `medians` of its
-// median edge, the median taken again after each round (splitting adds short
-// edges); at most 8 rounds. Returns the vertices added.
 // The edges of `m` longer than `bound`.
 std::vector<EdgeIndex> edges_longer_than(const Mesh& m, double bound) {
   std::vector<EdgeIndex> out;
@@ -137,6 +133,10 @@ std::vector<EdgeIndex> edges_longer_than(const Mesh& m, double bound) {
   return out;
 }
 
+// The swatch's edges split (PMP::split_long_edges: midpoints on the edge,
+// faces kept triangles and flat) until none is longer than `medians` of its
+// median edge, the median taken again after each round (splitting adds short
+// edges); at most 8 rounds. Returns the vertices added.
 std::size_t split_long_swatch_edges(Mesh& m, double medians) {
   const std::size_t before = m.number_of_vertices();
   for (int round = 0; round < 8; ++round) {
@@ -149,11 +149,7 @@ std::size_t split_long_swatch_edges(Mesh& m, double medians) {
     std::nth_element(len.begin(), len.begin() + static_cast<std::ptrdiff_t>(len.size() / 2), len.end());
     const double bound = medians * len[len.size() / 2];
     if (!(bound > 0) || longest <= bound) break;
-    std::vector<EdgeIndex> long_edges;
-    for (auto e : m.edges())
-      if (CGAL::squared_distance(m.point(m.source(m.halfedge(e))), m.point(m.target(m.halfedge(e)))) > bound * bound)
-        long_edges.push_back(e);
-    CGAL::Polygon_mesh_processing::split_long_edges(long_edges, bound, m);
+    CGAL::Polygon_mesh_processing::split_long_edges(edges_longer_than(m, bound), bound, m);
   }
   return m.number_of_vertices() - before;
 }
@@ -175,13 +171,14 @@ void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scal
 }  // namespace
 
 std::size_t split_long_base_edges(const Mesh& base, double bound, Mesh& fine) {
-  if (!(bound > 0) || edges_longer_than(base, bound).empty()) return 0;
-  fine = base;
-  // (The faces split get new edges, which may be long too: again, at most 8 rounds.)
-  for (int round = 0; round < 8; ++round) {
-    const std::vector<EdgeIndex> long_edges = edges_longer_than(fine, bound);
-    if (long_edges.empty()) break;
+  if (!(bound > 0)) return 0;
+  std::vector<EdgeIndex> long_edges = edges_longer_than(base, bound);
+  if (long_edges.empty()) return 0;
+  fine = base;  // (a copy: the same edge indices)
+  // The faces split get new edges, which may be long too: again, at most 8 rounds.
+  for (int round = 0; round < 8 && !long_edges.empty(); ++round) {
     CGAL::Polygon_mesh_processing::split_long_edges(long_edges, bound, fine);
+    long_edges = edges_longer_than(fine, bound);
   }
   return fine.number_of_vertices() - base.number_of_vertices();
 }
@@ -226,9 +223,9 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& input_base, const
   // quilt (its only fill there); filled again after the embedding, three do
   // (decision 102, session 44).
   std::vector<ElementMesh> fill_templates;
-  const bool fill_rigid = opt.fill_embedded && qo.scatter_attempts > 0 && !compact_swatch_elements(r.swatch).empty();
-  if (fill_rigid) fill_templates = compact_swatch_elements(r.swatch);
-  else if (opt.fill_embedded) fill_templates = thread_fill_templates(r.swatch, qo);
+  if (opt.fill_embedded && qo.scatter_attempts > 0) fill_templates = compact_swatch_elements(r.swatch);
+  const bool fill_rigid = !fill_templates.empty();
+  if (!fill_rigid && opt.fill_embedded) fill_templates = thread_fill_templates(r.swatch, qo);
   if (qo.refill_rounds < 0 && !fill_rigid && !fill_templates.empty()) qo.refill_rounds = kRefillRoundsBeforeEmbeddedFill;
   Timer t;
   r.quilt = quilt_surface(base, r.swatch, r.local, qo);
