@@ -4,9 +4,11 @@
 // 2); `surftex elements`: edit the elements of a result by id; the demo step
 // "quilt".
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -33,13 +35,36 @@ namespace {
 namespace quilt_command {  // named: the unity build joins these files
 
 struct QuiltArgs {
-  std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto";
+  std::string base, swatch, output, plane, render, field = "up", swatch_up = "auto", fill_smaller = "0.7,0.5,0.35";
   bool no_render = false, no_check = false, no_align = false, smooth_field = false;
   double scale = 0, cell = 0, shell_height = 1.0, max_turn = 15.0, align_bound = 45.0, split_edges = 2.5;
   std::vector<double> up{0, 1, 0};
   int subpatch = 0, stretch_iterations = 20, thread_pieces = 4;
   CommonOptions common;
 };
+
+// --fill-smaller: "none" or up to 8 comma-separated factors, each in (0, 1).
+std::vector<double> parse_fill_smaller(const std::string& text) {
+  std::vector<double> out;
+  if (text == "none") return out;
+  auto bad = [&text](const std::string& why) {
+    return InvalidInputError("quilt: --fill-smaller must be none or comma-separated factors in (0, 1), e.g. "
+                             "0.7,0.5 (got '" + text + "': " + why + ")");
+  };
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    char* end = nullptr;
+    const double f = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size()) throw bad("'" + item + "' is not a number");
+    if (!(f > 0 && f < 1)) throw bad(item + " is not in (0, 1)");
+    out.push_back(f);
+    start = comma + 1;
+  }
+  if (out.size() > 8) throw bad("more than 8 factors");
+  return out;
+}
 
 SwatchAxis swatch_axis(const std::string& s) {
   return s == "x" ? SwatchAxis::kX : s == "y" ? SwatchAxis::kY : s == "z" ? SwatchAxis::kZ : SwatchAxis::kAuto;
@@ -80,6 +105,7 @@ std::vector<std::string> check_quilt_args(QuiltArgs& a) {
     throw InvalidInputError("quilt: --field must be up or none (got '" + a.field + "')");
   if (a.up.size() != 3 || !(a.up[0] * a.up[0] + a.up[1] * a.up[1] + a.up[2] * a.up[2] > 0))
     throw InvalidInputError("quilt: --up must be three numbers, not all zero");
+  parse_fill_smaller(a.fill_smaller);  // (checked before any output)
   return inputs;
 }
 
@@ -149,6 +175,7 @@ QuiltSwatchOnSurfaceOptions surface_quilt_options(const QuiltArgs& a) {
   o.scatter_thread_parts = a.thread_pieces;
   o.progress = terminal_progress(a.common.quiet);
   d.split_edges_over_median = a.split_edges;
+  d.fill_smaller = parse_fill_smaller(a.fill_smaller);
   d.embed.shell_height = a.shell_height;
   d.embed.stretch.iterations = a.stretch_iterations;
   d.embed.check_self_intersections = !a.no_check;
@@ -216,8 +243,8 @@ void print_thin_parts_note(const nlohmann::json& rep) {
   if (bands.empty() || !(bands[worst] > 0.04)) return;
   std::fprintf(stderr,
                "note: %s of the %s quarter of the mesh's height (along --up) is bare: parts thinner than the "
-               "swatch's elements (at --scale %g) are not covered, as elements stay whole; a smaller --scale "
-               "places smaller elements there\n",
+               "swatch's elements (at --scale %g, and the smaller copies of --fill-smaller) are not covered, as "
+               "elements stay whole; a smaller --scale places smaller elements there\n",
                format_percent(bands[worst]).c_str(), kBand[worst], rep["scale"].get<double>());
 }
 
@@ -328,6 +355,11 @@ SubcommandRegistrar reg_quilt{
                       "swatch with none (a weave) with pieces of its threads, each thread cut into this many; "
                       "0 = no pieces (0..16, default 4)")
            ->check(CLI::Range(0, 16));
+       app.add_option("--fill-smaller", a->fill_smaller,
+                      "On a mesh, where a whole copy of a compact element (ring, tube, pebble) rests nowhere "
+                      "in what stays bare (a leg or a horn narrower than the element), smaller copies are tried: "
+                      "these factors of its size in turn, comma-separated, each in (0, 1), at most 8; none = the "
+                      "full size only (default 0.7,0.5,0.35)");
        app.add_option("--stretch-iterations", a->stretch_iterations,
                       "Sweeps of the shell-map stretch minimisation, 0..1000 (default 20)")
            ->check(CLI::Range(0, 1000));

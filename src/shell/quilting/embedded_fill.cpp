@@ -7,6 +7,7 @@
 #include <random>
 #include <string>
 
+#include "geometry/constants.h"
 #include "geometry/errors.h"
 #include "geometry/vec3.h"
 #include "shell/element_clearance.h"
@@ -17,8 +18,6 @@
 namespace surftex {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 void check_options(const EmbeddedFillOptions& o) {
   auto bad = [](const std::string& what) { throw InvalidInputError("fill_embedded_bare: " + what); };
@@ -33,6 +32,8 @@ void check_options(const EmbeddedFillOptions& o) {
   if (!(o.max_float >= 0) || !std::isfinite(o.max_float)) bad("max_float must be >= 0");
   if (!(o.clearance >= 0) || !std::isfinite(o.clearance)) bad("clearance must be >= 0");
   if (o.turns != 1 && o.turns != 4) bad("turns must be 1 or 4");
+  for (double f : o.smaller)
+    if (!(f > 0 && f < 1)) bad("smaller factors must be in (0, 1)");
   for (double u : o.up)
     if (!std::isfinite(u)) bad("up must be finite");
 }
@@ -181,6 +182,124 @@ bool place_rigid(const FillState& s, const EmbeddedFillOptions& o, const Element
   return true;
 }
 
+// A rigid template's proxy: at most ~48 of its vertices (evenly taken, and
+// the extremes along each axis), placed first to reject a place cheaply:
+// nearly every failed attempt fails on it already, and the full copy is
+// checked whenever it passes (decision 102, session 46).
+ElementMesh rigid_proxy(const ElementMesh& tpl) {
+  ElementMesh p;
+  const std::size_t n = tpl.points.size(), step = std::max<std::size_t>(1, n / 48);
+  std::vector<char> take(n, 0);
+  for (std::size_t v = 0; v < n; v += step) take[v] = 1;
+  for (int d = 0; d < 3 && n > 0; ++d) {
+    std::size_t lo = 0, hi = 0;
+    for (std::size_t v = 1; v < n; ++v) {
+      if (tpl.points[v][d] < tpl.points[lo][d]) lo = v;
+      if (tpl.points[v][d] > tpl.points[hi][d]) hi = v;
+    }
+    take[lo] = take[hi] = 1;
+  }
+  for (std::size_t v = 0; v < n; ++v)
+    if (take[v]) p.points.push_back(tpl.points[v]);
+  return p;
+}
+
+// One fill: the base's state, the elements placed so far (their feet and
+// exact collider) and the generator, over passes at decreasing sizes.
+class Filler {
+ public:
+  Filler(const ElementMesh& base, std::vector<ElementMesh>& els, const EmbeddedFillOptions& opt)
+      : opt_(opt), s_(base, opt.radius), els_(els), coll_(els, {}),
+        base_coll_(opt.rigid ? ElementCollider({base}, {}) : ElementCollider({}, {})), rng_(opt.seed),
+        cos_max_(std::cos(opt.max_normal_angle_deg * kPi / 180.0)) {
+    for (std::size_t e = 0; e < els.size(); ++e) s_.add_element(els[e], static_cast<int>(e));
+    std::vector<P3> pts;
+    for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
+    feet_ = feet_on_base(s_.tree, pts, opt.radius);
+    if (opt.rigid)
+      for (const ElementMesh& tpl : opt.templates) proxies_.push_back(rigid_proxy(tpl));
+  }
+
+  // Every base face with a bare sample tried once, with templates scaled by
+  // `factor` (rigid copies: their float bound and gap too).
+  void pass(double factor, EmbeddedFillResult& res) {
+    po_ = opt_;
+    po_.scale *= factor, po_.max_float *= factor, po_.clearance *= factor;
+    const ElementMesh& base = s_.base;
+    for (std::size_t f = 0; f < base.tris.size(); ++f) {
+      const Tri& t = base.tris[f];
+      const P3 &a = base.points[static_cast<std::size_t>(t[0])], &b = base.points[static_cast<std::size_t>(t[1])],
+               &c = base.points[static_cast<std::size_t>(t[2])];
+      if (bare_samples_of(a, b, c, feet_) == 0 || !(vec3::norm(s_.fn[f]) > 0)) continue;
+      ++res.faces_tried;
+      if (!fill_face(f, a, b, c)) continue;
+      add_placed();
+      ++res.placed;
+      if (factor < 1) ++res.placed_smaller;
+    }
+  }
+
+ private:
+  // Up to `attempts` placements on face f: quarter turns at its centroid
+  // first, then moved by up to a radius; true with m_ placed.
+  bool fill_face(std::size_t f, const P3& a, const P3& b, const P3& c2) {
+    const P3 n = s_.fn[f];
+    const P3 c{(a[0] + b[0] + c2[0]) / 3, (a[1] + b[1] + c2[1]) / 3, (a[2] + b[2] + c2[2]) / 3};
+    const P3 d = local_direction(s_, c, n, vec3::sub(b, a), opt_.up);
+    if (!(vec3::norm(d) > 0)) return false;
+    for (int k = 0; k < opt_.attempts; ++k) {
+      const std::size_t which = static_cast<std::size_t>(rng_() % opt_.templates.size());
+      const int turn = opt_.turns == 1 ? 0 : k & 3;
+      const P3 e1 = (turn & 1) ? vec3::cross(n, d) : d, e1s = (turn & 2) ? vec3::mul(e1, -1.0) : e1;
+      const P3 e2 = vec3::cross(n, e1s);
+      P3 at = c;
+      if (k >= opt_.turns) {  // (the draws named, so their order is fixed: a call's arguments have none)
+        const double along_e2 = unit_(rng_), along_e1 = unit_(rng_);
+        at = vec3::add(c, vec3::add(vec3::mul(e1s, opt_.radius * along_e1), vec3::mul(e2, opt_.radius * along_e2)));
+      }
+      if (attempt(which, at, e1s, e2, n)) return true;
+    }
+    return false;
+  }
+
+  // One placement of template `which` at `at` in the frame (e1, e2, n):
+  // rigid copies are placed as its proxy first (a cheap rejection), then
+  // whole; both must cross nothing.
+  bool attempt(std::size_t which, const P3& at, const P3& e1, const P3& e2, const P3& n) {
+    const ElementMesh& tpl = opt_.templates[which];
+    if (opt_.rigid) {
+      if (!place_rigid(s_, po_, proxies_[which], at, e1, e2, n, cos_max_, proxy_, placed_feet_)) return false;
+      if (!place_rigid(s_, po_, tpl, at, e1, e2, n, cos_max_, m_, placed_feet_)) return false;
+      return !base_coll_.any_hit(m_, -1, 0) && !coll_.any_hit(m_, -1, po_.clearance);
+    }
+    if (!place(s_, po_, tpl, at, e1, e2, n, cos_max_, m_, placed_feet_)) return false;
+    if (coll_.any_hit(m_, -1, po_.clearance)) return false;
+    return element_self_crossings(m_, false).size() <= opt_.own_crossings;
+  }
+
+  void add_placed() {
+    const int id = static_cast<int>(els_.size());
+    coll_.add(m_, id);
+    s_.add_element(m_, id);
+    for (const P3& p : placed_feet_) feet_.add(p);
+    els_.push_back(m_);
+  }
+
+  const EmbeddedFillOptions& opt_;
+  EmbeddedFillOptions po_;  // the pass's: sizes scaled
+  FillState s_;
+  std::vector<ElementMesh>& els_;
+  FootGrid feet_{1.0};
+  ElementCollider coll_;
+  const ElementCollider base_coll_;  // rigid copies must not cross the base either (exact)
+  std::mt19937_64 rng_;
+  std::uniform_real_distribution<double> unit_{-1.0, 1.0};
+  double cos_max_;
+  std::vector<ElementMesh> proxies_;
+  ElementMesh m_, proxy_;
+  std::vector<P3> placed_feet_;
+};
+
 }  // namespace
 
 EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<ElementMesh>& els,
@@ -188,60 +307,12 @@ EmbeddedFillResult fill_embedded_bare(const ElementMesh& base, std::vector<Eleme
   check_options(opt);
   EmbeddedFillResult res;
   if (opt.templates.empty() || base.tris.empty()) return res;
-  FillState s(base, opt.radius);
-  for (std::size_t e = 0; e < els.size(); ++e) s.add_element(els[e], static_cast<int>(e));
-  std::vector<P3> pts;
-  for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
-  FootGrid feet = feet_on_base(s.tree, pts, opt.radius);
-  ElementCollider coll(els, {});
-  // Rigid copies must not cross the base either (exact, as between elements).
-  const ElementCollider base_coll = opt.rigid ? ElementCollider({base}, {}) : ElementCollider({}, {});
-  std::mt19937_64 rng(opt.seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const double cos_max = std::cos(opt.max_normal_angle_deg * kPi / 180.0);
-  ElementMesh m;
-  std::vector<P3> placed_feet;
-  for (std::size_t f = 0; f < base.tris.size(); ++f) {
-    const Tri& t = base.tris[f];
-    const P3 &a = base.points[static_cast<std::size_t>(t[0])], &b = base.points[static_cast<std::size_t>(t[1])],
-             &c2 = base.points[static_cast<std::size_t>(t[2])];
-    if (bare_samples_of(a, b, c2, feet) == 0) continue;
-    const P3 n = s.fn[f];
-    if (!(vec3::norm(n) > 0)) continue;
-    ++res.faces_tried;
-    const P3 c{(a[0] + b[0] + c2[0]) / 3, (a[1] + b[1] + c2[1]) / 3, (a[2] + b[2] + c2[2]) / 3};
-    const P3 d = local_direction(s, c, n, vec3::sub(b, a), opt.up);
-    if (!(vec3::norm(d) > 0)) continue;
-    bool ok = false;
-    for (int k = 0; k < opt.attempts && !ok; ++k) {
-      const ElementMesh& tpl = opt.templates[static_cast<std::size_t>(rng() % opt.templates.size())];
-      // Quarter turns at the centroid first, then moved by up to a radius.
-      const int turn = opt.turns == 1 ? 0 : k & 3;
-      const P3 e1 = (turn & 1) ? vec3::cross(n, d) : d, e1s = (turn & 2) ? vec3::mul(e1, -1.0) : e1;
-      const P3 e2 = vec3::cross(n, e1s);
-      P3 at = c;
-      if (k >= opt.turns) {  // (the draws named, so their order is fixed: a call's arguments have none)
-        const double along_e2 = unit(rng), along_e1 = unit(rng);
-        at = vec3::add(c, vec3::add(vec3::mul(e1s, opt.radius * along_e1), vec3::mul(e2, opt.radius * along_e2)));
-      }
-      if (opt.rigid) {
-        if (!place_rigid(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
-        if (base_coll.any_hit(m, -1, 0) || coll.any_hit(m, -1, opt.clearance)) continue;
-      } else {
-        if (!place(s, opt, tpl, at, e1s, e2, n, cos_max, m, placed_feet)) continue;
-        if (coll.any_hit(m, -1, opt.clearance)) continue;
-        if (element_self_crossings(m, false).size() > opt.own_crossings) continue;
-      }
-      ok = true;
-    }
-    if (!ok) continue;
-    const int id = static_cast<int>(els.size());
-    coll.add(m, id);
-    s.add_element(m, id);
-    for (const P3& p : placed_feet) feet.add(p);
-    els.push_back(m);
-    ++res.placed;
-  }
+  Filler filler(base, els, opt);
+  // The full size first everywhere, then (rigid copies) smaller ones where
+  // it is still bare.
+  filler.pass(1.0, res);
+  if (opt.rigid)
+    for (const double factor : opt.smaller) filler.pass(factor, res);
   return res;
 }
 

@@ -54,6 +54,11 @@ struct EmbeddedFillOptions {
   double max_float = 0;
   /// Gap kept to every element (mesh units, >= 0; 0: only no crossing).
   double clearance = 0;
+  /// Rigid copies: further passes over what is still bare, with copies
+  /// scaled by these factors in turn (each in (0, 1); max_float and clearance
+  /// scaled with them): legs and horns narrower than an element take smaller
+  /// ones. Empty: the full size only.
+  std::vector<double> smaller;
   /// Quarter turns tried before the copy is moved: 4, or 1 (the direction only).
   int turns = 4;
   /// Non-zero: pieces run along its projection on the face (else the nearest element's axis).
@@ -64,6 +69,7 @@ struct EmbeddedFillOptions {
 struct EmbeddedFillResult {
   std::size_t faces_tried = 0;  ///< base faces with a bare sample point
   std::size_t placed = 0;       ///< pieces appended
+  std::size_t placed_smaller = 0;  ///< of which rigid copies smaller than the full size
 };
 
 /// See the header comment. Throws InvalidInputError for bad options.

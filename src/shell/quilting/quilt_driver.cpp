@@ -158,11 +158,14 @@ std::size_t split_long_swatch_edges(Mesh& m, double medians) {
 // places them: its gap kept to every element; a swatch scattered alone in the
 // guidance field's orientation (the up field's, unsmoothed) only; resting on
 // the base, floating at most the shell's height over where the shell would
-// hold it (its bottom stays in the shell; decision 102, session 45).
-void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scale, EmbeddedFillOptions& f) {
+// hold it (its bottom stays in the shell; decision 102, session 45); then
+// smaller copies where the full size rests nowhere (session 46).
+void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scale, const std::vector<double>& smaller,
+                    EmbeddedFillOptions& f) {
   f.rigid = true;
   f.clearance = scatter_gap(sw, qo) * scale;
   f.max_float = sw.height() * scale;
+  f.smaller = smaller;
   if (!scattered_alone(sw, qo)) return;
   f.turns = 1;
   if (qo.field == SurfaceQuiltOptions::Field::kUp) f.up = qo.up;
@@ -249,7 +252,7 @@ QuiltSwatchOnSurfaceResult quilt_swatch_on_surface(const Mesh& input_base, const
   eo.fill.max_stretch = qo.scatter_max_stretch;
   eo.fill.own_crossings = r.swatch.element_self_crossings;
   eo.fill.seed = opt.seed;
-  if (fill_rigid) set_rigid_fill(r.swatch, qo, r.local.scale, eo.fill);
+  if (fill_rigid) set_rigid_fill(r.swatch, qo, r.local.scale, opt.fill_smaller, eo.fill);
   t.reset();
   r.embedding = embed_surface_quilt(base, r.local, out, eo);
   r.seconds_embed = t.seconds();

@@ -92,7 +92,8 @@ void add_embedding(const EmbedSurfaceQuiltResult& er, nlohmann::json& j) {
   j["elements_untangled"] = er.elements_untangled;
   j["elements_placed_affine"] = er.elements_placed_affine;
   j["fill_faces_tried"] = er.fill.faces_tried;  // bare faces after the embedding (decision 102, session 44)
-  j["fill_placed"] = er.fill.placed;            // thread pieces placed there
+  j["fill_placed"] = er.fill.placed;            // thread pieces or whole copies placed there
+  j["fill_placed_smaller"] = er.fill.placed_smaller;  // of which copies smaller than the full size
   j["charts"] = er.atlas.num_charts;
   j["tets"] = er.tets;
   j["shell_height"] = er.shell_height;
