@@ -324,6 +324,7 @@ json run_case(const std::string& name, const std::string& outdir) {
          {"elements_untangled", er.elements_untangled},
          {"elements_placed_affine", er.elements_placed_affine},
          {"fill_placed", er.fill.placed},
+         {"fill_placed_smaller", er.fill.placed_smaller},
          {"fragments_removed", r.fragments_removed},
          {"dropped_new", r.dropped_new},
          {"new_trimmed", r.new_trimmed},

@@ -112,9 +112,10 @@ TEST(CmdQuilt, ThreadPiecesFillBareSpotsOfAWeaveAndZeroTurnsThemOff) {
   EXPECT_LT(on["bare_fraction"].get<double>(), off["bare_fraction"].get<double>());
 }
 
-// Rings wider than a horn: its tips stay bare, and the summary says why and
-// what to do (a smaller --scale); at the default scale the horn is covered
-// and nothing is said.
+// Rings wider than a horn, smaller copies off: its tips stay bare, and the
+// summary says why and what to do (a smaller --scale); with the default
+// --fill-smaller smaller rings go there; at the default scale the horn is
+// covered and nothing is said. A bad --fill-smaller writes nothing.
 TEST(CmdQuilt, ThinPartsLeftBareAreNamedWithTheScaleToLower) {
   const std::string dir = test::temp_dir("quilt-thin-parts");
   Mesh horn, ring;
@@ -130,12 +131,26 @@ TEST(CmdQuilt, ThinPartsLeftBareAreNamedWithTheScaleToLower) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return std::make_pair(r.err, read_json(dir + "/" + tag + ".json"));
   };
-  const auto [wide_err, wide] = run("0.3", "wide");
-  double worst = 0;
-  for (const auto& b : wide["bare_by_height"]) worst = std::max(worst, b.get<double>());
-  EXPECT_GT(worst, 0.04);
+  auto worst_band = [](const nlohmann::json& j) {
+    double worst = 0;
+    for (const auto& b : j["bare_by_height"]) worst = std::max(worst, b.get<double>());
+    return worst;
+  };
+  const auto [wide_err, wide] = run("0.3 --fill-smaller none", "wide");
+  EXPECT_GT(worst_band(wide), 0.04);
+  EXPECT_EQ(wide["fill_placed_smaller"].get<std::size_t>(), 0u);
   for (const char* w : {"parts thinner than", "quarter of the mesh's height", "--scale 0.3", "smaller --scale"})
     EXPECT_NE(wide_err.find(w), std::string::npos) << w << " in " << wide_err;
+  const auto [smaller_err, smaller] = run("0.3", "smaller");
+  EXPECT_GT(smaller["fill_placed_smaller"].get<std::size_t>(), 0u);
+  EXPECT_LT(worst_band(smaller), worst_band(wide));
+  for (const char* bad : {"1.2", "0.5,x", "0", "0.5,,0.3"}) {
+    const test::RunResult r = test::run_surftex("quilt '" + dir + "/horn.off' '" + dir + "/ring.off' -o '" + dir +
+                                                "/bad.obj' --fill-smaller " + bad + " --quiet");
+    EXPECT_EQ(r.exit_code, 2) << bad;
+    EXPECT_NE(r.err.find("error: quilt: --fill-smaller"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/bad.obj")) << bad;
+  }
   const auto [fine_err, fine] = run("0", "fine");
   for (const auto& b : fine["bare_by_height"]) EXPECT_LE(b.get<double>(), 0.04);
   EXPECT_EQ(fine_err.find("parts thinner than"), std::string::npos) << fine_err;

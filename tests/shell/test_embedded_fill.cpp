@@ -198,13 +198,51 @@ TEST(EmbeddedFill, CompactElementsGoWholeOntoAThinPart) {
   EXPECT_GE(smallest_element_gap(els, 1.0), o.clearance * (1 - 1e-9));
 }
 
-// The rigid fill's own options: turns 1 or 4, no negative float or clearance.
+// A horn much narrower than the ring (0.04 across, the ring 0.2; on one 0.12
+// across a ring still saddles within the cone): no full-size copy rests on
+// it; copies at the smaller factors do, each whole (its vertex
+// distances those of the template times one factor), crossing nothing.
+TEST(EmbeddedFill, SmallerCopiesGoWhereTheFullSizeRestsNowhere) {
+  Mesh horn;
+  make_ellipsoid(horn, 0.02, 0.02, 1.5, 3);
+  const ElementMesh b = element_mesh_from(horn);
+  EmbeddedFillOptions o = ring_fill();
+  o.attempts = 4;
+  std::vector<ElementMesh> full;
+  const EmbeddedFillResult r_full = fill_embedded_bare(b, full, o);
+  EXPECT_EQ(r_full.placed_smaller, 0u);
+  const double bare_full = bare(horn, full, o.radius);
+  EXPECT_GT(bare_full, 0.5) << r_full.placed << " full-size copies rest on the thin horn";
+  o.smaller = {0.7, 0.5, 0.35};
+  std::vector<ElementMesh> els;
+  const EmbeddedFillResult r = fill_embedded_bare(b, els, o);
+  EXPECT_GT(r.placed_smaller, 5u);
+  EXPECT_LT(bare(horn, els, o.radius), 0.5 * bare_full);
+  const ElementMesh& t = o.templates[0];
+  for (const ElementMesh& m : els) {
+    const double f = distance(m.points[1], m.points[40]) / distance(t.points[1], t.points[40]);
+    double worst = 1;
+    for (const double k : {1.0, 0.7, 0.5, 0.35}) worst = std::min(worst, std::abs(f - k));
+    EXPECT_LT(worst, 1e-9) << "a copy at " << f << " of the size";
+    for (std::size_t v = 1; v < t.points.size(); v += 7)
+      EXPECT_NEAR(distance(m.points[v], m.points[0]), f * distance(t.points[v], t.points[0]), 1e-9);
+  }
+  Mesh scene = horn, rings;
+  mesh_from_elements(els, rings);
+  scene.join(rings);
+  EXPECT_TRUE(self_intersecting_faces(scene).empty());
+}
+
+// The rigid fill's own options: turns 1 or 4, no negative float or clearance,
+// smaller factors in (0, 1).
 TEST(EmbeddedFill, RefusesImpossibleRigidOptions) {
   const ElementMesh b = element_mesh_from(test::flat_lens(1));
   std::vector<ElementMesh> els;
   for (auto edit : {+[](EmbeddedFillOptions& o) { o.turns = 2; }, +[](EmbeddedFillOptions& o) { o.max_float = -1; },
                     +[](EmbeddedFillOptions& o) { o.clearance = std::nan(""); },
-                    +[](EmbeddedFillOptions& o) { o.up = {0, std::nan(""), 0}; }}) {
+                    +[](EmbeddedFillOptions& o) { o.up = {0, std::nan(""), 0}; },
+                    +[](EmbeddedFillOptions& o) { o.smaller = {0.5, 1.0}; },
+                    +[](EmbeddedFillOptions& o) { o.smaller = {std::nan("")}; }}) {
     EmbeddedFillOptions o = ring_fill();
     edit(o);
     EXPECT_THROW(fill_embedded_bare(b, els, o), InvalidInputError);

@@ -577,6 +577,22 @@ void resolve_and_count_crossings(std::vector<char>& compact, const EmbedSurfaceQ
     res.embed.checked = true;
   }
 }
+// The shard bound, then the crossings; as removing elements moves the
+// median, again on the final elements while one is over its bound (three
+// passes at most). The crossings' cut pieces are held to the bound too; the
+// untangling's smoothing may stretch, so it runs in the first pass only.
+void hold_shard_bound(const EmbedSurfaceQuiltOptions& opt, bool untangle, std::vector<char>& compact,
+                      std::vector<ElementMesh>& els, Mesh& out, EmbedSurfaceQuiltResult& res) {
+  for (int pass = 0; pass < 3; ++pass) {
+    res.embedded_edge_bound = embedded_edge_bound(opt, els, res.embedded_median_edge);
+    if (pass > 0 && longest_edge_length(els) <= res.embedded_edge_bound) break;
+    remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
+    res.self_intersections_within = res.self_intersections_between = 0;
+    resolve_and_count_crossings(compact, opt, res.embedded_edge_bound, untangle && pass == 0, els, out, res);
+    if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;
+  }
+}
+
 // EmbedSurfaceQuiltOptions::fill: pieces into the bare faces; the crossings
 // that involve them (none by construction, but the count stays exact) added
 // to the counts.
@@ -663,19 +679,15 @@ EmbedSurfaceQuiltResult embed_surface_quilt(const Mesh& base, const SurfaceQuilt
   }
   count_mapping(quilt, vm, res);
   std::vector<char> compact = quilt.element_compact;
-  // The shard bound, then the crossings; as removing elements moves the
-  // median, again on the final elements while one is over its bound.
-  for (int pass = 0; pass < 3; ++pass) {
-    res.embedded_edge_bound = embedded_edge_bound(opt, els, res.embedded_median_edge);
-    if (pass > 0 && longest_edge_length(els) <= res.embedded_edge_bound) break;
-    remove_embedded_shards(res.embedded_edge_bound, opt.relax_stretched, compact, els, out, res);
-    res.self_intersections_within = res.self_intersections_between = 0;
-    // The crossings' cut pieces are held to the bound too; the untangling's
-    // smoothing may stretch, so it runs in the first pass only.
-    resolve_and_count_crossings(compact, opt, res.embedded_edge_bound, opt.untangle_folds && pass == 0, els, out, res);
-    if (!(opt.max_edge > 0 && opt.max_edge_over_median > 0)) break;
+  hold_shard_bound(opt, opt.untangle_folds, compact, els, out, res);
+  if (!opt.fill.templates.empty()) {
+    fill_and_count(base, opt, compact, els, out, res);
+    // Smaller copies (shorter edges) lower the median edge: where an element
+    // is now over the bound, it is held again (decision 102, session 46).
+    double median = 0;
+    if (res.fill.placed_smaller > 0 && longest_edge_length(els) > embedded_edge_bound(opt, els, median))
+      hold_shard_bound(opt, false, compact, els, out, res);
   }
-  if (!opt.fill.templates.empty()) fill_and_count(base, opt, compact, els, out, res);
   res.elements = els.size();
   res.seconds_embed = t.seconds();
   report_progress(opt.progress, "embed", 1.0);
