@@ -356,8 +356,8 @@ SubcommandRegistrar reg_quilt{
                       "0 = no pieces (0..16, default 4)")
            ->check(CLI::Range(0, 16));
        app.add_option("--fill-smaller", a->fill_smaller,
-                      "On a mesh, for a swatch scattered alone (see SWATCH): where a whole copy rests nowhere in "
-                      "what stays bare (a leg or a horn narrower than the element), smaller copies are tried: "
+                      "On a mesh, where a whole copy of a compact element (ring, tube, pebble) rests nowhere in "
+                      "what stays bare (a leg or a horn narrower than the element, a rim), smaller copies are tried: "
                       "these factors of its size in turn, comma-separated, each in (0, 1), at most 8; none = the "
                       "full size only (default 0.7,0.5,0.35)");
        app.add_option("--stretch-iterations", a->stretch_iterations,

@@ -158,16 +158,15 @@ std::size_t split_long_swatch_edges(Mesh& m, double medians) {
 // places them: its gap kept to every element; a swatch scattered alone in the
 // guidance field's orientation (the up field's, unsmoothed) only; resting on
 // the base, floating at most the shell's height over where the shell would
-// hold it (its bottom stays in the shell; decision 102, session 45). For a
-// swatch scattered alone (separate objects), smaller copies where the full
-// size rests nowhere (session 46); a quilted swatch keeps its pattern.
+// hold it (its bottom stays in the shell; decision 102, session 45); then
+// smaller copies where the full size rests nowhere (session 46).
 void set_rigid_fill(const Swatch& sw, const SurfaceQuiltOptions& qo, double scale, const std::vector<double>& smaller,
                     EmbeddedFillOptions& f) {
   f.rigid = true;
   f.clearance = scatter_gap(sw, qo) * scale;
   f.max_float = sw.height() * scale;
-  if (!scattered_alone(sw, qo)) return;
   f.smaller = smaller;
+  if (!scattered_alone(sw, qo)) return;
   f.turns = 1;
   if (qo.field == SurfaceQuiltOptions::Field::kUp) f.up = qo.up;
 }

@@ -111,12 +111,12 @@ struct QuiltSwatchOnSurfaceOptions {
   /// (split_long_base_edges): the fills try one place per base face. Default
   /// true (decision 102, session 45).
   bool split_base_edges = true;
-  /// A swatch scattered alone (scattered_alone): where a whole copy rests
-  /// nowhere (a leg or a horn narrower than an element), the embedded fill
-  /// tries copies scaled by these factors in turn, each in (0, 1)
-  /// (EmbeddedFillOptions::smaller); a quilted swatch (chain mail) keeps its
-  /// pattern. Empty: full size only. Default 0.7, 0.5, 0.35 (decision 102,
-  /// session 46: triceratops + torus_ring 10.9% of a band bare -> 1.1%).
+  /// Whole copies of compact elements: where the full size rests nowhere (a
+  /// leg or a horn narrower than an element, a rim), the embedded fill tries
+  /// copies scaled by these factors in turn, each in (0, 1)
+  /// (EmbeddedFillOptions::smaller). Empty: full size only. Default 0.7, 0.5,
+  /// 0.35 (decision 102, session 46: triceratops + torus_ring 10.9% of a band
+  /// bare -> 1.1%, coffee_cup + chain mail 3.0% -> 1.0%).
   std::vector<double> fill_smaller{0.7, 0.5, 0.35};
 };
 
