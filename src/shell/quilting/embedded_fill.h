@@ -24,7 +24,10 @@
 // tangent frame, rested on the base (lifted until no vertex lies below its
 // height over the base), kept only if no vertex floats more than max_float
 // over its height, it crosses neither the base nor an element (exact), and
-// keeps `clearance` to every element (the quilt scatter's gap).
+// keeps `clearance` to every element (the quilt scatter's gap). Where the
+// full size rests nowhere, passes with copies scaled by `smaller` follow
+// (legs, horns, rims narrower than an element). Each rigid attempt places a
+// proxy of ~48 template vertices first, so most failures cost little.
 // Reads: the base (triangles), the elements. Writes: appends to `els`.
 // Deterministic for a seed (faces in order, one generator).
 #include <cstddef>
