@@ -209,13 +209,11 @@ ElementMesh rigid_proxy(const ElementMesh& tpl) {
 class Filler {
  public:
   Filler(const ElementMesh& base, std::vector<ElementMesh>& els, const EmbeddedFillOptions& opt)
-      : opt_(opt), s_(base, opt.radius), els_(els), coll_(els, {}),
+      : opt_(opt), po_(without_templates(opt)), s_(base, opt.radius), els_(els),
+        feet_(feet_on_base(s_.tree, all_points(els), opt.radius)), coll_(els, {}),
         base_coll_(opt.rigid ? ElementCollider({base}, {}) : ElementCollider({}, {})), rng_(opt.seed),
         cos_max_(std::cos(opt.max_normal_angle_deg * kPi / 180.0)) {
     for (std::size_t e = 0; e < els.size(); ++e) s_.add_element(els[e], static_cast<int>(e));
-    std::vector<P3> pts;
-    for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
-    feet_ = feet_on_base(s_.tree, pts, opt.radius);
     if (opt.rigid)
       for (const ElementMesh& tpl : opt.templates) proxies_.push_back(rigid_proxy(tpl));
   }
@@ -223,8 +221,7 @@ class Filler {
   // Every base face with a bare sample tried once, with templates scaled by
   // `factor` (rigid copies: their float bound and gap too).
   void pass(double factor, EmbeddedFillResult& res) {
-    po_ = opt_;
-    po_.scale *= factor, po_.max_float *= factor, po_.clearance *= factor;
+    po_.scale = opt_.scale * factor, po_.max_float = opt_.max_float * factor, po_.clearance = opt_.clearance * factor;
     const ElementMesh& base = s_.base;
     for (std::size_t f = 0; f < base.tris.size(); ++f) {
       const Tri& t = base.tris[f];
@@ -277,6 +274,16 @@ class Filler {
     return element_self_crossings(m_, false).size() <= opt_.own_crossings;
   }
 
+  static EmbeddedFillOptions without_templates(EmbeddedFillOptions o) {
+    o.templates.clear();  // (each placement is given its template)
+    return o;
+  }
+  static std::vector<P3> all_points(const std::vector<ElementMesh>& els) {
+    std::vector<P3> pts;
+    for (const ElementMesh& m : els) pts.insert(pts.end(), m.points.begin(), m.points.end());
+    return pts;
+  }
+
   void add_placed() {
     const int id = static_cast<int>(els_.size());
     coll_.add(m_, id);
@@ -286,10 +293,10 @@ class Filler {
   }
 
   const EmbeddedFillOptions& opt_;
-  EmbeddedFillOptions po_;  // the pass's: sizes scaled
+  EmbeddedFillOptions po_;  // opt_ with the pass's sizes (scale, max_float, clearance), no templates
   FillState s_;
   std::vector<ElementMesh>& els_;
-  FootGrid feet_{1.0};
+  FootGrid feet_;
   ElementCollider coll_;
   const ElementCollider base_coll_;  // rigid copies must not cross the base either (exact)
   std::mt19937_64 rng_;
