@@ -60,7 +60,8 @@ std::vector<std::string> output_files(const std::string& dir) {
 // and surface.glb hold the asset's triangle copy (the atlas as base colour,
 // normal map, vertex colours kept as _COLOR beside the texture that holds
 // them: COLOR_0 would multiply it; roughness as the GLB's
-// metallicRoughnessTexture); render.png shows the vertex colours. Returns
+// metallicRoughnessTexture); render.png shows the atlas on the copy, as the
+// GLB shows it. Returns
 // the report's "export" block with "files" (every path written).
 nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, const Outputs& o, bool force) {
   nlohmann::json j;
@@ -93,11 +94,12 @@ nlohmann::json write_outputs(const Mesh& mesh, const SubdivisionAsset& asset, co
       },
       [&] {
         Timer tr;
-        ViewOptions view;
-        view.colors = ViewOptions::Colors::VertexColors;
+        ViewOptions view;  // what a glTF viewer shows: the atlas on the triangle copy
+        view.colors = ViewOptions::Colors::Texture;
+        view.texture = &asset.color.image;
         WriteImageOptions io;
         io.overwrite = force;
-        write_image(o.render, render_view(mesh, view), io);
+        write_image(o.render, render_view(*asset.mesh, view), io);
         seconds_render = tr.seconds();
       });
   std::vector<std::string> files = ply_files;
@@ -277,9 +279,12 @@ int run_subdiv(const SubdivArgs& a) {
   SubdivisionVertexMaps vmaps;
   SubdivisionAsset asset;
   DisplaceResult disp;
+  // the texture between the vertices follows the surface as synthesised
+  const SubdivisionSurfaceSources between = subdivision_surface_sources(mesh, r, maps, ex.width, ex.height);
   // frames of the surface as written (after --displace)
   auto bake = [&] {
     vmaps = exemplar_maps_at_vertices(mesh, r, maps, ex.width, ex.height);
+    vmaps.between = between;
     asset = bake_subdivision_asset(mesh, vmaps, ao);
   };
   auto measure = [&] { fidelity = subdivision_fidelity_report(mesh, r, a.common.seed); };
@@ -454,7 +459,9 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  SubdivisionAssetOptions ao;
                                  ao.atlas_size = 512;
                                  ao.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
-                                 const SubdivisionAsset asset = bake_subdivision_asset(mesh, {}, ao);
+                                 SubdivisionVertexMaps vm;
+                                 vm.between = subdivision_surface_sources(mesh, r, {}, ex.width, ex.height);
+                                 const SubdivisionAsset asset = bake_subdivision_asset(mesh, vm, ao);
                                  nlohmann::json written = write_outputs(mesh, asset, output_paths(dir), true);
                                  // Report keys as the CLI's (issue 16 item 7): names under the demo folder.
                                  for (const auto& f : written["files"])

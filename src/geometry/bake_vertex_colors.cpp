@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <string>
 
+#include <tbb/parallel_for.h>
+
 #include "geometry/atlas_gutter.h"
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
@@ -46,29 +48,38 @@ AtlasTexels rasterize_atlas(const Mesh& mesh, int size) {
   return at;
 }
 
-BakeResult bake_vertex_values(const Mesh& mesh, const std::vector<float>& values, int C, const BakeOptions& opt) {
-  if (C < 1 || values.size() != static_cast<std::size_t>(C) * mesh.num_vertices())
-    throw InvalidInputError("bake_vertex_values: " + std::to_string(values.size()) + " values for " +
-                            std::to_string(mesh.num_vertices()) + " vertices x " + std::to_string(C) + " channels");
+BakeResult bake_texel_values(const Mesh& mesh, int C, const TexelValueFn& value, const BakeOptions& opt) {
+  if (C < 1 || C > 4) throw InvalidInputError("bake_texel_values: channels must be 1..4 (got " + std::to_string(C) + ")");
   const AtlasTexels at = rasterize_atlas(mesh, opt.size);
   const int N = opt.size;
   BakeResult res;
   res.image = Image(N, N, C);
   res.chart = at.chart;
   res.covered = at.covered;
-  for (std::size_t i = 0; i < res.chart.size(); ++i) {
-    const int t = at.raster.triangle[i];
-    if (t < 0) continue;
-    for (int k = 0; k < C; ++k) {
-      float s = 0.f;
-      for (int c = 0; c < 3; ++c)
-        s += at.raster.bary[i][c] * values[mesh.target(HalfedgeIndex(static_cast<Mesh::size_type>(at.corner[t][c]))).idx() * C + k];
-      res.image.data[C * i + k] = s;
+  tbb::parallel_for(0, N, [&](int row) {  // each texel written once: any thread count gives the same bytes
+    for (std::size_t i = static_cast<std::size_t>(row) * N, e = i + N; i < e; ++i) {
+      const int t = at.raster.triangle[i];
+      if (t >= 0) value(at.corner[t], at.raster.bary[i], &res.image.data[C * i]);
     }
-  }
+  });
   res.owner = res.chart;
   if (res.covered > 0) dilate_charts(res.image, res.owner);
   return res;
+}
+
+BakeResult bake_vertex_values(const Mesh& mesh, const std::vector<float>& values, int C, const BakeOptions& opt) {
+  if (C < 1 || values.size() != static_cast<std::size_t>(C) * mesh.num_vertices())
+    throw InvalidInputError("bake_vertex_values: " + std::to_string(values.size()) + " values for " +
+                            std::to_string(mesh.num_vertices()) + " vertices x " + std::to_string(C) + " channels");
+  const auto blend = [&](const std::array<std::size_t, 3>& corner, const std::array<float, 3>& bary, float* out) {
+    for (int k = 0; k < C; ++k) {
+      float s = 0.f;
+      for (int c = 0; c < 3; ++c)
+        s += bary[c] * values[mesh.target(HalfedgeIndex(static_cast<Mesh::size_type>(corner[c]))).idx() * C + k];
+      out[k] = s;
+    }
+  };
+  return bake_texel_values(mesh, C, blend, opt);
 }
 
 BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt) {

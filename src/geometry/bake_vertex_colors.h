@@ -12,6 +12,7 @@
 // InvalidInputError (non-triangle face, missing map, size outside 1..16384).
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "geometry/image.h"
@@ -37,6 +38,15 @@ BakeResult bake_vertex_colors(const Mesh& mesh, const BakeOptions& opt = {});
 /// image has `channels` channels. Throws InvalidInputError on a size mismatch.
 BakeResult bake_vertex_values(const Mesh& mesh, const std::vector<float>& values, int channels,
                               const BakeOptions& opt = {});
+
+/// Any values per texel: `value(corner, bary, out)` writes `channels` floats
+/// for a covered texel of the triangle whose corners (halfedge indices,
+/// target = vertex) and barycentrics are given; rows run in parallel, so it
+/// must be safe to call from several threads. Throws InvalidInputError for
+/// channels outside 1..4.
+using TexelValueFn =
+    std::function<void(const std::array<std::size_t, 3>& corner, const std::array<float, 3>& bary, float* out)>;
+BakeResult bake_texel_values(const Mesh& mesh, int channels, const TexelValueFn& value, const BakeOptions& opt = {});
 
 /// The texels every face covers (faces in index order = raster triangles).
 struct AtlasTexels {

@@ -3,14 +3,18 @@
 // a triangle copy with its atlas, the maps' sources, the report's keys.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
+#include "geometry/bake_vertex_colors.h"
 #include "geometry/gutter_atlas.h"
 #include "geometry/mesh.h"
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
+#include "texture/procedural_texture.h"
 #include "texture/subdivision/subdivision_asset.h"
 #include "texture/subdivision/subdivision_synthesis.h"
 
@@ -56,6 +60,58 @@ TEST(SubdivisionAsset, BakesTheColoursOnATriangleCopy) {
   // The atlas texel density against the exemplar's: atlas texels per mesh
   // unit over exemplar texels per mesh unit.
   EXPECT_NEAR(a.atlas_texels_per_exemplar_texel, a.atlas.atlas.uv_per_length * 64 / 32.0, 1e-12);
+}
+
+// With the sources given, the atlas holds the exemplar read between the
+// vertices (SurfaceExemplarSource), the grey height map too, at every texel a
+// triangle covers; without them, the blend of the vertex colours.
+TEST(SubdivisionAsset, BakesTheExemplarBetweenTheVerticesWhenGivenTheSources) {
+  Mesh m;
+  make_grid(m, 6, 6);
+  SubdivisionSynthesisOptions so;
+  so.r_scale = 40;
+  so.levels = 2;
+  so.keys = {{0, {1, 0, 0}}};
+  const Image ex = make_cells(32, 3, 5);
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, so);
+  Image grey(32, 32, 1);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) grey.at(x, y) = ex.at(x, y, 1);
+  SubdivisionExemplarMaps maps;
+  maps.height = grey;
+  SubdivisionVertexMaps vm = exemplar_maps_at_vertices(m, r, maps, 32, 32);
+  SubdivisionAssetOptions o;
+  o.atlas_size = 256;
+  o.texels_per_length = 40;
+  const SubdivisionAsset blended = bake_subdivision_asset(m, vm, o);
+  vm.between = subdivision_surface_sources(m, r, maps, 32, 32);
+  ASSERT_TRUE(vm.between.color && vm.between.height && !vm.between.roughness);
+  const SubdivisionAsset a = bake_subdivision_asset(m, vm, o);
+  EXPECT_TRUE(a.color_between_vertices);
+  EXPECT_FALSE(blended.color_between_vertices);
+  EXPECT_EQ(to_json(a)["color_source"], "exemplar_between_vertices");
+  const Mesh& t = *a.mesh;
+  ASSERT_EQ(t.number_of_vertices(), m.number_of_vertices());  // a triangle mesh's copy keeps the vertices
+  const AtlasTexels at = rasterize_atlas(t, 256);
+  std::size_t texels = 0;
+  double off = 0;
+  for (std::size_t i = 0; i < at.chart.size(); ++i) {
+    const int tri = at.raster.triangle[i];
+    if (tri < 0) continue;
+    std::array<std::size_t, 3> v;
+    for (int k = 0; k < 3; ++k) v[k] = t.target(HalfedgeIndex(static_cast<Mesh::size_type>(at.corner[tri][k]))).idx();
+    const auto& b = at.raster.bary[i];
+    const auto want = (*vm.between.color)(v, {b[0], b[1], b[2]});
+    const auto h = (*vm.between.height)(v, {b[0], b[1], b[2]});
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_FLOAT_EQ(a.color.image.data[3 * i + c], want[c]) << i;
+      off += std::abs(blended.color.image.data[3 * i + c] - want[c]);
+    }
+    ASSERT_NEAR(a.height.data[i], std::clamp(0.2126f * h[0] + 0.7152f * h[1] + 0.0722f * h[2], 0.f, 1.f), 1e-6);
+    ++texels;
+  }
+  ASSERT_GT(texels, 256u * 256u / 10);
+  EXPECT_GT(off / (3.0 * texels), 0.02) << "the vertex blend is not the exemplar between the vertices";
 }
 
 TEST(SubdivisionAsset, MapsFromVertexValues) {

@@ -4,7 +4,9 @@
 // tangent_space_bake.h), issue 16 item 2.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 
 #include "geometry/bake_vertex_colors.h"
 #include "geometry/errors.h"
@@ -14,6 +16,7 @@
 #include "geometry/primitive_meshes.h"
 #include "geometry/properties.h"
 #include "texture/procedural_texture.h"
+#include "texture/subdivision/k_region_matching.h"
 #include "texture/subdivision/subdivision_exemplar_maps.h"
 #include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/tangent_space_bake.h"
@@ -116,6 +119,100 @@ TEST(SubdivisionExemplarMaps, ExemplarXFollowsTheFieldAndImageUpIsNormalCrossFie
     EXPECT_NEAR(on[v.idx()][1], 0.5, 1e-3);
     EXPECT_NEAR(on[v.idx()][2], std::sqrt(0.5), 1e-3);
   }
+}
+
+// Issue 18: between the vertices the surface carries the exemplar itself.
+// On a flat grid with the field along +x, a face whose three corners were
+// copied by one transfer (their lookups differ exactly by their offsets) reads,
+// at its centroid, the exemplar's level 0 at the carried position: not the
+// blend of the three vertex colours, which on 2.5-texel edges of a sharp
+// exemplar is far from it.
+TEST(SubdivisionExemplarMaps, SourceReadsTheExemplarBetweenVerticesCopiedTogether) {
+  const Image ex = make_cells(32, 3, 5);
+  Mesh m;
+  make_grid(m, 8, 8);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 40;
+  o.levels = 2;
+  o.keys = {{0, {1, 0, 0}}};
+  o.seed = 4;
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  const double texels = 1.0 / r.scale.texel_size;
+  auto col = find(m, kVertexColor).first;
+  std::vector<std::array<float, 3>> fallback(m.number_of_vertices());
+  for (VertexIndex v : m.vertices()) fallback[v.idx()] = {col[v][0], col[v][1], col[v][2]};
+  const SurfaceExemplarSource src(m, r, r.exemplar, fallback);
+  const ExemplarLevels level0 = make_exemplar_levels(r.exemplar, false, 1, std::min(r.bounded_levels, 1));
+  std::size_t together = 0;
+  double blend_error = 0;
+  for (FaceIndex f : m.faces()) {
+    std::array<std::size_t, 3> v;
+    int k = 0;
+    for (VertexIndex w : m.vertices_around_face(m.halfedge(f))) v[k++] = w.idx();
+    const auto p = [&](int i) { return m.point(VertexIndex(static_cast<Mesh::size_type>(v[i]))); };
+    const ExemplarLookup& l0 = r.lookup[v[0]];
+    bool same = l0.level >= 0;
+    for (int i = 1; i < 3 && same; ++i) {
+      const ExemplarLookup& li = r.lookup[v[i]];
+      const auto d = p(i) - p(0);
+      same = li.level >= 0 && std::abs(li.x - l0.x - texels * d.x()) < 1e-6 && std::abs(li.y - l0.y + texels * d.y()) < 1e-6;
+    }
+    if (!same) continue;
+    ++together;
+    const auto c = ((p(1) - p(0)) + (p(2) - p(0))) / 3.0;
+    const auto want = texel_bilinear(level0, 0, l0.x + texels * c.x(), l0.y - texels * c.y());
+    const auto got = src(v, {1.0 / 3, 1.0 / 3, 1.0 / 3});
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_NEAR(got[j], want[j], 1e-4) << "face " << f.idx();
+      blend_error += std::abs((fallback[v[0]][j] + fallback[v[1]][j] + fallback[v[2]][j]) / 3 - want[j]);
+    }
+  }
+  ASSERT_GT(together, m.number_of_faces() / 3);
+  EXPECT_GT(blend_error / (3.0 * together), 0.02) << "the vertex blend would have passed as well";
+  // A corner without a lookup gives its fallback value.
+  SubdivisionSynthesisResult none = r;
+  for (auto& l : none.lookup) l.level = -1;
+  const SurfaceExemplarSource fb(m, none, r.exemplar, fallback);
+  const auto at0 = fb({0, 1, 2}, {1, 0, 0});
+  for (int j = 0; j < 3; ++j) EXPECT_FLOAT_EQ(at0[j], fallback[0][j]);
+  fallback.pop_back();
+  EXPECT_THROW(SurfaceExemplarSource(m, r, r.exemplar, fallback), InvalidInputError);
+}
+
+// A copy matched coherently continues its neighbour's copy to the sub-texel
+// (not at the rounded integer match): on a flat grid with a 5-texel checker
+// and 2.3-texel edges, the lookups of most edges differ by exactly the edge's
+// offset in texels, up to whole periods of the checker (the rest: edges
+// across copies matched afresh). Matching at integer positions leaves every edge
+// across two copies off by the rounding (up to half a texel), which moves a
+// fine periodic pattern's phase from copy to copy.
+TEST(SubdivisionExemplarMaps, CoherentCopiesContinueTheirNeighboursToTheSubTexel) {
+  const Image ex = make_checker(40, 8);
+  Mesh m;
+  make_grid(m, 8, 8);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 37;
+  o.levels = 2;
+  o.keys = {{0, {1, 0, 0}}};
+  o.wrap = ExemplarWrap::Periodic;
+  o.seed = 3;
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  const double texels = 1.0 / r.scale.texel_size;
+  constexpr int kPeriod = 10;  // two 5-texel cells: lookups this far apart read the same colour
+  auto wrap = [](double d, int n) { return d - n * std::round(d / n); };
+  std::size_t edges = 0, exact = 0;
+  for (EdgeIndex e : m.edges()) {
+    const VertexIndex a = m.vertex(e, 0), b = m.vertex(e, 1);
+    const ExemplarLookup &la = r.lookup[a.idx()], &lb = r.lookup[b.idx()];
+    if (la.level < 0 || lb.level < 0) continue;
+    const auto d = m.point(b) - m.point(a);
+    ++edges;
+    exact += std::abs(wrap(lb.x - la.x - texels * d.x(), kPeriod)) < 0.02 &&
+             std::abs(wrap(lb.y - la.y + texels * d.y(), kPeriod)) < 0.02;
+  }
+  std::cout << exact << " of " << edges << " edges continue the checker's phase exactly\n";
+  ASSERT_GT(edges, m.number_of_edges() * 9 / 10);
+  EXPECT_GT(exact, edges * 8 / 10);  // 89% (integer matches: 70%)
 }
 
 // The baked tangent-space map, decoded through the frames the GLB carries

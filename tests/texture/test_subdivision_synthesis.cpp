@@ -848,7 +848,10 @@ TEST(SubdivisionSynthesis, DefaultScaleShowsFewerRepeatsRatherThanBlurAFineCheck
 
 // The same end to end: with the default trade the synthesised check keeps
 // its contrast on the vertices; reduced as far as the budget alone asks
-// (min_relative_detail 0) it averages to a flat colour.
+// (min_relative_detail 0) it averages to a flat colour (1e-4). The vertices
+// read the check at the sub-texel phase their copy continues (not at texel
+// centres), which keeps about 44% of a 3-texel check's deviation at one
+// texel per vertex (68% at integer matches; decision 212).
 TEST(SubdivisionSynthesis, AFineCheckKeepsItsContrastAtTheDefaultScale) {
   const Image check = fine_check(96, 3);
   std::vector<double> ex_grey;
@@ -873,7 +876,7 @@ TEST(SubdivisionSynthesis, AFineCheckKeepsItsContrastAtTheDefaultScale) {
   const double c_off = vertex_contrast(0.0, r_off);
   EXPECT_NEAR(r_off, 3.0, 1e-9);
   EXPECT_LT(r_default, r_off);
-  EXPECT_GT(c_default, 0.5) << "the check is washed out at " << r_default << " repeats";
+  EXPECT_GT(c_default, 0.35) << "the check is washed out at " << r_default << " repeats";
   EXPECT_GT(c_default, 1.5 * c_off) << "contrast " << c_default << " against " << c_off << " without the trade";
 }
 

@@ -171,6 +171,10 @@ struct MatchResult {
   double distance = 0;  ///< d(Q_best) (without the constant C when averaging)
   std::size_t comparisons = 0;  ///< samples or groups compared per candidate
   std::size_t candidates = 0;   ///< candidates summed to the end, not abandoned (ExemplarIndex::match)
+  /// A coherent candidate's sub-texel position (its vertex's lookup carried to
+  /// the centre), where the match is one; else qx, qy are used.
+  bool subtexel = false;
+  double x = 0, y = 0;
 };
 
 /// Exhaustive best match (Algorithm 1) of the samples at `center_level`:

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/subdivision/subdivision_asset.h"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "geometry/errors.h"
@@ -40,6 +41,37 @@ SubdivisionVertexMaps exemplar_maps_at_vertices(const Mesh& mesh, const Subdivis
   return vm;
 }
 
+namespace {
+
+std::vector<std::array<float, 3>> vertex_colors(const Mesh& mesh) {
+  auto col = find(mesh, kVertexColor);
+  if (!col.second) throw InvalidInputError("subdivision: the mesh has no vertex colours (kVertexColor)");
+  std::vector<std::array<float, 3>> c(mesh.number_of_vertices());
+  for (VertexIndex v : mesh.vertices()) c[v.idx()] = {col.first[v][0], col.first[v][1], col.first[v][2]};
+  return c;
+}
+
+// A grey map's vertex values (the fallback of its source), repeated in RGB.
+std::optional<SurfaceExemplarSource> grey_source(const Mesh& mesh, const SubdivisionSynthesisResult& r,
+                                                 const Image& map, int w, int h) {
+  if (map.empty()) return std::nullopt;
+  const std::vector<float> g = vertex_luminance(read_map_at_vertices(mesh, r, map, w, h));
+  std::vector<std::array<float, 3>> rgb(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i) rgb[i] = {g[i], g[i], g[i]};
+  return SurfaceExemplarSource(mesh, r, resample_as_synthesised(map, r.scale, r.periodic), std::move(rgb));
+}
+
+}  // namespace
+
+SubdivisionSurfaceSources subdivision_surface_sources(const Mesh& mesh, const SubdivisionSynthesisResult& r,
+                                                      const SubdivisionExemplarMaps& maps, int w, int h) {
+  SubdivisionSurfaceSources s;
+  s.color.emplace(mesh, r, r.exemplar, vertex_colors(mesh));
+  s.height = grey_source(mesh, r, maps.height, w, h);
+  s.roughness = grey_source(mesh, r, maps.roughness, w, h);
+  return s;
+}
+
 nlohmann::json subdivision_fidelity_report(const Mesh& mesh, const SubdivisionSynthesisResult& r,
                                            std::uint64_t seed) {
   SurfaceFidelityOptions fo;
@@ -48,7 +80,9 @@ nlohmann::json subdivision_fidelity_report(const Mesh& mesh, const SubdivisionSy
   fo.seed = seed;
   fo.source = vertex_source_coordinates(r.source);
   try {
-    return to_json(surface_fidelity(mesh, r.exemplar, vertex_color_source(mesh), frames_from_vertex_directions(mesh), fo));
+    const SurfaceExemplarSource between(mesh, r, r.exemplar, vertex_colors(mesh));
+    const SurfaceColorFn color = [between](const SurfacePoint& p) { return between(p.vertex, p.bary); };
+    return to_json(surface_fidelity(mesh, r.exemplar, color, frames_from_vertex_directions(mesh), fo));
   } catch (const InvalidInputError& e) {  // e.g. no chart fits a tiny or very thin mesh
     return {{"error", e.what()}};
   }
@@ -64,21 +98,43 @@ std::vector<T> on_copy(const std::vector<T>& per_vertex, const std::vector<std::
   return t;
 }
 
+// A source read at the copy's texels (corners mapped to the synthesised mesh's
+// vertices); grey = the luminance, clamped to [0, 1] as height_from_luminance.
+BakeResult bake_between(const Mesh& tri, const std::vector<std::uint32_t>& from, const SurfaceExemplarSource& src,
+                        int channels, const BakeOptions& bo) {
+  const auto value = [&](const std::array<std::size_t, 3>& corner, const std::array<float, 3>& bary, float* out) {
+    std::array<std::size_t, 3> v;
+    for (int k = 0; k < 3; ++k) v[k] = from[tri.target(HalfedgeIndex(static_cast<Mesh::size_type>(corner[k]))).idx()];
+    const auto c = src(v, {bary[0], bary[1], bary[2]});
+    if (channels == 3) {
+      for (int k = 0; k < 3; ++k) out[k] = c[k];
+    } else {
+      out[0] = std::clamp(0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2], 0.f, 1.f);
+    }
+  };
+  return bake_texel_values(tri, channels, value, bo);
+}
+
 // The PBR maps of the baked atlas (file comment).
 void bake_maps(SubdivisionAsset& a, const SubdivisionVertexMaps& maps, const std::vector<std::uint32_t>& from) {
   const Mesh& tri = *a.mesh;
   const SubdivisionAssetOptions& o = a.options;
   BakeOptions bo;
   bo.size = o.atlas_size;
-  a.height_from_exemplar = !maps.height.empty();
+  a.height_from_exemplar = !maps.height.empty() || maps.between.height.has_value();
   a.normal_from_exemplar = !maps.normal.empty();
-  a.height = maps.height.empty() ? height_from_luminance(a.color.image)
-                                 : bake_vertex_values(tri, on_copy(maps.height, from), 1, bo).image;
+  if (maps.between.height)
+    a.height = bake_between(tri, from, *maps.between.height, 1, bo).image;
+  else
+    a.height = maps.height.empty() ? height_from_luminance(a.color.image)
+                                   : bake_vertex_values(tri, on_copy(maps.height, from), 1, bo).image;
   a.atlas_texels_per_exemplar_texel = a.atlas.atlas.uv_per_length * o.atlas_size / o.texels_per_length;
   a.normal = maps.normal.empty()
                  ? normal_map_from_height(a.height, a.color.chart, o.bump * a.atlas_texels_per_exemplar_texel)
                  : tangent_space_normal_map(tri, on_copy(maps.normal, from), o.atlas_size);
-  if (!maps.roughness.empty())
+  if (maps.between.roughness)
+    a.metallic_roughness = metallic_roughness_from_roughness(bake_between(tri, from, *maps.between.roughness, 1, bo).image);
+  else if (!maps.roughness.empty())
     a.metallic_roughness =
         metallic_roughness_from_roughness(bake_vertex_values(tri, on_copy(maps.roughness, from), 1, bo).image);
 }
@@ -106,7 +162,8 @@ SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVerte
   a.atlas = compute_gutter_atlas(tri, options.atlas_size, 64, options.max_chart_faces);
   BakeOptions bo;
   bo.size = options.atlas_size;
-  a.color = bake_vertex_colors(tri, bo);
+  a.color_between_vertices = maps.between.color.has_value();
+  a.color = maps.between.color ? bake_between(tri, from, *maps.between.color, 3, bo) : bake_vertex_colors(tri, bo);
   bake_maps(a, maps, from);
   if (options.texel_size > 0) {
     a.seam = surface_seam_ratio(tri, atlas_color_source(tri, a.color.image), seam_edges_from_corner_uv(tri),
@@ -134,6 +191,7 @@ nlohmann::json to_json(const SubdivisionAsset& a) {
                       {"atlas_texels_per_exemplar_texel", a.atlas_texels_per_exemplar_texel},
                       {"normal_source", a.normal_from_exemplar ? "exemplar_normal" : "height"},
                       {"height_source", a.height_from_exemplar ? "exemplar_height" : "luminance"},
+                      {"color_source", a.color_between_vertices ? "exemplar_between_vertices" : "vertex_colors"},
                       {"roughness", !a.metallic_roughness.empty()},
                       {"seconds", {{"bake", a.seconds}, {"charts", a.atlas.seconds}}}};
   if (a.seam_measured) j["seam"] = to_json(a.seam);

@@ -5,9 +5,11 @@
 // atlas of a triangle copy of the mesh, with the PBR set of texture/pbr_maps.h.
 //
 // Steps: triangle copy (geometry/triangulated_copy.h), gutter atlas
-// (geometry/gutter_atlas.h), vertex-colour bake (geometry/bake_vertex_colors.h),
-// then the maps: height = the exemplar height's vertex values baked like the
-// colour, else the luminance of the colour atlas; normal = the exemplar
+// (geometry/gutter_atlas.h), colour bake (geometry/bake_vertex_colors.h): the
+// exemplar read between the vertices through their lookups where the sources
+// are given (SurfaceExemplarSource), else the vertex colours blended; then the
+// maps: height = the exemplar height baked like the colour, else the
+// luminance of the colour atlas; normal = the exemplar
 // normal's object-space vertex normals in the atlas's tangent frames
 // (texture/tangent_space_bake.h), else from the height's slopes; roughness
 // (metallicRoughness) only from the exemplar roughness. With a texel size, the
@@ -20,6 +22,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +32,7 @@
 #include "geometry/gutter_atlas.h"
 #include "geometry/image.h"
 #include "geometry/mesh_fwd.h"
+#include "texture/subdivision/subdivision_exemplar_maps.h"
 #include "texture/subdivision/subdivision_synthesis.h"
 #include "texture/surface_fidelity.h"
 
@@ -40,13 +44,25 @@ struct SubdivisionExemplarMaps {
   Image normal, height, roughness;
 };
 
+/// The colour and the exemplar's height and roughness read between the
+/// vertices (SurfaceExemplarSource); empty = the vertex values blended.
+struct SubdivisionSurfaceSources {
+  std::optional<SurfaceExemplarSource> color, height, roughness;
+};
+
 /// Per-vertex values of the exemplar maps, by vertex index of the
 /// synthesised mesh; empty = not given.
 struct SubdivisionVertexMaps {
   std::vector<float> height, roughness;        ///< luminance of the map
   std::vector<std::array<float, 3>> normal;    ///< object-space unit normals
   std::size_t filled = 0;  ///< vertices without a lookup (of the last map read)
+  SubdivisionSurfaceSources between;  ///< what the atlas bakes where set
 };
+
+/// The sources of the mesh as synthesised (before any displacement): the
+/// colour (fallback kVertexColor) and each given height and roughness map.
+SubdivisionSurfaceSources subdivision_surface_sources(const Mesh& mesh, const SubdivisionSynthesisResult& result,
+                                                      const SubdivisionExemplarMaps& maps, int width, int height);
 
 /// The maps read where each final vertex's colour was read
 /// (texture/subdivision/subdivision_exemplar_maps.h); `width` x `height` is
@@ -54,8 +70,9 @@ struct SubdivisionVertexMaps {
 SubdivisionVertexMaps exemplar_maps_at_vertices(const Mesh& mesh, const SubdivisionSynthesisResult& result,
                                                 const SubdivisionExemplarMaps& maps, int width, int height);
 
-/// The report's "fidelity" block: the vertex colours resampled in charts at
-/// the synthesis texel against the exemplar as synthesised; {"error": reason}
+/// The report's "fidelity" block: the colour between the vertices (what the
+/// atlas bakes, subdivision_surface_sources) resampled in charts at the
+/// synthesis texel against the exemplar as synthesised; {"error": reason}
 /// when no chart fits (tiny or very thin meshes).
 nlohmann::json subdivision_fidelity_report(const Mesh& mesh, const SubdivisionSynthesisResult& result,
                                            std::uint64_t seed);
@@ -81,6 +98,7 @@ struct SubdivisionAsset {
   SubdivisionAssetOptions options;
   double atlas_texels_per_exemplar_texel = 0;
   bool normal_from_exemplar = false, height_from_exemplar = false;
+  bool color_between_vertices = false;  ///< the colour from SubdivisionSurfaceSources, not the vertex colours
   bool seam_measured = false;      ///< options.texel_size > 0
   SurfaceSeamRatio seam;           ///< colour jumps across the atlas's chart seams
   double seconds = 0;              ///< the whole bake

@@ -8,6 +8,7 @@
 
 #include "geometry/errors.h"
 #include "geometry/mesh.h"
+#include "geometry/properties.h"
 #include "texture/subdivision/k_region_matching.h"
 
 namespace surftex {
@@ -129,6 +130,77 @@ std::vector<float> vertex_luminance(const VertexMapValues& v) {
     out[i] = std::clamp(0.2126f * v.values[3 * i] + 0.7152f * v.values[3 * i + 1] + 0.0722f * v.values[3 * i + 2],
                         0.f, 1.f);  // as height_from_luminance
   return out;
+}
+
+}  // namespace surftex
+
+namespace surftex {
+
+struct SurfaceExemplarSource::Data {
+  ExemplarLevels ex;
+  std::vector<std::array<double, 3>> position, u_axis, v_axis;
+  std::vector<ExemplarLookup> lookup;
+  std::vector<std::array<float, 3>> fallback;
+  double texels_per_unit = 1;  // synthesis texels per mesh unit
+};
+
+SurfaceExemplarSource::SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& r,
+                                             const Image& map, std::vector<std::array<float, 3>> fallback) {
+  const std::size_t nv = mesh.number_of_vertices();
+  if (r.lookup.size() != nv || fallback.size() != nv || mesh.has_garbage())
+    throw InvalidInputError("SurfaceExemplarSource: " + std::to_string(r.lookup.size()) + " lookups and " +
+                            std::to_string(fallback.size()) + " fallback values for " + std::to_string(nv) +
+                            " vertices");
+  if (!(r.scale.texel_size > 0)) throw InvalidInputError("SurfaceExemplarSource: the result has no texel size");
+  auto d = std::make_shared<Data>();
+  // A stack's level 0 alone (the exemplar, read as the synthesis read it); a pyramid whole.
+  d->ex = r.pyramid ? make_exemplar_levels(map, true, 0, r.bounded_levels)
+                    : make_exemplar_levels(map, false, 1, std::min(r.bounded_levels, 1));
+  const SurfaceFrames fr = compute_surface_frames(mesh);
+  d->position.resize(nv);
+  d->u_axis = fr.direction;
+  d->v_axis.resize(nv);
+  for (VertexIndex v : mesh.vertices()) {
+    const Point3& p = mesh.point(v);
+    const std::size_t i = v.idx();
+    d->position[i] = {p.x(), p.y(), p.z()};
+    const auto& n = fr.normal[i];
+    const auto& u = fr.direction[i];
+    d->v_axis[i] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+  }
+  d->lookup = r.lookup;
+  d->fallback = std::move(fallback);
+  d->texels_per_unit = 1.0 / r.scale.texel_size;
+  d_ = std::move(d);
+}
+
+SurfaceExemplarSource::~SurfaceExemplarSource() = default;
+
+std::array<float, 3> SurfaceExemplarSource::operator()(const std::array<std::size_t, 3>& vertex,
+                                                       const std::array<double, 3>& bary) const {
+  const Data& d = *d_;
+  std::array<double, 3> p{0, 0, 0};
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) p[j] += bary[k] * d.position[vertex[k]][j];
+  std::array<float, 3> c{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t v = vertex[k];
+    const ExemplarLookup& l = d.lookup[v];
+    std::array<float, 3> t = d.fallback[v];
+    if (l.level >= 0) {
+      const auto& q = d.position[v];
+      const std::array<double, 3> o{p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+      const auto& a = d.u_axis[v];
+      const auto& b = d.v_axis[v];
+      // In level-l texels: the match's offsets are level-0 texels over a^l (sample_offset).
+      const double s = d.texels_per_unit / d.ex.scale(d.ex.pyramid ? l.level : 0);
+      const double du = s * (o[0] * a[0] + o[1] * a[1] + o[2] * a[2]);
+      const double dv = s * (o[0] * b[0] + o[1] * b[1] + o[2] * b[2]);
+      t = texel_bilinear(d.ex, d.ex.pyramid ? l.level : 0, l.x + du, l.y - dv);
+    }
+    for (int j = 0; j < 3; ++j) c[j] += static_cast<float>(bary[k]) * t[j];
+  }
+  return c;
 }
 
 }  // namespace surftex

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "geometry/image.h"
@@ -37,6 +38,36 @@ VertexMapValues read_map_at_vertices(const Mesh& mesh, const SubdivisionSynthesi
 /// (reads kVertexDirection and the positions: call on the mesh as shown).
 /// Throws InvalidInputError for fewer than 3 channels or a missing field.
 std::vector<std::array<float, 3>> object_normals_from_map(const Mesh& mesh, const VertexMapValues& normal_map);
+
+/// The exemplar between the vertices (issue 18: the texture at the exemplar's
+/// resolution, not the vertices'). A point of a face reads, from each of its
+/// three corners, the corner's lookup carried to the point along the corner's
+/// frame (u along kVertexDirection, v along n x d: k_region_matching's
+/// offsets, in synthesis texels) and blends the three reads by its
+/// barycentrics. Where the corners were copied by one transfer the three reads
+/// agree, and the point gets the exemplar's own texel rather than a blend of
+/// vertex colours; across a transfer's cut it blends the two copies over one
+/// triangle. Stack lookups are read at level 0 (the antialiasing level is for
+/// the vertices' own colours), pyramid ones at their level. A corner without a
+/// lookup gives its `fallback` value (by vertex index).
+///
+/// `map_as_synthesised`: the exemplar as synthesised (result.exemplar) or a
+/// map resampled as it was (resample_as_synthesised); the mesh as synthesised
+/// (positions, kVertexDirection; copied: the mesh may change afterwards).
+/// Thread-safe. Throws InvalidInputError if the result, the fallback or the
+/// map does not fit the mesh.
+class SurfaceExemplarSource {
+ public:
+  SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& result, const Image& map_as_synthesised,
+                        std::vector<std::array<float, 3>> fallback);
+  ~SurfaceExemplarSource();
+  /// RGB (grey maps repeated) at the point with these corner vertices and barycentrics.
+  std::array<float, 3> operator()(const std::array<std::size_t, 3>& vertex, const std::array<double, 3>& bary) const;
+
+ private:
+  struct Data;
+  std::shared_ptr<const Data> d_;
+};
 
 /// One channel per vertex: the luminance (Rec. 709) of a 3-channel map, else the values.
 std::vector<float> vertex_luminance(const VertexMapValues& v);

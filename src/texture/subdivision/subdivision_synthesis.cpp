@@ -372,6 +372,24 @@ void group_footprint(const ExemplarLevels& ex, int lp, const std::vector<SampleG
 // Coherence search (SubdivisionSynthesisOptions::exhaustive_levels): the best
 // of the centres implied by the region's sources. found = false when no
 // region vertex has a source implying a centre inside the box.
+// The coherent candidate of region vertex i at the sub-texel position its
+// lookup gives (that lookup carried back to the centre), so that the new copy
+// continues its neighbour's without the rounding of the integer match: half a
+// texel of phase between neighbouring copies breaks a fine periodic pattern.
+// Stacks only (a pyramid's levels have their own texel grids).
+void continue_subtexel(const PassContext& c, const KRegion& reg, std::size_t i, const std::array<int, 2>& offset,
+                       int sc, MatchResult& best) {
+  const ExemplarLookup& l = c.lookup[reg.vertices[i]];
+  const auto& src = c.source[reg.vertices[i]];
+  best.subtexel = false;
+  if (c.ex.pyramid || l.level < 0) return;
+  const double rx = (l.x - c.r_scale * reg.uv[i][0]) - (src[0] / sc - offset[0]);
+  const double ry = (l.y + c.r_scale * reg.uv[i][1]) - (src[1] / sc - offset[1]);
+  if (!(std::abs(rx) <= 1.0 && std::abs(ry) <= 1.0)) return;
+  best.subtexel = true;
+  best.x = best.qx + rx, best.y = best.qy + ry;
+}
+
 MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, const MatchBox& box, JobScratch& s) {
   MatchResult best;
   const int W = c.ex.width(lp), H = c.ex.height(lp), sc = c.ex.scale(lp);
@@ -409,6 +427,7 @@ MatchResult coherent_match(const PassContext& c, const KRegion& reg, int lp, con
       bd = d;
       best.found = true;
       best.qx = qx, best.qy = qy, best.distance = d;
+      continue_subtexel(c, reg, i, s.offsets[i], sc, best);
     }
   }
   best.comparisons = s.groups.size();
@@ -511,6 +530,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
   } else {
     s.nodes.resize(reg.vertices.size());
     s.lookups.resize(reg.vertices.size());
+    const double mx = job.m.subtexel ? job.m.x : job.m.qx, my = job.m.subtexel ? job.m.y : job.m.qy;
     for (std::size_t i = 0; i < reg.vertices.size(); ++i) {
       const std::size_t v = reg.vertices[i];
       RegionSample smp{c.r_scale * reg.uv[i][0], c.r_scale * reg.uv[i][1], c.level[v], {}};
@@ -525,7 +545,7 @@ void run_job(const PassContext& c, std::size_t p, VertexJob& job, JobScratch& s)
       // exemplar, not a nearest-texel one whose duplicated and skipped texels
       // break its fine structure. Pinned vertices keep their colour.
       const double lsc = c.ex.pyramid ? static_cast<double>(sc) : 1.0;  // as sample_offset
-      s.lookups[i] = n.pinned ? c.lookup[v] : ExemplarLookup{lv, job.m.qx + smp.du / lsc, job.m.qy - smp.dv / lsc};
+      s.lookups[i] = n.pinned ? c.lookup[v] : ExemplarLookup{lv, mx + smp.du / lsc, my - smp.dv / lsc};
       n.texture = n.pinned ? n.surface : texel_bilinear(c.ex, lv, s.lookups[i].x, s.lookups[i].y);
       n.distance = std::sqrt(smp.du * smp.du + smp.dv * smp.dv);
       n.hops = reg.hops[i];
