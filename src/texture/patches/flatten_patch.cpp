@@ -92,7 +92,11 @@ FlatPatch flatten_patch_geometry(const Mesh& mesh, int patch, int seed_face, int
   const auto sv = face_vertices(mesh, sf);
   const Point3 o = CGAL::centroid(mesh.point(sv[0]), mesh.point(sv[1]), mesh.point(sv[2]));
   const Vector3 n = robust_face_normal(mesh, sf);
-  Vector3 e1 = mesh.point(sv[1]) - mesh.point(sv[0]);
+  // The raster's rows along the texture's +x at the seed (kFaceDirection, when
+  // the field is there), else along the seed's first edge: see
+  // docs/decisions/505-efros-leung-details.md ("raster frame").
+  auto fdir = find(mesh, kFaceDirection);
+  Vector3 e1 = fdir.second && fdir.first[sf].squared_length() > 0 ? fdir.first[sf] : mesh.point(sv[1]) - mesh.point(sv[0]);
   e1 = e1 - (e1 * n) * n;
   e1 = normalized_or(e1, std::abs(n.x()) < 0.9 ? CGAL::cross_product(n, Vector3(1, 0, 0))
                                                : CGAL::cross_product(n, Vector3(0, 1, 0)));
@@ -433,14 +437,24 @@ FlattenResult flatten_patches(const Mesh& mesh, const std::vector<int>& seeds,
     extent = std::max({extent, b.x1 - b.x0, b.y1 - b.y0});
   }
   const int R = opt.resolution;
-  const double texel = extent > 0 ? extent / (R - 2 * opt.margin) : 1.0;
+  // One texel of the side is kept for the grid's shift below (at most half a
+  // texel either way), so the margin holds.
+  const double texel = extent > 0 ? extent / std::max(1, R - 2 * opt.margin - 1) : 1.0;
   res.texel = texel;
   tbb::parallel_for(0, count, [&](int p) {
     FlatPatch& fp = res.patches[p];
     fp.res = R;
     fp.texel = texel;
-    fp.u0 = 0.5 * (pbox[p].x0 + pbox[p].x1) - 0.5 * R * texel;
-    fp.v0 = 0.5 * (pbox[p].y0 + pbox[p].y1) + 0.5 * R * texel;
+    // Pixel centres on one lattice of the texel in world coordinates along
+    // e1 and e2: patches whose planes and frames agree (a flat part under a
+    // steady field) then share one pixel grid, so a neighbour's pixels are
+    // read at their centres, not resampled half a texel off.
+    const auto lattice = [&](double centre, const std::array<double, 3>& e) {
+      const double w = fp.origin[0] * e[0] + fp.origin[1] * e[1] + fp.origin[2] * e[2];
+      return std::round((w + centre) / texel) * texel - w;
+    };
+    fp.u0 = lattice(0.5 * (pbox[p].x0 + pbox[p].x1) - 0.5 * R * texel, fp.e1);
+    fp.v0 = lattice(0.5 * (pbox[p].y0 + pbox[p].y1) + 0.5 * R * texel, fp.e2);
     rasterise_patch(fp);
   });
   for (const FlatPatch& fp : res.patches) {

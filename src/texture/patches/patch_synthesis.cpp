@@ -649,7 +649,7 @@ FlattenOptions raised_for_widths(const FlattenOptions& fo, const FlattenResult& 
   const double f = widths / shown;
   FlattenOptions up = fo;
   up.margin = std::max(fo.margin, static_cast<int>(std::ceil(fo.margin * f)));
-  const double inside = std::ceil((fo.resolution - 2 * fo.margin) * f);
+  const double inside = std::ceil((fo.resolution - 2 * fo.margin - 1) * f) + 1;  // flatten_patches keeps one texel
   up.resolution = static_cast<int>(std::min(4096.0, inside + 2 * up.margin));
   up.margin = std::min(up.margin, up.resolution / 4);
   double windows = 0;
