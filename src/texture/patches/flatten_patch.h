@@ -8,11 +8,13 @@
 // shared edge into it (the paper), ring by ring up to boundary_rings (ours:
 // ring 1 alone leaves gaps); boundary triangles overlapping (exact test) are
 // dropped; a patch overlapping itself is split (split_overlapping_patches).
-// Raster: res x res per patch at one texel size for all, pixels Inside,
+// Raster: res x res per patch at one texel size for all, rows along the
+// texture's +x at the seed (kFaceDirection when present), pixel centres on
+// one world lattice (patches on a plane share one grid); pixels Inside,
 // Boundary or Outside, each with its face and barycentrics. In full:
 // docs/decisions/505-efros-leung-details.md.
 //
-// Reads kFacePatch. split_overlapping_patches writes kFacePatch. Throws
+// Reads kFacePatch, kFaceDirection (optional). split_overlapping_patches writes kFacePatch. Throws
 // InvalidInputError (missing kFacePatch, a face without patch, bad options,
 // non-triangle faces).
 
