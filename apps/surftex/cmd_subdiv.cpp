@@ -354,9 +354,10 @@ SubcommandRegistrar reg_subdiv{
            ->required();
        app.add_option("-o,--output", a->outdir,
                       "Output folder: surface.ply (vertex colours), surface.glb (baked atlas as base colour, "
-                      "normal map, vertex colours as _COLOR), surface_atlas.obj/.mtl/.png (baked atlas) with "
+                      "normal map, vertex colours as _COLOR), surface_atlas.obj/.mtl/.png (baked atlas: the exemplar "
+                      "read between the vertices where their colours were read) with "
                       "surface_atlas_normal.png and surface_atlas_height.png (16-bit) (and surface_atlas_roughness.png "
-                      "with --exemplar-roughness), render.png, report.json")
+                      "with --exemplar-roughness), render.png (the atlas as a glTF viewer shows it), report.json")
            ->required();
        auto* ts = app.add_option("--texel-size", a->texel_size,
                                  "Texture scale: Nx = N exemplar widths across the longest bounding-box side, or "
