@@ -280,7 +280,7 @@ int run_subdiv(const SubdivArgs& a) {
   SubdivisionAsset asset;
   DisplaceResult disp;
   // the texture between the vertices follows the surface as synthesised
-  const SubdivisionSurfaceSources between = subdivision_surface_sources(mesh, r, maps, ex.width, ex.height);
+  const SubdivisionSurfaceSources between = subdivision_surface_sources(mesh, r, maps, ex.width, ex.height, &ex);
   // frames of the surface as written (after --displace)
   auto bake = [&] {
     vmaps = exemplar_maps_at_vertices(mesh, r, maps, ex.width, ex.height);
@@ -461,7 +461,7 @@ DemoStepRegistrar demo_subdiv{{50, "subdiv",
                                  ao.atlas_size = 512;
                                  ao.texels_per_length = 64 / r.object_unit;  // demo_run's r_scale
                                  SubdivisionVertexMaps vm;
-                                 vm.between = subdivision_surface_sources(mesh, r, {}, ex.width, ex.height);
+                                 vm.between = subdivision_surface_sources(mesh, r, {}, ex.width, ex.height, &ex);
                                  const SubdivisionAsset asset = bake_subdivision_asset(mesh, vm, ao);
                                  nlohmann::json written = write_outputs(mesh, asset, output_paths(dir), true);
                                  // Report keys as the CLI's (issue 16 item 7): names under the demo folder.

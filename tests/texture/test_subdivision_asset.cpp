@@ -112,6 +112,27 @@ TEST(SubdivisionAsset, BakesTheExemplarBetweenTheVerticesWhenGivenTheSources) {
   }
   ASSERT_GT(texels, 256u * 256u / 10);
   EXPECT_GT(off / (3.0 * texels), 0.02) << "the vertex blend is not the exemplar between the vertices";
+  EXPECT_EQ(a.color_stack_level, 0);
+  // An atlas sparser than the exemplar's texels (120 per unit) reads a
+  // prefiltered level: round(log2(map texels per atlas texel)).
+  Mesh fine;
+  make_grid(fine, 6, 6);
+  so.r_scale = 120;
+  const SubdivisionSynthesisResult rf = synthesize_on_subdivision(fine, ex, so);
+  SubdivisionVertexMaps fm;
+  fm.between = subdivision_surface_sources(fine, rf, {}, 32, 32, &ex);
+  SubdivisionAssetOptions sparse = o;
+  sparse.atlas_size = 64;
+  sparse.texels_per_length = 120;
+  sparse.texel_size = rf.scale.texel_size;
+  const SubdivisionAsset s = bake_subdivision_asset(fine, fm, sparse);
+  const double d = s.atlas.atlas.uv_per_length * 64 * rf.scale.texel_size;  // atlas texels per exemplar texel
+  ASSERT_LT(d, 0.7);
+  EXPECT_EQ(s.color_stack_level, std::lround(std::log2(1.0 / d)));
+  EXPECT_GE(s.color_stack_level, 1);
+  EXPECT_EQ(to_json(s)["color_stack_level"], s.color_stack_level);
+  const Image other(16, 16, 3);
+  EXPECT_THROW(subdivision_surface_sources(m, r, maps, 32, 32, &other), InvalidInputError) << "not the exemplar's size";
 }
 
 TEST(SubdivisionAsset, MapsFromVertexValues) {

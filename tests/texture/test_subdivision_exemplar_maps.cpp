@@ -179,6 +179,52 @@ TEST(SubdivisionExemplarMaps, SourceReadsTheExemplarBetweenVerticesCopiedTogethe
   EXPECT_THROW(SurfaceExemplarSource(m, r, r.exemplar, fallback), InvalidInputError);
 }
 
+// Where the vertex budget reduced the exemplar, the source reads the exemplar
+// as given at its own resolution: at a vertex, the lookup scaled to it (pixel
+// centres onto pixel centres), at any stack level built; reading the reduced
+// exemplar there gives other values (its detail is gone).
+TEST(SubdivisionExemplarMaps, SourceReadsTheInputAtItsOwnResolutionWhenTheSynthesisReducedIt) {
+  const Image ex = make_cells(64, 8, 3);
+  Mesh m;
+  make_icosphere(m, 1);
+  SubdivisionSynthesisOptions o;
+  o.repeats = 4;
+  o.max_vertices = 1000;
+  o.seed = 2;
+  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  ASSERT_LT(r.scale.exemplar_scale, 1.0);
+  std::vector<std::array<float, 3>> fallback(m.number_of_vertices(), {0.f, 0.f, 0.f});
+  ExemplarReadOptions read;
+  read.scale_x = 64.0 / r.exemplar.width;
+  read.scale_y = 64.0 / r.exemplar.height;
+  read.levels = 3;
+  const SurfaceExemplarSource src(m, r, ex, fallback, read);
+  const SurfaceExemplarSource reduced(m, r, r.exemplar, fallback);
+  EXPECT_EQ(src.levels(), 3);
+  EXPECT_EQ(src.at_level(7).level(), 2);
+  const ExemplarLevels stack = make_exemplar_levels(ex, false, 3, r.bounded_levels > 0 ? 3 : 0);
+  std::size_t read_at = 0;
+  double differs = 0;
+  for (VertexIndex v : m.vertices()) {
+    const ExemplarLookup& l = r.lookup[v.idx()];
+    if (l.level < 0) continue;
+    ++read_at;
+    const std::array<std::size_t, 3> c{v.idx(), v.idx(), v.idx()};
+    const double x = (l.x + 0.5) * read.scale_x - 0.5, y = (l.y + 0.5) * read.scale_y - 0.5;
+    for (int lv : {0, 2}) {
+      const auto got = src.at_level(lv)(c, {1, 0, 0});
+      const auto want = texel_bilinear(stack, lv, x, y);
+      for (int j = 0; j < 3; ++j) ASSERT_NEAR(got[j], want[j], 1e-5) << v.idx();
+    }
+    const auto full = src(c, {1, 0, 0}), small = reduced(c, {1, 0, 0});
+    for (int j = 0; j < 3; ++j) differs += std::abs(full[j] - small[j]);
+  }
+  ASSERT_GT(read_at, m.number_of_vertices() / 2);
+  EXPECT_GT(differs / (3.0 * read_at), 0.01);
+  read.scale_x = 0;
+  EXPECT_THROW(SurfaceExemplarSource(m, r, ex, fallback, read), InvalidInputError);
+}
+
 // A copy matched coherently continues its neighbour's copy to the sub-texel
 // (not at the rounded integer match): on a flat grid with a 5-texel checker
 // and 2.3-texel edges, the lookups of most edges differ by exactly the edge's

@@ -2,6 +2,7 @@
 #include "texture/subdivision/subdivision_asset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "geometry/errors.h"
@@ -51,6 +52,24 @@ std::vector<std::array<float, 3>> vertex_colors(const Mesh& mesh) {
   return c;
 }
 
+constexpr int kSourceLevels = 4;  // prefiltered reads down to an atlas 8x sparser than the map
+
+// Reads at the input's own resolution where the synthesis reduced the exemplar
+// (stacks only), else the map as synthesised.
+bool at_input_resolution(const SubdivisionSynthesisResult& r, int w, int h) {
+  return !r.pyramid && (w != r.exemplar.width || h != r.exemplar.height);
+}
+
+ExemplarReadOptions read_options(const SubdivisionSynthesisResult& r, int w, int h) {
+  ExemplarReadOptions o;
+  o.levels = kSourceLevels;
+  if (at_input_resolution(r, w, h)) {
+    o.scale_x = double(w) / r.exemplar.width;
+    o.scale_y = double(h) / r.exemplar.height;
+  }
+  return o;
+}
+
 // A grey map's vertex values (the fallback of its source), repeated in RGB.
 std::optional<SurfaceExemplarSource> grey_source(const Mesh& mesh, const SubdivisionSynthesisResult& r,
                                                  const Image& map, int w, int h) {
@@ -58,15 +77,35 @@ std::optional<SurfaceExemplarSource> grey_source(const Mesh& mesh, const Subdivi
   const std::vector<float> g = vertex_luminance(read_map_at_vertices(mesh, r, map, w, h));
   std::vector<std::array<float, 3>> rgb(g.size());
   for (std::size_t i = 0; i < g.size(); ++i) rgb[i] = {g[i], g[i], g[i]};
-  return SurfaceExemplarSource(mesh, r, resample_as_synthesised(map, r.scale, r.periodic), std::move(rgb));
+  const Image& m = at_input_resolution(r, w, h) ? map : resample_as_synthesised(map, r.scale, r.periodic);
+  return SurfaceExemplarSource(mesh, r, m, std::move(rgb), read_options(r, w, h));
+}
+
+// The stack level a bake reads: the atlas's texels per map pixel d, level
+// round(log2(1 / d)) below one (each level doubles the blur radius).
+int bake_level(const SurfaceExemplarSource& src, const SubdivisionAsset& a) {
+  const SubdivisionAssetOptions& o = a.options;
+  if (!(o.texel_size > 0)) return 0;
+  const double atlas_per_unit = a.atlas.atlas.uv_per_length * o.atlas_size;
+  const double map_per_unit = src.scale() / o.texel_size;
+  const double d = atlas_per_unit / map_per_unit;
+  return d >= 1 || !(d > 0) ? 0 : static_cast<int>(std::lround(std::log2(1.0 / d)));
 }
 
 }  // namespace
 
 SubdivisionSurfaceSources subdivision_surface_sources(const Mesh& mesh, const SubdivisionSynthesisResult& r,
-                                                      const SubdivisionExemplarMaps& maps, int w, int h) {
+                                                      const SubdivisionExemplarMaps& maps, int w, int h,
+                                                      const Image* input_exemplar) {
   SubdivisionSurfaceSources s;
-  s.color.emplace(mesh, r, r.exemplar, vertex_colors(mesh));
+  if (input_exemplar && (input_exemplar->width != w || input_exemplar->height != h))
+    throw InvalidInputError("subdivision_surface_sources: the input exemplar is " +
+                            std::to_string(input_exemplar->width) + " x " + std::to_string(input_exemplar->height) +
+                            ", not " + std::to_string(w) + " x " + std::to_string(h));
+  if (input_exemplar && at_input_resolution(r, w, h))
+    s.color.emplace(mesh, r, *input_exemplar, vertex_colors(mesh), read_options(r, w, h));
+  else
+    s.color.emplace(mesh, r, r.exemplar, vertex_colors(mesh), read_options(r, r.exemplar.width, r.exemplar.height));
   s.height = grey_source(mesh, r, maps.height, w, h);
   s.roughness = grey_source(mesh, r, maps.roughness, w, h);
   return s;
@@ -124,7 +163,7 @@ void bake_maps(SubdivisionAsset& a, const SubdivisionVertexMaps& maps, const std
   a.height_from_exemplar = !maps.height.empty() || maps.between.height.has_value();
   a.normal_from_exemplar = !maps.normal.empty();
   if (maps.between.height)
-    a.height = bake_between(tri, from, *maps.between.height, 1, bo).image;
+    a.height = bake_between(tri, from, maps.between.height->at_level(bake_level(*maps.between.height, a)), 1, bo).image;
   else
     a.height = maps.height.empty() ? height_from_luminance(a.color.image)
                                    : bake_vertex_values(tri, on_copy(maps.height, from), 1, bo).image;
@@ -133,7 +172,8 @@ void bake_maps(SubdivisionAsset& a, const SubdivisionVertexMaps& maps, const std
                  ? normal_map_from_height(a.height, a.color.chart, o.bump * a.atlas_texels_per_exemplar_texel)
                  : tangent_space_normal_map(tri, on_copy(maps.normal, from), o.atlas_size);
   if (maps.between.roughness)
-    a.metallic_roughness = metallic_roughness_from_roughness(bake_between(tri, from, *maps.between.roughness, 1, bo).image);
+    a.metallic_roughness = metallic_roughness_from_roughness(
+        bake_between(tri, from, maps.between.roughness->at_level(bake_level(*maps.between.roughness, a)), 1, bo).image);
   else if (!maps.roughness.empty())
     a.metallic_roughness =
         metallic_roughness_from_roughness(bake_vertex_values(tri, on_copy(maps.roughness, from), 1, bo).image);
@@ -163,7 +203,14 @@ SubdivisionAsset bake_subdivision_asset(const Mesh& mesh, const SubdivisionVerte
   BakeOptions bo;
   bo.size = options.atlas_size;
   a.color_between_vertices = maps.between.color.has_value();
-  a.color = maps.between.color ? bake_between(tri, from, *maps.between.color, 3, bo) : bake_vertex_colors(tri, bo);
+  if (maps.between.color) {
+    const SurfaceExemplarSource src = maps.between.color->at_level(bake_level(*maps.between.color, a));
+    a.color_stack_level = src.level();
+    a.color_map_scale = src.scale();
+    a.color = bake_between(tri, from, src, 3, bo);
+  } else {
+    a.color = bake_vertex_colors(tri, bo);
+  }
   bake_maps(a, maps, from);
   if (options.texel_size > 0) {
     a.seam = surface_seam_ratio(tri, atlas_color_source(tri, a.color.image), seam_edges_from_corner_uv(tri),
@@ -192,6 +239,8 @@ nlohmann::json to_json(const SubdivisionAsset& a) {
                       {"normal_source", a.normal_from_exemplar ? "exemplar_normal" : "height"},
                       {"height_source", a.height_from_exemplar ? "exemplar_height" : "luminance"},
                       {"color_source", a.color_between_vertices ? "exemplar_between_vertices" : "vertex_colors"},
+                      {"color_stack_level", a.color_stack_level},
+                      {"color_map_texels_per_synthesis_texel", a.color_map_scale},
                       {"roughness", !a.metallic_roughness.empty()},
                       {"seconds", {{"bake", a.seconds}, {"charts", a.atlas.seconds}}}};
   if (a.seam_measured) j["seam"] = to_json(a.seam);

@@ -60,9 +60,16 @@ struct SubdivisionVertexMaps {
 };
 
 /// The sources of the mesh as synthesised (before any displacement): the
-/// colour (fallback kVertexColor) and each given height and roughness map.
+/// colour (fallback kVertexColor) and each given height and roughness map,
+/// `width` x `height` = the exemplar as given. Where the synthesis reduced the
+/// exemplar for the vertex budget (a stack), they read the maps as given and
+/// `input_exemplar` (when given; else the exemplar as synthesised) at their
+/// own resolution, through the lookups scaled to it; the bake then reads the
+/// stack level its atlas's density asks (SubdivisionAsset::color_stack_level).
+/// Throws InvalidInputError if input_exemplar is not width x height.
 SubdivisionSurfaceSources subdivision_surface_sources(const Mesh& mesh, const SubdivisionSynthesisResult& result,
-                                                      const SubdivisionExemplarMaps& maps, int width, int height);
+                                                      const SubdivisionExemplarMaps& maps, int width, int height,
+                                                      const Image* input_exemplar = nullptr);
 
 /// The maps read where each final vertex's colour was read
 /// (texture/subdivision/subdivision_exemplar_maps.h); `width` x `height` is
@@ -99,6 +106,8 @@ struct SubdivisionAsset {
   double atlas_texels_per_exemplar_texel = 0;
   bool normal_from_exemplar = false, height_from_exemplar = false;
   bool color_between_vertices = false;  ///< the colour from SubdivisionSurfaceSources, not the vertex colours
+  int color_stack_level = 0;            ///< the source's stack level the colour bake read (prefilter)
+  double color_map_scale = 1;           ///< the source's pixels per synthesis texel (> 1: the exemplar as given)
   bool seam_measured = false;      ///< options.texel_size > 0
   SurfaceSeamRatio seam;           ///< colour jumps across the atlas's chart seams
   double seconds = 0;              ///< the whole bake

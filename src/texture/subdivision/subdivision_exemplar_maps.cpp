@@ -142,20 +142,29 @@ struct SurfaceExemplarSource::Data {
   std::vector<ExemplarLookup> lookup;
   std::vector<std::array<float, 3>> fallback;
   double texels_per_unit = 1;  // synthesis texels per mesh unit
+  double scale_x = 1, scale_y = 1;
 };
 
-SurfaceExemplarSource::SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& r,
-                                             const Image& map, std::vector<std::array<float, 3>> fallback) {
+SurfaceExemplarSource::SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& r, const Image& map,
+                                             std::vector<std::array<float, 3>> fallback,
+                                             const ExemplarReadOptions& read) {
   const std::size_t nv = mesh.number_of_vertices();
   if (r.lookup.size() != nv || fallback.size() != nv || mesh.has_garbage())
     throw InvalidInputError("SurfaceExemplarSource: " + std::to_string(r.lookup.size()) + " lookups and " +
                             std::to_string(fallback.size()) + " fallback values for " + std::to_string(nv) +
                             " vertices");
   if (!(r.scale.texel_size > 0)) throw InvalidInputError("SurfaceExemplarSource: the result has no texel size");
+  if (!(read.scale_x > 0 && read.scale_y > 0 && std::isfinite(read.scale_x) && std::isfinite(read.scale_y)) ||
+      read.levels < 1 || read.levels > 8 || (r.pyramid && (read.scale_x != 1 || read.scale_y != 1)))
+    throw InvalidInputError("SurfaceExemplarSource: read scale " + std::to_string(read.scale_x) + " x " +
+                            std::to_string(read.scale_y) + " and " + std::to_string(read.levels) +
+                            " levels (> 0, 1..8, scale 1 for a pyramid)");
   auto d = std::make_shared<Data>();
-  // A stack's level 0 alone (the exemplar, read as the synthesis read it); a pyramid whole.
+  // A stack read as the synthesis read it (bounded: clamped at every level
+  // read); a pyramid whole.
+  const int L = read.levels;
   d->ex = r.pyramid ? make_exemplar_levels(map, true, 0, r.bounded_levels)
-                    : make_exemplar_levels(map, false, 1, std::min(r.bounded_levels, 1));
+                    : make_exemplar_levels(map, false, L, r.bounded_levels > 0 ? L : 0);
   const SurfaceFrames fr = compute_surface_frames(mesh);
   d->position.resize(nv);
   d->u_axis = fr.direction;
@@ -171,10 +180,21 @@ SurfaceExemplarSource::SurfaceExemplarSource(const Mesh& mesh, const Subdivision
   d->lookup = r.lookup;
   d->fallback = std::move(fallback);
   d->texels_per_unit = 1.0 / r.scale.texel_size;
+  d->scale_x = read.scale_x, d->scale_y = read.scale_y;
   d_ = std::move(d);
 }
 
 SurfaceExemplarSource::~SurfaceExemplarSource() = default;
+
+SurfaceExemplarSource SurfaceExemplarSource::at_level(int level) const {
+  SurfaceExemplarSource s = *this;
+  s.level_ = d_->ex.pyramid ? 0 : std::clamp(level, 0, levels() - 1);
+  return s;
+}
+
+int SurfaceExemplarSource::levels() const { return static_cast<int>(d_->ex.levels.size()); }
+
+double SurfaceExemplarSource::scale() const { return d_->scale_x; }
 
 std::array<float, 3> SurfaceExemplarSource::operator()(const std::array<std::size_t, 3>& vertex,
                                                        const std::array<double, 3>& bary) const {
@@ -194,9 +214,12 @@ std::array<float, 3> SurfaceExemplarSource::operator()(const std::array<std::siz
       const auto& b = d.v_axis[v];
       // In level-l texels: the match's offsets are level-0 texels over a^l (sample_offset).
       const double s = d.texels_per_unit / d.ex.scale(d.ex.pyramid ? l.level : 0);
-      const double du = s * (o[0] * a[0] + o[1] * a[1] + o[2] * a[2]);
-      const double dv = s * (o[0] * b[0] + o[1] * b[1] + o[2] * b[2]);
-      t = texel_bilinear(d.ex, d.ex.pyramid ? l.level : 0, l.x + du, l.y - dv);
+      const double x = l.x + s * (o[0] * a[0] + o[1] * a[1] + o[2] * a[2]);
+      const double y = l.y - s * (o[0] * b[0] + o[1] * b[1] + o[2] * b[2]);
+      if (d.ex.pyramid)
+        t = texel_bilinear(d.ex, l.level, x, y);
+      else  // synthesis texel centres onto the map's pixel centres
+        t = texel_bilinear(d.ex, level_, (x + 0.5) * d.scale_x - 0.5, (y + 0.5) * d.scale_y - 0.5);
     }
     for (int j = 0; j < 3; ++j) c[j] += static_cast<float>(bary[k]) * t[j];
   }

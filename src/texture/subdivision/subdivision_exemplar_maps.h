@@ -51,22 +51,41 @@ std::vector<std::array<float, 3>> object_normals_from_map(const Mesh& mesh, cons
 /// the vertices' own colours), pyramid ones at their level. A corner without a
 /// lookup gives its `fallback` value (by vertex index).
 ///
-/// `map_as_synthesised`: the exemplar as synthesised (result.exemplar) or a
-/// map resampled as it was (resample_as_synthesised); the mesh as synthesised
+/// `map`: the exemplar as synthesised (result.exemplar) or a map resampled as
+/// it was (resample_as_synthesised), or see `read` below; the mesh as synthesised
 /// (positions, kVertexDirection; copied: the mesh may change afterwards).
 /// Thread-safe. Throws InvalidInputError if the result, the fallback or the
 /// map does not fit the mesh.
+///
+/// With `read` the map may be the input exemplar (or map) at its own
+/// resolution where the synthesis reduced it: lookups and offsets are scaled
+/// by its pixels per synthesis texel, and a Gaussian stack of `levels` levels
+/// is built so that a bake sparser than its pixels can read a prefiltered
+/// level (at_level). A stack only: a pyramid synthesis reads the map as
+/// synthesised at each lookup's level.
+struct ExemplarReadOptions {
+  double scale_x = 1, scale_y = 1;  ///< map pixels per synthesis texel (> 0)
+  int levels = 1;                   ///< stack levels built, 1..8
+};
+
 class SurfaceExemplarSource {
  public:
-  SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& result, const Image& map_as_synthesised,
-                        std::vector<std::array<float, 3>> fallback);
+  SurfaceExemplarSource(const Mesh& mesh, const SubdivisionSynthesisResult& result, const Image& map,
+                        std::vector<std::array<float, 3>> fallback, const ExemplarReadOptions& read = {});
   ~SurfaceExemplarSource();
   /// RGB (grey maps repeated) at the point with these corner vertices and barycentrics.
   std::array<float, 3> operator()(const std::array<std::size_t, 3>& vertex, const std::array<double, 3>& bary) const;
+  /// The same source reading stack level `level` (clamped to the levels built; 0 = sharp).
+  SurfaceExemplarSource at_level(int level) const;
+  int level() const { return level_; }
+  int levels() const;
+  /// Map pixels per synthesis texel along x (ExemplarReadOptions::scale_x).
+  double scale() const;
 
  private:
   struct Data;
   std::shared_ptr<const Data> d_;
+  int level_ = 0;
 };
 
 /// One channel per vertex: the luminance (Rec. 709) of a 3-channel map, else the values.
