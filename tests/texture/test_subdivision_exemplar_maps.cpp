@@ -30,6 +30,17 @@ D3 unit(const D3& a) {
   const double l = std::sqrt(dot(a, a));
   return {a[0] / l, a[1] / l, a[2] / l};
 }
+// An 8 x 8 unit grid (normal +z) with the field along +x, 40 texels per unit,
+// two sqrt(2) levels: about 2.5 texels per edge.
+SubdivisionSynthesisResult synthesize_on_flat_grid(Mesh& m, const Image& ex) {
+  make_grid(m, 8, 8);
+  SubdivisionSynthesisOptions o;
+  o.r_scale = 40;
+  o.levels = 2;
+  o.keys = {{0, {1, 0, 0}}};
+  o.seed = 4;
+  return synthesize_on_subdivision(m, ex, o);
+}
 }  // namespace
 
 // "One synthesis, every channel": the exemplar read as a map at the vertices
@@ -85,13 +96,7 @@ TEST(SubdivisionExemplarMaps, LookupsReadBackTheColoursAlsoFromAReducedExemplar)
 TEST(SubdivisionExemplarMaps, ExemplarXFollowsTheFieldAndImageUpIsNormalCrossField) {
   const Image ex = make_cells(32, 3, 5);
   Mesh m;
-  make_grid(m, 8, 8);
-  SubdivisionSynthesisOptions o;
-  o.r_scale = 40;
-  o.levels = 2;
-  o.keys = {{0, {1, 0, 0}}};
-  o.seed = 4;
-  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  const SubdivisionSynthesisResult r = synthesize_on_flat_grid(m, ex);
   const double texels = 1.0 / r.scale.texel_size;  // per mesh unit
   const int W = r.exemplar.width, H = r.exemplar.height;
   auto wrap = [](double d, int n) { return d - n * std::round(d / n); };
@@ -130,13 +135,7 @@ TEST(SubdivisionExemplarMaps, ExemplarXFollowsTheFieldAndImageUpIsNormalCrossFie
 TEST(SubdivisionExemplarMaps, SourceReadsTheExemplarBetweenVerticesCopiedTogether) {
   const Image ex = make_cells(32, 3, 5);
   Mesh m;
-  make_grid(m, 8, 8);
-  SubdivisionSynthesisOptions o;
-  o.r_scale = 40;
-  o.levels = 2;
-  o.keys = {{0, {1, 0, 0}}};
-  o.seed = 4;
-  const SubdivisionSynthesisResult r = synthesize_on_subdivision(m, ex, o);
+  const SubdivisionSynthesisResult r = synthesize_on_flat_grid(m, ex);
   const double texels = 1.0 / r.scale.texel_size;
   auto col = find(m, kVertexColor).first;
   std::vector<std::array<float, 3>> fallback(m.number_of_vertices());
