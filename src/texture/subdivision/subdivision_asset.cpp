@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 #include "texture/subdivision/subdivision_asset.h"
 
-#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -77,8 +76,9 @@ std::optional<SurfaceExemplarSource> grey_source(const Mesh& mesh, const Subdivi
   const std::vector<float> g = vertex_luminance(read_map_at_vertices(mesh, r, map, w, h));
   std::vector<std::array<float, 3>> rgb(g.size());
   for (std::size_t i = 0; i < g.size(); ++i) rgb[i] = {g[i], g[i], g[i]};
-  const Image& m = at_input_resolution(r, w, h) ? map : resample_as_synthesised(map, r.scale, r.periodic);
-  return SurfaceExemplarSource(mesh, r, m, std::move(rgb), read_options(r, w, h));
+  if (at_input_resolution(r, w, h)) return SurfaceExemplarSource(mesh, r, map, std::move(rgb), read_options(r, w, h));
+  return SurfaceExemplarSource(mesh, r, resample_as_synthesised(map, r.scale, r.periodic), std::move(rgb),
+                               read_options(r, w, h));
 }
 
 // The stack level a bake reads: the atlas's texels per map pixel d, level
@@ -138,7 +138,7 @@ std::vector<T> on_copy(const std::vector<T>& per_vertex, const std::vector<std::
 }
 
 // A source read at the copy's texels (corners mapped to the synthesised mesh's
-// vertices); grey = the luminance, clamped to [0, 1] as height_from_luminance.
+// vertices); grey = its clamped luminance.
 BakeResult bake_between(const Mesh& tri, const std::vector<std::uint32_t>& from, const SurfaceExemplarSource& src,
                         int channels, const BakeOptions& bo) {
   const auto value = [&](const std::array<std::size_t, 3>& corner, const std::array<float, 3>& bary, float* out) {
@@ -148,7 +148,7 @@ BakeResult bake_between(const Mesh& tri, const std::vector<std::uint32_t>& from,
     if (channels == 3) {
       for (int k = 0; k < 3; ++k) out[k] = c[k];
     } else {
-      out[0] = std::clamp(0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2], 0.f, 1.f);
+      out[0] = clamped_luminance(c);
     }
   };
   return bake_texel_values(tri, channels, value, bo);

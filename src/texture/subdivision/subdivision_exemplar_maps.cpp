@@ -127,14 +127,13 @@ std::vector<float> vertex_luminance(const VertexMapValues& v) {
   }
   std::vector<float> out(v.values.size() / 3);
   for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = std::clamp(0.2126f * v.values[3 * i] + 0.7152f * v.values[3 * i + 1] + 0.0722f * v.values[3 * i + 2],
-                        0.f, 1.f);  // as height_from_luminance
+    out[i] = clamped_luminance({v.values[3 * i], v.values[3 * i + 1], v.values[3 * i + 2]});
   return out;
 }
 
-}  // namespace surftex
-
-namespace surftex {
+float clamped_luminance(const std::array<float, 3>& c) {
+  return std::clamp(0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2], 0.f, 1.f);  // as height_from_luminance
+}
 
 struct SurfaceExemplarSource::Data {
   ExemplarLevels ex;

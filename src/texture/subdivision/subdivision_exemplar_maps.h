@@ -88,6 +88,9 @@ class SurfaceExemplarSource {
   int level_ = 0;
 };
 
+/// Rec. 709 luminance of an RGB value, clamped to [0, 1] (as height_from_luminance).
+float clamped_luminance(const std::array<float, 3>& rgb);
+
 /// One channel per vertex: the luminance (Rec. 709) of a 3-channel map, else the values.
 std::vector<float> vertex_luminance(const VertexMapValues& v);
 
